@@ -1,0 +1,119 @@
+"""Build the Cython extensions of softgym, with OpenMP when the compiler has it.
+
+OpenMP is probed, not assumed: a tiny ``omp.h`` program is compiled and linked;
+if that fails the extensions are built serially and one warning says so.
+``softgym.engine.openmp_enabled()`` reports the outcome at run time.
+
+Environment switches
+--------------------
+SOFTGYM_DEBUG=1
+    Turn Cython's bounds, wraparound and initialisation checks back on
+    (for a debug test run).
+SOFTGYM_NO_OPENMP=1
+    Build serially even when OpenMP is available.
+"""
+
+import os
+import shutil
+import subprocess
+import sys
+import sysconfig
+import tempfile
+import warnings
+
+import numpy as np
+from Cython.Build import cythonize
+from setuptools import Extension, setup
+
+PROBE = r"""
+#include <omp.h>
+int main(void) {
+    int n = 0;
+    #pragma omp parallel reduction(+:n)
+    n += 1;
+    return omp_get_max_threads() > 0 && n > 0 ? 0 : 1;
+}
+"""
+
+
+def _openmp_flags():
+    """Return (compile_args, link_args) for OpenMP, or None when it does not build."""
+    if os.environ.get("SOFTGYM_NO_OPENMP"):
+        return None
+    if sys.platform == "win32":
+        candidates = [(["/openmp"], [])]
+    elif sys.platform == "darwin":
+        candidates = [(["-Xpreprocessor", "-fopenmp"], ["-lomp"]), (["-fopenmp"], ["-fopenmp"])]
+    else:
+        candidates = [(["-fopenmp"], ["-fopenmp"])]
+    cc = os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc"
+    cc = cc.split()
+    if shutil.which(cc[0]) is None:
+        return None
+    tmp = tempfile.mkdtemp(prefix="softgym-omp-")
+    try:
+        src = os.path.join(tmp, "probe.c")
+        with open(src, "w") as fh:
+            fh.write(PROBE)
+        for cflags, lflags in candidates:
+            exe = os.path.join(tmp, "probe")
+            cmd = [*cc, *cflags, src, "-o", exe, *lflags]
+            try:
+                res = subprocess.run(cmd, capture_output=True, timeout=60)
+            except (OSError, subprocess.SubprocessError):
+                continue
+            if res.returncode == 0 and subprocess.run([exe], capture_output=True).returncode == 0:
+                return cflags, lflags
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    return None
+
+
+debug = bool(os.environ.get("SOFTGYM_DEBUG"))
+omp = _openmp_flags()
+if omp is None:
+    warnings.warn(
+        "softgym: OpenMP is not available with this compiler; building the engine serially "
+        "(robots in a batch run one after another).",
+        stacklevel=1,
+    )
+    omp_cflags, omp_lflags = [], []
+else:
+    omp_cflags, omp_lflags = omp
+
+if sys.platform == "win32":
+    opt = ["/O2"]
+else:
+    opt = ["-O3", "-ffp-contract=off", "-fno-math-errno"]
+
+ext_kwargs = dict(
+    include_dirs=[np.get_include()],
+    define_macros=[
+        ("NPY_NO_DEPRECATED_API", "NPY_1_7_API_VERSION"),
+        ("SOFTGYM_OPENMP", "1" if omp is not None else "0"),
+    ],
+    extra_compile_args=opt + omp_cflags,
+    extra_link_args=omp_lflags,
+)
+
+extensions = [
+    Extension("softgym.engine._core", ["softgym/engine/_core.pyx"], **ext_kwargs),
+    Extension("softgym.engine._openmp", ["softgym/engine/_openmp.pyx"], **ext_kwargs),
+]
+
+directives = {
+    "language_level": 3,
+    "boundscheck": debug,
+    "wraparound": debug,
+    "initializedcheck": debug,
+    "cdivision": True,
+    "nonecheck": False,
+    "embedsignature": True,
+}
+
+setup(
+    ext_modules=cythonize(
+        extensions,
+        compiler_directives=directives,
+    ),
+)

@@ -1,0 +1,22 @@
+"""The batched voxel physics engine of softgym.
+
+One :class:`Simulation` holds many robots (:class:`Body`) in flat arrays and
+advances them in parallel; :meth:`Simulation.run` returns a :class:`Rollout`.
+"""
+
+from softgym.engine._openmp import omp_max_threads, openmp_enabled
+from softgym.engine.body import Body
+from softgym.engine.config import SimConfig
+from softgym.engine.rollout import Rollout
+from softgym.engine.simulation import Simulation, as_body, default_num_threads
+
+__all__ = [
+    "Body",
+    "Rollout",
+    "SimConfig",
+    "Simulation",
+    "as_body",
+    "default_num_threads",
+    "omp_max_threads",
+    "openmp_enabled",
+]

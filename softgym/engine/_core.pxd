@@ -1,0 +1,85 @@
+# The contract of the step kernel: one struct of raw pointers into the flat
+# structure-of-arrays state of a whole batch, and the per-robot helpers that
+# run without the GIL. Arrays are C-contiguous float64 unless said otherwise;
+# "(n, 3)" means n rows of 3 stored row-major. Units are SI.
+
+from softgym.engine._typedefs cimport float64_t, intp_t, step_t, int32, flag_t
+
+# Status codes returned by the nogil helpers (errors cross nogil as codes).
+cdef enum:
+    STATUS_OK = 0
+    STATUS_STRAIN = 1       # a link's engineering strain exceeded max_strain (or was NaN)
+    STATUS_NONFINITE = 2    # a voxel's position or momentum became non-finite / runaway
+
+
+cdef struct Batch:
+    # ---- global settings -------------------------------------------------
+    intp_t n_robots          # robots in the batch
+    float64_t L              # lattice dimension, nominal voxel edge (m)
+    float64_t gravity        # gravitational acceleration along +z (m/s^2; -9.81 = down)
+    float64_t init_time      # settling time: no sinusoidal actuation before it; IniCM after it (s)
+    float64_t min_scale      # smallest actuated edge, as a fraction of L
+    float64_t max_strain     # divergence threshold on |link engineering strain|
+    float64_t trace_interval # seconds between centre-of-mass samples
+    int32 floor_enabled      # 1: floor plane z = 0 with penalty contact and friction
+    int32 actuation_mode     # 0: seed (contraction only, hold out-of-bounds); 1: symmetric
+    intp_t trace_capacity    # samples allocated per robot in trace_t / trace_cm
+
+    # ---- per robot ----------------------------------------------------------
+    intp_t* vox_start        # (n_robots + 1,) robot r owns voxels [vox_start[r], vox_start[r+1])
+    intp_t* link_start       # (n_robots + 1,) robot r owns links [link_start[r], link_start[r+1])
+    float64_t* dt            # (n_robots,) time step (s)
+    step_t* steps            # (n_robots,) steps taken; the robot's clock is steps * dt
+    float64_t* temp_amp      # (n_robots,) amplitude dT of the temperature sinusoid (degC)
+    float64_t* period        # (n_robots,) period of the temperature sinusoid (s)
+    flag_t* use_temp         # (n_robots,) 1: per-voxel temperatures replace the sinusoid
+    flag_t* diverged         # (n_robots,) 1: frozen after divergence
+    float64_t* diverged_time # (n_robots,) time of divergence (s)
+    int32* diverged_code     # (n_robots,) STATUS_* code of the divergence
+    flag_t* init_done        # (n_robots,) 1: cm_init recorded
+    float64_t* cm_init       # (n_robots, 3) CM at the first step with t > init_time (m)
+    float64_t* mass_total    # (n_robots,) total mass (kg)
+    intp_t* trace_n          # (n_robots,) samples recorded
+    float64_t* trace_t       # (n_robots, trace_capacity) sample times (s)
+    float64_t* trace_cm      # (n_robots, trace_capacity, 3) sampled CM (m)
+
+    # ---- per voxel ------------------------------------------------------------
+    float64_t* pos           # (n_voxels, 3) centre position (m)
+    float64_t* mom           # (n_voxels, 3) linear momentum (kg m/s)
+    float64_t* quat          # (n_voxels, 4) orientation, unit quaternion (w, x, y, z)
+    float64_t* angmom        # (n_voxels, 3) angular momentum, world frame (kg m^2/s)
+    float64_t* rot           # (n_voxels, 9) rotation matrix of quat, row-major (derived)
+    float64_t* force         # (n_voxels, 3) scratch: accumulated force (N)
+    float64_t* moment        # (n_voxels, 3) scratch: accumulated moment (N m)
+    float64_t* ext_force     # (n_voxels, 3) constant external force (N)
+    float64_t* mass          # (n_voxels,) rho L^3 (kg)
+    float64_t* inv_mass      # (n_voxels,) 1 / mass
+    float64_t* inv_inertia   # (n_voxels,) 1 / (mass L^2 / 6)
+    float64_t* scale         # (n_voxels,) current actuated edge length (m)
+    float64_t* cte           # (n_voxels,) coefficient of thermal expansion (1/degC)
+    float64_t* cos_phase     # (n_voxels,) cos of the voxel's phase offset
+    float64_t* sin_phase     # (n_voxels,) sin of the voxel's phase offset
+    float64_t* temp          # (n_voxels,) temperature used when use_temp (degC)
+    float64_t* k_floor       # (n_voxels,) floor penalty stiffness 2 E L (N/m)
+    float64_t* c_floor       # (n_voxels,) floor normal damping zeta_c 2 sqrt(m E L) (N s/m)
+    float64_t* c_global      # (n_voxels,) global damping zeta_g 2 sqrt(m E L) (N s/m)
+    float64_t* rot_damp      # (n_voxels,) per-step angular momentum factor of global damping
+    float64_t* mu_s          # (n_voxels,) static friction coefficient
+    float64_t* mu_k          # (n_voxels,) kinetic friction coefficient
+    flag_t* fixed            # (n_voxels,) 1: all six degrees of freedom fixed
+
+    # ---- per link (beam between face neighbours v1 -> v2 along +axis) ------
+    intp_t* v1               # (n_links,) voxel on the negative side
+    intp_t* v2               # (n_links,) voxel on the positive side
+    int32* axis              # (n_links,) 0, 1, 2 for x, y, z
+    float64_t* k_axial       # (n_links,) E L (N/m)
+    float64_t* k_torsion     # (n_links,) E L^3 / (12 (1 + nu)) (N m/rad)
+    float64_t* k_bend        # (n_links,) E L^3 / 6 (N m/rad), the b3 of the seed
+    float64_t* c_axial       # (n_links,) axial damping (N s/m)
+    float64_t* c_torsion     # (n_links,) torsional damping (N m s/rad)
+    float64_t* c_bend        # (n_links,) bending damping (N m s/rad)
+
+
+cdef int advance_robot(Batch* b, intp_t r, step_t target) noexcept nogil
+cdef void robot_cm(Batch* b, intp_t r, float64_t* out) noexcept nogil
+cdef void robot_energy(Batch* b, intp_t r, float64_t* out) noexcept nogil

@@ -1,0 +1,549 @@
+# The step kernel of softgym: a co-rotational beam lattice of rigid voxels,
+# integrated with symplectic Euler, batched over robots and parallel over them.
+#
+# Physics (see SEED_REFERENCE section 1 and softgym/engine/simulation.py):
+# - each voxel is a rigid cube (position, quaternion, linear and angular momentum);
+# - each face-adjacent pair is joined by an Euler-Bernoulli beam measured in the
+#   frame of its chord (co-rotational), so large rigid rotations are exact:
+#       axial extension   e    = |d| - (s1 + s2) / 2
+#       bending vectors   b_i  = u x a_i      (u = chord direction, a_i = voxel i's
+#                                               lattice axis of the link)
+#       twist             tau  = u . (y1 x y2 + z1 x z2) / 2
+#   with the Hermite beam element's moments M1 = -k_b (2 b1 + b2),
+#   M2 = -k_b (b1 + 2 b2), torsion +-k_t tau u, axial force -k_a e u on voxel 2
+#   and the shear force that balances the moments, u x (M1 + M2) / |d|.
+#   Damping uses the same forms with the deformation rates, so its power is
+#   never positive.
+# - floor: penalty normal force, collision damping and Coulomb friction
+#   (static threshold, kinetic coefficient) as the seed's engine.
+#
+# The code walks flat arrays through raw pointers; bounds are checked by the
+# Python wrapper (simulation.py) once, never here.
+
+from cython.parallel cimport prange, parallel
+from libc.math cimport sin, cos, sqrt, fabs, M_PI
+
+cimport numpy as cnp
+
+from softgym.engine._typedefs cimport float64_t, intp_t, step_t, int32, flag_t
+
+cnp.import_array()
+
+cdef float64_t RUNAWAY = 1.0e6  # |coordinate| (m) or |momentum| beyond which a robot diverged
+
+
+cdef inline void _rotation_matrix(const float64_t* q, float64_t* R) noexcept nogil:
+    # R = rotation matrix of the unit quaternion q = (w, x, y, z), row-major.
+    cdef float64_t w = q[0], x = q[1], y = q[2], z = q[3]
+    R[0] = 1.0 - 2.0 * (y * y + z * z)
+    R[1] = 2.0 * (x * y - w * z)
+    R[2] = 2.0 * (x * z + w * y)
+    R[3] = 2.0 * (x * y + w * z)
+    R[4] = 1.0 - 2.0 * (x * x + z * z)
+    R[5] = 2.0 * (y * z - w * x)
+    R[6] = 2.0 * (x * z - w * y)
+    R[7] = 2.0 * (y * z + w * x)
+    R[8] = 1.0 - 2.0 * (x * x + y * y)
+
+
+cdef inline void _actuate(Batch* b, intp_t r) noexcept nogil:
+    # OUT: b.scale of robot r's voxels at the robot's current time.
+    cdef:
+        intp_t i
+        intp_t vs = b.vox_start[r]
+        intp_t ve = b.vox_start[r + 1]
+        float64_t t = b.steps[r] * b.dt[r]
+        float64_t L = b.L
+        float64_t lo = b.min_scale * L
+        float64_t f, new, s, c, amp, w
+        int32 seed = b.actuation_mode == 0
+    if b.use_temp[r]:
+        for i in range(vs, ve):
+            if b.cte[i] == 0.0:
+                continue
+            new = L * (1.0 + b.cte[i] * b.temp[i])
+            if seed:
+                if new >= lo and new <= L:
+                    b.scale[i] = new
+            else:
+                b.scale[i] = new if new > lo else lo
+        return
+    if t < b.init_time:
+        return  # nominal sizes until the settling time is over (scale starts at L)
+    w = 2.0 * M_PI / b.period[r]
+    s = sin(w * t)
+    c = cos(w * t)
+    amp = b.temp_amp[r]
+    for i in range(vs, ve):
+        if b.cte[i] == 0.0:
+            continue
+        f = b.cte[i] * amp * (s * b.cos_phase[i] + c * b.sin_phase[i])
+        new = L * (1.0 + f)
+        if seed:
+            # the seed's engine: outside [min_scale L, L] the previous size is kept
+            if new >= lo and new <= L:
+                b.scale[i] = new
+        else:
+            b.scale[i] = new if new > lo else lo
+
+
+cdef inline int _link_forces(Batch* b, intp_t r) noexcept nogil:
+    # IN: positions, rotations, momenta, scales. OUT (accumulated): force, moment.
+    cdef:
+        intp_t li, i, j, ax, p, q
+        float64_t dx, dy, dz, ell, inv_l, ux, uy, uz, e
+        float64_t a1x, a1y, a1z, a2x, a2y, a2z
+        float64_t b1x, b1y, b1z, b2x, b2y, b2z
+        float64_t y1x, y1y, y1z, y2x, y2y, y2z, z1x, z1y, z1z, z2x, z2y, z2z
+        float64_t tw, twdot, edot, uw
+        float64_t dvx, dvy, dvz, w1x, w1y, w1z, w2x, w2y, w2z, wcx, wcy, wcz
+        float64_t r1x, r1y, r1z, r2x, r2y, r2z
+        float64_t kb, cb, tor, fa
+        float64_t m1x, m1y, m1z, m2x, m2y, m2z, sx, sy, sz, fx, fy, fz
+        float64_t inv_L = 1.0 / b.L
+        float64_t max_strain = b.max_strain
+        const float64_t* R1
+        const float64_t* R2
+        float64_t* pos = b.pos
+        float64_t* mom = b.mom
+        float64_t* am = b.angmom
+    for li in range(b.link_start[r], b.link_start[r + 1]):
+        i = b.v1[li]
+        j = b.v2[li]
+        ax = b.axis[li]
+        p = ax + 1
+        if p == 3:
+            p = 0
+        q = 3 - ax - p
+        dx = pos[3 * j] - pos[3 * i]
+        dy = pos[3 * j + 1] - pos[3 * i + 1]
+        dz = pos[3 * j + 2] - pos[3 * i + 2]
+        ell = sqrt(dx * dx + dy * dy + dz * dz)
+        e = ell - 0.5 * (b.scale[i] + b.scale[j])
+        if not (fabs(e) * inv_L <= max_strain):
+            return STATUS_STRAIN  # also catches NaN
+        inv_l = 1.0 / ell
+        ux = dx * inv_l
+        uy = dy * inv_l
+        uz = dz * inv_l
+        R1 = b.rot + 9 * i
+        R2 = b.rot + 9 * j
+        # lattice axis of the link in each voxel (column ax of its rotation)
+        a1x = R1[ax]; a1y = R1[3 + ax]; a1z = R1[6 + ax]
+        a2x = R2[ax]; a2y = R2[3 + ax]; a2z = R2[6 + ax]
+        # bending: rotation of each voxel relative to the chord, b = u x a
+        b1x = uy * a1z - uz * a1y
+        b1y = uz * a1x - ux * a1z
+        b1z = ux * a1y - uy * a1x
+        b2x = uy * a2z - uz * a2y
+        b2y = uz * a2x - ux * a2z
+        b2z = ux * a2y - uy * a2x
+        # twist of voxel 2 relative to voxel 1 about the chord
+        y1x = R1[p]; y1y = R1[3 + p]; y1z = R1[6 + p]
+        y2x = R2[p]; y2y = R2[3 + p]; y2z = R2[6 + p]
+        z1x = R1[q]; z1y = R1[3 + q]; z1z = R1[6 + q]
+        z2x = R2[q]; z2y = R2[3 + q]; z2z = R2[6 + q]
+        tw = 0.5 * (ux * (y1y * y2z - y1z * y2y + z1y * z2z - z1z * z2y)
+                    + uy * (y1z * y2x - y1x * y2z + z1z * z2x - z1x * z2z)
+                    + uz * (y1x * y2y - y1y * y2x + z1x * z2y - z1y * z2x))
+        # rates
+        dvx = mom[3 * j] * b.inv_mass[j] - mom[3 * i] * b.inv_mass[i]
+        dvy = mom[3 * j + 1] * b.inv_mass[j] - mom[3 * i + 1] * b.inv_mass[i]
+        dvz = mom[3 * j + 2] * b.inv_mass[j] - mom[3 * i + 2] * b.inv_mass[i]
+        w1x = am[3 * i] * b.inv_inertia[i]
+        w1y = am[3 * i + 1] * b.inv_inertia[i]
+        w1z = am[3 * i + 2] * b.inv_inertia[i]
+        w2x = am[3 * j] * b.inv_inertia[j]
+        w2y = am[3 * j + 1] * b.inv_inertia[j]
+        w2z = am[3 * j + 2] * b.inv_inertia[j]
+        edot = ux * dvx + uy * dvy + uz * dvz
+        # angular velocity of the chord (perpendicular to u)
+        wcx = (uy * dvz - uz * dvy) * inv_l
+        wcy = (uz * dvx - ux * dvz) * inv_l
+        wcz = (ux * dvy - uy * dvx) * inv_l
+        uw = ux * w1x + uy * w1y + uz * w1z
+        r1x = w1x - wcx - uw * ux
+        r1y = w1y - wcy - uw * uy
+        r1z = w1z - wcz - uw * uz
+        twdot = -uw
+        uw = ux * w2x + uy * w2y + uz * w2z
+        r2x = w2x - wcx - uw * ux
+        r2y = w2y - wcy - uw * uy
+        r2z = w2z - wcz - uw * uz
+        twdot = twdot + uw
+        # moments on the two voxels
+        kb = b.k_bend[li]
+        cb = b.c_bend[li]
+        tor = b.k_torsion[li] * tw + b.c_torsion[li] * twdot
+        m1x = -kb * (2.0 * b1x + b2x) - cb * (2.0 * r1x + r2x) + tor * ux
+        m1y = -kb * (2.0 * b1y + b2y) - cb * (2.0 * r1y + r2y) + tor * uy
+        m1z = -kb * (2.0 * b1z + b2z) - cb * (2.0 * r1z + r2z) + tor * uz
+        m2x = -kb * (b1x + 2.0 * b2x) - cb * (r1x + 2.0 * r2x) - tor * ux
+        m2y = -kb * (b1y + 2.0 * b2y) - cb * (r1y + 2.0 * r2y) - tor * uy
+        m2z = -kb * (b1z + 2.0 * b2z) - cb * (r1z + 2.0 * r2z) - tor * uz
+        # force on voxel 2: axial, plus the shear that balances the moments
+        sx = m1x + m2x
+        sy = m1y + m2y
+        sz = m1z + m2z
+        fa = b.k_axial[li] * e + b.c_axial[li] * edot
+        fx = (uy * sz - uz * sy) * inv_l - fa * ux
+        fy = (uz * sx - ux * sz) * inv_l - fa * uy
+        fz = (ux * sy - uy * sx) * inv_l - fa * uz
+        b.force[3 * j] += fx
+        b.force[3 * j + 1] += fy
+        b.force[3 * j + 2] += fz
+        b.force[3 * i] -= fx
+        b.force[3 * i + 1] -= fy
+        b.force[3 * i + 2] -= fz
+        b.moment[3 * i] += m1x
+        b.moment[3 * i + 1] += m1y
+        b.moment[3 * i + 2] += m1z
+        b.moment[3 * j] += m2x
+        b.moment[3 * j + 1] += m2y
+        b.moment[3 * j + 2] += m2z
+    return STATUS_OK
+
+
+cdef inline int _integrate(Batch* b, intp_t r) noexcept nogil:
+    # IN: force, moment. OUT: pos, mom, quat, angmom, rot (symplectic Euler).
+    cdef:
+        intp_t i
+        float64_t dt = b.dt[r]
+        float64_t fx, fy, fz, vx, vy, vz, m, pen, fn, fxy, vxy, fk, cg
+        float64_t wx, wy, wz, qw, qx, qy, qz, nq
+        float64_t* pos = b.pos
+        float64_t* mom = b.mom
+        float64_t* am = b.angmom
+        float64_t* qq
+        float64_t g = b.gravity
+    for i in range(b.vox_start[r], b.vox_start[r + 1]):
+        if b.fixed[i]:
+            mom[3 * i] = 0.0
+            mom[3 * i + 1] = 0.0
+            mom[3 * i + 2] = 0.0
+            am[3 * i] = 0.0
+            am[3 * i + 1] = 0.0
+            am[3 * i + 2] = 0.0
+            continue
+        m = b.mass[i]
+        vx = mom[3 * i] * b.inv_mass[i]
+        vy = mom[3 * i + 1] * b.inv_mass[i]
+        vz = mom[3 * i + 2] * b.inv_mass[i]
+        cg = b.c_global[i]
+        fx = b.force[3 * i] + b.ext_force[3 * i] - cg * vx
+        fy = b.force[3 * i + 1] + b.ext_force[3 * i + 1] - cg * vy
+        fz = b.force[3 * i + 2] + b.ext_force[3 * i + 2] - cg * vz + m * g
+        if b.floor_enabled:
+            pen = 0.5 * b.scale[i] - pos[3 * i + 2]
+            if pen > 0.0:
+                fn = b.k_floor[i] * pen - b.c_floor[i] * vz
+                if fn < 0.0:
+                    fn = 0.0  # the floor pushes, never pulls
+                fz = fz + fn
+                if vx == 0.0 and vy == 0.0:
+                    # at rest: static friction holds below mu_s N; above it the
+                    # voxel starts to slide (no friction on this first step)
+                    fxy = sqrt(fx * fx + fy * fy)
+                    if fxy <= b.mu_s[i] * fn:
+                        fx = 0.0
+                        fy = 0.0
+                else:
+                    vxy = sqrt(vx * vx + vy * vy)
+                    fk = b.mu_k[i] * fn
+                    if fk * dt >= m * vxy:
+                        # kinetic friction would reverse the motion: stop (static)
+                        mom[3 * i] = 0.0
+                        mom[3 * i + 1] = 0.0
+                        fx = 0.0
+                        fy = 0.0
+                    else:
+                        fx = fx - fk * vx / vxy
+                        fy = fy - fk * vy / vxy
+        mom[3 * i] += fx * dt
+        mom[3 * i + 1] += fy * dt
+        mom[3 * i + 2] += fz * dt
+        pos[3 * i] += mom[3 * i] * b.inv_mass[i] * dt
+        pos[3 * i + 1] += mom[3 * i + 1] * b.inv_mass[i] * dt
+        pos[3 * i + 2] += mom[3 * i + 2] * b.inv_mass[i] * dt
+        if not (fabs(pos[3 * i]) + fabs(pos[3 * i + 1]) + fabs(pos[3 * i + 2]) < RUNAWAY):
+            return STATUS_NONFINITE
+        # rotation: L += M dt, global damping, q += 0.5 dt (0, w) q
+        am[3 * i] = (am[3 * i] + b.moment[3 * i] * dt) * b.rot_damp[i]
+        am[3 * i + 1] = (am[3 * i + 1] + b.moment[3 * i + 1] * dt) * b.rot_damp[i]
+        am[3 * i + 2] = (am[3 * i + 2] + b.moment[3 * i + 2] * dt) * b.rot_damp[i]
+        wx = am[3 * i] * b.inv_inertia[i] * 0.5 * dt
+        wy = am[3 * i + 1] * b.inv_inertia[i] * 0.5 * dt
+        wz = am[3 * i + 2] * b.inv_inertia[i] * 0.5 * dt
+        qq = b.quat + 4 * i
+        qw = qq[0] - wx * qq[1] - wy * qq[2] - wz * qq[3]
+        qx = qq[1] + wx * qq[0] + wy * qq[3] - wz * qq[2]
+        qy = qq[2] + wy * qq[0] + wz * qq[1] - wx * qq[3]
+        qz = qq[3] + wz * qq[0] + wx * qq[2] - wy * qq[1]
+        nq = 1.0 / sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+        qq[0] = qw * nq
+        qq[1] = qx * nq
+        qq[2] = qy * nq
+        qq[3] = qz * nq
+        _rotation_matrix(qq, b.rot + 9 * i)
+    return STATUS_OK
+
+
+cdef void robot_cm(Batch* b, intp_t r, float64_t* out) noexcept nogil:
+    # OUT: out[0:3] = mass-weighted centre of the robot's voxels (m).
+    cdef:
+        intp_t i
+        float64_t sx = 0.0, sy = 0.0, sz = 0.0, m
+    for i in range(b.vox_start[r], b.vox_start[r + 1]):
+        m = b.mass[i]
+        sx += m * b.pos[3 * i]
+        sy += m * b.pos[3 * i + 1]
+        sz += m * b.pos[3 * i + 2]
+    m = 1.0 / b.mass_total[r]
+    out[0] = sx * m
+    out[1] = sy * m
+    out[2] = sz * m
+
+
+cdef inline void _record(Batch* b, intp_t r) noexcept nogil:
+    # Centre-of-mass bookkeeping after a step: IniCM and the trace samples.
+    cdef:
+        float64_t t = b.steps[r] * b.dt[r]
+        float64_t cm[3]
+        int32 have = 0
+        intp_t k
+    if not b.init_done[r] and t > b.init_time:
+        robot_cm(b, r, cm)
+        have = 1
+        b.cm_init[3 * r] = cm[0]
+        b.cm_init[3 * r + 1] = cm[1]
+        b.cm_init[3 * r + 2] = cm[2]
+        b.init_done[r] = 1
+    # sample k at the first step with t >= k * trace_interval (to within 1e-6 dt)
+    while (b.trace_n[r] < b.trace_capacity
+           and t >= b.trace_n[r] * b.trace_interval - 1e-6 * b.dt[r]):
+        if not have:
+            robot_cm(b, r, cm)
+            have = 1
+        k = r * b.trace_capacity + b.trace_n[r]
+        b.trace_t[k] = t
+        b.trace_cm[3 * k] = cm[0]
+        b.trace_cm[3 * k + 1] = cm[1]
+        b.trace_cm[3 * k + 2] = cm[2]
+        b.trace_n[r] += 1
+
+
+cdef int advance_robot(Batch* b, intp_t r, step_t target) noexcept nogil:
+    """Step robot r until steps[r] == target, or until it diverges.
+
+    Modifies in place every per-voxel state array of the robot, its step count,
+    traces and divergence flags. Returns a STATUS_* code.
+    """
+    cdef:
+        intp_t i
+        int status = STATUS_OK
+        intp_t vs = b.vox_start[r]
+        intp_t ve = b.vox_start[r + 1]
+    if b.diverged[r]:
+        return STATUS_OK
+    if b.steps[r] == 0:
+        _record(b, r)
+    while b.steps[r] < target:
+        _actuate(b, r)
+        for i in range(3 * vs, 3 * ve):
+            b.force[i] = 0.0
+            b.moment[i] = 0.0
+        status = _link_forces(b, r)
+        if status == STATUS_OK:
+            status = _integrate(b, r)
+        if status != STATUS_OK:
+            b.diverged[r] = 1
+            b.diverged_code[r] = status
+            b.diverged_time[r] = b.steps[r] * b.dt[r]
+            return status
+        b.steps[r] += 1
+        _record(b, r)
+    return STATUS_OK
+
+
+cdef void robot_energy(Batch* b, intp_t r, float64_t* out) noexcept nogil:
+    # OUT: out[0] kinetic (translation + rotation), out[1] elastic (links + floor),
+    # out[2] gravitational potential m |g|... relative to z = 0 (J).
+    cdef:
+        intp_t i, j, li, ax, p, q
+        float64_t ke = 0.0, pe = 0.0, ge = 0.0
+        float64_t dx, dy, dz, ell, ux, uy, uz, e, pen, tw
+        float64_t b1x, b1y, b1z, b2x, b2y, b2z
+        const float64_t* R1
+        const float64_t* R2
+        float64_t* mm = b.mom
+        float64_t* am = b.angmom
+    for i in range(b.vox_start[r], b.vox_start[r + 1]):
+        ke += 0.5 * b.inv_mass[i] * (mm[3 * i] ** 2 + mm[3 * i + 1] ** 2 + mm[3 * i + 2] ** 2)
+        ke += 0.5 * b.inv_inertia[i] * (am[3 * i] ** 2 + am[3 * i + 1] ** 2 + am[3 * i + 2] ** 2)
+        ge -= b.mass[i] * b.gravity * b.pos[3 * i + 2]
+        if b.floor_enabled:
+            pen = 0.5 * b.scale[i] - b.pos[3 * i + 2]
+            if pen > 0.0:
+                pe += 0.5 * b.k_floor[i] * pen * pen
+    for li in range(b.link_start[r], b.link_start[r + 1]):
+        i = b.v1[li]
+        j = b.v2[li]
+        ax = b.axis[li]
+        p = (ax + 1) % 3
+        q = 3 - ax - p
+        dx = b.pos[3 * j] - b.pos[3 * i]
+        dy = b.pos[3 * j + 1] - b.pos[3 * i + 1]
+        dz = b.pos[3 * j + 2] - b.pos[3 * i + 2]
+        ell = sqrt(dx * dx + dy * dy + dz * dz)
+        e = ell - 0.5 * (b.scale[i] + b.scale[j])
+        ux = dx / ell
+        uy = dy / ell
+        uz = dz / ell
+        R1 = b.rot + 9 * i
+        R2 = b.rot + 9 * j
+        b1x = uy * R1[6 + ax] - uz * R1[3 + ax]
+        b1y = uz * R1[ax] - ux * R1[6 + ax]
+        b1z = ux * R1[3 + ax] - uy * R1[ax]
+        b2x = uy * R2[6 + ax] - uz * R2[3 + ax]
+        b2y = uz * R2[ax] - ux * R2[6 + ax]
+        b2z = ux * R2[3 + ax] - uy * R2[ax]
+        tw = 0.5 * (ux * (R1[3 + p] * R2[6 + p] - R1[6 + p] * R2[3 + p]
+                          + R1[3 + q] * R2[6 + q] - R1[6 + q] * R2[3 + q])
+                    + uy * (R1[6 + p] * R2[p] - R1[p] * R2[6 + p]
+                            + R1[6 + q] * R2[q] - R1[q] * R2[6 + q])
+                    + uz * (R1[p] * R2[3 + p] - R1[3 + p] * R2[p]
+                            + R1[q] * R2[3 + q] - R1[3 + q] * R2[q]))
+        pe += 0.5 * b.k_axial[li] * e * e
+        pe += 0.5 * b.k_torsion[li] * tw * tw
+        pe += b.k_bend[li] * (b1x * b1x + b1y * b1y + b1z * b1z
+                              + b1x * b2x + b1y * b2y + b1z * b2z
+                              + b2x * b2x + b2y * b2y + b2z * b2z)
+    out[0] = ke
+    out[1] = pe
+    out[2] = ge
+
+
+# ---------------------------------------------------------------------------
+# Python-facing entry points. The wrapper (simulation.py) has validated dtypes,
+# shapes and contiguity; here arrays are only bound to the struct.
+
+cdef inline float64_t* _f(object arrays, str name) except NULL:
+    cdef cnp.ndarray a = arrays[name]
+    return <float64_t*> cnp.PyArray_DATA(a)
+
+
+cdef inline void* _p(object arrays, str name) except NULL:
+    cdef cnp.ndarray a = arrays[name]
+    return cnp.PyArray_DATA(a)
+
+
+cdef int _bind(Batch* b, dict a, dict s) except -1:
+    b.n_robots = s["n_robots"]
+    b.L = s["L"]
+    b.gravity = s["gravity"]
+    b.init_time = s["init_time"]
+    b.min_scale = s["min_scale"]
+    b.max_strain = s["max_strain"]
+    b.trace_interval = s["trace_interval"]
+    b.floor_enabled = s["floor_enabled"]
+    b.actuation_mode = s["actuation_mode"]
+    b.trace_capacity = a["trace_t"].shape[1]
+    b.vox_start = <intp_t*> _p(a, "vox_start")
+    b.link_start = <intp_t*> _p(a, "link_start")
+    b.dt = _f(a, "dt")
+    b.steps = <step_t*> _p(a, "steps")
+    b.temp_amp = _f(a, "temp_amp")
+    b.period = _f(a, "period")
+    b.use_temp = <flag_t*> _p(a, "use_temp")
+    b.diverged = <flag_t*> _p(a, "diverged")
+    b.diverged_time = _f(a, "diverged_time")
+    b.diverged_code = <int32*> _p(a, "diverged_code")
+    b.init_done = <flag_t*> _p(a, "init_done")
+    b.cm_init = _f(a, "cm_init")
+    b.mass_total = _f(a, "mass_total")
+    b.trace_n = <intp_t*> _p(a, "trace_n")
+    b.trace_t = _f(a, "trace_t")
+    b.trace_cm = _f(a, "trace_cm")
+    b.pos = _f(a, "pos")
+    b.mom = _f(a, "mom")
+    b.quat = _f(a, "quat")
+    b.angmom = _f(a, "angmom")
+    b.rot = _f(a, "rot")
+    b.force = _f(a, "force")
+    b.moment = _f(a, "moment")
+    b.ext_force = _f(a, "ext_force")
+    b.mass = _f(a, "mass")
+    b.inv_mass = _f(a, "inv_mass")
+    b.inv_inertia = _f(a, "inv_inertia")
+    b.scale = _f(a, "scale")
+    b.cte = _f(a, "cte")
+    b.cos_phase = _f(a, "cos_phase")
+    b.sin_phase = _f(a, "sin_phase")
+    b.temp = _f(a, "temp")
+    b.k_floor = _f(a, "k_floor")
+    b.c_floor = _f(a, "c_floor")
+    b.c_global = _f(a, "c_global")
+    b.rot_damp = _f(a, "rot_damp")
+    b.mu_s = _f(a, "mu_s")
+    b.mu_k = _f(a, "mu_k")
+    b.fixed = <flag_t*> _p(a, "fixed")
+    # links: a robot without links leaves these arrays empty (never dereferenced)
+    if a["v1"].shape[0] > 0:
+        b.v1 = <intp_t*> _p(a, "v1")
+        b.v2 = <intp_t*> _p(a, "v2")
+        b.axis = <int32*> _p(a, "axis")
+        b.k_axial = _f(a, "k_axial")
+        b.k_torsion = _f(a, "k_torsion")
+        b.k_bend = _f(a, "k_bend")
+        b.c_axial = _f(a, "c_axial")
+        b.c_torsion = _f(a, "c_torsion")
+        b.c_bend = _f(a, "c_bend")
+    return 0
+
+
+def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads):
+    """Advance every robot of a batch to its target step count.
+
+    Parameters
+    ----------
+    arrays : dict of str to ndarray
+        The batch state (see ``_core.pxd`` for names, shapes and units);
+        modified in place.
+    settings : dict
+        Global scalars of the batch (``L``, ``gravity``...).
+    targets : ndarray of shape (n_robots,), int64
+        Step count each robot must reach.
+    n_threads : int
+        OpenMP threads; robots are distributed over them.
+
+    Divergence is reported through ``arrays["diverged"]`` and friends.
+    """
+    cdef:
+        Batch b
+        intp_t r
+        intp_t n
+    _bind(&b, arrays, settings)
+    n = b.n_robots
+    if targets.shape[0] != n:
+        raise ValueError("targets must hold one step count per robot")
+    with nogil, parallel(num_threads=n_threads):
+        # dynamic: robots of one batch differ in cost by 10x or more (bone shrinks dt)
+        for r in prange(n, schedule="dynamic", chunksize=1):
+            advance_robot(&b, r, targets[r])
+
+
+def compute_energy(dict arrays, dict settings, float64_t[:, ::1] out):
+    """Fill ``out`` (n_robots, 3) with kinetic, elastic and gravitational energy (J)."""
+    cdef Batch b
+    cdef intp_t r
+    _bind(&b, arrays, settings)
+    for r in range(b.n_robots):
+        robot_energy(&b, r, &out[r, 0])
+
+
+def refresh_rotations(float64_t[:, ::1] quat, float64_t[:, ::1] rot):
+    """Recompute ``rot`` (n_voxels, 9) from ``quat`` (n_voxels, 4) after the state was set."""
+    cdef intp_t i
+    with nogil:
+        for i in range(quat.shape[0]):
+            _rotation_matrix(&quat[i, 0], &rot[i, 0])

@@ -1,0 +1,8 @@
+# C scalar types of the engine, in one place (see STYLE.md rule 2).
+from libc.stdint cimport int8_t, int32_t, int64_t
+
+ctypedef double float64_t      # every physical quantity (SI units)
+ctypedef Py_ssize_t intp_t     # indices and counts into the flat batch arrays
+ctypedef int64_t step_t        # step counters
+ctypedef int32_t int32         # small integer codes (link axis, flags)
+ctypedef int8_t flag_t         # booleans stored in arrays

@@ -1,0 +1,124 @@
+"""`SimConfig`: the physical and numerical settings of a simulation."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, fields, replace
+from typing import Any, Literal
+
+from softgym.exceptions import InvalidParameterError
+
+__all__ = ["SimConfig"]
+
+
+@dataclass(frozen=True)
+class SimConfig:
+    """Settings shared by every robot of a :class:`~softgym.engine.Simulation`.
+
+    The defaults are the seed study's (evosoro's ``.vxa`` settings,
+    SEED_REFERENCE section 2.1): the ``"seed"`` preset.
+
+    Parameters
+    ----------
+    voxel_size : float
+        Lattice dimension L (m), 0.01 in the seed.
+    dt_frac : float
+        Fraction of the stable time step bound
+        ``1 / (2 pi sqrt(max k_axial / m))`` over the robot's links (0.9).
+    gravity : float
+        Gravitational acceleration (m/s^2) pulling along -z; 0 disables gravity (9.81).
+    floor : bool
+        Penalty floor at z = 0 with Coulomb friction (True).
+    bond_damping : float
+        Internal damping ratio of the links, the seed's ``BondDampingZ`` (1.0).
+    collision_damping : float
+        Damping ratio of floor contact, ``ColDampingZ`` (0.8).
+    global_damping : float
+        Damping ratio towards rest in the world frame, ``SlowDampingZ`` (0.01).
+    init_time : float
+        Settling time (s): the sinusoid starts and the fitness reference
+        ``cm_init`` is taken after it (1.0).
+    actuation : {"seed", "symmetric"}
+        ``"seed"``: a voxel's size follows ``L (1 + CTE T)`` only while it stays
+        within ``[min_scale L, L]``, otherwise it keeps its previous size, so
+        muscles only contract (the seed's engine). ``"symmetric"``: muscles
+        expand and contract (newer Voxelyze), sizes floored at ``min_scale L``.
+    min_scale : float
+        Smallest actuated size as a fraction of L (0.1, the seed's MinTempFact).
+    max_strain : float
+        A link whose engineering strain magnitude exceeds this flags its robot
+        as diverged (100, the seed's threshold).
+    trace_interval : float
+        Seconds between centre-of-mass samples of the rollout (0.1: the seed's
+        obstacle runs; its novelty runs use 0.5).
+    on_divergence : {"flag", "raise"}
+        ``"flag"``: a diverged robot is frozen and flagged, the others go on;
+        ``"raise"``: :class:`~softgym.exceptions.SimulationDivergedError` is
+        raised after the call, naming the first diverged robot.
+    """
+
+    voxel_size: float = 0.01
+    dt_frac: float = 0.9
+    gravity: float = 9.81
+    floor: bool = True
+    bond_damping: float = 1.0
+    collision_damping: float = 0.8
+    global_damping: float = 0.01
+    init_time: float = 1.0
+    actuation: Literal["seed", "symmetric"] = "seed"
+    min_scale: float = 0.1
+    max_strain: float = 100.0
+    trace_interval: float = 0.1
+    on_divergence: Literal["flag", "raise"] = "flag"
+
+    def __post_init__(self) -> None:
+        def check(name: str, ok: bool, what: str) -> None:
+            value = getattr(self, name)
+            if not ok:
+                raise InvalidParameterError(f"SimConfig.{name} must be {what}, got {value!r}")
+
+        def finite(name: str) -> float:
+            value = getattr(self, name)
+            try:
+                v = float(value)
+            except (TypeError, ValueError):
+                raise InvalidParameterError(
+                    f"SimConfig.{name} must be a number, got {value!r}"
+                ) from None
+            check(name, math.isfinite(v), "finite")
+            return v
+
+        check("voxel_size", finite("voxel_size") > 0, "> 0 m")
+        check("dt_frac", 0 < finite("dt_frac") <= 10, "in (0, 10]")
+        check("gravity", finite("gravity") >= 0, ">= 0 m/s^2 (it pulls along -z)")
+        for name in ("bond_damping", "collision_damping", "global_damping"):
+            check(name, finite(name) >= 0, ">= 0")
+        check("init_time", finite("init_time") >= 0, ">= 0 s")
+        check("min_scale", 0 < finite("min_scale") <= 1, "in (0, 1]")
+        check("max_strain", finite("max_strain") > 0, "> 0")
+        check("trace_interval", finite("trace_interval") > 0, "> 0 s")
+        check("actuation", self.actuation in ("seed", "symmetric"), '"seed" or "symmetric"')
+        check("on_divergence", self.on_divergence in ("flag", "raise"), '"flag" or "raise"')
+        check("floor", isinstance(self.floor, (bool, int)), "a bool")
+
+    @classmethod
+    def seed(cls, **overrides: Any) -> SimConfig:
+        """The seed study's settings (the defaults), with optional overrides."""
+        return cls(**overrides)
+
+    def replace(self, **changes: Any) -> SimConfig:
+        """Return a copy with some settings changed (validated)."""
+        return replace(self, **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-JSON dictionary of the settings."""
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> SimConfig:
+        """Inverse of :meth:`to_dict`; unknown keys raise InvalidParameterError."""
+        known = {f.name for f in fields(cls)}
+        unknown = set(data) - known
+        if unknown:
+            raise InvalidParameterError(f"unknown SimConfig keys: {sorted(unknown)}")
+        return cls(**data)

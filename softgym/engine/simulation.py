@@ -1,0 +1,597 @@
+"""`Simulation`: a batch of voxel robots advanced together by the Cython kernel.
+
+The wrapper validates and lays out the batch as flat structure-of-arrays
+(float64, C-contiguous, per-robot offsets), computes every constant of the
+lattice model once, and calls :func:`softgym.engine._core.advance`, which runs
+the robots in parallel without the GIL.
+
+The physics is the seed's engine (SEED_REFERENCE section 1), re-derived:
+
+* voxel: rigid cube, mass ``rho L^3``, inertia ``m L^2 / 6``;
+* link between face neighbours: Euler-Bernoulli beam with the harmonic-mean
+  modulus ``E = 2 E1 E2 / (E1 + E2)`` (and Poisson ratio), constants
+  ``k_axial = E L``, ``k_torsion = E L^3 / (12 (1 + nu))``,
+  ``k_bend = E L^3 / 6`` (``b3`` of the seed; its ``b1 = E L`` and
+  ``b2 = E L^2 / 2`` follow from the beam element), measured in the frame of
+  the link's chord so large rotations are exact;
+* bond damping ``zeta_b sqrt(k m)`` (axial, the seed's ``0.5 zeta_b 2 sqrt(a1 m)``),
+  ``zeta_b sqrt(k_bend I) / 2`` (bending moments, the seed's coefficient; the
+  shear damping follows from the moments) and ``zeta_b sqrt(k_torsion I) / 2``
+  (torsion), with the reduced mass ``2 m1 m2 / (m1 + m2)`` (= m for equal
+  voxels) so mixed links are symmetric. Damping acts on deformation rates
+  only, so its power is never positive and rigid motion is not damped;
+* global damping ``zeta_g 2 sqrt(m E L)`` on velocity and the seed's
+  multiplicative factor on angular momentum;
+* floor at z = 0: normal force ``2 E L p`` (p: penetration of the voxel's
+  half actuated size) minus ``zeta_c 2 sqrt(m E L) v_z`` (never pulling),
+  static friction below ``mu_s N``, kinetic ``mu_k N`` against the sliding
+  direction;
+* time step ``dt_frac / (2 pi sqrt(max k_axial / m))`` per robot, so a stiff
+  robot does not slow the others of its batch;
+* actuation: ``scale = L (1 + CTE T)``, ``T = dT sin(2 pi t / period + phase)``
+  from ``init_time`` on, or per-voxel temperatures set by the caller.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from softgym.engine import _core
+from softgym.engine._openmp import omp_max_threads
+from softgym.engine.body import Body
+from softgym.engine.config import SimConfig
+from softgym.engine.rollout import Rollout
+from softgym.exceptions import (
+    InvalidActionError,
+    InvalidDesignError,
+    InvalidParameterError,
+    SimulationDivergedError,
+)
+
+__all__ = ["Simulation", "as_body", "default_num_threads"]
+
+_REASONS = {1: "link strain above max_strain (or NaN)", 2: "non-finite or runaway voxel state"}
+
+# state arrays that change while the simulation runs (checkpointed by get_state)
+_STATE = (
+    "pos", "mom", "quat", "angmom", "rot", "scale", "steps", "diverged", "diverged_time",
+    "diverged_code", "init_done", "cm_init", "trace_n", "trace_t", "trace_cm", "temp",
+    "use_temp", "ext_force",
+)  # fmt: skip
+
+
+def default_num_threads() -> int:
+    """Threads used when none is given: ``SOFTGYM_NUM_THREADS``, else OpenMP's default."""
+    env = os.environ.get("SOFTGYM_NUM_THREADS")
+    if env:
+        try:
+            n = int(env)
+        except ValueError:
+            raise InvalidParameterError(f"SOFTGYM_NUM_THREADS must be an integer, got {env!r}") from None
+        if n < 1:
+            raise InvalidParameterError(f"SOFTGYM_NUM_THREADS must be >= 1, got {n}")
+        return n
+    return max(1, omp_max_threads())
+
+
+def as_body(obj: Any) -> Body:
+    """Return ``obj`` as a :class:`Body` (a Body, or anything with ``to_body()``)."""
+    if isinstance(obj, Body):
+        return obj
+    to_body = getattr(obj, "to_body", None)
+    if callable(to_body):
+        body = to_body()
+        if not isinstance(body, Body):
+            raise InvalidDesignError(f"{type(obj).__name__}.to_body() did not return a Body")
+        return body
+    raise InvalidDesignError(
+        f"expected a softgym Body or a design with to_body(), got {type(obj).__name__}"
+    )
+
+
+def _harmonic(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    s = a + b
+    out = np.zeros_like(s)
+    nz = s > 0
+    out[nz] = 2.0 * a[nz] * b[nz] / s[nz]
+    return out
+
+
+class Simulation:
+    """A batch of voxel robots simulated together.
+
+    Parameters
+    ----------
+    bodies : Body, design, or sequence of them
+        The robots. Designs are converted with their ``to_body()`` method.
+        Robots may differ in shape, size and materials.
+    config : SimConfig, optional
+        Shared settings; the seed's by default.
+    n_threads : int, optional
+        OpenMP threads used by :meth:`run` (default :func:`default_num_threads`).
+        Results are bit-identical for any thread count.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from softgym.engine import Body, Simulation
+    >>> sim = Simulation([Body.uniform(np.ones((2, 2, 2)))])
+    >>> rollout = sim.run(0.5)
+    >>> rollout.cm.shape
+    (1, 6, 3)
+    """
+
+    def __init__(
+        self,
+        bodies: Any,
+        config: SimConfig | None = None,
+        n_threads: int | None = None,
+    ) -> None:
+        if isinstance(bodies, (Body,)) or hasattr(bodies, "to_body"):
+            bodies = [bodies]
+        if not isinstance(bodies, Sequence) or len(bodies) == 0:
+            raise InvalidDesignError("Simulation needs a non-empty sequence of bodies")
+        self.bodies: list[Body] = [as_body(b) for b in bodies]
+        self.config = SimConfig() if config is None else config
+        if not isinstance(self.config, SimConfig):
+            raise InvalidParameterError(f"config must be a SimConfig, got {type(config).__name__}")
+        self.n_threads = default_num_threads() if n_threads is None else int(n_threads)
+        if self.n_threads < 1:
+            raise InvalidParameterError(f"n_threads must be >= 1, got {n_threads}")
+        self._build()
+        self._initial = {k: self._a[k].copy() for k in _STATE}
+        self._t_target = 0.0
+
+    # ------------------------------------------------------------------ layout
+    def _build(self) -> None:
+        cfg = self.config
+        L = float(cfg.voxel_size)
+        n_robots = len(self.bodies)
+        per_vox: dict[str, list[np.ndarray]] = {}
+        per_link: dict[str, list[np.ndarray]] = {}
+        vox_start = [0]
+        link_start = [0]
+        dts, masses = [], []
+        grid_index = []
+        self._grid_maps: list[np.ndarray] = []
+
+        def add(store, name, value):
+            store.setdefault(name, []).append(np.asarray(value))
+
+        for body in self.bodies:
+            grid = body.grid
+            idx = np.argwhere(grid > 0)
+            n = idx.shape[0]
+            vmap = np.full(grid.shape, -1, dtype=np.int64)
+            vmap[tuple(idx.T)] = np.arange(n)
+            self._grid_maps.append(vmap)
+            mat = grid[tuple(idx.T)]
+            E = body.youngs_modulus[mat]
+            rho = body.density[mat]
+            nu = body.poisson[mat]
+            m = rho * L**3
+            inertia = m * L**2 / 6.0
+            fixed = (
+                np.zeros(n, dtype=np.int8)
+                if body.fixed is None
+                else body.fixed[tuple(idx.T)].astype(np.int8)
+            )
+            # links along +x, +y, +z between filled face neighbours
+            v1s, v2s, axes = [], [], []
+            for ax in range(3):
+                lo = [slice(None)] * 3
+                hi = [slice(None)] * 3
+                lo[ax] = slice(0, -1)
+                hi[ax] = slice(1, None)
+                a = vmap[tuple(lo)]
+                b = vmap[tuple(hi)]
+                ok = (a >= 0) & (b >= 0)
+                v1s.append(a[ok])
+                v2s.append(b[ok])
+                axes.append(np.full(int(ok.sum()), ax, dtype=np.int32))
+            v1 = np.concatenate(v1s)
+            v2 = np.concatenate(v2s)
+            axis = np.concatenate(axes)
+            keep = ~((fixed[v1] == 1) & (fixed[v2] == 1))
+            v1, v2, axis = v1[keep], v2[keep], axis[keep]
+            Eh = _harmonic(E[v1], E[v2])
+            nuh = _harmonic(nu[v1], nu[v2])
+            mr = _harmonic(m[v1], m[v2])
+            Ir = _harmonic(inertia[v1], inertia[v2])
+            k_axial = Eh * L
+            k_torsion = Eh * L**3 / (12.0 * (1.0 + nuh))
+            k_bend = Eh * L**3 / 6.0
+            zb = cfg.bond_damping
+            add(per_link, "v1", v1 + vox_start[-1])
+            add(per_link, "v2", v2 + vox_start[-1])
+            add(per_link, "axis", axis)
+            add(per_link, "k_axial", k_axial)
+            add(per_link, "k_torsion", k_torsion)
+            add(per_link, "k_bend", k_bend)
+            add(per_link, "c_axial", zb * np.sqrt(k_axial * mr))
+            add(per_link, "c_bend", 0.5 * zb * np.sqrt(k_bend * Ir))
+            add(per_link, "c_torsion", 0.5 * zb * np.sqrt(k_torsion * Ir))
+            # time step: the seed's CalcMaxDt over this robot's links
+            if v1.size:
+                w2 = np.max(np.maximum(k_axial / m[v1], k_axial / m[v2]))
+            else:
+                w2 = np.max(E * L / m)
+            dt = cfg.dt_frac / (2.0 * math.pi * math.sqrt(w2))
+            dts.append(dt)
+            masses.append(float(m.sum()))
+            crit = 2.0 * np.sqrt(m * E * L)
+            pos = body.origin + (idx + 0.5) * L
+            add(per_vox, "pos", pos)
+            add(per_vox, "mass", m)
+            add(per_vox, "inv_mass", 1.0 / m)
+            add(per_vox, "inv_inertia", 1.0 / inertia)
+            add(per_vox, "cte", body.cte[mat])
+            add(per_vox, "cos_phase", np.cos(body.phase[mat]))
+            add(per_vox, "sin_phase", np.sin(body.phase[mat]))
+            add(per_vox, "k_floor", 2.0 * E * L)
+            add(per_vox, "c_floor", cfg.collision_damping * crit)
+            add(per_vox, "c_global", cfg.global_damping * crit)
+            rot_damp = 1.0 - 10.0 * cfg.global_damping * 2.0 * np.sqrt(inertia * E * L**3) / inertia * dt
+            add(per_vox, "rot_damp", np.clip(rot_damp, 0.0, 1.0))
+            add(per_vox, "mu_s", body.mu_static[mat])
+            add(per_vox, "mu_k", body.mu_kinetic[mat])
+            add(per_vox, "fixed", fixed)
+            grid_index.append(idx)
+            vox_start.append(vox_start[-1] + n)
+            link_start.append(link_start[-1] + v1.size)
+
+        n_vox = vox_start[-1]
+        a: dict[str, np.ndarray] = {}
+        for name, parts in per_vox.items():
+            a[name] = np.ascontiguousarray(np.concatenate(parts))
+        a["fixed"] = a["fixed"].astype(np.int8)
+        for name, parts in per_link.items():
+            a[name] = np.ascontiguousarray(np.concatenate(parts))
+        for name in ("v1", "v2"):
+            a[name] = a[name].astype(np.intp)
+        a["axis"] = a["axis"].astype(np.int32)
+        a["quat"] = np.zeros((n_vox, 4))
+        a["quat"][:, 0] = 1.0
+        a["rot"] = np.zeros((n_vox, 9))
+        a["rot"][:, [0, 4, 8]] = 1.0
+        for name in ("mom", "angmom", "force", "moment", "ext_force"):
+            a[name] = np.zeros((n_vox, 3))
+        a["scale"] = np.full(n_vox, L)
+        a["temp"] = np.zeros(n_vox)
+        a["vox_start"] = np.asarray(vox_start, dtype=np.intp)
+        a["link_start"] = np.asarray(link_start, dtype=np.intp)
+        a["dt"] = np.asarray(dts, dtype=np.float64)
+        a["steps"] = np.zeros(n_robots, dtype=np.int64)
+        a["temp_amp"] = np.array([b.temp_amplitude for b in self.bodies], dtype=np.float64)
+        a["period"] = np.array([b.period for b in self.bodies], dtype=np.float64)
+        a["use_temp"] = np.zeros(n_robots, dtype=np.int8)
+        a["diverged"] = np.zeros(n_robots, dtype=np.int8)
+        a["diverged_time"] = np.full(n_robots, np.inf)
+        a["diverged_code"] = np.zeros(n_robots, dtype=np.int32)
+        a["init_done"] = np.zeros(n_robots, dtype=np.int8)
+        a["cm_init"] = np.zeros((n_robots, 3))
+        a["mass_total"] = np.asarray(masses, dtype=np.float64)
+        a["trace_n"] = np.zeros(n_robots, dtype=np.intp)
+        a["trace_t"] = np.zeros((n_robots, 8))
+        a["trace_cm"] = np.zeros((n_robots, 8, 3))
+        self._a = a
+        self._grid_index = np.ascontiguousarray(np.concatenate(grid_index)).astype(np.int64)
+        self._settings = {
+            "n_robots": n_robots,
+            "L": L,
+            "gravity": -float(cfg.gravity),
+            "init_time": float(cfg.init_time),
+            "min_scale": float(cfg.min_scale),
+            "max_strain": float(cfg.max_strain),
+            "trace_interval": float(cfg.trace_interval),
+            "floor_enabled": int(bool(cfg.floor)),
+            "actuation_mode": 0 if cfg.actuation == "seed" else 1,
+        }
+
+    # --------------------------------------------------------------- properties
+    @property
+    def n_robots(self) -> int:
+        """Number of robots in the batch."""
+        return len(self.bodies)
+
+    @property
+    def n_voxels(self) -> int:
+        """Total number of voxels over the batch."""
+        return int(self._a["vox_start"][-1])
+
+    @property
+    def n_links(self) -> int:
+        """Total number of links over the batch."""
+        return int(self._a["link_start"][-1])
+
+    @property
+    def voxel_offsets(self) -> np.ndarray:
+        """Ndarray of shape (n_robots + 1,): robot i owns voxels ``[off[i], off[i+1])``."""
+        return self._a["vox_start"].astype(np.int64)
+
+    @property
+    def dt(self) -> np.ndarray:
+        """Ndarray of shape (n_robots,): each robot's time step (s)."""
+        return self._a["dt"].copy()
+
+    @property
+    def time(self) -> np.ndarray:
+        """Ndarray of shape (n_robots,): each robot's simulated time (s)."""
+        a = self._a
+        t = a["steps"] * a["dt"]
+        return np.where(a["diverged"] == 1, a["diverged_time"], t)
+
+    @property
+    def diverged(self) -> np.ndarray:
+        """Ndarray of shape (n_robots,), bool: robots frozen after divergence."""
+        return self._a["diverged"].astype(bool)
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes held by the batch's arrays."""
+        return int(sum(v.nbytes for v in self._a.values()))
+
+    def _slice(self, robot: int) -> slice:
+        if not 0 <= robot < self.n_robots:
+            raise IndexError(f"robot index {robot} out of range for {self.n_robots} robots")
+        s = self._a["vox_start"]
+        return slice(int(s[robot]), int(s[robot + 1]))
+
+    def positions(self, robot: int) -> np.ndarray:
+        """Voxel centres (m) of one robot, shape (n_voxels_r, 3) (a copy)."""
+        return self._a["pos"][self._slice(robot)].copy()
+
+    def velocities(self, robot: int) -> np.ndarray:
+        """Voxel velocities (m/s) of one robot, shape (n_voxels_r, 3)."""
+        s = self._slice(robot)
+        return self._a["mom"][s] * self._a["inv_mass"][s, None]
+
+    def orientations(self, robot: int) -> np.ndarray:
+        """Voxel quaternions (w, x, y, z) of one robot, shape (n_voxels_r, 4) (a copy)."""
+        return self._a["quat"][self._slice(robot)].copy()
+
+    def angular_velocities(self, robot: int) -> np.ndarray:
+        """Voxel angular velocities (rad/s, world frame), shape (n_voxels_r, 3)."""
+        s = self._slice(robot)
+        return self._a["angmom"][s] * self._a["inv_inertia"][s, None]
+
+    def scales(self, robot: int) -> np.ndarray:
+        """Current actuated voxel edge lengths (m) of one robot, shape (n_voxels_r,)."""
+        return self._a["scale"][self._slice(robot)].copy()
+
+    def grid_index(self, robot: int) -> np.ndarray:
+        """Lattice index (i, j, k) of each voxel of one robot, shape (n_voxels_r, 3)."""
+        return self._grid_index[self._slice(robot)].copy()
+
+    def masses(self, robot: int) -> np.ndarray:
+        """Voxel masses (kg) of one robot, shape (n_voxels_r,)."""
+        return self._a["mass"][self._slice(robot)].copy()
+
+    def center_of_mass(self) -> np.ndarray:
+        """Ndarray of shape (n_robots, 3): current centre of mass of each robot (m)."""
+        a = self._a
+        w = a["mass"][:, None] * a["pos"]
+        sums = np.add.reduceat(w, a["vox_start"][:-1], axis=0)
+        return sums / a["mass_total"][:, None]
+
+    def momentum(self) -> np.ndarray:
+        """Ndarray of shape (n_robots, 3): total linear momentum of each robot (kg m/s)."""
+        a = self._a
+        return np.add.reduceat(a["mom"], a["vox_start"][:-1], axis=0)
+
+    def energy(self) -> np.ndarray:
+        """Mechanical energy per robot (J).
+
+        Returns
+        -------
+        ndarray of shape (n_robots, 3), float64
+            Kinetic (translation + rotation), elastic (links + floor penalty)
+            and gravitational potential energy (zero at z = 0).
+        """
+        out = np.zeros((self.n_robots, 3))
+        _core.compute_energy(self._a, self._settings, out)
+        return out
+
+    # ------------------------------------------------------------------ control
+    def _per_voxel(self, robot: int, values: Any, name: str, width: int | None) -> np.ndarray:
+        s = self._slice(robot)
+        n = s.stop - s.start
+        arr = np.asarray(values, dtype=np.float64)
+        grid_shape = self.bodies[robot].grid.shape
+        if width is None and arr.shape == grid_shape:
+            arr = arr[tuple(self._grid_index[s].T)]
+        elif width is not None and arr.shape == (*grid_shape, width):
+            arr = arr[tuple(self._grid_index[s].T)]
+        want = (n,) if width is None else (n, width)
+        if arr.shape != want:
+            raise InvalidActionError(
+                f"{name} for robot {robot} must have shape {want} (one per voxel) "
+                f"or the grid's shape {grid_shape}, got {arr.shape}"
+            )
+        if not np.isfinite(arr).all():
+            raise InvalidActionError(f"{name} for robot {robot} holds NaN or infinite values")
+        return arr
+
+    def set_temperature(self, robot: int, temperature: Any) -> None:
+        """Replace the sinusoid of one robot by per-voxel temperatures (degC).
+
+        Parameters
+        ----------
+        robot : int
+            Robot index.
+        temperature : array_like of shape (n_voxels_r,) or the grid's shape, or None
+            Temperature of each voxel until the next call; a voxel's size then
+            follows ``L (1 + CTE T)`` under the configured actuation law
+            (no settling delay). ``None`` gives the robot back its sinusoid.
+
+        Raises
+        ------
+        InvalidActionError
+            On a wrong shape or a non-finite value; the state is unchanged.
+        """
+        s = self._slice(robot)
+        if temperature is None:
+            self._a["use_temp"][robot] = 0
+            return
+        arr = self._per_voxel(robot, temperature, "temperature", None)
+        self._a["temp"][s] = arr
+        self._a["use_temp"][robot] = 1
+
+    def set_external_force(self, robot: int, force: Any) -> None:
+        """Apply a constant external force (N) to each voxel of one robot.
+
+        Parameters
+        ----------
+        robot : int
+            Robot index.
+        force : array_like of shape (3,), (n_voxels_r, 3) or (*grid_shape, 3)
+            A shape (3,) force is applied to every voxel.
+        """
+        s = self._slice(robot)
+        arr = np.asarray(force, dtype=np.float64)
+        if arr.shape == (3,):
+            arr = np.broadcast_to(arr, (s.stop - s.start, 3))
+        arr = self._per_voxel(robot, arr, "external force", 3)
+        self._a["ext_force"][s] = arr
+
+    # -------------------------------------------------------------------- run
+    def _ensure_trace_capacity(self, t_end: float) -> None:
+        need = int(math.floor(t_end / self.config.trace_interval + 1e-9)) + 3
+        cap = self._a["trace_t"].shape[1]
+        if need <= cap:
+            return
+        new = max(need, 2 * cap)
+        for name in ("trace_t", "trace_cm"):
+            old = self._a[name]
+            arr = np.zeros((old.shape[0], new, *old.shape[2:]))
+            arr[:, :cap] = old
+            self._a[name] = arr
+
+    def advance(self, seconds: float) -> None:
+        """Advance every robot by ``seconds`` of simulated time (no rollout built).
+
+        Each robot steps with its own ``dt`` until its clock reaches the common
+        target time. Diverged robots stay frozen.
+
+        Raises
+        ------
+        InvalidParameterError
+            If ``seconds`` is negative or not finite.
+        SimulationDivergedError
+            With ``on_divergence="raise"``, naming the first robot that diverged
+            during this call (the others have advanced).
+        """
+        seconds = float(seconds)
+        if not (math.isfinite(seconds) and seconds >= 0):
+            raise InvalidParameterError(f"seconds must be finite and >= 0, got {seconds}")
+        self.advance_to(self._t_target + seconds)
+
+    def advance_to(self, time: float) -> None:
+        """Advance every robot until its clock reaches ``time`` (s)."""
+        time = float(time)
+        if not (math.isfinite(time) and time >= self._t_target):
+            raise InvalidParameterError(
+                f"time must be finite and >= the current target {self._t_target}, got {time}"
+            )
+        self._t_target = time
+        self._ensure_trace_capacity(time + self._a["dt"].max())
+        a = self._a
+        targets = np.ceil(time / a["dt"] - 1e-9).astype(np.int64)
+        targets = np.maximum(targets, a["steps"])
+        before = a["diverged"].copy()
+        _core.advance(a, self._settings, targets, self.n_threads)
+        if self.config.on_divergence == "raise":
+            new = np.flatnonzero((a["diverged"] == 1) & (before == 0))
+            if new.size:
+                r = int(new[0])
+                raise SimulationDivergedError(
+                    r, float(a["diverged_time"][r]), _REASONS.get(int(a["diverged_code"][r]), "diverged")
+                )
+
+    def run(self, seconds: float) -> Rollout:
+        """Advance every robot by ``seconds`` and return the rollout since t = 0.
+
+        Parameters
+        ----------
+        seconds : float
+            Simulated time to add (s); 5 s in the seed study.
+
+        Returns
+        -------
+        Rollout
+        """
+        self.advance(seconds)
+        return self.rollout()
+
+    def rollout(self) -> Rollout:
+        """The :class:`Rollout` of the current state (traces since t = 0)."""
+        a = self._a
+        cfg = self.config
+        n_samples = int(math.floor(self._t_target / cfg.trace_interval + 1e-9)) + 1
+        n = a["trace_n"]
+        idx = np.minimum(np.arange(n_samples)[None, :], np.maximum(n - 1, 0)[:, None])
+        rows = np.arange(self.n_robots)[:, None]
+        times = a["trace_t"][rows, idx]
+        cm = a["trace_cm"][rows, idx]
+        if (n == 0).any():  # never stepped: the initial centre of mass
+            cm0 = self.center_of_mass()
+            cm[n == 0] = cm0[n == 0][:, None, :]
+            times[n == 0] = 0.0
+        init = a["init_done"].astype(bool)
+        cm_init = np.where(init[:, None], a["cm_init"], cm[:, 0])
+        return Rollout(
+            times=times,
+            cm=cm,
+            cm_init=cm_init,
+            init_reached=init,
+            cm_final=self.center_of_mass(),
+            positions=a["pos"].copy(),
+            orientations=a["quat"].copy(),
+            voxel_offsets=self.voxel_offsets,
+            grid_index=self._grid_index.copy(),
+            dt=a["dt"].copy(),
+            steps=a["steps"].copy(),
+            time=self.time,
+            diverged=a["diverged"].astype(bool),
+            diverged_time=a["diverged_time"].copy(),
+            mass=a["mass_total"].copy(),
+            voxel_size=float(cfg.voxel_size),
+            init_time=float(cfg.init_time),
+            trace_interval=float(cfg.trace_interval),
+        )
+
+    # ------------------------------------------------------------------ state
+    def reset(self) -> None:
+        """Return every robot to its initial state (t = 0, sinusoidal drive)."""
+        for k, v in self._initial.items():
+            self._a[k] = v.copy()
+        self._t_target = 0.0
+
+    def get_state(self) -> dict[str, np.ndarray]:
+        """Copy of the full dynamic state (plain arrays, for checkpoints)."""
+        state = {k: self._a[k].copy() for k in _STATE}
+        state["t_target"] = np.array(self._t_target)
+        return state
+
+    def set_state(self, state: dict[str, np.ndarray]) -> None:
+        """Restore a state from :meth:`get_state` of an identical batch."""
+        for k in _STATE:
+            if k not in state:
+                raise InvalidParameterError(f"state is missing array {k!r}")
+            v = np.asarray(state[k])
+            cur = self._a[k]
+            if k in ("trace_t", "trace_cm"):
+                if v.shape[0] != cur.shape[0] or v.shape[2:] != cur.shape[2:]:
+                    raise InvalidParameterError(f"state array {k!r} has shape {v.shape}")
+            elif v.shape != cur.shape:
+                raise InvalidParameterError(
+                    f"state array {k!r} has shape {v.shape}, expected {cur.shape}"
+                )
+        for k in _STATE:
+            self._a[k] = np.ascontiguousarray(np.asarray(state[k]), dtype=self._a[k].dtype)
+        self._t_target = float(state.get("t_target", 0.0))
