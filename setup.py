@@ -96,8 +96,16 @@ ext_kwargs = dict(
     extra_link_args=omp_lflags,
 )
 
+core_kwargs = dict(ext_kwargs)
+# the kernel's `cdef inline` helpers take constant lattice axes: force inlining
+# so the compiler specialises them (Cython's guard lets us predefine the macro)
+if sys.platform != "win32":
+    core_kwargs["define_macros"] = ext_kwargs["define_macros"] + [
+        ("CYTHON_INLINE", "__inline__ __attribute__((always_inline))"),
+    ]
+
 extensions = [
-    Extension("softgym.engine._core", ["softgym/engine/_core.pyx"], **ext_kwargs),
+    Extension("softgym.engine._core", ["softgym/engine/_core.pyx"], **core_kwargs),
     Extension("softgym.engine._openmp", ["softgym/engine/_openmp.pyx"], **ext_kwargs),
 ]
 

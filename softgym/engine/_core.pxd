@@ -9,7 +9,7 @@ from softgym.engine._typedefs cimport float64_t, intp_t, step_t, int32, flag_t
 cdef enum:
     STATUS_OK = 0
     STATUS_STRAIN = 1       # a link's engineering strain exceeded max_strain (or was NaN)
-    STATUS_NONFINITE = 2    # a voxel's position or momentum became non-finite / runaway
+    STATUS_NONFINITE = 2    # a voxel's position became non-finite or ran away
 
 
 cdef struct Batch:
@@ -28,6 +28,7 @@ cdef struct Batch:
     # ---- per robot ----------------------------------------------------------
     intp_t* vox_start        # (n_robots + 1,) robot r owns voxels [vox_start[r], vox_start[r+1])
     intp_t* link_start       # (n_robots + 1,) robot r owns links [link_start[r], link_start[r+1])
+    intp_t* link_axis_count  # (n_robots, 3) its links along x, then y, then z (sorted by axis)
     float64_t* dt            # (n_robots,) time step (s)
     step_t* steps            # (n_robots,) steps taken; the robot's clock is steps * dt
     float64_t* temp_amp      # (n_robots,) amplitude dT of the temperature sinusoid (degC)
@@ -45,9 +46,9 @@ cdef struct Batch:
 
     # ---- per voxel ------------------------------------------------------------
     float64_t* pos           # (n_voxels, 3) centre position (m)
-    float64_t* mom           # (n_voxels, 3) linear momentum (kg m/s)
+    float64_t* vel           # (n_voxels, 3) velocity (m/s)
     float64_t* quat          # (n_voxels, 4) orientation, unit quaternion (w, x, y, z)
-    float64_t* angmom        # (n_voxels, 3) angular momentum, world frame (kg m^2/s)
+    float64_t* angvel        # (n_voxels, 3) angular velocity, world frame (rad/s)
     float64_t* rot           # (n_voxels, 9) rotation matrix of quat, row-major (derived)
     float64_t* force         # (n_voxels, 3) scratch: accumulated force (N)
     float64_t* moment        # (n_voxels, 3) scratch: accumulated moment (N m)

@@ -2,13 +2,13 @@
 # integrated with symplectic Euler, batched over robots and parallel over them.
 #
 # Physics (see SEED_REFERENCE section 1 and softgym/engine/simulation.py):
-# - each voxel is a rigid cube (position, quaternion, linear and angular momentum);
+# - each voxel is a rigid cube (position, quaternion, velocity, angular velocity);
 # - each face-adjacent pair is joined by an Euler-Bernoulli beam measured in the
 #   frame of its chord (co-rotational), so large rigid rotations are exact:
 #       axial extension   e    = |d| - (s1 + s2) / 2
 #       bending vectors   b_i  = u x a_i      (u = chord direction, a_i = voxel i's
 #                                               lattice axis of the link)
-#       twist             tau  = u . (y1 x y2 + z1 x z2) / 2
+#       twist             tau  = (z1 . y2 - y1 . z2) / 2  (y, z: the other lattice axes)
 #   with the Hermite beam element's moments M1 = -k_b (2 b1 + b2),
 #   M2 = -k_b (b1 + 2 b2), torsion +-k_t tau u, axial force -k_a e u on voxel 2
 #   and the shear force that balances the moments, u x (M1 + M2) / |d|.
@@ -22,6 +22,7 @@
 
 from cython.parallel cimport prange, parallel
 from libc.math cimport sin, cos, sqrt, fabs, M_PI
+from libc.string cimport memset
 
 cimport numpy as cnp
 
@@ -29,7 +30,7 @@ from softgym.engine._typedefs cimport float64_t, intp_t, step_t, int32, flag_t
 
 cnp.import_array()
 
-cdef float64_t RUNAWAY = 1.0e6  # |coordinate| (m) or |momentum| beyond which a robot diverged
+cdef float64_t RUNAWAY = 1.0e6  # |coordinate| (m) beyond which a robot diverged
 
 
 cdef inline void _rotation_matrix(const float64_t* q, float64_t* R) noexcept nogil:
@@ -88,39 +89,53 @@ cdef inline void _actuate(Batch* b, intp_t r) noexcept nogil:
 
 
 cdef inline int _link_forces(Batch* b, intp_t r) noexcept nogil:
-    # IN: positions, rotations, momenta, scales. OUT (accumulated): force, moment.
+    # IN: positions, rotations, velocities, scales. OUT (accumulated): force, moment.
+    # A robot's links are sorted by axis (x, then y, then z); each run gets a
+    # copy of the loop with constant axis indices.
     cdef:
-        intp_t li, i, j, ax, p, q
+        intp_t lo = b.link_start[r]
+        intp_t hi = b.link_start[r + 1]
+        intp_t nx = b.link_axis_count[3 * r]
+        intp_t ny = b.link_axis_count[3 * r + 1]
+    if _links_along(b, lo, lo + nx, 0, 1, 2) != STATUS_OK:
+        return STATUS_STRAIN
+    if _links_along(b, lo + nx, lo + nx + ny, 1, 2, 0) != STATUS_OK:
+        return STATUS_STRAIN
+    return _links_along(b, lo + nx + ny, hi, 2, 0, 1)
+
+
+cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
+                             const intp_t ax, const intp_t p, const intp_t q) noexcept nogil:
+    # Links lo..hi, all along lattice axis `ax`; (ax, p, q) is a cyclic
+    # permutation of (0, 1, 2).
+    cdef:
+        intp_t li, i, j
         float64_t dx, dy, dz, ell, inv_l, ux, uy, uz, e
         float64_t a1x, a1y, a1z, a2x, a2y, a2z
         float64_t b1x, b1y, b1z, b2x, b2y, b2z
-        float64_t y1x, y1y, y1z, y2x, y2y, y2z, z1x, z1y, z1z, z2x, z2y, z2z
         float64_t tw, twdot, edot, uw
         float64_t dvx, dvy, dvz, w1x, w1y, w1z, w2x, w2y, w2z, wcx, wcy, wcz
         float64_t r1x, r1y, r1z, r2x, r2y, r2z
         float64_t kb, cb, tor, fa
         float64_t m1x, m1y, m1z, m2x, m2y, m2z, sx, sy, sz, fx, fy, fz
-        float64_t inv_L = 1.0 / b.L
-        float64_t max_strain = b.max_strain
+        float64_t max_ext = b.max_strain * b.L
         const float64_t* R1
         const float64_t* R2
-        float64_t* pos = b.pos
-        float64_t* mom = b.mom
-        float64_t* am = b.angmom
-    for li in range(b.link_start[r], b.link_start[r + 1]):
+        const float64_t* pos = b.pos
+        const float64_t* vel = b.vel
+        const float64_t* av = b.angvel
+        const float64_t* scale = b.scale
+        float64_t* force = b.force
+        float64_t* moment = b.moment
+    for li in range(lo, hi):
         i = b.v1[li]
         j = b.v2[li]
-        ax = b.axis[li]
-        p = ax + 1
-        if p == 3:
-            p = 0
-        q = 3 - ax - p
         dx = pos[3 * j] - pos[3 * i]
         dy = pos[3 * j + 1] - pos[3 * i + 1]
         dz = pos[3 * j + 2] - pos[3 * i + 2]
         ell = sqrt(dx * dx + dy * dy + dz * dz)
-        e = ell - 0.5 * (b.scale[i] + b.scale[j])
-        if not (fabs(e) * inv_L <= max_strain):
+        e = ell - 0.5 * (scale[i] + scale[j])
+        if not (fabs(e) <= max_ext):
             return STATUS_STRAIN  # also catches NaN
         inv_l = 1.0 / ell
         ux = dx * inv_l
@@ -138,24 +153,20 @@ cdef inline int _link_forces(Batch* b, intp_t r) noexcept nogil:
         b2x = uy * a2z - uz * a2y
         b2y = uz * a2x - ux * a2z
         b2z = ux * a2y - uy * a2x
-        # twist of voxel 2 relative to voxel 1 about the chord
-        y1x = R1[p]; y1y = R1[3 + p]; y1z = R1[6 + p]
-        y2x = R2[p]; y2y = R2[3 + p]; y2z = R2[6 + p]
-        z1x = R1[q]; z1y = R1[3 + q]; z1z = R1[6 + q]
-        z2x = R2[q]; z2y = R2[3 + q]; z2z = R2[6 + q]
-        tw = 0.5 * (ux * (y1y * y2z - y1z * y2y + z1y * z2z - z1z * z2y)
-                    + uy * (y1z * y2x - y1x * y2z + z1z * z2x - z1x * z2z)
-                    + uz * (y1x * y2y - y1y * y2x + z1x * z2y - z1y * z2x))
+        # twist of voxel 2 relative to voxel 1 about the chord: with y, z the
+        # voxels' two other lattice axes, sin(twist) = (z1 . y2 - y1 . z2) / 2
+        tw = 0.5 * (R1[q] * R2[p] + R1[3 + q] * R2[3 + p] + R1[6 + q] * R2[6 + p]
+                    - R1[p] * R2[q] - R1[3 + p] * R2[3 + q] - R1[6 + p] * R2[6 + q])
         # rates
-        dvx = mom[3 * j] * b.inv_mass[j] - mom[3 * i] * b.inv_mass[i]
-        dvy = mom[3 * j + 1] * b.inv_mass[j] - mom[3 * i + 1] * b.inv_mass[i]
-        dvz = mom[3 * j + 2] * b.inv_mass[j] - mom[3 * i + 2] * b.inv_mass[i]
-        w1x = am[3 * i] * b.inv_inertia[i]
-        w1y = am[3 * i + 1] * b.inv_inertia[i]
-        w1z = am[3 * i + 2] * b.inv_inertia[i]
-        w2x = am[3 * j] * b.inv_inertia[j]
-        w2y = am[3 * j + 1] * b.inv_inertia[j]
-        w2z = am[3 * j + 2] * b.inv_inertia[j]
+        dvx = vel[3 * j] - vel[3 * i]
+        dvy = vel[3 * j + 1] - vel[3 * i + 1]
+        dvz = vel[3 * j + 2] - vel[3 * i + 2]
+        w1x = av[3 * i]
+        w1y = av[3 * i + 1]
+        w1z = av[3 * i + 2]
+        w2x = av[3 * j]
+        w2y = av[3 * j + 1]
+        w2z = av[3 * j + 2]
         edot = ux * dvx + uy * dvy + uz * dvz
         # angular velocity of the chord (perpendicular to u)
         wcx = (uy * dvz - uz * dvy) * inv_l
@@ -189,46 +200,46 @@ cdef inline int _link_forces(Batch* b, intp_t r) noexcept nogil:
         fx = (uy * sz - uz * sy) * inv_l - fa * ux
         fy = (uz * sx - ux * sz) * inv_l - fa * uy
         fz = (ux * sy - uy * sx) * inv_l - fa * uz
-        b.force[3 * j] += fx
-        b.force[3 * j + 1] += fy
-        b.force[3 * j + 2] += fz
-        b.force[3 * i] -= fx
-        b.force[3 * i + 1] -= fy
-        b.force[3 * i + 2] -= fz
-        b.moment[3 * i] += m1x
-        b.moment[3 * i + 1] += m1y
-        b.moment[3 * i + 2] += m1z
-        b.moment[3 * j] += m2x
-        b.moment[3 * j + 1] += m2y
-        b.moment[3 * j + 2] += m2z
+        force[3 * j] += fx
+        force[3 * j + 1] += fy
+        force[3 * j + 2] += fz
+        force[3 * i] -= fx
+        force[3 * i + 1] -= fy
+        force[3 * i + 2] -= fz
+        moment[3 * i] += m1x
+        moment[3 * i + 1] += m1y
+        moment[3 * i + 2] += m1z
+        moment[3 * j] += m2x
+        moment[3 * j + 1] += m2y
+        moment[3 * j + 2] += m2z
     return STATUS_OK
 
 
 cdef inline int _integrate(Batch* b, intp_t r) noexcept nogil:
-    # IN: force, moment. OUT: pos, mom, quat, angmom, rot (symplectic Euler).
+    # IN: force, moment. OUT: pos, vel, quat, angvel, rot (symplectic Euler).
     cdef:
         intp_t i
         float64_t dt = b.dt[r]
-        float64_t fx, fy, fz, vx, vy, vz, m, pen, fn, fxy, vxy, fk, cg
+        float64_t fx, fy, fz, vx, vy, vz, m, h, pen, fn, fxy, vxy, fk, cg, rd
         float64_t wx, wy, wz, qw, qx, qy, qz, nq
         float64_t* pos = b.pos
-        float64_t* mom = b.mom
-        float64_t* am = b.angmom
+        float64_t* vel = b.vel
+        float64_t* av = b.angvel
         float64_t* qq
         float64_t g = b.gravity
     for i in range(b.vox_start[r], b.vox_start[r + 1]):
         if b.fixed[i]:
-            mom[3 * i] = 0.0
-            mom[3 * i + 1] = 0.0
-            mom[3 * i + 2] = 0.0
-            am[3 * i] = 0.0
-            am[3 * i + 1] = 0.0
-            am[3 * i + 2] = 0.0
+            vel[3 * i] = 0.0
+            vel[3 * i + 1] = 0.0
+            vel[3 * i + 2] = 0.0
+            av[3 * i] = 0.0
+            av[3 * i + 1] = 0.0
+            av[3 * i + 2] = 0.0
             continue
         m = b.mass[i]
-        vx = mom[3 * i] * b.inv_mass[i]
-        vy = mom[3 * i + 1] * b.inv_mass[i]
-        vz = mom[3 * i + 2] * b.inv_mass[i]
+        vx = vel[3 * i]
+        vy = vel[3 * i + 1]
+        vz = vel[3 * i + 2]
         cg = b.c_global[i]
         fx = b.force[3 * i] + b.ext_force[3 * i] - cg * vx
         fy = b.force[3 * i + 1] + b.ext_force[3 * i + 1] - cg * vy
@@ -252,28 +263,31 @@ cdef inline int _integrate(Batch* b, intp_t r) noexcept nogil:
                     fk = b.mu_k[i] * fn
                     if fk * dt >= m * vxy:
                         # kinetic friction would reverse the motion: stop (static)
-                        mom[3 * i] = 0.0
-                        mom[3 * i + 1] = 0.0
+                        vel[3 * i] = 0.0
+                        vel[3 * i + 1] = 0.0
                         fx = 0.0
                         fy = 0.0
                     else:
                         fx = fx - fk * vx / vxy
                         fy = fy - fk * vy / vxy
-        mom[3 * i] += fx * dt
-        mom[3 * i + 1] += fy * dt
-        mom[3 * i + 2] += fz * dt
-        pos[3 * i] += mom[3 * i] * b.inv_mass[i] * dt
-        pos[3 * i + 1] += mom[3 * i + 1] * b.inv_mass[i] * dt
-        pos[3 * i + 2] += mom[3 * i + 2] * b.inv_mass[i] * dt
+        h = dt * b.inv_mass[i]
+        vel[3 * i] += fx * h
+        vel[3 * i + 1] += fy * h
+        vel[3 * i + 2] += fz * h
+        pos[3 * i] += vel[3 * i] * dt
+        pos[3 * i + 1] += vel[3 * i + 1] * dt
+        pos[3 * i + 2] += vel[3 * i + 2] * dt
         if not (fabs(pos[3 * i]) + fabs(pos[3 * i + 1]) + fabs(pos[3 * i + 2]) < RUNAWAY):
             return STATUS_NONFINITE
-        # rotation: L += M dt, global damping, q += 0.5 dt (0, w) q
-        am[3 * i] = (am[3 * i] + b.moment[3 * i] * dt) * b.rot_damp[i]
-        am[3 * i + 1] = (am[3 * i + 1] + b.moment[3 * i + 1] * dt) * b.rot_damp[i]
-        am[3 * i + 2] = (am[3 * i + 2] + b.moment[3 * i + 2] * dt) * b.rot_damp[i]
-        wx = am[3 * i] * b.inv_inertia[i] * 0.5 * dt
-        wy = am[3 * i + 1] * b.inv_inertia[i] * 0.5 * dt
-        wz = am[3 * i + 2] * b.inv_inertia[i] * 0.5 * dt
+        # rotation: w += M dt / I, global damping, q += 0.5 dt (0, w) q
+        h = dt * b.inv_inertia[i]
+        rd = b.rot_damp[i]
+        av[3 * i] = (av[3 * i] + b.moment[3 * i] * h) * rd
+        av[3 * i + 1] = (av[3 * i + 1] + b.moment[3 * i + 1] * h) * rd
+        av[3 * i + 2] = (av[3 * i + 2] + b.moment[3 * i + 2] * h) * rd
+        wx = av[3 * i] * 0.5 * dt
+        wy = av[3 * i + 1] * 0.5 * dt
+        wz = av[3 * i + 2] * 0.5 * dt
         qq = b.quat + 4 * i
         qw = qq[0] - wx * qq[1] - wy * qq[2] - wz * qq[3]
         qx = qq[1] + wx * qq[0] + wy * qq[3] - wz * qq[2]
@@ -339,7 +353,6 @@ cdef int advance_robot(Batch* b, intp_t r, step_t target) noexcept nogil:
     traces and divergence flags. Returns a STATUS_* code.
     """
     cdef:
-        intp_t i
         int status = STATUS_OK
         intp_t vs = b.vox_start[r]
         intp_t ve = b.vox_start[r + 1]
@@ -349,9 +362,8 @@ cdef int advance_robot(Batch* b, intp_t r, step_t target) noexcept nogil:
         _record(b, r)
     while b.steps[r] < target:
         _actuate(b, r)
-        for i in range(3 * vs, 3 * ve):
-            b.force[i] = 0.0
-            b.moment[i] = 0.0
+        memset(b.force + 3 * vs, 0, 3 * (ve - vs) * sizeof(float64_t))
+        memset(b.moment + 3 * vs, 0, 3 * (ve - vs) * sizeof(float64_t))
         status = _link_forces(b, r)
         if status == STATUS_OK:
             status = _integrate(b, r)
@@ -375,11 +387,11 @@ cdef void robot_energy(Batch* b, intp_t r, float64_t* out) noexcept nogil:
         float64_t b1x, b1y, b1z, b2x, b2y, b2z
         const float64_t* R1
         const float64_t* R2
-        float64_t* mm = b.mom
-        float64_t* am = b.angmom
+        float64_t* vv = b.vel
+        float64_t* av = b.angvel
     for i in range(b.vox_start[r], b.vox_start[r + 1]):
-        ke += 0.5 * b.inv_mass[i] * (mm[3 * i] ** 2 + mm[3 * i + 1] ** 2 + mm[3 * i + 2] ** 2)
-        ke += 0.5 * b.inv_inertia[i] * (am[3 * i] ** 2 + am[3 * i + 1] ** 2 + am[3 * i + 2] ** 2)
+        ke += 0.5 * b.mass[i] * (vv[3 * i] ** 2 + vv[3 * i + 1] ** 2 + vv[3 * i + 2] ** 2)
+        ke += 0.5 / b.inv_inertia[i] * (av[3 * i] ** 2 + av[3 * i + 1] ** 2 + av[3 * i + 2] ** 2)
         ge -= b.mass[i] * b.gravity * b.pos[3 * i + 2]
         if b.floor_enabled:
             pen = 0.5 * b.scale[i] - b.pos[3 * i + 2]
@@ -407,12 +419,8 @@ cdef void robot_energy(Batch* b, intp_t r, float64_t* out) noexcept nogil:
         b2x = uy * R2[6 + ax] - uz * R2[3 + ax]
         b2y = uz * R2[ax] - ux * R2[6 + ax]
         b2z = ux * R2[3 + ax] - uy * R2[ax]
-        tw = 0.5 * (ux * (R1[3 + p] * R2[6 + p] - R1[6 + p] * R2[3 + p]
-                          + R1[3 + q] * R2[6 + q] - R1[6 + q] * R2[3 + q])
-                    + uy * (R1[6 + p] * R2[p] - R1[p] * R2[6 + p]
-                            + R1[6 + q] * R2[q] - R1[q] * R2[6 + q])
-                    + uz * (R1[p] * R2[3 + p] - R1[3 + p] * R2[p]
-                            + R1[q] * R2[3 + q] - R1[3 + q] * R2[q]))
+        tw = 0.5 * (R1[q] * R2[p] + R1[3 + q] * R2[3 + p] + R1[6 + q] * R2[6 + p]
+                    - R1[p] * R2[q] - R1[3 + p] * R2[3 + q] - R1[6 + p] * R2[6 + q])
         pe += 0.5 * b.k_axial[li] * e * e
         pe += 0.5 * b.k_torsion[li] * tw * tw
         pe += b.k_bend[li] * (b1x * b1x + b1y * b1y + b1z * b1z
@@ -465,9 +473,9 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.trace_t = _f(a, "trace_t")
     b.trace_cm = _f(a, "trace_cm")
     b.pos = _f(a, "pos")
-    b.mom = _f(a, "mom")
+    b.vel = _f(a, "vel")
     b.quat = _f(a, "quat")
-    b.angmom = _f(a, "angmom")
+    b.angvel = _f(a, "angvel")
     b.rot = _f(a, "rot")
     b.force = _f(a, "force")
     b.moment = _f(a, "moment")
@@ -487,6 +495,7 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.mu_s = _f(a, "mu_s")
     b.mu_k = _f(a, "mu_k")
     b.fixed = <flag_t*> _p(a, "fixed")
+    b.link_axis_count = <intp_t*> _p(a, "link_axis_count")
     # links: a robot without links leaves these arrays empty (never dereferenced)
     if a["v1"].shape[0] > 0:
         b.v1 = <intp_t*> _p(a, "v1")

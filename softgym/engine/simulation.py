@@ -59,7 +59,7 @@ _REASONS = {1: "link strain above max_strain (or NaN)", 2: "non-finite or runawa
 
 # state arrays that change while the simulation runs (checkpointed by get_state)
 _STATE = (
-    "pos", "mom", "quat", "angmom", "rot", "scale", "steps", "diverged", "diverged_time",
+    "pos", "vel", "quat", "angvel", "rot", "scale", "steps", "diverged", "diverged_time",
     "diverged_code", "init_done", "cm_init", "trace_n", "trace_t", "trace_cm", "temp",
     "use_temp", "ext_force",
 )  # fmt: skip
@@ -156,7 +156,7 @@ class Simulation:
         per_link: dict[str, list[np.ndarray]] = {}
         vox_start = [0]
         link_start = [0]
-        dts, masses = [], []
+        dts, masses, axis_counts = [], [], []
         grid_index = []
         self._grid_maps: list[np.ndarray] = []
 
@@ -199,6 +199,7 @@ class Simulation:
             axis = np.concatenate(axes)
             keep = ~((fixed[v1] == 1) & (fixed[v2] == 1))
             v1, v2, axis = v1[keep], v2[keep], axis[keep]
+            axis_counts.append(np.bincount(axis, minlength=3))  # links stay sorted by axis
             Eh = _harmonic(E[v1], E[v2])
             nuh = _harmonic(nu[v1], nu[v2])
             mr = _harmonic(m[v1], m[v2])
@@ -259,12 +260,13 @@ class Simulation:
         a["quat"][:, 0] = 1.0
         a["rot"] = np.zeros((n_vox, 9))
         a["rot"][:, [0, 4, 8]] = 1.0
-        for name in ("mom", "angmom", "force", "moment", "ext_force"):
+        for name in ("vel", "angvel", "force", "moment", "ext_force"):
             a[name] = np.zeros((n_vox, 3))
         a["scale"] = np.full(n_vox, L)
         a["temp"] = np.zeros(n_vox)
         a["vox_start"] = np.asarray(vox_start, dtype=np.intp)
         a["link_start"] = np.asarray(link_start, dtype=np.intp)
+        a["link_axis_count"] = np.ascontiguousarray(np.asarray(axis_counts), dtype=np.intp)
         a["dt"] = np.asarray(dts, dtype=np.float64)
         a["steps"] = np.zeros(n_robots, dtype=np.int64)
         a["temp_amp"] = np.array([b.temp_amplitude for b in self.bodies], dtype=np.float64)
@@ -348,8 +350,7 @@ class Simulation:
 
     def velocities(self, robot: int) -> np.ndarray:
         """Voxel velocities (m/s) of one robot, shape (n_voxels_r, 3)."""
-        s = self._slice(robot)
-        return self._a["mom"][s] * self._a["inv_mass"][s, None]
+        return self._a["vel"][self._slice(robot)].copy()
 
     def orientations(self, robot: int) -> np.ndarray:
         """Voxel quaternions (w, x, y, z) of one robot, shape (n_voxels_r, 4) (a copy)."""
@@ -357,8 +358,7 @@ class Simulation:
 
     def angular_velocities(self, robot: int) -> np.ndarray:
         """Voxel angular velocities (rad/s, world frame), shape (n_voxels_r, 3)."""
-        s = self._slice(robot)
-        return self._a["angmom"][s] * self._a["inv_inertia"][s, None]
+        return self._a["angvel"][self._slice(robot)].copy()
 
     def scales(self, robot: int) -> np.ndarray:
         """Current actuated voxel edge lengths (m) of one robot, shape (n_voxels_r,)."""
@@ -382,7 +382,7 @@ class Simulation:
     def momentum(self) -> np.ndarray:
         """Ndarray of shape (n_robots, 3): total linear momentum of each robot (kg m/s)."""
         a = self._a
-        return np.add.reduceat(a["mom"], a["vox_start"][:-1], axis=0)
+        return np.add.reduceat(a["mass"][:, None] * a["vel"], a["vox_start"][:-1], axis=0)
 
     def energy(self) -> np.ndarray:
         """Mechanical energy per robot (J).
