@@ -1,0 +1,148 @@
+"""Engine throughput: voxel-steps per second of the batched Cython kernel.
+
+The reference robot (issue 3): a 6x6x6 block, x < 3 muscle with CTE +0.01,
+x >= 3 muscle with CTE -0.01, E 5e6 Pa, density 1e6 kg/m^3, Poisson 0.35,
+L 0.01 m, floor and gravity, seed damping, dT 14, period 0.25 s, 5 s simulated.
+
+Prints voxel-steps/s for batches of 1, 16 and 64 robots with 1 and 2 threads,
+robot sizes 4^3, 6^3 and 10^3, peak memory per robot, and ratios to the
+reference engines measured on this machine kind (quoted, not re-measured here:
+the seed's engine at -O3 ~2.3 M voxel-steps/s per core, the 2015 Voxelyze
+library 1.4-2.1 M). Appends a table to benchmarks/RESULTS.md.
+
+    python benchmarks/bench_engine.py            # full table (about 2 minutes)
+    python benchmarks/bench_engine.py --quick --json   # < 60 s, last line is JSON
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as _dt
+import json
+import platform
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from softgym.engine import Body, SimConfig, Simulation, openmp_enabled
+
+SEED_ENGINE_O3 = 2.3e6  # voxel-steps/s per core, the seed's engine compiled with -O3 (issue 3)
+VOXELYZE_2015 = (1.4e6, 2.1e6)  # the 2015 Voxelyze library on this machine kind (issue 3)
+RESULTS = Path(__file__).with_name("RESULTS.md")
+
+
+def reference_robot(n: int = 6) -> Body:
+    grid = np.ones((n, n, n), dtype=np.int32)
+    grid[n // 2 :] = 2
+    return Body(
+        grid=grid,
+        youngs_modulus=[0.0, 5e6, 5e6],
+        density=[0.0, 1e6, 1e6],
+        poisson=[0.0, 0.35, 0.35],
+        cte=[0.0, 0.01, -0.01],
+        mu_static=[0.0, 1.0, 1.0],
+        mu_kinetic=[0.0, 0.5, 0.5],
+        temp_amplitude=14.0,
+        period=0.25,
+    )
+
+
+def measure(n: int, batch: int, threads: int, seconds: float, repeats: int, cfg: SimConfig | None = None):
+    """Best-of-`repeats` voxel-steps/s for `batch` reference robots of size n^3."""
+    best = 0.0
+    nbytes = 0
+    diverged = 0
+    for _ in range(repeats):
+        sim = Simulation([reference_robot(n)] * batch, cfg or SimConfig(), n_threads=threads)
+        t0 = time.perf_counter()
+        rollout = sim.run(seconds)
+        wall = time.perf_counter() - t0
+        vsteps = float(np.sum(np.diff(rollout.voxel_offsets) * rollout.steps))
+        best = max(best, vsteps / wall)
+        nbytes = sim.nbytes
+        diverged = int(rollout.diverged.sum())
+    return {
+        "size": f"{n}^3",
+        "batch": batch,
+        "threads": threads,
+        "seconds_simulated": seconds,
+        "voxel_steps_per_s": best,
+        "bytes_per_robot": nbytes / batch,
+        "diverged": diverged,
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true", help="short runs, finishes in < 60 s")
+    ap.add_argument("--json", action="store_true", help="print one JSON object as the last line")
+    ap.add_argument("--no-append", action="store_true", help="do not append to RESULTS.md")
+    args = ap.parse_args(argv)
+
+    seconds = 5.0
+    repeats = 1 if args.quick else 2  # best of
+    rows = []
+    print(f"softgym engine benchmark: OpenMP {'on' if openmp_enabled() else 'off'}, "
+          f"{seconds} s simulated per robot", file=sys.stderr)
+
+    def run(n, batch, threads):
+        row = measure(n, batch, threads, seconds, repeats)
+        rows.append(row)
+        print(f"  {row['size']:>5} batch {batch:3d} threads {threads}: "
+              f"{row['voxel_steps_per_s'] / 1e6:7.2f} M voxel-steps/s, "
+              f"{row['bytes_per_robot'] / 1024:7.1f} KiB/robot", file=sys.stderr)
+        return row
+
+    if args.quick:
+        plan = [(6, 16, 1), (6, 16, 2)]
+    else:
+        plan = [(6, b, t) for b in (1, 16, 64) for t in (1, 2)]
+        plan += [(n, 16, t) for n in (4, 10) for t in (1, 2)]
+    for n, b, t in plan:
+        run(n, b, t)
+
+    ref1 = next(r for r in rows if r["size"] == "6^3" and r["batch"] == 16 and r["threads"] == 1)
+    ref2 = next(r for r in rows if r["size"] == "6^3" and r["batch"] == 16 and r["threads"] == 2)
+    v1, v2 = ref1["voxel_steps_per_s"], ref2["voxel_steps_per_s"]
+    summary = {
+        "voxel_steps_per_s_1thread": v1,
+        "voxel_steps_per_s_2threads": v2,
+        "thread_scaling": v2 / v1,
+        "vs_seed_engine_O3_per_core": v1 / SEED_ENGINE_O3,
+        "vs_voxelyze_2015_per_core": [v1 / VOXELYZE_2015[1], v1 / VOXELYZE_2015[0]],
+        "seconds_per_soft_robot_5s_1thread": 216 * (5.0 / Simulation(reference_robot()).dt[0]) / v1,
+        "openmp": openmp_enabled(),
+        "quick": args.quick,
+    }
+    print(f"reference robot, batch 16: {v1 / 1e6:.2f} M voxel-steps/s on 1 thread, "
+          f"{v2 / 1e6:.2f} M on 2 threads ({v2 / v1:.2f}x); "
+          f"{v1 / SEED_ENGINE_O3:.1f}x the seed's engine at -O3 per core, "
+          f"{v1 / VOXELYZE_2015[1]:.1f}-{v1 / VOXELYZE_2015[0]:.1f}x Voxelyze 2015 per core; "
+          f"{summary['seconds_per_soft_robot_5s_1thread'] * 1000:.0f} ms per 6^3 soft robot "
+          f"(5 s simulated) on one core", file=sys.stderr)
+
+    if not args.no_append:
+        stamp = _dt.datetime.now().strftime("%Y-%m-%d %H:%M")
+        lines = [
+            f"\n### bench_engine.py{' --quick' if args.quick else ''} — {stamp}, "
+            f"{platform.machine()}, OpenMP {'on' if openmp_enabled() else 'off'}\n",
+            "| robot | batch | threads | M voxel-steps/s | KiB per robot | diverged |",
+            "|---|---|---|---|---|---|",
+        ]
+        for r in rows:
+            lines.append(f"| {r['size']} | {r['batch']} | {r['threads']} | "
+                         f"{r['voxel_steps_per_s'] / 1e6:.2f} | {r['bytes_per_robot'] / 1024:.1f} | "
+                         f"{r['diverged']} |")
+        lines.append(f"\n2 threads / 1 thread (6^3, batch 16): {v2 / v1:.2f}x; "
+                     f"vs the seed's engine at -O3: {v1 / SEED_ENGINE_O3:.1f}x per core.\n")
+        with RESULTS.open("a") as fh:
+            fh.write("\n".join(lines))
+    if args.json:
+        print(json.dumps(summary))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
