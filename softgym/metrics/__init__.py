@@ -1,0 +1,54 @@
+"""The seed's measures: displacement, MaxXYDist, L coefficient, composition, AMSS novelty.
+
+Functions take a :class:`~softgym.engine.rollout.Rollout` (vectorised over its
+robots) or plain arrays (the ``*_from_arrays`` variants). Distances are in
+voxel lengths; diverged robots get :data:`WORST_FITNESS`.
+"""
+
+from softgym.metrics.fitness import (
+    WORST_FITNESS,
+    WORST_MINIMIZED,
+    Composition,
+    LCoefficient,
+    composition_counts,
+    l_coefficient,
+    l_coefficient_details,
+    l_coefficient_from_arrays,
+    max_xy_dist,
+    max_xy_dist_from_arrays,
+    norm_final_dist,
+    norm_final_dist_from_arrays,
+)
+from softgym.metrics.novelty import (
+    NO_TRAJECTORY_NOVELTY,
+    NoveltyArchive,
+    amss,
+    amss_matrix,
+    novelty_scores,
+    similarity_matrix,
+    traces_from_rollout,
+    trajectory_vectors,
+)
+
+__all__ = [
+    "NO_TRAJECTORY_NOVELTY",
+    "WORST_FITNESS",
+    "WORST_MINIMIZED",
+    "Composition",
+    "LCoefficient",
+    "NoveltyArchive",
+    "amss",
+    "amss_matrix",
+    "composition_counts",
+    "l_coefficient",
+    "l_coefficient_details",
+    "l_coefficient_from_arrays",
+    "max_xy_dist",
+    "max_xy_dist_from_arrays",
+    "norm_final_dist",
+    "norm_final_dist_from_arrays",
+    "novelty_scores",
+    "similarity_matrix",
+    "traces_from_rollout",
+    "trajectory_vectors",
+]
