@@ -681,8 +681,8 @@ def default_walker() -> RobotDesign:
 
     All 216 voxels are filled, 180 are muscle: it passes
     :meth:`CompositionRules.seed`. In softgym's engine with the seed's
-    settings it covers about 5.5 voxel lengths in the seed's fitness window
-    (t = 1 to 5 s), at a steady ~1.4 voxel lengths per second.
+    settings it covers about 3 voxel lengths in the seed's fitness window
+    (t = 1 to 5 s), at a steady ~0.7 voxel lengths per second.
 
     Returns
     -------

@@ -3,15 +3,19 @@
 #
 # Physics (see SEED_REFERENCE section 1 and softgym/engine/simulation.py):
 # - each voxel is a rigid cube (position, quaternion, velocity, angular velocity);
-# - each face-adjacent pair is joined by an Euler-Bernoulli beam measured in the
-#   frame of its chord (co-rotational), so large rigid rotations are exact:
-#       axial extension   e    = |d| - (s1 + s2) / 2
-#       bending vectors   b_i  = u x a_i      (u = chord direction, a_i = voxel i's
-#                                               lattice axis of the link)
+# - each face-adjacent pair is joined by an Euler-Bernoulli beam measured in a
+#   frame that turns with the link (co-rotational), so large rigid rotations are
+#   exact:
+#       axial extension   e    = |d| - (s1 + s2) / 2   along u = d / |d|
+#       bending vectors   b_i  = r x a_i - r x d / L
+#                         (a_i = voxel i's lattice axis of the link,
+#                          r = (a1 + a2) / |a1 + a2|, L the nominal size: the
+#                          seed's small-angle beam, whose stiffness does not
+#                          grow when actuated voxels shrink)
 #       twist             tau  = (z1 . y2 - y1 . z2) / 2  (y, z: the other lattice axes)
 #   with the Hermite beam element's moments M1 = -k_b (2 b1 + b2),
 #   M2 = -k_b (b1 + 2 b2), torsion +-k_t tau u, axial force -k_a e u on voxel 2
-#   and the shear force that balances the moments, u x (M1 + M2) / |d|.
+#   and the shear force that balances the moments, r x (M1 + M2) / L.
 #   Damping uses the same forms with the deformation rates, so its power is
 #   never positive.
 # - floor: penalty normal force, collision damping and Coulomb friction
@@ -119,6 +123,8 @@ cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
         float64_t kb, cb, tor, fa
         float64_t m1x, m1y, m1z, m2x, m2y, m2z, sx, sy, sz, fx, fy, fz
         float64_t max_ext = b.max_strain * b.L
+        float64_t inv_L = 1.0 / b.L
+        float64_t rx, ry, rz, inv_r, cx, cy, cz
         const float64_t* R1
         const float64_t* R2
         const float64_t* pos = b.pos
@@ -144,16 +150,30 @@ cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
         R1 = b.rot + 9 * i
         R2 = b.rot + 9 * j
         # lattice axis of the link in each voxel (column ax of its rotation)
+        # and the link's frame axis r, their bisector
         a1x = R1[ax]; a1y = R1[3 + ax]; a1z = R1[6 + ax]
         a2x = R2[ax]; a2y = R2[3 + ax]; a2z = R2[6 + ax]
-        # bending: rotation of each voxel relative to the chord, b = u x a
-        b1x = uy * a1z - uz * a1y
-        b1y = uz * a1x - ux * a1z
-        b1z = ux * a1y - uy * a1x
-        b2x = uy * a2z - uz * a2y
-        b2y = uz * a2x - ux * a2z
-        b2z = ux * a2y - uy * a2x
-        # twist of voxel 2 relative to voxel 1 about the chord: with y, z the
+        rx = a1x + a2x
+        ry = a1y + a2y
+        rz = a1z + a2z
+        inv_r = 1.0 / sqrt(rx * rx + ry * ry + rz * rz)
+        rx = rx * inv_r
+        ry = ry * inv_r
+        rz = rz * inv_r
+        # transverse offset of voxel 2 as an angle on the nominal length,
+        # c = r x d / L (the seed's Pos2.y / L: stiffness does not grow when
+        # actuated voxels shrink)
+        cx = (ry * dz - rz * dy) * inv_L
+        cy = (rz * dx - rx * dz) * inv_L
+        cz = (rx * dy - ry * dx) * inv_L
+        # bending: rotation of each voxel relative to the chord, b = r x a - c
+        b1x = ry * a1z - rz * a1y - cx
+        b1y = rz * a1x - rx * a1z - cy
+        b1z = rx * a1y - ry * a1x - cz
+        b2x = ry * a2z - rz * a2y - cx
+        b2y = rz * a2x - rx * a2z - cy
+        b2z = rx * a2y - ry * a2x - cz
+        # twist of voxel 2 relative to voxel 1 about the link: with y, z the
         # voxels' two other lattice axes, sin(twist) = (z1 . y2 - y1 . z2) / 2
         tw = 0.5 * (R1[q] * R2[p] + R1[3 + q] * R2[3 + p] + R1[6 + q] * R2[6 + p]
                     - R1[p] * R2[q] - R1[3 + p] * R2[3 + q] - R1[6 + p] * R2[6 + q])
@@ -168,38 +188,39 @@ cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
         w2y = av[3 * j + 1]
         w2z = av[3 * j + 2]
         edot = ux * dvx + uy * dvy + uz * dvz
-        # angular velocity of the chord (perpendicular to u)
-        wcx = (uy * dvz - uz * dvy) * inv_l
-        wcy = (uz * dvx - ux * dvz) * inv_l
-        wcz = (ux * dvy - uy * dvx) * inv_l
-        uw = ux * w1x + uy * w1y + uz * w1z
-        r1x = w1x - wcx - uw * ux
-        r1y = w1y - wcy - uw * uy
-        r1z = w1z - wcz - uw * uz
+        # rate of the transverse angle c (perpendicular to r)
+        wcx = (ry * dvz - rz * dvy) * inv_L
+        wcy = (rz * dvx - rx * dvz) * inv_L
+        wcz = (rx * dvy - ry * dvx) * inv_L
+        uw = rx * w1x + ry * w1y + rz * w1z
+        r1x = w1x - wcx - uw * rx
+        r1y = w1y - wcy - uw * ry
+        r1z = w1z - wcz - uw * rz
         twdot = -uw
-        uw = ux * w2x + uy * w2y + uz * w2z
-        r2x = w2x - wcx - uw * ux
-        r2y = w2y - wcy - uw * uy
-        r2z = w2z - wcz - uw * uz
+        uw = rx * w2x + ry * w2y + rz * w2z
+        r2x = w2x - wcx - uw * rx
+        r2y = w2y - wcy - uw * ry
+        r2z = w2z - wcz - uw * rz
         twdot = twdot + uw
         # moments on the two voxels
         kb = b.k_bend[li]
         cb = b.c_bend[li]
         tor = b.k_torsion[li] * tw + b.c_torsion[li] * twdot
-        m1x = -kb * (2.0 * b1x + b2x) - cb * (2.0 * r1x + r2x) + tor * ux
-        m1y = -kb * (2.0 * b1y + b2y) - cb * (2.0 * r1y + r2y) + tor * uy
-        m1z = -kb * (2.0 * b1z + b2z) - cb * (2.0 * r1z + r2z) + tor * uz
-        m2x = -kb * (b1x + 2.0 * b2x) - cb * (r1x + 2.0 * r2x) - tor * ux
-        m2y = -kb * (b1y + 2.0 * b2y) - cb * (r1y + 2.0 * r2y) - tor * uy
-        m2z = -kb * (b1z + 2.0 * b2z) - cb * (r1z + 2.0 * r2z) - tor * uz
-        # force on voxel 2: axial, plus the shear that balances the moments
+        m1x = -kb * (2.0 * b1x + b2x) - cb * (2.0 * r1x + r2x) + tor * rx
+        m1y = -kb * (2.0 * b1y + b2y) - cb * (2.0 * r1y + r2y) + tor * ry
+        m1z = -kb * (2.0 * b1z + b2z) - cb * (2.0 * r1z + r2z) + tor * rz
+        m2x = -kb * (b1x + 2.0 * b2x) - cb * (r1x + 2.0 * r2x) - tor * rx
+        m2y = -kb * (b1y + 2.0 * b2y) - cb * (r1y + 2.0 * r2y) - tor * ry
+        m2z = -kb * (b1z + 2.0 * b2z) - cb * (r1z + 2.0 * r2z) - tor * rz
+        # force on voxel 2: axial along the chord, plus the shear that balances
+        # the moments over the nominal length
         sx = m1x + m2x
         sy = m1y + m2y
         sz = m1z + m2z
         fa = b.k_axial[li] * e + b.c_axial[li] * edot
-        fx = (uy * sz - uz * sy) * inv_l - fa * ux
-        fy = (uz * sx - ux * sz) * inv_l - fa * uy
-        fz = (ux * sy - uy * sx) * inv_l - fa * uz
+        fx = (ry * sz - rz * sy) * inv_L - fa * ux
+        fy = (rz * sx - rx * sz) * inv_L - fa * uy
+        fz = (rx * sy - ry * sx) * inv_L - fa * uz
         force[3 * j] += fx
         force[3 * j + 1] += fy
         force[3 * j + 2] += fz
@@ -383,7 +404,7 @@ cdef void robot_energy(Batch* b, intp_t r, float64_t* out) noexcept nogil:
     cdef:
         intp_t i, j, li, ax, p, q
         float64_t ke = 0.0, pe = 0.0, ge = 0.0
-        float64_t dx, dy, dz, ell, ux, uy, uz, e, pen, tw
+        float64_t dx, dy, dz, ell, e, pen, tw, rx, ry, rz, inv_r, cx, cy, cz
         float64_t b1x, b1y, b1z, b2x, b2y, b2z
         const float64_t* R1
         const float64_t* R2
@@ -408,17 +429,24 @@ cdef void robot_energy(Batch* b, intp_t r, float64_t* out) noexcept nogil:
         dz = b.pos[3 * j + 2] - b.pos[3 * i + 2]
         ell = sqrt(dx * dx + dy * dy + dz * dz)
         e = ell - 0.5 * (b.scale[i] + b.scale[j])
-        ux = dx / ell
-        uy = dy / ell
-        uz = dz / ell
         R1 = b.rot + 9 * i
         R2 = b.rot + 9 * j
-        b1x = uy * R1[6 + ax] - uz * R1[3 + ax]
-        b1y = uz * R1[ax] - ux * R1[6 + ax]
-        b1z = ux * R1[3 + ax] - uy * R1[ax]
-        b2x = uy * R2[6 + ax] - uz * R2[3 + ax]
-        b2y = uz * R2[ax] - ux * R2[6 + ax]
-        b2z = ux * R2[3 + ax] - uy * R2[ax]
+        rx = R1[ax] + R2[ax]
+        ry = R1[3 + ax] + R2[3 + ax]
+        rz = R1[6 + ax] + R2[6 + ax]
+        inv_r = 1.0 / sqrt(rx * rx + ry * ry + rz * rz)
+        rx = rx * inv_r
+        ry = ry * inv_r
+        rz = rz * inv_r
+        cx = (ry * dz - rz * dy) / b.L
+        cy = (rz * dx - rx * dz) / b.L
+        cz = (rx * dy - ry * dx) / b.L
+        b1x = ry * R1[6 + ax] - rz * R1[3 + ax] - cx
+        b1y = rz * R1[ax] - rx * R1[6 + ax] - cy
+        b1z = rx * R1[3 + ax] - ry * R1[ax] - cz
+        b2x = ry * R2[6 + ax] - rz * R2[3 + ax] - cx
+        b2y = rz * R2[ax] - rx * R2[6 + ax] - cy
+        b2z = rx * R2[3 + ax] - ry * R2[ax] - cz
         tw = 0.5 * (R1[q] * R2[p] + R1[3 + q] * R2[3 + p] + R1[6 + q] * R2[6 + p]
                     - R1[p] * R2[q] - R1[3 + p] * R2[3 + q] - R1[6 + p] * R2[6 + q])
         pe += 0.5 * b.k_axial[li] * e * e

@@ -51,6 +51,15 @@ class SimConfig:
     trace_interval : float
         Seconds between centre-of-mass samples of the rollout (0.1: the seed's
         obstacle runs; its novelty runs use 0.5).
+    self_collision : bool
+        Contact between voxels of one robot that are more than
+        ``collision_exclusion`` bond hops apart (the seed's law: spherical
+        envelopes of diameter 1.5 voxels, penalty stiffness ``E L``, no
+        damping, no friction). On in the seed's setup (True).
+    collision_exclusion : int
+        Voxels within this many bond hops never collide (3, the seed's
+        ``int(1.5 * CollisionHorizon)``); lattice diagonals would otherwise
+        overlap at rest.
     on_divergence : {"flag", "raise"}
         ``"flag"``: a diverged robot is frozen and flagged, the others go on;
         ``"raise"``: :class:`~softgym.exceptions.SimulationDivergedError` is
@@ -69,6 +78,8 @@ class SimConfig:
     min_scale: float = 0.1
     max_strain: float = 100.0
     trace_interval: float = 0.1
+    self_collision: bool = True
+    collision_exclusion: int = 3
     on_divergence: Literal["flag", "raise"] = "flag"
 
     def __post_init__(self) -> None:
@@ -100,6 +111,12 @@ class SimConfig:
         check("actuation", self.actuation in ("seed", "symmetric"), '"seed" or "symmetric"')
         check("on_divergence", self.on_divergence in ("flag", "raise"), '"flag" or "raise"')
         check("floor", isinstance(self.floor, (bool, int)), "a bool")
+        check("self_collision", isinstance(self.self_collision, (bool, int)), "a bool")
+        check(
+            "collision_exclusion",
+            isinstance(self.collision_exclusion, int) and 1 <= self.collision_exclusion <= 8,
+            "an integer in [1, 8]",
+        )
 
     @classmethod
     def seed(cls, **overrides: Any) -> SimConfig:

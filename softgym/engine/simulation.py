@@ -50,6 +50,7 @@ from softgym.exceptions import (
     InvalidActionError,
     InvalidDesignError,
     InvalidParameterError,
+    InvalidTerrainError,
     SimulationDivergedError,
 )
 
@@ -94,6 +95,38 @@ def as_body(obj: Any) -> Body:
     )
 
 
+def _hop_neighbours(n: int, v1: np.ndarray, v2: np.ndarray, hops: int):
+    """Voxels within ``hops`` bond hops of each voxel (itself excluded), as CSR.
+
+    Returns
+    -------
+    start : ndarray of shape (n + 1,), int64
+    index : ndarray of shape (start[-1],), int64
+        Row ``i`` (``index[start[i]:start[i+1]]``) lists, sorted, the voxels
+        reachable from ``i`` through at most ``hops`` links.
+    """
+    src = np.concatenate([v1, v2]).astype(np.int64)
+    dst = np.concatenate([v2, v1]).astype(np.int64)
+    order = np.argsort(src, kind="stable")
+    adj_start = np.concatenate([[0], np.cumsum(np.bincount(src, minlength=n))])
+    adj = dst[order]
+    reach = np.arange(n, dtype=np.int64) * (n + 1)  # pairs (a, b) encoded a * n + b
+    frontier = reach
+    for _ in range(hops):
+        a, b = np.divmod(frontier, n)
+        deg = adj_start[b + 1] - adj_start[b]
+        rep_a = np.repeat(a, deg)
+        offs = np.repeat(adj_start[b], deg) + (np.arange(deg.sum()) - np.repeat(np.cumsum(deg) - deg, deg))
+        new = np.unique(rep_a * n + adj[offs])
+        frontier = np.setdiff1d(new, reach, assume_unique=True)
+        reach = np.union1d(reach, frontier)
+    a, b = np.divmod(reach, n)
+    keep = a != b
+    a, b = a[keep], b[keep]  # np.union1d sorted: rows by a, then b
+    start = np.concatenate([[0], np.cumsum(np.bincount(a, minlength=n))])
+    return start, b
+
+
 def _harmonic(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     s = a + b
     out = np.zeros_like(s)
@@ -112,6 +145,11 @@ class Simulation:
         Robots may differ in shape, size and materials.
     config : SimConfig, optional
         Shared settings; the seed's by default.
+    terrain : Terrain or sequence of Terrain, optional
+        The world: boxes in voxel lengths (:mod:`softgym.terrain`). One
+        terrain for every robot, or one per robot. Robots never touch each
+        other: each lives in its own copy of its world. The floor is
+        ``config.floor`` (a terrain built with ``floor=False`` turns it off).
     n_threads : int, optional
         OpenMP threads used by :meth:`run` (default :func:`default_num_threads`).
         Results are bit-identical for any thread count.
@@ -131,6 +169,7 @@ class Simulation:
         bodies: Any,
         config: SimConfig | None = None,
         n_threads: int | None = None,
+        terrain: Any = None,
     ) -> None:
         if isinstance(bodies, (Body,)) or hasattr(bodies, "to_body"):
             bodies = [bodies]
@@ -143,11 +182,36 @@ class Simulation:
         self.n_threads = default_num_threads() if n_threads is None else int(n_threads)
         if self.n_threads < 1:
             raise InvalidParameterError(f"n_threads must be >= 1, got {n_threads}")
+        self.terrains = self._terrains(terrain)
         self._build()
         self._initial = {k: self._a[k].copy() for k in _STATE}
         self._t_target = 0.0
 
     # ------------------------------------------------------------------ layout
+    def _terrains(self, terrain: Any) -> list:
+        from softgym.terrain import Terrain
+
+        if terrain is None:
+            terrain = Terrain.flat()
+        if isinstance(terrain, Terrain):
+            terrains = [terrain] * self.n_robots
+        else:
+            terrains = list(terrain)
+            if len(terrains) != self.n_robots:
+                raise InvalidTerrainError(
+                    f"give one terrain or one per robot: {len(terrains)} terrains for "
+                    f"{self.n_robots} robots"
+                )
+        L = self.config.voxel_size
+        for t, body in zip(terrains, self.bodies):
+            if not isinstance(t, Terrain):
+                raise InvalidTerrainError(f"expected a softgym Terrain, got {type(t).__name__}")
+            filled = np.argwhere(body.grid > 0)
+            lo = body.origin / L + filled.min(axis=0)
+            hi = body.origin / L + filled.max(axis=0) + 1
+            t.validate(lo, hi)
+        return terrains
+
     def _build(self) -> None:
         cfg = self.config
         L = float(cfg.voxel_size)
@@ -156,7 +220,7 @@ class Simulation:
         per_link: dict[str, list[np.ndarray]] = {}
         vox_start = [0]
         link_start = [0]
-        dts, masses, axis_counts = [], [], []
+        dts, masses, axis_counts, excl = [], [], [], []
         grid_index = []
         self._grid_maps: list[np.ndarray] = []
 
@@ -243,6 +307,9 @@ class Simulation:
             add(per_vox, "mu_k", body.mu_kinetic[mat])
             add(per_vox, "fixed", fixed)
             grid_index.append(idx)
+            ex_start, ex_idx = _hop_neighbours(n, v1, v2, cfg.collision_exclusion)
+            add(per_vox, "excl_count", np.diff(ex_start))
+            excl.append(ex_idx + vox_start[-1])
             vox_start.append(vox_start[-1] + n)
             link_start.append(link_start[-1] + v1.size)
 
@@ -251,6 +318,12 @@ class Simulation:
         for name, parts in per_vox.items():
             a[name] = np.ascontiguousarray(np.concatenate(parts))
         a["fixed"] = a["fixed"].astype(np.int8)
+        a["excl_start"] = np.concatenate([[0], np.cumsum(a.pop("excl_count"))]).astype(np.intp)
+        a["excl_idx"] = np.ascontiguousarray(np.concatenate(excl), dtype=np.intp)
+        boxes = [t.as_array(L) for t in self.terrains]
+        a["box_start"] = np.concatenate([[0], np.cumsum([len(b) for b in boxes])]).astype(np.intp)
+        a["boxes"] = np.ascontiguousarray(np.concatenate(boxes), dtype=np.float64).reshape(-1, 6)
+        a["floor"] = np.array([int(t.floor and cfg.floor) for t in self.terrains], dtype=np.int8)
         for name, parts in per_link.items():
             a[name] = np.ascontiguousarray(np.concatenate(parts))
         for name in ("v1", "v2"):
@@ -292,6 +365,7 @@ class Simulation:
             "max_strain": float(cfg.max_strain),
             "trace_interval": float(cfg.trace_interval),
             "floor_enabled": int(bool(cfg.floor)),
+            "self_collision": int(bool(cfg.self_collision)),
             "actuation_mode": 0 if cfg.actuation == "seed" else 1,
         }
 
