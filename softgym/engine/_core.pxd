@@ -3,6 +3,8 @@
 # run without the GIL. Arrays are C-contiguous float64 unless said otherwise;
 # "(n, 3)" means n rows of 3 stored row-major. Units are SI.
 
+from libc.stdint cimport int64_t
+
 from softgym.engine._typedefs cimport float64_t, intp_t, step_t, int32, flag_t
 
 # Status codes returned by the nogil helpers (errors cross nogil as codes).
@@ -10,6 +12,7 @@ cdef enum:
     STATUS_OK = 0
     STATUS_STRAIN = 1       # a link's engineering strain exceeded max_strain (or was NaN)
     STATUS_NONFINITE = 2    # a voxel's position became non-finite or ran away
+    STATUS_MEMORY = 3       # the self-collision candidate list could not be allocated
 
 
 cdef struct Batch:
@@ -21,7 +24,7 @@ cdef struct Batch:
     float64_t min_scale      # smallest actuated edge, as a fraction of L
     float64_t max_strain     # divergence threshold on |link engineering strain|
     float64_t trace_interval # seconds between centre-of-mass samples
-    int32 floor_enabled      # 1: floor plane z = 0 with penalty contact and friction
+    int32 self_collision     # 1: contact between voxels more than the exclusion hops apart
     int32 actuation_mode     # 0: seed (contraction only, hold out-of-bounds); 1: symmetric
     intp_t trace_capacity    # samples allocated per robot in trace_t / trace_cm
 
@@ -34,6 +37,9 @@ cdef struct Batch:
     float64_t* temp_amp      # (n_robots,) amplitude dT of the temperature sinusoid (degC)
     float64_t* period        # (n_robots,) period of the temperature sinusoid (s)
     flag_t* use_temp         # (n_robots,) 1: per-voxel temperatures replace the sinusoid
+    flag_t* floor            # (n_robots,) 1: floor plane z = 0 with penalty contact and friction
+    intp_t* box_start        # (n_robots + 1,) robot r's obstacles are boxes [box_start[r], box_start[r+1])
+    float64_t* boxes         # (n_boxes, 6) static boxes x0, y0, z0, x1, y1, z1 (m)
     flag_t* diverged         # (n_robots,) 1: frozen after divergence
     float64_t* diverged_time # (n_robots,) time of divergence (s)
     int32* diverged_code     # (n_robots,) STATUS_* code of the divergence
@@ -68,6 +74,8 @@ cdef struct Batch:
     float64_t* mu_s          # (n_voxels,) static friction coefficient
     float64_t* mu_k          # (n_voxels,) kinetic friction coefficient
     flag_t* fixed            # (n_voxels,) 1: all six degrees of freedom fixed
+    intp_t* excl_start       # (n_voxels + 1,) CSR rows of voxels that never collide with voxel i
+    intp_t* excl_idx         # (excl_start[-1],) their indices, sorted within each row
 
     # ---- per link (beam between face neighbours v1 -> v2 along +axis) ------
     intp_t* v1               # (n_links,) voxel on the negative side
@@ -79,6 +87,25 @@ cdef struct Batch:
     float64_t* c_axial       # (n_links,) axial damping (N s/m)
     float64_t* c_torsion     # (n_links,) torsional damping (N m s/rad)
     float64_t* c_bend        # (n_links,) bending damping (N m s/rad)
+
+
+# Self-collision candidates of one robot, rebuilt inside advance_robot (scratch
+# owned by the calling thread, freed before it returns).
+cdef struct KeyIndex:
+    int64_t key              # cell key of a voxel
+    intp_t index             # the voxel
+
+
+cdef struct Contacts:
+    intp_t* pairs            # (capacity, 2) candidate pairs i < j, sorted by (i, j)
+    intp_t n_pairs           # pairs in use
+    intp_t capacity          # pairs allocated
+    KeyIndex* cells          # (n_voxels_r,) voxels sorted by spatial-hash cell
+    intp_t* row              # (n_voxels_r,) scratch: candidates of one voxel
+    float64_t travel         # largest displacement of any voxel since the rebuild (bound, m)
+    float64_t margin         # horizon - largest contact envelope (m)
+    float64_t built_scale    # largest voxel size when the list was built (m)
+    int32 stale              # 1: rebuild before the next use
 
 
 cdef int advance_robot(Batch* b, intp_t r, step_t target) noexcept nogil

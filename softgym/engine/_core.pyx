@@ -25,7 +25,9 @@
 # Python wrapper (simulation.py) once, never here.
 
 from cython.parallel cimport prange, parallel
-from libc.math cimport sin, cos, sqrt, fabs, M_PI
+from libc.math cimport sin, cos, sqrt, fabs, floor, M_PI
+from libc.stdint cimport int64_t
+from libc.stdlib cimport malloc, realloc, free, qsort
 from libc.string cimport memset
 
 cimport numpy as cnp
@@ -51,8 +53,9 @@ cdef inline void _rotation_matrix(const float64_t* q, float64_t* R) noexcept nog
     R[8] = 1.0 - 2.0 * (x * x + y * y)
 
 
-cdef inline void _actuate(Batch* b, intp_t r) noexcept nogil:
+cdef inline float64_t _actuate(Batch* b, intp_t r) noexcept nogil:
     # OUT: b.scale of robot r's voxels at the robot's current time.
+    # Returns the largest size written this step (0 if none).
     cdef:
         intp_t i
         intp_t vs = b.vox_start[r]
@@ -61,6 +64,7 @@ cdef inline void _actuate(Batch* b, intp_t r) noexcept nogil:
         float64_t L = b.L
         float64_t lo = b.min_scale * L
         float64_t f, new, s, c, amp, w
+        float64_t smax = 0.0
         int32 seed = b.actuation_mode == 0
     if b.use_temp[r]:
         for i in range(vs, ve):
@@ -72,9 +76,11 @@ cdef inline void _actuate(Batch* b, intp_t r) noexcept nogil:
                     b.scale[i] = new
             else:
                 b.scale[i] = new if new > lo else lo
-        return
+            if b.scale[i] > smax:
+                smax = b.scale[i]
+        return smax
     if t < b.init_time:
-        return  # nominal sizes until the settling time is over (scale starts at L)
+        return smax  # nominal sizes until the settling time is over (scale starts at L)
     w = 2.0 * M_PI / b.period[r]
     s = sin(w * t)
     c = cos(w * t)
@@ -90,6 +96,9 @@ cdef inline void _actuate(Batch* b, intp_t r) noexcept nogil:
                 b.scale[i] = new
         else:
             b.scale[i] = new if new > lo else lo
+        if b.scale[i] > smax:
+            smax = b.scale[i]
+    return smax
 
 
 cdef inline int _link_forces(Batch* b, intp_t r) noexcept nogil:
@@ -236,18 +245,124 @@ cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
     return STATUS_OK
 
 
-cdef inline int _integrate(Batch* b, intp_t r) noexcept nogil:
-    # IN: force, moment. OUT: pos, vel, quat, angvel, rot (symplectic Euler).
+cdef inline void _surface_contact(Batch* b, intp_t i, float64_t nx, float64_t ny, float64_t nz,
+                                  float64_t pen, float64_t dt, float64_t* f) noexcept nogil:
+    # Penalty contact of voxel i with a static surface of outward unit normal n,
+    # penetration pen > 0: normal force 2 E L pen minus collision damping (never
+    # pulling), then Coulomb friction in the tangent plane (the seed's floor law,
+    # SEED_REFERENCE 1.6, for any normal). IN/OUT: f (force on the voxel), and
+    # the voxel's velocity when kinetic friction stops it.
     cdef:
-        intp_t i
+        float64_t* v = b.vel + 3 * i
+        float64_t vn, fn, vtx, vty, vtz, vt, ftn, ftx, fty, ftz, fk
+    vn = v[0] * nx + v[1] * ny + v[2] * nz
+    fn = b.k_floor[i] * pen - b.c_floor[i] * vn
+    if fn <= 0.0:
+        return  # the surface pushes, never pulls
+    f[0] += fn * nx
+    f[1] += fn * ny
+    f[2] += fn * nz
+    vtx = v[0] - vn * nx
+    vty = v[1] - vn * ny
+    vtz = v[2] - vn * nz
+    ftn = f[0] * nx + f[1] * ny + f[2] * nz
+    ftx = f[0] - ftn * nx
+    fty = f[1] - ftn * ny
+    ftz = f[2] - ftn * nz
+    if vtx == 0.0 and vty == 0.0 and vtz == 0.0:
+        # at rest: static friction holds below mu_s N; above it the voxel
+        # starts to slide (no friction on this first step)
+        if ftx * ftx + fty * fty + ftz * ftz <= (b.mu_s[i] * fn) ** 2:
+            f[0] -= ftx
+            f[1] -= fty
+            f[2] -= ftz
+        return
+    vt = sqrt(vtx * vtx + vty * vty + vtz * vtz)
+    fk = b.mu_k[i] * fn
+    if fk * dt >= b.mass[i] * vt:
+        # kinetic friction would reverse the sliding: stop (static from now on)
+        v[0] -= vtx
+        v[1] -= vty
+        v[2] -= vtz
+        f[0] -= ftx
+        f[1] -= fty
+        f[2] -= ftz
+    else:
+        fk = fk / vt
+        f[0] -= fk * vtx
+        f[1] -= fk * vty
+        f[2] -= fk * vtz
+
+
+cdef inline float64_t _box_penetration(const float64_t* B, const float64_t* p, float64_t rad,
+                                       float64_t* n) noexcept nogil:
+    # Penetration (m, > 0 when touching) of a sphere of radius rad centred at p
+    # into the box B = (x0, y0, z0, x1, y1, z1); n gets the outward unit normal.
+    cdef:
+        float64_t cx, cy, cz, dx, dy, dz, d2, dist, depth
+        intp_t k
+    if (p[0] + rad <= B[0] or p[0] - rad >= B[3] or p[1] + rad <= B[1]
+            or p[1] - rad >= B[4] or p[2] + rad <= B[2] or p[2] - rad >= B[5]):
+        return 0.0
+    cx = B[0] if p[0] < B[0] else (B[3] if p[0] > B[3] else p[0])
+    cy = B[1] if p[1] < B[1] else (B[4] if p[1] > B[4] else p[1])
+    cz = B[2] if p[2] < B[2] else (B[5] if p[2] > B[5] else p[2])
+    dx = p[0] - cx
+    dy = p[1] - cy
+    dz = p[2] - cz
+    d2 = dx * dx + dy * dy + dz * dz
+    if d2 > 0.0:
+        if d2 >= rad * rad:
+            return 0.0
+        dist = sqrt(d2)
+        n[0] = dx / dist
+        n[1] = dy / dist
+        n[2] = dz / dist
+        return rad - dist
+    # centre inside the box: push out through the nearest face
+    n[0] = 0.0
+    n[1] = 0.0
+    n[2] = 0.0
+    depth = p[0] - B[0]
+    k = 0
+    if B[3] - p[0] < depth:
+        depth = B[3] - p[0]
+        k = 1
+    if p[1] - B[1] < depth:
+        depth = p[1] - B[1]
+        k = 2
+    if B[4] - p[1] < depth:
+        depth = B[4] - p[1]
+        k = 3
+    if p[2] - B[2] < depth:
+        depth = p[2] - B[2]
+        k = 4
+    if B[5] - p[2] < depth:
+        depth = B[5] - p[2]
+        k = 5
+    n[k // 2] = 1.0 if k % 2 == 1 else -1.0
+    return rad + depth
+
+
+cdef inline int _integrate(Batch* b, intp_t r, float64_t* vmax2) noexcept nogil:
+    # IN: force, moment. OUT: pos, vel, quat, angvel, rot (symplectic Euler);
+    # vmax2: the largest squared speed of the robot's voxels after the step.
+    cdef:
+        intp_t i, k
         float64_t dt = b.dt[r]
-        float64_t fx, fy, fz, vx, vy, vz, m, h, pen, fn, fxy, vxy, fk, cg, rd
+        float64_t m, h, pen, cg, rd, v2
         float64_t wx, wy, wz, qw, qx, qy, qz, nq
+        float64_t f[3]
+        float64_t n[3]
         float64_t* pos = b.pos
         float64_t* vel = b.vel
         float64_t* av = b.angvel
         float64_t* qq
         float64_t g = b.gravity
+        int32 has_floor = b.floor[r]
+        intp_t k0 = b.box_start[r]
+        intp_t k1 = b.box_start[r + 1]
+    vmax2[0] = 0.0
     for i in range(b.vox_start[r], b.vox_start[r + 1]):
         if b.fixed[i]:
             vel[3 * i] = 0.0
@@ -258,48 +373,30 @@ cdef inline int _integrate(Batch* b, intp_t r) noexcept nogil:
             av[3 * i + 2] = 0.0
             continue
         m = b.mass[i]
-        vx = vel[3 * i]
-        vy = vel[3 * i + 1]
-        vz = vel[3 * i + 2]
         cg = b.c_global[i]
-        fx = b.force[3 * i] + b.ext_force[3 * i] - cg * vx
-        fy = b.force[3 * i + 1] + b.ext_force[3 * i + 1] - cg * vy
-        fz = b.force[3 * i + 2] + b.ext_force[3 * i + 2] - cg * vz + m * g
-        if b.floor_enabled:
+        f[0] = b.force[3 * i] + b.ext_force[3 * i] - cg * vel[3 * i]
+        f[1] = b.force[3 * i + 1] + b.ext_force[3 * i + 1] - cg * vel[3 * i + 1]
+        f[2] = b.force[3 * i + 2] + b.ext_force[3 * i + 2] - cg * vel[3 * i + 2] + m * g
+        if has_floor:
             pen = 0.5 * b.scale[i] - pos[3 * i + 2]
             if pen > 0.0:
-                fn = b.k_floor[i] * pen - b.c_floor[i] * vz
-                if fn < 0.0:
-                    fn = 0.0  # the floor pushes, never pulls
-                fz = fz + fn
-                if vx == 0.0 and vy == 0.0:
-                    # at rest: static friction holds below mu_s N; above it the
-                    # voxel starts to slide (no friction on this first step)
-                    fxy = sqrt(fx * fx + fy * fy)
-                    if fxy <= b.mu_s[i] * fn:
-                        fx = 0.0
-                        fy = 0.0
-                else:
-                    vxy = sqrt(vx * vx + vy * vy)
-                    fk = b.mu_k[i] * fn
-                    if fk * dt >= m * vxy:
-                        # kinetic friction would reverse the motion: stop (static)
-                        vel[3 * i] = 0.0
-                        vel[3 * i + 1] = 0.0
-                        fx = 0.0
-                        fy = 0.0
-                    else:
-                        fx = fx - fk * vx / vxy
-                        fy = fy - fk * vy / vxy
+                _surface_contact(b, i, 0.0, 0.0, 1.0, pen, dt, f)
+        for k in range(k0, k1):
+            pen = _box_penetration(b.boxes + 6 * k, pos + 3 * i, 0.5 * b.scale[i], n)
+            if pen > 0.0:
+                _surface_contact(b, i, n[0], n[1], n[2], pen, dt, f)
         h = dt * b.inv_mass[i]
-        vel[3 * i] += fx * h
-        vel[3 * i + 1] += fy * h
-        vel[3 * i + 2] += fz * h
+        vel[3 * i] += f[0] * h
+        vel[3 * i + 1] += f[1] * h
+        vel[3 * i + 2] += f[2] * h
         pos[3 * i] += vel[3 * i] * dt
         pos[3 * i + 1] += vel[3 * i + 1] * dt
         pos[3 * i + 2] += vel[3 * i + 2] * dt
         if not (fabs(pos[3 * i]) + fabs(pos[3 * i + 1]) + fabs(pos[3 * i + 2]) < RUNAWAY):
             return STATUS_NONFINITE
+        v2 = vel[3 * i] * vel[3 * i] + vel[3 * i + 1] * vel[3 * i + 1] + vel[3 * i + 2] * vel[3 * i + 2]
+        if v2 > vmax2[0]:
+            vmax2[0] = v2
         # rotation: w += M dt / I, global damping, q += 0.5 dt (0, w) q
         h = dt * b.inv_inertia[i]
         rd = b.rot_damp[i]
@@ -321,6 +418,175 @@ cdef inline int _integrate(Batch* b, intp_t r) noexcept nogil:
         qq[3] = qz * nq
         _rotation_matrix(qq, b.rot + 9 * i)
     return STATUS_OK
+
+
+# ---------------------------------------------------------------------------
+# Self-collision (SEED_REFERENCE 1.7): voxels more than `collision_exclusion`
+# bond hops apart repel when their spherical envelopes, of diameter
+# 1.5 x their actuated size, overlap: F = E_h L (0.75 (s1 + s2) - |d|) along d,
+# E_h the harmonic mean of their moduli; no damping, no friction. Candidate
+# pairs come from a spatial hash (cells of the candidate horizon) and are kept
+# until some voxel may have crossed the horizon's slack, so the cost grows
+# about linearly with the number of voxels. The candidate list is always a
+# superset of the touching pairs and is sorted, so forces do not depend on
+# when it was rebuilt: results stay bit-identical.
+
+cdef enum:
+    CELL_BITS = 20
+
+
+cdef int _cmp_key_index(const void* a, const void* b) noexcept nogil:
+    cdef const KeyIndex* x = <const KeyIndex*> a
+    cdef const KeyIndex* y = <const KeyIndex*> b
+    if x.key != y.key:
+        return -1 if x.key < y.key else 1
+    return -1 if x.index < y.index else (1 if x.index > y.index else 0)
+
+
+cdef int _cmp_intp(const void* a, const void* b) noexcept nogil:
+    cdef intp_t x = (<const intp_t*> a)[0]
+    cdef intp_t y = (<const intp_t*> b)[0]
+    return -1 if x < y else (1 if x > y else 0)
+
+
+cdef inline bint _excluded(Batch* b, intp_t i, intp_t j) noexcept nogil:
+    # binary search of j in voxel i's sorted exclusion row
+    cdef intp_t lo = b.excl_start[i], hi = b.excl_start[i + 1], mid
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if b.excl_idx[mid] < j:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo < b.excl_start[i + 1] and b.excl_idx[lo] == j
+
+
+cdef inline intp_t _lower_bound(const KeyIndex* cells, intp_t n, int64_t key) noexcept nogil:
+    cdef intp_t lo = 0, hi = n, mid
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if cells[mid].key < key:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+cdef int _rebuild_contacts(Batch* b, intp_t r, Contacts* c) noexcept nogil:
+    # OUT: c.pairs, sorted candidate pairs within the horizon. Returns a STATUS.
+    cdef:
+        intp_t vs = b.vox_start[r]
+        intp_t ve = b.vox_start[r + 1]
+        intp_t n = ve - vs
+        intp_t i, j, k, m, pos_, n_row
+        int64_t ci, cj, ck, key
+        int di, dj, dk
+        float64_t L = b.L
+        float64_t smax = L, env, horizon, h2, inv_cell, x0, y0, z0, dx, dy, dz
+        const float64_t* P = b.pos
+        intp_t* grown
+    if c.cells == NULL:
+        c.cells = <KeyIndex*> malloc(n * sizeof(KeyIndex))
+        c.row = <intp_t*> malloc(n * sizeof(intp_t))
+        if c.cells == NULL or c.row == NULL:
+            return STATUS_MEMORY
+    for i in range(vs, ve):
+        if b.scale[i] > smax:
+            smax = b.scale[i]
+    env = 1.5 * smax                 # the largest envelope 0.75 (s1 + s2)
+    c.margin = 0.5 * L
+    horizon = env + c.margin
+    h2 = horizon * horizon
+    inv_cell = 1.0 / horizon
+    c.built_scale = smax
+    c.travel = 0.0
+    c.stale = 0
+    c.n_pairs = 0
+    x0 = P[3 * vs]
+    y0 = P[3 * vs + 1]
+    z0 = P[3 * vs + 2]
+    for i in range(vs, ve):
+        if P[3 * i] < x0:
+            x0 = P[3 * i]
+        if P[3 * i + 1] < y0:
+            y0 = P[3 * i + 1]
+        if P[3 * i + 2] < z0:
+            z0 = P[3 * i + 2]
+    for k in range(n):
+        i = vs + k
+        ci = <int64_t> floor((P[3 * i] - x0) * inv_cell) + 1
+        cj = <int64_t> floor((P[3 * i + 1] - y0) * inv_cell) + 1
+        ck = <int64_t> floor((P[3 * i + 2] - z0) * inv_cell) + 1
+        c.cells[k].key = (ci << (2 * CELL_BITS)) | (cj << CELL_BITS) | ck
+        c.cells[k].index = i
+    qsort(c.cells, n, sizeof(KeyIndex), _cmp_key_index)
+    for i in range(vs, ve):
+        ci = <int64_t> floor((P[3 * i] - x0) * inv_cell) + 1
+        cj = <int64_t> floor((P[3 * i + 1] - y0) * inv_cell) + 1
+        ck = <int64_t> floor((P[3 * i + 2] - z0) * inv_cell) + 1
+        n_row = 0
+        for di in range(-1, 2):
+            for dj in range(-1, 2):
+                for dk in range(-1, 2):
+                    key = ((ci + di) << (2 * CELL_BITS)) | ((cj + dj) << CELL_BITS) | (ck + dk)
+                    pos_ = _lower_bound(c.cells, n, key)
+                    while pos_ < n and c.cells[pos_].key == key:
+                        j = c.cells[pos_].index
+                        pos_ += 1
+                        if j <= i:
+                            continue
+                        dx = P[3 * j] - P[3 * i]
+                        dy = P[3 * j + 1] - P[3 * i + 1]
+                        dz = P[3 * j + 2] - P[3 * i + 2]
+                        if dx * dx + dy * dy + dz * dz >= h2:
+                            continue
+                        if _excluded(b, i, j):
+                            continue
+                        c.row[n_row] = j
+                        n_row += 1
+        if n_row == 0:
+            continue
+        qsort(c.row, n_row, sizeof(intp_t), _cmp_intp)
+        if c.n_pairs + n_row > c.capacity:
+            m = 2 * (c.n_pairs + n_row) + 64
+            grown = <intp_t*> realloc(c.pairs, 2 * m * sizeof(intp_t))
+            if grown == NULL:
+                return STATUS_MEMORY
+            c.pairs = grown
+            c.capacity = m
+        for k in range(n_row):
+            c.pairs[2 * c.n_pairs] = i
+            c.pairs[2 * c.n_pairs + 1] = c.row[k]
+            c.n_pairs += 1
+    return STATUS_OK
+
+
+cdef inline void _collide(Batch* b, Contacts* c) noexcept nogil:
+    # OUT (accumulated): force of the touching candidate pairs.
+    cdef:
+        intp_t k, i, j
+        float64_t dx, dy, dz, d2, env, dist, kk, fmag
+        const float64_t* P = b.pos
+    for k in range(c.n_pairs):
+        i = c.pairs[2 * k]
+        j = c.pairs[2 * k + 1]
+        dx = P[3 * j] - P[3 * i]
+        dy = P[3 * j + 1] - P[3 * i + 1]
+        dz = P[3 * j + 2] - P[3 * i + 2]
+        d2 = dx * dx + dy * dy + dz * dz
+        env = 0.75 * (b.scale[i] + b.scale[j])
+        if d2 >= env * env or d2 == 0.0:
+            continue
+        dist = sqrt(d2)
+        # E_h L = harmonic mean of the voxels' E L = k1 k2 / (k1 + k2), k = 2 E L
+        kk = b.k_floor[i] * b.k_floor[j] / (b.k_floor[i] + b.k_floor[j])
+        fmag = kk * (env - dist) / dist
+        b.force[3 * j] += fmag * dx
+        b.force[3 * j + 1] += fmag * dy
+        b.force[3 * j + 2] += fmag * dz
+        b.force[3 * i] -= fmag * dx
+        b.force[3 * i + 1] -= fmag * dy
+        b.force[3 * i + 2] -= fmag * dz
 
 
 cdef void robot_cm(Batch* b, intp_t r, float64_t* out) noexcept nogil:
@@ -377,33 +643,51 @@ cdef int advance_robot(Batch* b, intp_t r, step_t target) noexcept nogil:
         int status = STATUS_OK
         intp_t vs = b.vox_start[r]
         intp_t ve = b.vox_start[r + 1]
+        float64_t smax, vmax2 = 0.0
+        Contacts c
     if b.diverged[r]:
         return STATUS_OK
+    memset(&c, 0, sizeof(Contacts))
+    c.stale = 1
     if b.steps[r] == 0:
         _record(b, r)
     while b.steps[r] < target:
-        _actuate(b, r)
+        smax = _actuate(b, r)
         memset(b.force + 3 * vs, 0, 3 * (ve - vs) * sizeof(float64_t))
         memset(b.moment + 3 * vs, 0, 3 * (ve - vs) * sizeof(float64_t))
         status = _link_forces(b, r)
+        if status == STATUS_OK and b.self_collision:
+            if c.stale or smax > c.built_scale:
+                status = _rebuild_contacts(b, r, &c)
+            _collide(b, &c)
         if status == STATUS_OK:
-            status = _integrate(b, r)
+            status = _integrate(b, r, &vmax2)
         if status != STATUS_OK:
             b.diverged[r] = 1
             b.diverged_code[r] = status
             b.diverged_time[r] = b.steps[r] * b.dt[r]
-            return status
+            break
+        if b.self_collision:
+            # two voxels approach by at most twice the largest displacement
+            c.travel += sqrt(vmax2) * b.dt[r]
+            if 2.0 * c.travel >= c.margin:
+                c.stale = 1
         b.steps[r] += 1
         _record(b, r)
-    return STATUS_OK
+    free(c.pairs)
+    free(c.cells)
+    free(c.row)
+    return status
 
 
 cdef void robot_energy(Batch* b, intp_t r, float64_t* out) noexcept nogil:
-    # OUT: out[0] kinetic (translation + rotation), out[1] elastic (links + floor),
+    # OUT: out[0] kinetic (translation + rotation), out[1] elastic (links, floor
+    # and box contact; self-contact is not included),
     # out[2] gravitational potential m |g|... relative to z = 0 (J).
     cdef:
-        intp_t i, j, li, ax, p, q
+        intp_t i, j, li, ax, p, q, k
         float64_t ke = 0.0, pe = 0.0, ge = 0.0
+        float64_t nrm[3]
         float64_t dx, dy, dz, ell, e, pen, tw, rx, ry, rz, inv_r, cx, cy, cz
         float64_t b1x, b1y, b1z, b2x, b2y, b2z
         const float64_t* R1
@@ -414,8 +698,12 @@ cdef void robot_energy(Batch* b, intp_t r, float64_t* out) noexcept nogil:
         ke += 0.5 * b.mass[i] * (vv[3 * i] ** 2 + vv[3 * i + 1] ** 2 + vv[3 * i + 2] ** 2)
         ke += 0.5 / b.inv_inertia[i] * (av[3 * i] ** 2 + av[3 * i + 1] ** 2 + av[3 * i + 2] ** 2)
         ge -= b.mass[i] * b.gravity * b.pos[3 * i + 2]
-        if b.floor_enabled:
+        if b.floor[r]:
             pen = 0.5 * b.scale[i] - b.pos[3 * i + 2]
+            if pen > 0.0:
+                pe += 0.5 * b.k_floor[i] * pen * pen
+        for k in range(b.box_start[r], b.box_start[r + 1]):
+            pen = _box_penetration(b.boxes + 6 * k, b.pos + 3 * i, 0.5 * b.scale[i], nrm)
             if pen > 0.0:
                 pe += 0.5 * b.k_floor[i] * pen * pen
     for li in range(b.link_start[r], b.link_start[r + 1]):
@@ -481,7 +769,7 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.min_scale = s["min_scale"]
     b.max_strain = s["max_strain"]
     b.trace_interval = s["trace_interval"]
-    b.floor_enabled = s["floor_enabled"]
+    b.self_collision = s["self_collision"]
     b.actuation_mode = s["actuation_mode"]
     b.trace_capacity = a["trace_t"].shape[1]
     b.vox_start = <intp_t*> _p(a, "vox_start")
@@ -491,6 +779,9 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.temp_amp = _f(a, "temp_amp")
     b.period = _f(a, "period")
     b.use_temp = <flag_t*> _p(a, "use_temp")
+    b.floor = <flag_t*> _p(a, "floor")
+    b.box_start = <intp_t*> _p(a, "box_start")
+    b.boxes = _f(a, "boxes") if a["boxes"].shape[0] > 0 else NULL
     b.diverged = <flag_t*> _p(a, "diverged")
     b.diverged_time = _f(a, "diverged_time")
     b.diverged_code = <int32*> _p(a, "diverged_code")
@@ -524,6 +815,8 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.mu_k = _f(a, "mu_k")
     b.fixed = <flag_t*> _p(a, "fixed")
     b.link_axis_count = <intp_t*> _p(a, "link_axis_count")
+    b.excl_start = <intp_t*> _p(a, "excl_start")
+    b.excl_idx = <intp_t*> _p(a, "excl_idx") if a["excl_idx"].shape[0] > 0 else NULL
     # links: a robot without links leaves these arrays empty (never dereferenced)
     if a["v1"].shape[0] > 0:
         b.v1 = <intp_t*> _p(a, "v1")

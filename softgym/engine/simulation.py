@@ -56,7 +56,11 @@ from softgym.exceptions import (
 
 __all__ = ["Simulation", "as_body", "default_num_threads"]
 
-_REASONS = {1: "link strain above max_strain (or NaN)", 2: "non-finite or runaway voxel state"}
+_REASONS = {
+    1: "link strain above max_strain (or NaN)",
+    2: "non-finite or runaway voxel state",
+    3: "out of memory for the self-collision candidates",
+}
 
 # state arrays that change while the simulation runs (checkpointed by get_state)
 _STATE = (
@@ -364,7 +368,6 @@ class Simulation:
             "min_scale": float(cfg.min_scale),
             "max_strain": float(cfg.max_strain),
             "trace_interval": float(cfg.trace_interval),
-            "floor_enabled": int(bool(cfg.floor)),
             "self_collision": int(bool(cfg.self_collision)),
             "actuation_mode": 0 if cfg.actuation == "seed" else 1,
         }

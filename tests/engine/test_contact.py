@@ -1,0 +1,173 @@
+"""Contact with terrain boxes and self-collision (tolerances stated per test)."""
+
+import numpy as np
+import pytest
+from engine_builders import reference_robot
+
+from softgym.engine import Body, SimConfig, Simulation
+from softgym.terrain import Box, Terrain
+
+L = 0.01
+
+
+def test_block_dropped_onto_a_box_rests_on_its_top_within_2_percent():
+    # A 2x2x1 block dropped from 2 voxels above a 2-voxel-high platform comes to
+    # rest with its centres at top + L/2 (within 2 %).
+    platform = Terrain.from_boxes([Box((-4, -4, 0), (6, 6, 2))])
+    body = Body.uniform(np.ones((2, 2, 1)), origin=(0.0, 0.0, 4 * L))
+    sim = Simulation(body, SimConfig(init_time=0.0), terrain=platform)
+    sim.advance(1.5)
+    z = sim.positions(0)[:, 2]
+    assert np.abs(sim.velocities(0)).max() < 1e-4
+    np.testing.assert_allclose(z, 2 * L + 0.5 * L, rtol=0.02)
+
+
+def test_robot_driven_into_a_wall_never_enters_it():
+    # The seed's 1-voxel fence; a flat 2x2x1 block (at the benchmark's dt)
+    # pushed towards the east wall with 0.8 times its weight (kinetic friction
+    # takes 0.5): no voxel centre is ever inside a wall box, and the block
+    # stops at the wall.
+    fence = Terrain.fence(inner=10, height=1, thickness=1, center=(1.0, 1.0))
+    walls = fence.as_array(L)
+    body = Body.uniform(np.ones((2, 2, 1)))
+    sim = Simulation(body, SimConfig(init_time=0.0), terrain=fence)
+    m = sim.masses(0)[0]
+    sim.set_external_force(0, [0.8 * 9.81 * m, 0.0, 0.0])
+    dt = sim.dt[0]
+    x_late = None
+    for step in range(int(2.0 / dt)):
+        sim.advance(dt)
+        if step == int(1.8 / dt):
+            x_late = sim.positions(0)[:, 0].copy()
+        p = sim.positions(0)
+        inside = (
+            (p[:, None, 0] > walls[None, :, 0]) & (p[:, None, 0] < walls[None, :, 3])
+            & (p[:, None, 1] > walls[None, :, 1]) & (p[:, None, 1] < walls[None, :, 4])
+            & (p[:, None, 2] > walls[None, :, 2]) & (p[:, None, 2] < walls[None, :, 5])
+        )  # fmt: skip
+        assert not inside.any(), f"a voxel centre entered a wall at t = {sim.time[0]:.4f} s"
+    east_wall_x = 1.0 * L + 5 * L  # centre + inner / 2
+    assert sim.positions(0)[:, 0].max() < east_wall_x
+    assert sim.positions(0)[:, 0].max() > east_wall_x - L  # it got there
+    assert np.abs(sim.positions(0)[:, 0] - x_late).max() < 1e-4  # and stays there
+
+
+def _block_on_platform(mu_s, mu_k):
+    platform = Terrain.from_boxes([Box((-20, -20, 0), (40, 40, 2))])
+    body = Body.uniform(np.ones((2, 2, 1)), mu_static=mu_s, mu_kinetic=mu_k,
+                        origin=(0.0, 0.0, 2 * L))  # fmt: skip
+    sim = Simulation(body, SimConfig(init_time=0.0, global_damping=0.0), terrain=platform)
+    sim.advance(0.5)
+    return sim
+
+
+def test_static_friction_on_a_box_top_matches_the_floor():
+    # F = 0.9 mu_s N: no sliding (< 1e-6 m in 1 s), as on the floor.
+    sim = _block_on_platform(1.0, 0.5)
+    m = sim.masses(0)[0]
+    x0 = sim.positions(0)[:, :2].copy()
+    sim.set_external_force(0, [0.9 * 9.81 * m * 0.6, 0.9 * 9.81 * m * 0.8, 0.0])
+    sim.advance(1.0)
+    assert np.abs(sim.positions(0)[:, :2] - x0).max() < 1e-6
+
+
+def test_kinetic_friction_on_a_box_top_matches_the_floor():
+    # F = 1.5 mu_s N: a = (F - mu_k N) / m within 2 %, as on the floor.
+    mu_s, mu_k = 1.0, 0.5
+    sim = _block_on_platform(mu_s, mu_k)
+    m = sim.masses(0)[0]
+    N = m * 9.81
+    F = 1.5 * mu_s * N
+    sim.set_external_force(0, [F, 0.0, 0.0])
+    sim.advance(0.1)
+    v1, t1 = sim.velocities(0)[:, 0].mean(), sim.time[0]
+    sim.advance(0.3)
+    v2, t2 = sim.velocities(0)[:, 0].mean(), sim.time[0]
+    assert (v2 - v1) / (t2 - t1) == pytest.approx((F - mu_k * N) / m, rel=0.02)
+
+
+def _c_shape_pulled_shut(self_collision):
+    # A flat C (base along y, two arms along x), tips pulled towards each other.
+    g = np.zeros((6, 5, 1), dtype=np.int32)
+    g[0, :, 0] = 1
+    g[:, 0, 0] = 1
+    g[:, 4, 0] = 1
+    body = Body.uniform(g, youngs_modulus=5e5)
+    cfg = SimConfig(self_collision=self_collision, init_time=0.0, gravity=0.0, floor=False,
+                    global_damping=0.05)  # fmt: skip
+    sim = Simulation(body, cfg)
+    idx = sim.grid_index(0)
+    f = np.zeros((len(idx), 3))
+    f[(idx[:, 0] == 5) & (idx[:, 1] == 0), 1] = 2.0
+    f[(idx[:, 0] == 5) & (idx[:, 1] == 4), 1] = -2.0
+    sim.set_external_force(0, f)
+    return sim
+
+
+def _min_distance_of_colliding_pairs(sim, seconds, hops=3):
+    # smallest centre distance over pairs more than `hops` bonds apart, in L
+    from softgym.engine.simulation import _hop_neighbours
+
+    off = sim.voxel_offsets
+    a = sim._a
+    v1 = a["v1"] - off[0]
+    v2 = a["v2"] - off[0]
+    n = off[1] - off[0]
+    start, index = _hop_neighbours(n, v1, v2, hops)
+    near = np.eye(n, dtype=bool)
+    for i in range(n):
+        near[i, index[start[i] : start[i + 1]]] = True
+    smallest = np.inf
+    for _ in range(int(seconds / 0.02)):
+        sim.advance(0.02)
+        p = sim.positions(0)
+        d = np.linalg.norm(p[:, None] - p[None], axis=-1)
+        smallest = min(smallest, d[~near].min())
+    return smallest / L
+
+
+def test_self_collision_prevents_interpenetration_of_a_folded_body():
+    # With self-collision the arms stop at the contact law's envelope (1.5 L,
+    # less the penalty overlap): never closer than 1 L. Without it they pass
+    # through each other (the test really folds the body).
+    assert _min_distance_of_colliding_pairs(_c_shape_pulled_shut(True), 3.0) > 1.0
+    assert _min_distance_of_colliding_pairs(_c_shape_pulled_shut(False), 3.0) < 0.5
+
+
+def _contact_batch():
+    fence = Terrain.fence(center=(1.5, 1.5), inner=8)
+    pulled = _c_shape_pulled_shut(True).bodies[0]
+    return [reference_robot(3), pulled, reference_robot(4, cte=0.03)], [fence, Terrain.flat(), fence]
+
+
+def test_contact_results_bit_identical_alone_batched_and_threaded():
+    bodies, terrains = _contact_batch()
+    cfg = SimConfig(actuation="symmetric")
+    finals = []
+    for n_threads in (1, 2):
+        sim = Simulation(bodies, cfg, n_threads=n_threads, terrain=terrains)
+        rollout = sim.run(1.6)
+        finals.append(rollout.positions)
+    assert np.array_equal(finals[0], finals[1])
+    for r, (body, terrain) in enumerate(zip(bodies, terrains)):
+        alone = Simulation([body], cfg, terrain=terrain).run(1.6)
+        assert np.array_equal(alone.robot_positions(0), Simulation(bodies, cfg, terrain=terrains).run(1.6).robot_positions(r))
+
+
+def test_split_runs_equal_one_run_with_contacts():
+    # candidate lists are rebuilt at each call: results must not depend on it
+    bodies, terrains = _contact_batch()
+    one = Simulation(bodies, terrain=terrains).run(1.5)
+    sim = Simulation(bodies, terrain=terrains)
+    for _ in range(15):
+        sim.advance(0.1)
+    assert np.array_equal(one.positions, sim.rollout().positions)
+
+
+def test_obstacles_are_not_robot_mass():
+    # the centre of mass uses the robot's voxels only (the seed counted walls)
+    body = Body.uniform(np.ones((2, 2, 2)))
+    flat = Simulation(body).rollout()
+    fenced = Simulation(body, terrain=Terrain.fence(center=(1, 1))).rollout()
+    np.testing.assert_array_equal(flat.cm, fenced.cm)
+    assert fenced.mass[0] == pytest.approx(8.0)
