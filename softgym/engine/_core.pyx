@@ -28,7 +28,7 @@ from cython.parallel cimport prange, parallel
 from libc.math cimport sin, cos, sqrt, fabs, floor, M_PI
 from libc.stdint cimport int64_t
 from libc.stdlib cimport malloc, realloc, free, qsort
-from libc.string cimport memset
+from libc.string cimport memcpy, memset
 
 cimport numpy as cnp
 
@@ -125,15 +125,13 @@ cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
         intp_t li, i, j
         float64_t dx, dy, dz, ell, inv_l, ux, uy, uz, e
         float64_t a1x, a1y, a1z, a2x, a2y, a2z
-        float64_t b1x, b1y, b1z, b2x, b2y, b2z
         float64_t tw, twdot, edot, uw
         float64_t dvx, dvy, dvz, w1x, w1y, w1z, w2x, w2y, w2z, wcx, wcy, wcz
-        float64_t r1x, r1y, r1z, r2x, r2y, r2z
         float64_t kb, cb, tor, fa
         float64_t m1x, m1y, m1z, m2x, m2y, m2z, sx, sy, sz, fx, fy, fz
         float64_t max_ext = b.max_strain * b.L
         float64_t inv_L = 1.0 / b.L
-        float64_t rx, ry, rz, inv_r, cx, cy, cz
+        float64_t rx, ry, rz, inv_r, cx, cy, cz, hx, hy, hz
         const float64_t* R1
         const float64_t* R2
         const float64_t* pos = b.pos
@@ -165,7 +163,9 @@ cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
         rx = a1x + a2x
         ry = a1y + a2y
         rz = a1z + a2z
-        inv_r = 1.0 / sqrt(rx * rx + ry * ry + rz * rz)
+        # 1 / |a1 + a2| by one Newton step from 1/2 (|a1 + a2|^2 = 4 - |a1 - a2|^2
+        # is near 4): relative error 0.14 % at 0.5 rad of relative bending
+        inv_r = 0.5 * (1.5 - 0.125 * (rx * rx + ry * ry + rz * rz))
         rx = rx * inv_r
         ry = ry * inv_r
         rz = rz * inv_r
@@ -175,54 +175,54 @@ cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
         cx = (ry * dz - rz * dy) * inv_L
         cy = (rz * dx - rx * dz) * inv_L
         cz = (rx * dy - ry * dx) * inv_L
-        # bending: rotation of each voxel relative to the chord, b = r x a - c
-        b1x = ry * a1z - rz * a1y - cx
-        b1y = rz * a1x - rx * a1z - cy
-        b1z = rx * a1y - ry * a1x - cz
-        b2x = ry * a2z - rz * a2y - cx
-        b2y = rz * a2x - rx * a2z - cy
-        b2z = rx * a2y - ry * a2x - cz
+        # bending of each voxel relative to the link, b_i = r x a_i - c; as r
+        # bisects a1 and a2, r x a2 = -(r x a1) = h = inv_r (a1 x a2), so
+        # b1 = -h - c and b2 = h - c
+        hx = (a1y * a2z - a1z * a2y) * inv_r
+        hy = (a1z * a2x - a1x * a2z) * inv_r
+        hz = (a1x * a2y - a1y * a2x) * inv_r
         # twist of voxel 2 relative to voxel 1 about the link: with y, z the
         # voxels' two other lattice axes, sin(twist) = (z1 . y2 - y1 . z2) / 2
         tw = 0.5 * (R1[q] * R2[p] + R1[3 + q] * R2[3 + p] + R1[6 + q] * R2[6 + p]
                     - R1[p] * R2[q] - R1[3 + p] * R2[3 + q] - R1[6 + p] * R2[6 + q])
-        # rates
+        # rates: extension, transverse angle (wc = r x dv / L), the voxels'
+        # angular velocities across the link (w_i minus its part along r) and twist
         dvx = vel[3 * j] - vel[3 * i]
         dvy = vel[3 * j + 1] - vel[3 * i + 1]
         dvz = vel[3 * j + 2] - vel[3 * i + 2]
-        w1x = av[3 * i]
-        w1y = av[3 * i + 1]
-        w1z = av[3 * i + 2]
-        w2x = av[3 * j]
-        w2y = av[3 * j + 1]
-        w2z = av[3 * j + 2]
         edot = ux * dvx + uy * dvy + uz * dvz
-        # rate of the transverse angle c (perpendicular to r)
         wcx = (ry * dvz - rz * dvy) * inv_L
         wcy = (rz * dvx - rx * dvz) * inv_L
         wcz = (rx * dvy - ry * dvx) * inv_L
+        w1x = av[3 * i]
+        w1y = av[3 * i + 1]
+        w1z = av[3 * i + 2]
         uw = rx * w1x + ry * w1y + rz * w1z
-        r1x = w1x - wcx - uw * rx
-        r1y = w1y - wcy - uw * ry
-        r1z = w1z - wcz - uw * rz
+        w1x = w1x - uw * rx
+        w1y = w1y - uw * ry
+        w1z = w1z - uw * rz
         twdot = -uw
+        w2x = av[3 * j]
+        w2y = av[3 * j + 1]
+        w2z = av[3 * j + 2]
         uw = rx * w2x + ry * w2y + rz * w2z
-        r2x = w2x - wcx - uw * rx
-        r2y = w2y - wcy - uw * ry
-        r2z = w2z - wcz - uw * rz
+        w2x = w2x - uw * rx
+        w2y = w2y - uw * ry
+        w2z = w2z - uw * rz
         twdot = twdot + uw
-        # moments on the two voxels
+        # bending moments: elastic -k_b (2 b1 + b2) = k_b (h + 3 c) on voxel 1,
+        # -k_b (b1 + 2 b2) = k_b (3 c - h) on voxel 2; damping the same form
+        # with the bending rates (w_i - wc)
         kb = b.k_bend[li]
         cb = b.c_bend[li]
-        tor = b.k_torsion[li] * tw + b.c_torsion[li] * twdot
-        m1x = -kb * (2.0 * b1x + b2x) - cb * (2.0 * r1x + r2x) + tor * rx
-        m1y = -kb * (2.0 * b1y + b2y) - cb * (2.0 * r1y + r2y) + tor * ry
-        m1z = -kb * (2.0 * b1z + b2z) - cb * (2.0 * r1z + r2z) + tor * rz
-        m2x = -kb * (b1x + 2.0 * b2x) - cb * (r1x + 2.0 * r2x) - tor * rx
-        m2y = -kb * (b1y + 2.0 * b2y) - cb * (r1y + 2.0 * r2y) - tor * ry
-        m2z = -kb * (b1z + 2.0 * b2z) - cb * (r1z + 2.0 * r2z) - tor * rz
+        m1x = kb * (hx + 3.0 * cx) - cb * (2.0 * w1x + w2x - 3.0 * wcx)
+        m1y = kb * (hy + 3.0 * cy) - cb * (2.0 * w1y + w2y - 3.0 * wcy)
+        m1z = kb * (hz + 3.0 * cz) - cb * (2.0 * w1z + w2z - 3.0 * wcz)
+        m2x = kb * (3.0 * cx - hx) - cb * (w1x + 2.0 * w2x - 3.0 * wcx)
+        m2y = kb * (3.0 * cy - hy) - cb * (w1y + 2.0 * w2y - 3.0 * wcy)
+        m2z = kb * (3.0 * cz - hz) - cb * (w1z + 2.0 * w2z - 3.0 * wcz)
         # force on voxel 2: axial along the chord, plus the shear that balances
-        # the moments over the nominal length
+        # the bending moments over the nominal length
         sx = m1x + m2x
         sy = m1y + m2y
         sz = m1z + m2z
@@ -230,6 +230,14 @@ cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
         fx = (ry * sz - rz * sy) * inv_L - fa * ux
         fy = (rz * sx - rx * sz) * inv_L - fa * uy
         fz = (rx * sy - ry * sx) * inv_L - fa * uz
+        # torsion, equal and opposite along r
+        tor = b.k_torsion[li] * tw + b.c_torsion[li] * twdot
+        m1x = m1x + tor * rx
+        m1y = m1y + tor * ry
+        m1z = m1z + tor * rz
+        m2x = m2x - tor * rx
+        m2y = m2y - tor * ry
+        m2z = m2z - tor * rz
         force[3 * j] += fx
         force[3 * j + 1] += fy
         force[3 * j + 2] += fz
@@ -344,13 +352,31 @@ cdef inline float64_t _box_penetration(const float64_t* B, const float64_t* p, f
     return rad + depth
 
 
-cdef inline int _integrate(Batch* b, intp_t r, float64_t* vmax2) noexcept nogil:
-    # IN: force, moment. OUT: pos, vel, quat, angvel, rot (symplectic Euler);
-    # vmax2: the largest squared speed of the robot's voxels after the step.
+cdef inline void _clear(Batch* b, intp_t i) noexcept nogil:
+    b.force[3 * i] = 0.0
+    b.force[3 * i + 1] = 0.0
+    b.force[3 * i + 2] = 0.0
+    b.moment[3 * i] = 0.0
+    b.moment[3 * i + 1] = 0.0
+    b.moment[3 * i + 2] = 0.0
+
+
+cdef void _clear_robot(Batch* b, intp_t r) noexcept nogil:
+    # zero the robot's force/moment scratch (after an early exit)
+    cdef intp_t vs = b.vox_start[r], ve = b.vox_start[r + 1]
+    memset(b.force + 3 * vs, 0, 3 * (ve - vs) * sizeof(float64_t))
+    memset(b.moment + 3 * vs, 0, 3 * (ve - vs) * sizeof(float64_t))
+
+
+cdef inline int _integrate(Batch* b, intp_t r, const float64_t* ref,
+                           float64_t* dmax2) noexcept nogil:
+    # IN: force, moment. OUT: pos, vel, quat, angvel, rot (symplectic Euler).
+    # If ref (the robot's positions when its contact list was built) is not
+    # NULL, dmax2 gets the largest squared displacement from it.
     cdef:
         intp_t i, k
         float64_t dt = b.dt[r]
-        float64_t m, h, pen, cg, rd, v2
+        float64_t m, h, pen, cg, rd, d2, mx, my, mz
         float64_t wx, wy, wz, qw, qx, qy, qz, nq
         float64_t f[3]
         float64_t n[3]
@@ -362,7 +388,8 @@ cdef inline int _integrate(Batch* b, intp_t r, float64_t* vmax2) noexcept nogil:
         int32 has_floor = b.floor[r]
         intp_t k0 = b.box_start[r]
         intp_t k1 = b.box_start[r + 1]
-    vmax2[0] = 0.0
+        intp_t vs = b.vox_start[r]
+    dmax2[0] = 0.0
     for i in range(b.vox_start[r], b.vox_start[r + 1]):
         if b.fixed[i]:
             vel[3 * i] = 0.0
@@ -371,12 +398,17 @@ cdef inline int _integrate(Batch* b, intp_t r, float64_t* vmax2) noexcept nogil:
             av[3 * i] = 0.0
             av[3 * i + 1] = 0.0
             av[3 * i + 2] = 0.0
+            _clear(b, i)
             continue
         m = b.mass[i]
         cg = b.c_global[i]
         f[0] = b.force[3 * i] + b.ext_force[3 * i] - cg * vel[3 * i]
         f[1] = b.force[3 * i + 1] + b.ext_force[3 * i + 1] - cg * vel[3 * i + 1]
         f[2] = b.force[3 * i + 2] + b.ext_force[3 * i + 2] - cg * vel[3 * i + 2] + m * g
+        mx = b.moment[3 * i]
+        my = b.moment[3 * i + 1]
+        mz = b.moment[3 * i + 2]
+        _clear(b, i)  # the scratch is zero again for the next step
         if has_floor:
             pen = 0.5 * b.scale[i] - pos[3 * i + 2]
             if pen > 0.0:
@@ -393,16 +425,20 @@ cdef inline int _integrate(Batch* b, intp_t r, float64_t* vmax2) noexcept nogil:
         pos[3 * i + 1] += vel[3 * i + 1] * dt
         pos[3 * i + 2] += vel[3 * i + 2] * dt
         if not (fabs(pos[3 * i]) + fabs(pos[3 * i + 1]) + fabs(pos[3 * i + 2]) < RUNAWAY):
+            _clear_robot(b, r)
             return STATUS_NONFINITE
-        v2 = vel[3 * i] * vel[3 * i] + vel[3 * i + 1] * vel[3 * i + 1] + vel[3 * i + 2] * vel[3 * i + 2]
-        if v2 > vmax2[0]:
-            vmax2[0] = v2
+        if ref != NULL:
+            k = 3 * (i - vs)
+            d2 = ((pos[3 * i] - ref[k]) ** 2 + (pos[3 * i + 1] - ref[k + 1]) ** 2
+                  + (pos[3 * i + 2] - ref[k + 2]) ** 2)
+            if d2 > dmax2[0]:
+                dmax2[0] = d2
         # rotation: w += M dt / I, global damping, q += 0.5 dt (0, w) q
         h = dt * b.inv_inertia[i]
         rd = b.rot_damp[i]
-        av[3 * i] = (av[3 * i] + b.moment[3 * i] * h) * rd
-        av[3 * i + 1] = (av[3 * i + 1] + b.moment[3 * i + 1] * h) * rd
-        av[3 * i + 2] = (av[3 * i + 2] + b.moment[3 * i + 2] * h) * rd
+        av[3 * i] = (av[3 * i] + mx * h) * rd
+        av[3 * i + 1] = (av[3 * i + 1] + my * h) * rd
+        av[3 * i + 2] = (av[3 * i + 2] + mz * h) * rd
         wx = av[3 * i] * 0.5 * dt
         wy = av[3 * i + 1] * 0.5 * dt
         wz = av[3 * i + 2] * 0.5 * dt
@@ -411,7 +447,9 @@ cdef inline int _integrate(Batch* b, intp_t r, float64_t* vmax2) noexcept nogil:
         qx = qq[1] + wx * qq[0] + wy * qq[3] - wz * qq[2]
         qy = qq[2] + wy * qq[0] + wz * qq[1] - wx * qq[3]
         qz = qq[3] + wz * qq[0] + wx * qq[2] - wy * qq[1]
-        nq = 1.0 / sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+        # renormalise: |q|^2 = 1 + O((w dt)^2), so one Newton step of 1/sqrt
+        # from 1 is exact to rounding
+        nq = 1.5 - 0.5 * (qw * qw + qx * qx + qy * qy + qz * qz)
         qq[0] = qw * nq
         qq[1] = qx * nq
         qq[2] = qy * nq
@@ -488,8 +526,10 @@ cdef int _rebuild_contacts(Batch* b, intp_t r, Contacts* c) noexcept nogil:
     if c.cells == NULL:
         c.cells = <KeyIndex*> malloc(n * sizeof(KeyIndex))
         c.row = <intp_t*> malloc(n * sizeof(intp_t))
-        if c.cells == NULL or c.row == NULL:
+        c.ref = <float64_t*> malloc(3 * n * sizeof(float64_t))
+        if c.cells == NULL or c.row == NULL or c.ref == NULL:
             return STATUS_MEMORY
+    memcpy(c.ref, P + 3 * vs, 3 * n * sizeof(float64_t))
     for i in range(vs, ve):
         if b.scale[i] > smax:
             smax = b.scale[i]
@@ -643,7 +683,7 @@ cdef int advance_robot(Batch* b, intp_t r, step_t target) noexcept nogil:
         int status = STATUS_OK
         intp_t vs = b.vox_start[r]
         intp_t ve = b.vox_start[r + 1]
-        float64_t smax, vmax2 = 0.0
+        float64_t smax, dmax2 = 0.0
         Contacts c
     if b.diverged[r]:
         return STATUS_OK
@@ -652,31 +692,32 @@ cdef int advance_robot(Batch* b, intp_t r, step_t target) noexcept nogil:
     if b.steps[r] == 0:
         _record(b, r)
     while b.steps[r] < target:
+        # force and moment scratch are zero here: _integrate clears them
         smax = _actuate(b, r)
-        memset(b.force + 3 * vs, 0, 3 * (ve - vs) * sizeof(float64_t))
-        memset(b.moment + 3 * vs, 0, 3 * (ve - vs) * sizeof(float64_t))
         status = _link_forces(b, r)
         if status == STATUS_OK and b.self_collision:
             if c.stale or smax > c.built_scale:
                 status = _rebuild_contacts(b, r, &c)
             _collide(b, &c)
         if status == STATUS_OK:
-            status = _integrate(b, r, &vmax2)
+            status = _integrate(b, r, c.ref if b.self_collision else NULL, &dmax2)
         if status != STATUS_OK:
+            _clear_robot(b, r)
             b.diverged[r] = 1
             b.diverged_code[r] = status
             b.diverged_time[r] = b.steps[r] * b.dt[r]
             break
         if b.self_collision:
             # two voxels approach by at most twice the largest displacement
-            c.travel += sqrt(vmax2) * b.dt[r]
-            if 2.0 * c.travel >= c.margin:
+            # since the list was built: rebuild before that can eat the slack
+            if 4.0 * dmax2 >= c.margin * c.margin:
                 c.stale = 1
         b.steps[r] += 1
         _record(b, r)
     free(c.pairs)
     free(c.cells)
     free(c.row)
+    free(c.ref)
     return status
 
 
@@ -722,7 +763,7 @@ cdef void robot_energy(Batch* b, intp_t r, float64_t* out) noexcept nogil:
         rx = R1[ax] + R2[ax]
         ry = R1[3 + ax] + R2[3 + ax]
         rz = R1[6 + ax] + R2[6 + ax]
-        inv_r = 1.0 / sqrt(rx * rx + ry * ry + rz * rz)
+        inv_r = 0.5 * (1.5 - 0.125 * (rx * rx + ry * ry + rz * rz))  # as the link forces
         rx = rx * inv_r
         ry = ry * inv_r
         rz = rz * inv_r
