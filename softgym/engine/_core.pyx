@@ -123,7 +123,7 @@ cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
     # permutation of (0, 1, 2).
     cdef:
         intp_t li, i, j
-        float64_t dx, dy, dz, ell, inv_l, ux, uy, uz, e
+        float64_t dx, dy, dz, ell, inv_l, e
         float64_t a1x, a1y, a1z, a2x, a2y, a2z
         float64_t tw, twdot, edot, uw
         float64_t dvx, dvy, dvz, w1x, w1y, w1z, w2x, w2y, w2z, wcx, wcy, wcz
@@ -150,10 +150,16 @@ cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
         e = ell - 0.5 * (scale[i] + scale[j])
         if not (fabs(e) <= max_ext):
             return STATUS_STRAIN  # also catches NaN
+        # axial force on voxel 2 along the chord u = d / |d| (elastic + damping)
+        dvx = vel[3 * j] - vel[3 * i]
+        dvy = vel[3 * j + 1] - vel[3 * i + 1]
+        dvz = vel[3 * j + 2] - vel[3 * i + 2]
         inv_l = 1.0 / ell
-        ux = dx * inv_l
-        uy = dy * inv_l
-        uz = dz * inv_l
+        edot = (dx * dvx + dy * dvy + dz * dvz) * inv_l
+        fa = (b.k_axial[li] * e + b.c_axial[li] * edot) * inv_l
+        fx = -fa * dx
+        fy = -fa * dy
+        fz = -fa * dz
         R1 = b.rot + 9 * i
         R2 = b.rot + 9 * j
         # lattice axis of the link in each voxel (column ax of its rotation)
@@ -185,12 +191,8 @@ cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
         # voxels' two other lattice axes, sin(twist) = (z1 . y2 - y1 . z2) / 2
         tw = 0.5 * (R1[q] * R2[p] + R1[3 + q] * R2[3 + p] + R1[6 + q] * R2[6 + p]
                     - R1[p] * R2[q] - R1[3 + p] * R2[3 + q] - R1[6 + p] * R2[6 + q])
-        # rates: extension, transverse angle (wc = r x dv / L), the voxels'
-        # angular velocities across the link (w_i minus its part along r) and twist
-        dvx = vel[3 * j] - vel[3 * i]
-        dvy = vel[3 * j + 1] - vel[3 * i + 1]
-        dvz = vel[3 * j + 2] - vel[3 * i + 2]
-        edot = ux * dvx + uy * dvy + uz * dvz
+        # rates: transverse angle (wc = r x dv / L), the voxels' angular
+        # velocities across the link (w_i minus its part along r) and twist
         wcx = (ry * dvz - rz * dvy) * inv_L
         wcy = (rz * dvx - rx * dvz) * inv_L
         wcz = (rx * dvy - ry * dvx) * inv_L
@@ -221,15 +223,13 @@ cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
         m2x = kb * (3.0 * cx - hx) - cb * (w1x + 2.0 * w2x - 3.0 * wcx)
         m2y = kb * (3.0 * cy - hy) - cb * (w1y + 2.0 * w2y - 3.0 * wcy)
         m2z = kb * (3.0 * cz - hz) - cb * (w1z + 2.0 * w2z - 3.0 * wcz)
-        # force on voxel 2: axial along the chord, plus the shear that balances
-        # the bending moments over the nominal length
+        # plus the shear that balances the bending moments over the nominal length
         sx = m1x + m2x
         sy = m1y + m2y
         sz = m1z + m2z
-        fa = b.k_axial[li] * e + b.c_axial[li] * edot
-        fx = (ry * sz - rz * sy) * inv_L - fa * ux
-        fy = (rz * sx - rx * sz) * inv_L - fa * uy
-        fz = (rx * sy - ry * sx) * inv_L - fa * uz
+        fx = fx + (ry * sz - rz * sy) * inv_L
+        fy = fy + (rz * sx - rx * sz) * inv_L
+        fz = fz + (rx * sy - ry * sx) * inv_L
         # torsion, equal and opposite along r
         tor = b.k_torsion[li] * tw + b.c_torsion[li] * twdot
         m1x = m1x + tor * rx
