@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from softgym.engine import Body, SimConfig, Simulation, openmp_enabled
+from softgym.terrain import Terrain
 
 SEED_ENGINE_O3 = 2.3e6  # voxel-steps/s per core, the seed's engine compiled with -O3 (issue 3)
 VOXELYZE_2015 = (1.4e6, 2.1e6)  # the 2015 Voxelyze library on this machine kind (issue 3)
@@ -49,13 +50,17 @@ def reference_robot(n: int = 6) -> Body:
     )
 
 
-def measure(n: int, batch: int, threads: int, seconds: float, repeats: int, cfg: SimConfig | None = None):
+def measure(n: int, batch: int, threads: int, seconds: float, repeats: int,
+            collisions: bool = False, world: str = "flat"):  # fmt: skip
     """Best-of-`repeats` voxel-steps/s for `batch` reference robots of size n^3."""
     best = 0.0
     nbytes = 0
     diverged = 0
+    cfg = SimConfig(self_collision=collisions)
+    # the seed's fence: a 2-voxel gap around the robot on every side
+    terrain = Terrain.fence(inner=n + 4, center=(n / 2, n / 2)) if world == "fence" else None
     for _ in range(repeats):
-        sim = Simulation([reference_robot(n)] * batch, cfg or SimConfig(), n_threads=threads)
+        sim = Simulation([reference_robot(n)] * batch, cfg, n_threads=threads, terrain=terrain)
         t0 = time.perf_counter()
         rollout = sim.run(seconds)
         wall = time.perf_counter() - t0
@@ -67,6 +72,8 @@ def measure(n: int, batch: int, threads: int, seconds: float, repeats: int, cfg:
         "size": f"{n}^3",
         "batch": batch,
         "threads": threads,
+        "collisions": collisions,
+        "world": world,
         "seconds_simulated": seconds,
         "voxel_steps_per_s": best,
         "bytes_per_robot": nbytes / batch,
@@ -87,28 +94,39 @@ def main(argv: list[str] | None = None) -> int:
     print(f"softgym engine benchmark: OpenMP {'on' if openmp_enabled() else 'off'}, "
           f"{seconds} s simulated per robot", file=sys.stderr)
 
-    def run(n, batch, threads):
-        row = measure(n, batch, threads, seconds, repeats)
+    def run(n, batch, threads, collisions=False, world="flat"):
+        row = measure(n, batch, threads, seconds, repeats, collisions, world)
         rows.append(row)
-        print(f"  {row['size']:>5} batch {batch:3d} threads {threads}: "
+        print(f"  {row['size']:>5} batch {batch:3d} threads {threads} "
+              f"{'self-collision' if collisions else 'no collision  '} {world:5s}: "
               f"{row['voxel_steps_per_s'] / 1e6:7.2f} M voxel-steps/s, "
               f"{row['bytes_per_robot'] / 1024:7.1f} KiB/robot", file=sys.stderr)
         return row
 
     if args.quick:
-        plan = [(6, 16, 1), (6, 16, 2)]
+        plan = [(6, 16, 1, False, "flat"), (6, 16, 2, False, "flat"), (6, 16, 1, True, "flat")]
     else:
-        plan = [(6, b, t) for b in (1, 16, 64) for t in (1, 2)]
-        plan += [(n, 16, t) for n in (4, 10) for t in (1, 2)]
-    for n, b, t in plan:
-        run(n, b, t)
+        plan = [(6, b, t, False, "flat") for b in (1, 16, 64) for t in (1, 2)]
+        plan += [(n, 16, t, False, "flat") for n in (4, 10) for t in (1, 2)]
+        # the world (issue 4): self-collision on, flat and inside the fence,
+        # sizes 4^3 .. 16^3 show how the collision cost grows
+        plan += [(n, 16 if n < 16 else 4, 1, True, w) for n in (4, 6, 10, 16)
+                 for w in ("flat", "fence")]  # fmt: skip
+        plan += [(6, 16, 2, True, "fence")]
+    for p in plan:
+        run(*p)
 
-    ref1 = next(r for r in rows if r["size"] == "6^3" and r["batch"] == 16 and r["threads"] == 1)
-    ref2 = next(r for r in rows if r["size"] == "6^3" and r["batch"] == 16 and r["threads"] == 2)
-    v1, v2 = ref1["voxel_steps_per_s"], ref2["voxel_steps_per_s"]
+    def find(size, threads, collisions, world="flat"):
+        return next(r for r in rows if r["size"] == size and r["batch"] == 16
+                    and r["threads"] == threads and r["collisions"] == collisions
+                    and r["world"] == world)["voxel_steps_per_s"]  # fmt: skip
+
+    v1, v2 = find("6^3", 1, False), find("6^3", 2, False)
+    vc = find("6^3", 1, True)
     summary = {
         "voxel_steps_per_s_1thread": v1,
         "voxel_steps_per_s_2threads": v2,
+        "voxel_steps_per_s_1thread_collisions": vc,
         "thread_scaling": v2 / v1,
         "vs_seed_engine_O3_per_core": v1 / SEED_ENGINE_O3,
         "vs_voxelyze_2015_per_core": [v1 / VOXELYZE_2015[1], v1 / VOXELYZE_2015[0]],
@@ -117,7 +135,8 @@ def main(argv: list[str] | None = None) -> int:
         "quick": args.quick,
     }
     print(f"reference robot, batch 16: {v1 / 1e6:.2f} M voxel-steps/s on 1 thread, "
-          f"{v2 / 1e6:.2f} M on 2 threads ({v2 / v1:.2f}x); "
+          f"{v2 / 1e6:.2f} M on 2 threads ({v2 / v1:.2f}x), {vc / 1e6:.2f} M on 1 thread "
+          f"with self-collision; "
           f"{v1 / SEED_ENGINE_O3:.1f}x the seed's engine at -O3 per core, "
           f"{v1 / VOXELYZE_2015[1]:.1f}-{v1 / VOXELYZE_2015[0]:.1f}x Voxelyze 2015 per core; "
           f"{summary['seconds_per_soft_robot_5s_1thread'] * 1000:.0f} ms per 6^3 soft robot "
@@ -128,14 +147,16 @@ def main(argv: list[str] | None = None) -> int:
         lines = [
             f"\n### bench_engine.py{' --quick' if args.quick else ''} — {stamp}, "
             f"{platform.machine()}, OpenMP {'on' if openmp_enabled() else 'off'}\n",
-            "| robot | batch | threads | M voxel-steps/s | KiB per robot | diverged |",
-            "|---|---|---|---|---|---|",
+            "| robot | batch | threads | self-collision | world | M voxel-steps/s | KiB per robot | diverged |",
+            "|---|---|---|---|---|---|---|---|",
         ]
         for r in rows:
             lines.append(f"| {r['size']} | {r['batch']} | {r['threads']} | "
+                         f"{'on' if r['collisions'] else 'off'} | {r['world']} | "
                          f"{r['voxel_steps_per_s'] / 1e6:.2f} | {r['bytes_per_robot'] / 1024:.1f} | "
                          f"{r['diverged']} |")
-        lines.append(f"\n2 threads / 1 thread (6^3, batch 16): {v2 / v1:.2f}x; "
+        lines.append(f"\n2 threads / 1 thread (6^3, batch 16): {v2 / v1:.2f}x; with self-collision "
+                     f"{vc / 1e6:.2f} M voxel-steps/s on 1 thread; "
                      f"vs the seed's engine at -O3: {v1 / SEED_ENGINE_O3:.1f}x per core.\n")
         with RESULTS.open("a") as fh:
             fh.write("\n".join(lines))
