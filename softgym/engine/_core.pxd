@@ -78,6 +78,8 @@ cdef struct Batch:
     intp_t* excl_idx         # (excl_start[-1],) their indices, sorted within each row
 
     # ---- per link (beam between face neighbours v1 -> v2 along +axis) ------
+    intp_t n_links           # links in the batch
+    float64_t* link_out      # (10, n_links) scratch: |extension|, force on v2, moments on v1, v2
     intp_t* v1               # (n_links,) voxel on the negative side
     intp_t* v2               # (n_links,) voxel on the positive side
     int32* axis              # (n_links,) 0, 1, 2 for x, y, z

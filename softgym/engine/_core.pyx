@@ -117,55 +117,64 @@ cdef inline int _link_forces(Batch* b, intp_t r) noexcept nogil:
     return _links_along(b, lo + nx + ny, hi, 2, 0, 1)
 
 
-cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
-                             const intp_t ax, const intp_t p, const intp_t q) noexcept nogil:
-    # Links lo..hi, all along lattice axis `ax`; (ax, p, q) is a cyclic
-    # permutation of (0, 1, 2).
+cdef extern from *:
+    # restrict-qualified pointers: the link kernel's inputs and outputs never
+    # alias, which lets the compiler vectorise it (gathers + SIMD arithmetic)
+    ctypedef double* f64_rp "double * __restrict__"
+    ctypedef const double* cf64_rp "const double * __restrict__"
+    ctypedef const Py_ssize_t* cintp_rp "const Py_ssize_t * __restrict__"
+
+
+cdef enum:
+    N_LINK_OUT = 10  # rows of the per-link output scratch (see _link_kernel)
+
+
+cdef void _link_kernel(intp_t lo, intp_t hi, intp_t ax, intp_t p, intp_t q,
+                       float64_t inv_L, cintp_rp v1, cintp_rp v2,
+                       cf64_rp pos, cf64_rp vel, cf64_rp av, cf64_rp rot, cf64_rp scale,
+                       cf64_rp k_axial, cf64_rp c_axial, cf64_rp k_bend, cf64_rp c_bend,
+                       cf64_rp k_torsion, cf64_rp c_torsion,
+                       f64_rp ext, f64_rp fx, f64_rp fy, f64_rp fz,
+                       f64_rp m1x, f64_rp m1y, f64_rp m1z,
+                       f64_rp m2x, f64_rp m2y, f64_rp m2z) noexcept nogil:
+    # Links lo..hi, all along lattice axis `ax` ((ax, p, q) a cyclic
+    # permutation of (0, 1, 2)). IN: the voxels' state. OUT, per link: |axial
+    # extension| (ext), force on voxel 2 (f; voxel 1 gets -f) and moments on
+    # voxels 1 and 2 (m1, m2). No branches and no scatter: the loop vectorises.
     cdef:
         intp_t li, i, j
-        float64_t dx, dy, dz, ell, inv_l, e
-        float64_t a1x, a1y, a1z, a2x, a2y, a2z
-        float64_t tw, twdot, edot, uw
-        float64_t dvx, dvy, dvz, w1x, w1y, w1z, w2x, w2y, w2z, wcx, wcy, wcz
-        float64_t kb, cb, tor, fa
-        float64_t m1x, m1y, m1z, m2x, m2y, m2z, sx, sy, sz, fx, fy, fz
-        float64_t max_ext = b.max_strain * b.L
-        float64_t inv_L = 1.0 / b.L
-        float64_t rx, ry, rz, inv_r, cx, cy, cz, hx, hy, hz
-        const float64_t* R1
-        const float64_t* R2
-        const float64_t* pos = b.pos
-        const float64_t* vel = b.vel
-        const float64_t* av = b.angvel
-        const float64_t* scale = b.scale
-        float64_t* force = b.force
-        float64_t* moment = b.moment
+        float64_t dx, dy, dz, ell, inv_l, e, edot, fa, ax_x, ax_y, ax_z
+        float64_t dvx, dvy, dvz, a1x, a1y, a1z, a2x, a2y, a2z
+        float64_t rx, ry, rz, inv_r, cx, cy, cz, hx, hy, hz, tw, twdot, uw
+        float64_t wcx, wcy, wcz, w1x, w1y, w1z, w2x, w2y, w2z
+        float64_t kb, cb, tor, n1x, n1y, n1z, n2x, n2y, n2z, sx, sy, sz
     for li in range(lo, hi):
-        i = b.v1[li]
-        j = b.v2[li]
+        i = v1[li]
+        j = v2[li]
         dx = pos[3 * j] - pos[3 * i]
         dy = pos[3 * j + 1] - pos[3 * i + 1]
         dz = pos[3 * j + 2] - pos[3 * i + 2]
         ell = sqrt(dx * dx + dy * dy + dz * dz)
         e = ell - 0.5 * (scale[i] + scale[j])
-        if not (fabs(e) <= max_ext):
-            return STATUS_STRAIN  # also catches NaN
+        ext[li] = fabs(e)  # NaN stays NaN: the caller's check catches it
         # axial force on voxel 2 along the chord u = d / |d| (elastic + damping)
         dvx = vel[3 * j] - vel[3 * i]
         dvy = vel[3 * j + 1] - vel[3 * i + 1]
         dvz = vel[3 * j + 2] - vel[3 * i + 2]
         inv_l = 1.0 / ell
         edot = (dx * dvx + dy * dvy + dz * dvz) * inv_l
-        fa = (b.k_axial[li] * e + b.c_axial[li] * edot) * inv_l
-        fx = -fa * dx
-        fy = -fa * dy
-        fz = -fa * dz
-        R1 = b.rot + 9 * i
-        R2 = b.rot + 9 * j
+        fa = (k_axial[li] * e + c_axial[li] * edot) * inv_l
+        ax_x = -fa * dx
+        ax_y = -fa * dy
+        ax_z = -fa * dz
         # lattice axis of the link in each voxel (column ax of its rotation)
         # and the link's frame axis r, their bisector
-        a1x = R1[ax]; a1y = R1[3 + ax]; a1z = R1[6 + ax]
-        a2x = R2[ax]; a2y = R2[3 + ax]; a2z = R2[6 + ax]
+        a1x = rot[9 * i + ax]
+        a1y = rot[9 * i + 3 + ax]
+        a1z = rot[9 * i + 6 + ax]
+        a2x = rot[9 * j + ax]
+        a2y = rot[9 * j + 3 + ax]
+        a2z = rot[9 * j + 6 + ax]
         rx = a1x + a2x
         ry = a1y + a2y
         rz = a1z + a2z
@@ -189,8 +198,10 @@ cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
         hz = (a1x * a2y - a1y * a2x) * inv_r
         # twist of voxel 2 relative to voxel 1 about the link: with y, z the
         # voxels' two other lattice axes, sin(twist) = (z1 . y2 - y1 . z2) / 2
-        tw = 0.5 * (R1[q] * R2[p] + R1[3 + q] * R2[3 + p] + R1[6 + q] * R2[6 + p]
-                    - R1[p] * R2[q] - R1[3 + p] * R2[3 + q] - R1[6 + p] * R2[6 + q])
+        tw = 0.5 * (rot[9 * i + q] * rot[9 * j + p] + rot[9 * i + 3 + q] * rot[9 * j + 3 + p]
+                    + rot[9 * i + 6 + q] * rot[9 * j + 6 + p] - rot[9 * i + p] * rot[9 * j + q]
+                    - rot[9 * i + 3 + p] * rot[9 * j + 3 + q]
+                    - rot[9 * i + 6 + p] * rot[9 * j + 6 + q])
         # rates: transverse angle (wc = r x dv / L), the voxels' angular
         # velocities across the link (w_i minus its part along r) and twist
         wcx = (ry * dvz - rz * dvy) * inv_L
@@ -215,41 +226,66 @@ cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
         # bending moments: elastic -k_b (2 b1 + b2) = k_b (h + 3 c) on voxel 1,
         # -k_b (b1 + 2 b2) = k_b (3 c - h) on voxel 2; damping the same form
         # with the bending rates (w_i - wc)
-        kb = b.k_bend[li]
-        cb = b.c_bend[li]
-        m1x = kb * (hx + 3.0 * cx) - cb * (2.0 * w1x + w2x - 3.0 * wcx)
-        m1y = kb * (hy + 3.0 * cy) - cb * (2.0 * w1y + w2y - 3.0 * wcy)
-        m1z = kb * (hz + 3.0 * cz) - cb * (2.0 * w1z + w2z - 3.0 * wcz)
-        m2x = kb * (3.0 * cx - hx) - cb * (w1x + 2.0 * w2x - 3.0 * wcx)
-        m2y = kb * (3.0 * cy - hy) - cb * (w1y + 2.0 * w2y - 3.0 * wcy)
-        m2z = kb * (3.0 * cz - hz) - cb * (w1z + 2.0 * w2z - 3.0 * wcz)
-        # plus the shear that balances the bending moments over the nominal length
-        sx = m1x + m2x
-        sy = m1y + m2y
-        sz = m1z + m2z
-        fx = fx + (ry * sz - rz * sy) * inv_L
-        fy = fy + (rz * sx - rx * sz) * inv_L
-        fz = fz + (rx * sy - ry * sx) * inv_L
+        kb = k_bend[li]
+        cb = c_bend[li]
+        n1x = kb * (hx + 3.0 * cx) - cb * (2.0 * w1x + w2x - 3.0 * wcx)
+        n1y = kb * (hy + 3.0 * cy) - cb * (2.0 * w1y + w2y - 3.0 * wcy)
+        n1z = kb * (hz + 3.0 * cz) - cb * (2.0 * w1z + w2z - 3.0 * wcz)
+        n2x = kb * (3.0 * cx - hx) - cb * (w1x + 2.0 * w2x - 3.0 * wcx)
+        n2y = kb * (3.0 * cy - hy) - cb * (w1y + 2.0 * w2y - 3.0 * wcy)
+        n2z = kb * (3.0 * cz - hz) - cb * (w1z + 2.0 * w2z - 3.0 * wcz)
+        # force on voxel 2: axial plus the shear that balances the bending
+        # moments over the nominal length
+        sx = n1x + n2x
+        sy = n1y + n2y
+        sz = n1z + n2z
+        fx[li] = ax_x + (ry * sz - rz * sy) * inv_L
+        fy[li] = ax_y + (rz * sx - rx * sz) * inv_L
+        fz[li] = ax_z + (rx * sy - ry * sx) * inv_L
         # torsion, equal and opposite along r
-        tor = b.k_torsion[li] * tw + b.c_torsion[li] * twdot
-        m1x = m1x + tor * rx
-        m1y = m1y + tor * ry
-        m1z = m1z + tor * rz
-        m2x = m2x - tor * rx
-        m2y = m2y - tor * ry
-        m2z = m2z - tor * rz
-        force[3 * j] += fx
-        force[3 * j + 1] += fy
-        force[3 * j + 2] += fz
-        force[3 * i] -= fx
-        force[3 * i + 1] -= fy
-        force[3 * i + 2] -= fz
-        moment[3 * i] += m1x
-        moment[3 * i + 1] += m1y
-        moment[3 * i + 2] += m1z
-        moment[3 * j] += m2x
-        moment[3 * j + 1] += m2y
-        moment[3 * j + 2] += m2z
+        tor = k_torsion[li] * tw + c_torsion[li] * twdot
+        m1x[li] = n1x + tor * rx
+        m1y[li] = n1y + tor * ry
+        m1z[li] = n1z + tor * rz
+        m2x[li] = n2x - tor * rx
+        m2y[li] = n2y - tor * ry
+        m2z[li] = n2z - tor * rz
+
+
+cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
+                             const intp_t ax, const intp_t p, const intp_t q) noexcept nogil:
+    # Links lo..hi along axis `ax`: the vectorised kernel, then the strain
+    # check and the scatter of forces and moments in link order.
+    cdef:
+        intp_t li, i, j
+        intp_t n = b.n_links
+        float64_t max_ext = b.max_strain * b.L
+        float64_t* o = b.link_out
+        float64_t* force = b.force
+        float64_t* moment = b.moment
+    if hi <= lo:
+        return STATUS_OK
+    _link_kernel(lo, hi, ax, p, q, 1.0 / b.L, b.v1, b.v2, b.pos, b.vel, b.angvel, b.rot,
+                 b.scale, b.k_axial, b.c_axial, b.k_bend, b.c_bend, b.k_torsion, b.c_torsion,
+                 o, o + n, o + 2 * n, o + 3 * n, o + 4 * n, o + 5 * n, o + 6 * n,
+                 o + 7 * n, o + 8 * n, o + 9 * n)
+    for li in range(lo, hi):
+        if not (o[li] <= max_ext):
+            return STATUS_STRAIN  # also catches NaN
+        i = b.v1[li]
+        j = b.v2[li]
+        force[3 * j] += o[n + li]
+        force[3 * j + 1] += o[2 * n + li]
+        force[3 * j + 2] += o[3 * n + li]
+        force[3 * i] -= o[n + li]
+        force[3 * i + 1] -= o[2 * n + li]
+        force[3 * i + 2] -= o[3 * n + li]
+        moment[3 * i] += o[4 * n + li]
+        moment[3 * i + 1] += o[5 * n + li]
+        moment[3 * i + 2] += o[6 * n + li]
+        moment[3 * j] += o[7 * n + li]
+        moment[3 * j + 1] += o[8 * n + li]
+        moment[3 * j + 2] += o[9 * n + li]
     return STATUS_OK
 
 
@@ -859,7 +895,9 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.excl_start = <intp_t*> _p(a, "excl_start")
     b.excl_idx = <intp_t*> _p(a, "excl_idx") if a["excl_idx"].shape[0] > 0 else NULL
     # links: a robot without links leaves these arrays empty (never dereferenced)
+    b.n_links = a["v1"].shape[0]
     if a["v1"].shape[0] > 0:
+        b.link_out = _f(a, "link_out")
         b.v1 = <intp_t*> _p(a, "v1")
         b.v2 = <intp_t*> _p(a, "v2")
         b.axis = <int32*> _p(a, "axis")

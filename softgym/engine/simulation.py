@@ -333,6 +333,7 @@ class Simulation:
         for name in ("v1", "v2"):
             a[name] = a[name].astype(np.intp)
         a["axis"] = a["axis"].astype(np.int32)
+        a["link_out"] = np.zeros((10, a["v1"].shape[0]))  # kernel scratch (rows: see _core.pyx)
         a["quat"] = np.zeros((n_vox, 4))
         a["quat"][:, 0] = 1.0
         a["rot"] = np.zeros((n_vox, 9))
