@@ -408,11 +408,14 @@ cdef inline int _integrate(Batch* b, intp_t r, const float64_t* ref,
                            float64_t* dmax2) noexcept nogil:
     # IN: force, moment. OUT: pos, vel, quat, angvel, rot (symplectic Euler).
     # If ref (the robot's positions when its contact list was built) is not
-    # NULL, dmax2 gets the largest squared displacement from it.
+    # NULL, dmax2 gets the largest squared displacement from it, relative to
+    # the first voxel's (any common shift c bounds the approach of two voxels:
+    # |dp_i - dp_j| <= |dp_i - c| + |dp_j - c|).
     cdef:
         intp_t i, k
         float64_t dt = b.dt[r]
         float64_t m, h, pen, cg, rd, d2, mx, my, mz
+        float64_t c0 = 0.0, c1 = 0.0, c2 = 0.0
         float64_t wx, wy, wz, qw, qx, qy, qz, nq
         float64_t f[3]
         float64_t n[3]
@@ -464,9 +467,15 @@ cdef inline int _integrate(Batch* b, intp_t r, const float64_t* ref,
             _clear_robot(b, r)
             return STATUS_NONFINITE
         if ref != NULL:
+            # displacement since the rebuild, less the first voxel's: a common
+            # translation does not bring voxels closer, so walking costs no rebuild
             k = 3 * (i - vs)
-            d2 = ((pos[3 * i] - ref[k]) ** 2 + (pos[3 * i + 1] - ref[k + 1]) ** 2
-                  + (pos[3 * i + 2] - ref[k + 2]) ** 2)
+            if i == vs:
+                c0 = pos[3 * i] - ref[k]
+                c1 = pos[3 * i + 1] - ref[k + 1]
+                c2 = pos[3 * i + 2] - ref[k + 2]
+            d2 = ((pos[3 * i] - ref[k] - c0) ** 2 + (pos[3 * i + 1] - ref[k + 1] - c1) ** 2
+                  + (pos[3 * i + 2] - ref[k + 2] - c2) ** 2)
             if d2 > dmax2[0]:
                 dmax2[0] = d2
         # rotation: w += M dt / I, global damping, q += 0.5 dt (0, w) q
@@ -744,8 +753,9 @@ cdef int advance_robot(Batch* b, intp_t r, step_t target) noexcept nogil:
             b.diverged_time[r] = b.steps[r] * b.dt[r]
             break
         if b.self_collision:
-            # two voxels approach by at most twice the largest displacement
-            # since the list was built: rebuild before that can eat the slack
+            # two voxels approach by at most twice the largest (relative)
+            # displacement since the list was built: rebuild before that can
+            # eat the slack
             if 4.0 * dmax2 >= c.margin * c.margin:
                 c.stale = 1
         b.steps[r] += 1
