@@ -1,0 +1,128 @@
+"""Bad input gets a typed error naming what is wrong, and changes nothing."""
+
+import numpy as np
+import pytest
+from engine_builders import reference_robot
+
+from softgym.engine import Body, SimConfig, Simulation
+from softgym.exceptions import (
+    InvalidActionError,
+    InvalidDesignError,
+    InvalidParameterError,
+    SoftGymError,
+)
+
+TABLES = dict(
+    youngs_modulus=[0, 5e6], density=[0, 1e6], poisson=[0, 0.35], cte=[0, 0.0],
+    mu_static=[0, 1.0], mu_kinetic=[0, 0.5],
+)  # fmt: skip
+
+
+def _body(**over):
+    kw = dict(grid=np.ones((2, 2, 2), dtype=np.int8), **TABLES)
+    kw.update(over)
+    return Body(**kw)
+
+
+@pytest.mark.parametrize(
+    ("over", "error", "match"),
+    [
+        (dict(grid=np.ones((2, 2))), InvalidDesignError, "3-D"),
+        (dict(grid=np.ones((2, 2, 2), dtype=float)), InvalidDesignError, "integer dtype"),
+        (dict(grid=np.zeros((2, 2, 2), dtype=int)), InvalidDesignError, "empty robot"),
+        (dict(grid=np.full((2, 2, 2), 3)), InvalidDesignError, "unknown material ids \\[3\\]"),
+        (dict(grid=np.full((2, 2, 2), -1)), InvalidDesignError, "unknown material ids"),
+        (dict(youngs_modulus=[0, -5e6]), InvalidParameterError, "youngs_modulus must be > 0"),
+        (dict(youngs_modulus=[0, np.nan]), InvalidParameterError, "not finite"),
+        (dict(density=[0, 0.0]), InvalidParameterError, "density must be > 0"),
+        (dict(poisson=[0, 0.5]), InvalidParameterError, "poisson"),
+        (dict(poisson=[0, -0.1]), InvalidParameterError, "poisson"),
+        (dict(mu_static=[0, -1.0]), InvalidParameterError, "friction"),
+        (dict(cte=[0, 0.0, 1.0]), InvalidParameterError, "one entry per material"),
+        (dict(period=0.0), InvalidParameterError, "period"),
+        (dict(temp_amplitude=float("inf")), InvalidParameterError, "temp_amplitude"),
+        (dict(fixed=np.ones((3, 3, 3), dtype=bool)), InvalidDesignError, "fixed mask"),
+        (dict(origin=(0, 0)), InvalidParameterError, "origin"),
+    ],
+)
+def test_invalid_bodies_raise_typed_errors(over, error, match):
+    with pytest.raises(error, match=match):
+        _body(**over)
+
+
+def test_errors_subclass_builtins():
+    with pytest.raises(ValueError):
+        _body(density=[0, -1.0])
+    assert issubclass(InvalidDesignError, SoftGymError)
+
+
+@pytest.mark.parametrize(
+    ("name", "value"),
+    [
+        ("voxel_size", 0.0), ("voxel_size", float("nan")), ("dt_frac", 0.0), ("dt_frac", 50.0),
+        ("gravity", -9.81), ("bond_damping", -1.0), ("init_time", -1.0), ("min_scale", 0.0),
+        ("max_strain", 0.0), ("trace_interval", 0.0), ("actuation", "both"),
+        ("on_divergence", "ignore"), ("collision_exclusion", 0), ("voxel_size", "big"),
+    ],
+)  # fmt: skip
+def test_invalid_config_raises_naming_the_field(name, value):
+    with pytest.raises(InvalidParameterError, match=f"SimConfig.{name}"):
+        SimConfig(**{name: value})
+
+
+def test_config_dict_round_trip_and_unknown_keys():
+    cfg = SimConfig(gravity=0.0, actuation="symmetric")
+    assert SimConfig.from_dict(cfg.to_dict()) == cfg
+    with pytest.raises(InvalidParameterError, match="unknown SimConfig keys"):
+        SimConfig.from_dict({"gravty": 1.0})
+
+
+def test_simulation_rejects_bad_arguments():
+    with pytest.raises(InvalidDesignError):
+        Simulation([])
+    with pytest.raises(InvalidDesignError, match="Body or a design"):
+        Simulation(["not a body"])
+    with pytest.raises(InvalidParameterError, match="n_threads"):
+        Simulation(_body(), n_threads=0)
+    sim = Simulation(_body())
+    with pytest.raises(InvalidParameterError):
+        sim.advance(-1.0)
+    with pytest.raises(InvalidParameterError):
+        sim.advance(float("nan"))
+    with pytest.raises(IndexError):
+        sim.positions(3)
+
+
+def test_nan_temperatures_raise_and_leave_the_state_unchanged():
+    sim = Simulation(reference_robot(3), SimConfig(actuation="symmetric"))
+    sim.advance(0.2)
+    before = sim.get_state()
+    temps = np.zeros(27)
+    temps[4] = np.nan
+    with pytest.raises(InvalidActionError, match="NaN"):
+        sim.set_temperature(0, temps)
+    with pytest.raises(InvalidActionError, match="shape"):
+        sim.set_temperature(0, np.zeros(5))
+    after = sim.get_state()
+    for k in before:
+        assert np.array_equal(before[k], after[k]), k
+    # a grid-shaped temperature field is accepted and drives the muscles
+    sim.set_temperature(0, np.full((3, 3, 3), 10.0))
+    sim.advance(0.1)
+    assert not np.allclose(sim.scales(0), 0.01)
+
+
+def test_state_round_trip_resumes_bit_for_bit():
+    sim = Simulation(reference_robot(3))
+    sim.advance(1.2)
+    state = sim.get_state()
+    sim.advance(0.6)
+    end = sim.rollout()
+    again = Simulation(reference_robot(3))
+    again.set_state(state)
+    again.advance(0.6)
+    other = again.rollout()
+    assert np.array_equal(end.positions, other.positions)
+    assert np.array_equal(end.cm, other.cm)
+    with pytest.raises(InvalidParameterError, match="missing"):
+        again.set_state({"pos": state["pos"]})
