@@ -5,6 +5,17 @@ Subcommands
 simulate
     Simulate the embedded default walker (or a design JSON) and write its
     centre-of-mass trajectory figure and a summary JSON.
+evolve
+    Run one of the seed study's experiments (native loop, DEAP or pymoo),
+    locally or on Dask, into a resumable run folder with log, checkpoints,
+    best designs and figures.
+replay
+    Re-simulate the best robot of a run folder and render it (figures + GIF).
+compare
+    Best fitness per generation of several run folders in one figure (the
+    report's Fig. 4).
+experiments
+    List the named experiments.
 """
 
 from __future__ import annotations
@@ -35,8 +46,13 @@ def _default_body():
     grid = np.ones((6, 6, 6), dtype=np.int32)
     grid[3:] = 2
     return Body(
-        grid=grid, youngs_modulus=[0, 5e6, 5e6], density=[0, 1e6, 1e6], poisson=[0, 0.35, 0.35],
-        cte=[0, 0.01, -0.01], mu_static=[0, 1, 1], mu_kinetic=[0, 0.5, 0.5],
+        grid=grid,
+        youngs_modulus=[0, 5e6, 5e6],
+        density=[0, 1e6, 1e6],
+        poisson=[0, 0.35, 0.35],
+        cte=[0, 0.01, -0.01],
+        mu_static=[0, 1, 1],
+        mu_kinetic=[0, 0.5, 0.5],
     )
 
 
@@ -79,7 +95,9 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     ax1.plot(trace[:, 0] / L, trace[:, 1] / L, "-o", ms=2)
     ax1.plot(trace[0, 0] / L, trace[0, 1] / L, "gs", label="start")
     ax1.plot(trace[-1, 0] / L, trace[-1, 1] / L, "r^", label="end")
-    ax1.set(xlabel="x (voxels)", ylabel="y (voxels)", title="centre of mass, top view", aspect="equal")
+    ax1.set(
+        xlabel="x (voxels)", ylabel="y (voxels)", title="centre of mass, top view", aspect="equal"
+    )
     ax1.legend()
     ax2.plot(trace[:, 3], trace[:, 2] / L)
     ax2.axvline(rollout.init_time, color="k", ls=":", label="init time")
@@ -93,6 +111,157 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _make_run(args: argparse.Namespace, batch_fn):
+    from evolvers.experiments import get_experiment
+
+    overrides = {"pop_size": args.pop}
+    if args.seconds is not None:
+        overrides["seconds"] = args.seconds
+    if args.shape is not None:
+        overrides["shape"] = tuple(args.shape)
+    if args.selection is not None:
+        overrides["selection"] = args.selection
+    exp = get_experiment(args.experiment, **overrides)
+    if args.backend == "deap":
+        from evolvers.deap_runner import DeapRun as Run
+    elif args.backend == "pymoo":
+        from evolvers.pymoo_runner import PymooRun as Run
+    else:
+        from evolvers.runner import EvolutionRun as Run
+    return Run(
+        exp, args.out, seed=args.seed, generations=args.generations, batch_fn=batch_fn,
+        n_threads=args.threads, figures=not args.no_figures, gif=not args.no_gif,
+    )  # fmt: skip
+
+
+def _cmd_evolve(args: argparse.Namespace) -> int:
+    import contextlib
+
+    from tqdm import tqdm
+
+    from softgym.exceptions import SoftGymError
+
+    t0 = time.perf_counter()
+    with contextlib.ExitStack() as stack:
+        batch_fn = None
+        if args.dask:
+            from evolvers.distributed import DaskBatchFn, dask_client
+
+            client = stack.enter_context(dask_client(args.dask, n_workers=args.workers))
+            batch_fn = DaskBatchFn(client)
+        try:
+            run = _make_run(args, batch_fn)
+        except SoftGymError as exc:
+            print(f"softgym evolve: {exc}", file=sys.stderr)
+            return 2
+        fit = run.experiment.fitness
+        bar = tqdm(total=run.generations + 1, desc=f"{run.experiment.name} [{run.backend}]",
+                   unit="gen", dynamic_ncols=True, disable=args.quiet)  # fmt: skip
+
+        def progress(r, row):
+            bar.n = row["generation"] + 1
+            best = row.get(f"{fit.name}_best", float("nan"))
+            bar.set_postfix(best=f"{best:.3f}", evals=row["evaluations_total"], refresh=False)
+            bar.refresh()
+
+        run.on_generation = progress
+        try:
+            run.run(resume=args.resume)
+        except SoftGymError as exc:
+            bar.close()
+            print(f"softgym evolve: {exc}", file=sys.stderr)
+            return 2
+        bar.close()
+    wall = time.perf_counter() - t0
+    best = run.hall_of_fame[0]["individual"] if run.hall_of_fame else None
+    summary = {
+        "experiment": run.experiment.name,
+        "backend": run.backend,
+        "generations": run.generation,
+        "evaluations": run.evaluations_total,
+        "best": None if best is None else best["objectives"].get(fit.name),
+        "best_id": None if best is None else best["id"],
+        "wall_seconds": round(wall, 2),
+        "out": str(run.out),
+        "figures": sorted(str(p) for p in (run.out / "figures").glob("*"))
+        if (run.out / "figures").exists()
+        else [],
+    }
+    print(json.dumps(summary, indent=2))
+    return 0
+
+
+def _cmd_replay(args: argparse.Namespace) -> int:
+    from softgym.design import RobotDesign
+    from softgym.evaluate import Task, evaluate, make_terrain
+    from softgym.exceptions import SoftGymError
+    from softgym.render.figures import plot_robot, plot_trajectory, save_robot_gif
+
+    run_dir = Path(args.run_dir)
+    try:
+        cfg = json.loads((run_dir / "config.json").read_text())
+        design = RobotDesign.load(run_dir / "best_design.json")
+        best = json.loads((run_dir / "best_designs.json").read_text())["best"][0]
+    except (OSError, ValueError, KeyError, SoftGymError) as exc:
+        print(f"softgym replay: {run_dir} is not a finished run folder ({exc})", file=sys.stderr)
+        return 2
+    exp = cfg["experiment"]
+    seconds = float(exp["seconds"] if args.seconds is None else args.seconds)
+    task = Task(
+        terrain=exp["terrain"],
+        seconds=seconds,
+        trace_interval=exp["trace_interval"],
+        sim=exp.get("sim", {}),
+    )
+    m = evaluate([design], task=task, traces=True)
+    out = Path(args.out) if args.out else run_dir / "replay"
+    terrain = make_terrain(task.terrain, design.shape)
+    fine = evaluate([design], task=Task(**{**task.to_dict(), "trace_interval": 0.05}), traces=True)
+    paths = [
+        plot_robot(design, out / "best_robot.png", title=f"best robot ({exp['name']})"),
+        plot_trajectory(
+            fine["traces"][0], out / "best_trajectory.png", init_time=1.0, terrain=terrain
+        ),
+    ]
+    if not args.no_gif:
+        paths.append(
+            save_robot_gif(design, out / "best_robot.gif", terrain, seconds, config=task.config())
+        )
+    metrics = {
+        k: (v[0].item() if hasattr(v[0], "item") else v[0]) for k, v in m.items() if k != "traces"
+    }
+    summary = {"experiment": exp["name"], "seconds": seconds, "metrics": metrics,
+               "recorded": best["objectives"], "files": [str(p) for p in paths]}  # fmt: skip
+    print(json.dumps(summary, indent=2))
+    return 0
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    from softgym.render.figures import plot_best_fitness, read_log
+
+    curves = {}
+    metric = args.metric
+    for d in args.run_dirs:
+        cfg = json.loads((Path(d) / "config.json").read_text())
+        label = f"{cfg['experiment']['name']} ({cfg['backend']}, seed {cfg['seed']})"
+        curves[label] = read_log(d)
+        if metric is None:
+            first = cfg["experiment"]["objectives"][0]["name"]
+            metric = first if first != "age" else "norm_final_dist"
+    path = plot_best_fitness(curves, metric, args.out, ylabel=f"Best {metric}")
+    print(path)
+    return 0
+
+
+def _cmd_experiments(args: argparse.Namespace) -> int:
+    from evolvers.experiments import EXPERIMENTS
+
+    for name, exp in EXPERIMENTS.items():
+        objs = ", ".join(f"{o.name} ({'max' if o.maximize else 'min'})" for o in exp.objectives)
+        print(f"{name:24s} {exp.selection:16s} {objs}\n{'':24s} {exp.description}")
+    return 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``softgym`` command."""
     parser = argparse.ArgumentParser(prog="softgym", description=__doc__.split("\n")[0])
@@ -103,6 +272,57 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--actuation", choices=["seed", "symmetric"], default="seed")
     p.add_argument("--out", default="runs/simulate")
     p.set_defaults(func=_cmd_simulate)
+
+    p = sub.add_parser("evolve", help="evolve robots with one of the seed's experiments")
+    p.add_argument(
+        "--experiment",
+        default="controller-tournament",
+        help="experiment name (softgym experiments lists them)",
+    )
+    p.add_argument("--generations", type=int, default=10, help="generations after generation 0")
+    p.add_argument("--pop", type=int, default=15, help="population size")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--out", default="runs/evolve", help="run folder")
+    p.add_argument(
+        "--resume", action="store_true", help="continue the run folder's last checkpoint"
+    )
+    p.add_argument(
+        "--dask",
+        metavar="local|tcp://ADDRESS",
+        help="evaluate on Dask: a LocalCluster or an existing scheduler",
+    )
+    p.add_argument("--workers", type=int, default=2, help="LocalCluster workers (--dask local)")
+    p.add_argument("--backend", choices=["native", "deap", "pymoo"], default="native")
+    p.add_argument("--seconds", type=float, help="simulated seconds per evaluation (default 5)")
+    p.add_argument(
+        "--shape", type=int, nargs=3, metavar=("NX", "NY", "NZ"), help="robot grid (default 6 6 6)"
+    )
+    p.add_argument(
+        "--selection",
+        choices=["pareto", "tournament", "novelty", "novelty-archive", "nsga2"],
+        help="override the experiment's selection (native and DEAP backends)",
+    )
+    p.add_argument("--threads", type=int, help="OpenMP threads of local simulations")
+    p.add_argument("--no-figures", action="store_true")
+    p.add_argument("--no-gif", action="store_true")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_evolve)
+
+    p = sub.add_parser("replay", help="re-simulate and render the best robot of a run folder")
+    p.add_argument("run_dir")
+    p.add_argument("--seconds", type=float, help="simulated seconds (default: the run's)")
+    p.add_argument("--out", help="output folder (default RUN_DIR/replay)")
+    p.add_argument("--no-gif", action="store_true")
+    p.set_defaults(func=_cmd_replay)
+
+    p = sub.add_parser("compare", help="best fitness per generation of several runs (Fig. 4)")
+    p.add_argument("run_dirs", nargs="+")
+    p.add_argument("--metric", help="metric to compare (default: the first run's fitness)")
+    p.add_argument("--out", default="runs/compare.png")
+    p.set_defaults(func=_cmd_compare)
+
+    p = sub.add_parser("experiments", help="list the named experiments")
+    p.set_defaults(func=_cmd_experiments)
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     return int(args.func(args))

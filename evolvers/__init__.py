@@ -1,0 +1,48 @@
+"""Evolve soft robots as the seed study did: genomes, operators, selections, runners.
+
+* :class:`Individual` (:mod:`evolvers.genome`): CPPN + material genes + controller genes + age + lineage.
+* :mod:`evolvers.operators`: arithmetic crossover, bounded Gaussian mutation, CPPN mutation.
+* :mod:`evolvers.selection`: the seed's Pareto (with age), NSGA-II, fitness tournament, AMSS novelty.
+* :class:`Evaluator` (:mod:`evolvers.evaluation`): batched, phenotype-cached evaluation.
+* :data:`EXPERIMENTS` (:mod:`evolvers.experiments`): the seed's scenarios by name.
+* Runners with run folders, checkpoints and exact resume: :class:`EvolutionRun`
+  (the seed's loop), :class:`~evolvers.deap_runner.DeapRun` (a DEAP toolbox),
+  :class:`~evolvers.pymoo_runner.PymooRun` (pymoo's NSGA2); Dask evaluation in
+  :mod:`evolvers.distributed`.
+
+The DEAP, pymoo and Dask modules are imported on demand (``from evolvers.deap_runner import DeapRun``).
+"""
+
+from evolvers.evaluation import Evaluator, PhenotypeCache
+from evolvers.experiments import EXPERIMENTS, Experiment, get_experiment, list_experiments
+from evolvers.genome import Individual
+from evolvers.operators import cx_arithmetic, make_children, mut_controller, mut_cppn, mut_materials
+from evolvers.runner import EvolutionRun
+from evolvers.selection import (
+    Objective,
+    sel_fitness_tournament,
+    sel_novelty,
+    sel_nsga2,
+    sel_pareto,
+)
+
+__all__ = [
+    "EXPERIMENTS",
+    "EvolutionRun",
+    "Evaluator",
+    "Experiment",
+    "Individual",
+    "Objective",
+    "PhenotypeCache",
+    "cx_arithmetic",
+    "get_experiment",
+    "list_experiments",
+    "make_children",
+    "mut_controller",
+    "mut_cppn",
+    "mut_materials",
+    "sel_fitness_tournament",
+    "sel_novelty",
+    "sel_nsga2",
+    "sel_pareto",
+]

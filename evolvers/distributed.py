@@ -1,0 +1,115 @@
+"""Population evaluation on Dask: a LocalCluster or an existing scheduler.
+
+:class:`DaskBatchFn` is a drop-in ``batch_fn`` for
+:class:`~evolvers.evaluation.Evaluator`: it splits a generation's designs into
+one contiguous batch per worker thread, ships each batch as plain JSON-ready
+data (``design.to_dict()``) to :func:`softgym.evaluate.evaluate_payload`, and
+concatenates the results in order. Each batch is one batched Simulation on the
+worker. A robot's result does not depend on its batch, so the results equal a
+local run bit for bit. A batch lost with its worker is recomputed by Dask on
+another worker (tasks are submitted with ``retries``).
+
+>>> from evolvers.distributed import dask_client
+>>> with dask_client("local", n_workers=2) as client:   # doctest: +SKIP
+...     run = EvolutionRun(exp, "runs/x", batch_fn=DaskBatchFn(client))
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+
+from softgym.evaluate import Task, evaluate_payload
+
+__all__ = ["DaskBatchFn", "dask_client", "split_batches"]
+
+
+def split_batches(n: int, n_batches: int) -> list[tuple[int, int]]:
+    """Split ``range(n)`` into at most ``n_batches`` contiguous, near-equal ``(start, stop)`` slices."""
+    n_batches = max(1, min(int(n_batches), n))
+    edges = np.linspace(0, n, n_batches + 1).round().astype(int)
+    return [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:]) if b > a]
+
+
+def _merge(parts: list[dict[str, Any]]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key in parts[0]:
+        if key == "traces":
+            out[key] = [t for p in parts for t in p[key]]
+        else:
+            out[key] = np.concatenate([np.asarray(p[key]) for p in parts])
+    return out
+
+
+class DaskBatchFn:
+    """Evaluate a batch of designs over the workers of a Dask client.
+
+    Parameters
+    ----------
+    client : distributed.Client
+    n_batches : int, optional
+        Batches per generation (default: the cluster's total worker threads).
+    retries : int
+        Times a failed batch (e.g. its worker died) is resubmitted.
+    """
+
+    def __init__(self, client: Any, n_batches: int | None = None, retries: int = 3) -> None:
+        self.client = client
+        self.n_batches = n_batches
+        self.retries = int(retries)
+
+    def _default_batches(self) -> int:
+        try:
+            return max(1, sum(self.client.nthreads().values()))
+        except Exception:  # pragma: no cover - scheduler without the call
+            return 1
+
+    def __call__(self, designs: list[dict[str, Any]], task: Task) -> dict[str, Any]:
+        """``(design dicts, task) -> metrics``, like :func:`evolvers.evaluation.local_batch_fn`."""
+        slices = split_batches(len(designs), self.n_batches or self._default_batches())
+        # one engine thread per batch: workers already run batches in parallel
+        task_dict = {**task.to_dict(), "n_threads": 1}
+        payloads = [{"designs": designs[a:b], "task": task_dict} for a, b in slices]
+        futures = self.client.map(evaluate_payload, payloads, pure=False, retries=self.retries)
+        parts = self.client.gather(futures)
+        return _merge(parts)
+
+
+@contextlib.contextmanager
+def dask_client(
+    address: str = "local", n_workers: int = 2, processes: bool = True
+) -> Iterator[Any]:
+    """A Dask client: ``"local"`` starts a LocalCluster, anything else is a scheduler address.
+
+    Parameters
+    ----------
+    address : str
+        ``"local"`` or e.g. ``"tcp://10.0.0.5:8786"``.
+    n_workers : int
+        Workers of the LocalCluster (one thread each).
+    processes : bool
+        LocalCluster workers as processes (True) or threads of this process
+        (the engine releases the GIL, so threads run in parallel too).
+    """
+    from distributed import Client, LocalCluster
+
+    if address == "local":
+        cluster = LocalCluster(
+            n_workers=n_workers, threads_per_worker=1, processes=processes,
+            dashboard_address=None,
+        )  # fmt: skip
+        client = Client(cluster)
+        try:
+            yield client
+        finally:
+            client.close()
+            cluster.close()
+    else:
+        client = Client(address)
+        try:
+            yield client
+        finally:
+            client.close()

@@ -1,0 +1,211 @@
+"""Batched population evaluation with a phenotype cache.
+
+An :class:`Evaluator` turns individuals into designs, skips those whose
+phenotype (grid + used materials + controller, :meth:`Individual.phenotype_key`)
+was already simulated, and simulates all the others **in one batched
+Simulation** (locally) or in a few batches spread over Dask workers
+(:mod:`evolvers.distributed`). A robot's result does not depend on its batch,
+so local and distributed runs, cached and fresh evaluations, agree bit for bit.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from evolvers.experiments import Experiment
+from evolvers.genome import Individual
+from softgym.evaluate import METRIC_KEYS, Task, evaluate
+from softgym.metrics import WORST_FITNESS, WORST_MINIMIZED
+
+__all__ = [
+    "FITNESS_METRICS",
+    "BatchFn",
+    "EvalStats",
+    "Evaluator",
+    "PhenotypeCache",
+    "local_batch_fn",
+    "pack_traces",
+    "unpack_traces",
+]
+
+#: Maximised metrics (the rest are counts, minimised when they are objectives).
+FITNESS_METRICS: tuple[str, ...] = ("norm_final_dist", "max_xy_dist", "l_coefficient")
+
+#: ``(designs as dicts, task) -> softgym.evaluate output with traces``.
+BatchFn = Callable[[list[dict[str, Any]], Task], dict[str, Any]]
+
+_STORED = tuple(k for k in METRIC_KEYS if k != "time_max_xy_dist")
+
+
+def local_batch_fn(designs: list[dict[str, Any]], task: Task) -> dict[str, Any]:
+    """Evaluate every design in one local Simulation (:func:`softgym.evaluate`)."""
+    return evaluate(designs, task=task, traces=True)
+
+
+def pack_traces(traces: Sequence[np.ndarray | None]) -> tuple[np.ndarray, np.ndarray]:
+    """Pad traces into one array.
+
+    Returns
+    -------
+    data : ndarray of shape (n, max_points, 4), float64
+    lengths : ndarray of shape (n,), int64
+        Points of each trace; -1 for None.
+    """
+    n = len(traces)
+    lengths = np.array([-1 if t is None else len(t) for t in traces], dtype=np.int64)
+    m = max([0, *lengths.tolist()])
+    data = np.zeros((n, m, 4))
+    for i, t in enumerate(traces):
+        if t is not None and len(t):
+            data[i, : len(t)] = t
+    return data, lengths
+
+
+def unpack_traces(data: np.ndarray, lengths: np.ndarray) -> list[np.ndarray | None]:
+    """Inverse of :func:`pack_traces`."""
+    return [None if n < 0 else np.array(data[i, :n]) for i, n in enumerate(lengths.tolist())]
+
+
+class PhenotypeCache:
+    """Results by phenotype key: metric values and the centre-of-mass trace."""
+
+    def __init__(self) -> None:
+        self._data: dict[str, tuple[dict[str, float], np.ndarray | None]] = {}
+
+    def __len__(self) -> int:
+        return len(self._data)
+
+    def __contains__(self, key: str) -> bool:
+        return key in self._data
+
+    def get(self, key: str) -> tuple[dict[str, float], np.ndarray | None]:
+        """The stored ``(objectives, trace)`` of ``key``."""
+        return self._data[key]
+
+    def put(self, key: str, objectives: dict[str, float], trace: np.ndarray | None) -> None:
+        """Store a result."""
+        self._data[key] = (dict(objectives), trace)
+
+    def to_arrays(self) -> dict[str, np.ndarray]:
+        """Checkpoint arrays (plain dtypes, no pickle)."""
+        keys = list(self._data)
+        values = np.array(
+            [[self._data[k][0].get(m, np.nan) for m in _STORED] for k in keys], dtype=np.float64
+        ).reshape(len(keys), len(_STORED))
+        data, lengths = pack_traces([self._data[k][1] for k in keys])
+        return {
+            "cache_keys": np.array(keys, dtype="<U64"),
+            "cache_values": values,
+            "cache_traces": data,
+            "cache_trace_len": lengths,
+        }
+
+    @classmethod
+    def from_arrays(cls, arrays: dict[str, np.ndarray]) -> PhenotypeCache:
+        """Inverse of :meth:`to_arrays` (an empty cache if the arrays are absent)."""
+        cache = cls()
+        if "cache_keys" not in arrays:
+            return cache
+        traces = unpack_traces(arrays["cache_traces"], arrays["cache_trace_len"])
+        for key, row, tr in zip(arrays["cache_keys"].tolist(), arrays["cache_values"], traces):
+            cache._data[str(key)] = ({m: float(v) for m, v in zip(_STORED, row)}, tr)
+        return cache
+
+
+@dataclass
+class EvalStats:
+    """What one :meth:`Evaluator.evaluate` call did."""
+
+    n_individuals: int = 0
+    n_simulated: int = 0
+    n_cached: int = 0
+    n_invalid: int = 0
+    n_diverged: int = 0
+    n_bone: int = 0
+
+
+def _worst_objectives() -> dict[str, float]:
+    out = {m: (WORST_FITNESS if m in FITNESS_METRICS else WORST_MINIMIZED) for m in _STORED}
+    out["diverged"] = 0.0
+    return out
+
+
+class Evaluator:
+    """Evaluate individuals of an experiment, batched and cached.
+
+    Parameters
+    ----------
+    experiment : Experiment
+        Gives the task (terrain, seconds, trace interval), the grid shape and the rules.
+    batch_fn : callable, optional
+        ``(design dicts, task) -> metrics`` (default :func:`local_batch_fn`:
+        one local Simulation). :class:`evolvers.distributed.DaskBatchFn` spreads
+        the batch over Dask workers.
+    n_threads : int, optional
+        OpenMP threads of local simulations.
+    cache : PhenotypeCache, optional
+        Shared results (a fresh cache by default).
+    """
+
+    def __init__(
+        self,
+        experiment: Experiment,
+        batch_fn: BatchFn | None = None,
+        n_threads: int | None = None,
+        cache: PhenotypeCache | None = None,
+    ) -> None:
+        self.experiment = experiment
+        self.task = experiment.task(n_threads)
+        self.batch_fn = batch_fn or local_batch_fn
+        self.cache = PhenotypeCache() if cache is None else cache
+        self.n_evaluations = 0
+
+    def evaluate(self, individuals: Sequence[Individual]) -> EvalStats:
+        """Fill ``objectives`` and ``trace`` of every individual (in place).
+
+        All metrics of :func:`softgym.evaluate` are stored (``diverged`` as
+        0/1). Invalid bodies (breaking the experiment's rules) are not
+        simulated and get the worst values; identical phenotypes are
+        simulated once.
+        """
+        exp = self.experiment
+        stats = EvalStats(n_individuals=len(individuals))
+        todo: dict[str, list[Individual]] = {}
+        for ind in individuals:
+            grid = ind.grid(exp.shape)
+            if exp.rules.violations(grid):
+                ind.objectives = _worst_objectives()
+                ind.trace = None
+                stats.n_invalid += 1
+                continue
+            if (grid == 2).any():
+                stats.n_bone += 1
+            key = ind.phenotype_key(exp.shape)
+            if key in self.cache:
+                obj, tr = self.cache.get(key)
+                ind.objectives = dict(obj)
+                ind.trace = tr
+                stats.n_cached += 1
+            else:
+                todo.setdefault(key, []).append(ind)
+        if todo:
+            keys = list(todo)
+            designs = [todo[k][0].design(exp.shape).to_dict() for k in keys]
+            res = self.batch_fn(designs, self.task)
+            for i, key in enumerate(keys):
+                obj = {m: float(res[m][i]) for m in _STORED}
+                tr = res["traces"][i]
+                tr = None if tr is None else np.asarray(tr, dtype=np.float64)
+                self.cache.put(key, obj, tr)
+                stats.n_diverged += int(obj["diverged"])
+                for ind in todo[key]:
+                    ind.objectives = dict(obj)
+                    ind.trace = tr
+            stats.n_simulated = len(keys)
+            stats.n_cached += sum(len(v) - 1 for v in todo.values())
+        self.n_evaluations += stats.n_simulated
+        return stats

@@ -1,0 +1,282 @@
+"""The seed study's scenarios as named, runnable configurations (SEED_REFERENCE §3.8).
+
+==========================  =====================  ==============  ============================================
+name                        variation              selection       objectives
+==========================  =====================  ==============  ============================================
+``basic``                   CPPN                   Pareto          NormFinalDist (max), muscle voxels (min)
+``materials-t1``            CPPN + material GA     Pareto          NormFinalDist (max), old materials (min)
+``materials-t2``            CPPN + material GA     Pareto          ... + robot voxels (min)
+``novelty``                 CPPN                   AMSS (seed)     novelty; fitness and energy logged
+``novelty-archive``         CPPN                   AMSS + archive  novelty against past generations too
+``controller-tournament``   CPPN + controller GA   tournament (2)  NormFinalDist (max)
+``controller-pareto``       CPPN + controller GA   Pareto          NormFinalDist (max), muscle voxels (min)
+``obstacles``               CPPN + controller GA   Pareto + age    MaxXYDist (max), L coeff. (max), age (min)
+``obstacles-attempt1``      CPPN                   Pareto          MaxXYDist (max), muscle voxels (min)
+``obstacles-attempt2``      CPPN + controller GA   tournament (2)  MaxXYDist (max)
+==========================  =====================  ==============  ============================================
+
+``materials`` is an alias of ``materials-t1``. Obstacle experiments run in the
+seed's 1-voxel-high fence (10-voxel interior) with centre-of-mass samples every
+0.1 s; ``obstacles`` also applies the seed's composition constraints (>= 10 %
+tissue, >= 1 bone, >= 10 % muscle). Every experiment: 6x6x6 CPPN robots,
+population 15, 15 children and 1 random newcomer per generation, 5 s simulated.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields, replace
+from typing import Any
+
+from evolvers.selection import Objective
+from softgym.design import MATERIAL_TREE_4, MATERIAL_TREE_8, CompositionRules
+from softgym.evaluate import Task
+from softgym.exceptions import InvalidParameterError
+
+__all__ = ["EXPERIMENTS", "SELECTIONS", "Experiment", "get_experiment", "list_experiments"]
+
+#: Selection schemes an experiment may name.
+SELECTIONS: tuple[str, ...] = ("pareto", "tournament", "novelty", "novelty-archive", "nsga2")
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """A runnable evolutionary scenario.
+
+    Parameters
+    ----------
+    name : str
+    description : str
+    objectives : tuple of Objective
+        Selection objectives, most important first (the first is "the
+        fitness" shown in progress bars and trend figures).
+    logged : tuple of str
+        Extra metrics recorded in the log (not selected on).
+    selection : {"pareto", "tournament", "novelty", "novelty-archive", "nsga2"}
+    evolve_controller, evolve_materials : bool
+        Whether the controller / material genes evolve (crossover + mutation).
+    cppn_outputs : tuple of str
+        CPPN outputs: the 4-output tree, or the 8-output tree of materials evolution.
+    rules : CompositionRules
+        Validity of a body (enforced by generation and mutation; pymoo's G).
+    terrain : {"flat", "fence"}
+    seconds : float
+        Simulated seconds per evaluation (5).
+    trace_interval : float
+        Seconds between centre-of-mass samples (0.5 novelty, 0.1 otherwise).
+    pop_size, n_random : int
+        Population size (15) and random newcomers per generation (1).
+    generations : int
+        Default number of generations (the report's).
+    crossover_rate : float
+        Arithmetic crossover rate (0.4).
+    shape : tuple of 3 int
+        Robot grid (6, 6, 6).
+    sim : dict
+        :class:`~softgym.engine.SimConfig` overrides.
+    """
+
+    name: str
+    description: str
+    objectives: tuple[Objective, ...]
+    logged: tuple[str, ...] = ()
+    selection: str = "pareto"
+    evolve_controller: bool = False
+    evolve_materials: bool = False
+    cppn_outputs: tuple[str, ...] = MATERIAL_TREE_4
+    rules: CompositionRules = field(default_factory=CompositionRules.seed)
+    terrain: str = "flat"
+    seconds: float = 5.0
+    trace_interval: float = 0.1
+    pop_size: int = 15
+    n_random: int = 1
+    generations: int = 40
+    crossover_rate: float = 0.4
+    shape: tuple[int, int, int] = (6, 6, 6)
+    sim: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.selection not in SELECTIONS:
+            raise InvalidParameterError(
+                f"unknown selection {self.selection!r}; expected one of {SELECTIONS}"
+            )
+        if self.pop_size < 2:
+            raise InvalidParameterError(f"pop_size must be >= 2, got {self.pop_size}")
+        if not self.objectives:
+            raise InvalidParameterError("an experiment needs at least one objective")
+        object.__setattr__(self, "shape", tuple(int(s) for s in self.shape))
+
+    @property
+    def fitness(self) -> Objective:
+        """The first (most important) objective."""
+        return self.objectives[0]
+
+    @property
+    def metrics(self) -> tuple[str, ...]:
+        """Every metric recorded: the objectives' (age excluded) and the logged ones."""
+        names = [o.name for o in self.objectives if o.name != "age"] + list(self.logged)
+        return tuple(dict.fromkeys(names))
+
+    def task(self, n_threads: int | None = None) -> Task:
+        """The :class:`~softgym.evaluate.Task` evaluations run."""
+        return Task(
+            terrain=self.terrain,
+            seconds=self.seconds,
+            trace_interval=self.trace_interval,
+            sim=dict(self.sim),
+            n_threads=n_threads,
+        )
+
+    def replace(self, **changes: Any) -> Experiment:
+        """A copy with some fields changed (e.g. ``pop_size``, ``seconds``, ``shape``)."""
+        return replace(self, **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict."""
+        out: dict[str, Any] = {}
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if f.name == "objectives":
+                v = [o.to_dict() for o in v]
+            elif f.name == "rules":
+                v = v.to_dict()
+            elif isinstance(v, tuple):
+                v = list(v)
+            out[f.name] = v
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Experiment:
+        """Inverse of :meth:`to_dict`."""
+        kw = dict(data)
+        kw["objectives"] = tuple(Objective(**o) for o in kw["objectives"])
+        kw["rules"] = CompositionRules.from_dict(kw["rules"])
+        for name in ("logged", "cppn_outputs", "shape"):
+            kw[name] = tuple(kw[name])
+        return cls(**kw)
+
+
+_FIT = Objective("norm_final_dist", True)
+_ENERGY = Objective("n_muscle", False)
+
+EXPERIMENTS: dict[str, Experiment] = {
+    e.name: e
+    for e in (
+        Experiment(
+            "basic",
+            "evosoro's baseline: CPPN mutation, Pareto on distance and muscle count (report Fig. 4)",
+            (_FIT, _ENERGY),
+            selection="pareto",
+            generations=40,
+        ),
+        Experiment(
+            "materials-t1",
+            "materials evolution, treatment 1: distance vs. use of the old materials (report Fig. 1)",
+            (_FIT, Objective("n_old_materials", False)),
+            logged=("n_voxels",),
+            evolve_materials=True,
+            cppn_outputs=MATERIAL_TREE_8,
+            generations=300,
+        ),
+        Experiment(
+            "materials-t2",
+            "materials evolution, treatment 2: treatment 1 plus fewer voxels",
+            (_FIT, Objective("n_old_materials", False), Objective("n_voxels", False)),
+            evolve_materials=True,
+            cppn_outputs=MATERIAL_TREE_8,
+            generations=50,
+        ),
+        Experiment(
+            "novelty",
+            "novelty search: AMSS similarity of centre-of-mass trajectories within the generation",
+            (_FIT,),
+            logged=("n_muscle",),
+            selection="novelty",
+            trace_interval=0.5,
+            generations=200,
+        ),
+        Experiment(
+            "novelty-archive",
+            "novelty search with an archive of past behaviours (k nearest neighbours)",
+            (_FIT,),
+            logged=("n_muscle",),
+            selection="novelty-archive",
+            trace_interval=0.5,
+            generations=200,
+        ),
+        Experiment(
+            "controller-tournament",
+            "controller evolution with the fitness tournament (report Fig. 4)",
+            (_FIT,),
+            logged=("n_muscle",),
+            selection="tournament",
+            evolve_controller=True,
+            generations=40,
+        ),
+        Experiment(
+            "controller-pareto",
+            "controller evolution with Pareto on distance and muscle count (report Fig. 4)",
+            (_FIT, _ENERGY),
+            selection="pareto",
+            evolve_controller=True,
+            generations=40,
+        ),
+        Experiment(
+            "obstacles",
+            "evolution vs. a 1-voxel wall, final setup: MaxXYDist, L coefficient and age, composition rules",
+            (
+                Objective("max_xy_dist", True),
+                Objective("l_coefficient", True),
+                Objective("age", False),
+            ),
+            logged=("n_muscle", "n_bone"),
+            selection="pareto",
+            evolve_controller=True,
+            rules=CompositionRules.obstacles(),
+            terrain="fence",
+            generations=80,
+        ),
+        Experiment(
+            "obstacles-attempt1",
+            "evolution vs. a wall, attempt 1: default controller, Pareto on MaxXYDist and muscle count",
+            (Objective("max_xy_dist", True), _ENERGY),
+            logged=("l_coefficient",),
+            selection="pareto",
+            terrain="fence",
+            generations=20,
+        ),
+        Experiment(
+            "obstacles-attempt2",
+            "evolution vs. a wall, attempt 2: controller evolution with the fitness tournament on MaxXYDist",
+            (Objective("max_xy_dist", True),),
+            logged=("l_coefficient", "n_muscle"),
+            selection="tournament",
+            evolve_controller=True,
+            terrain="fence",
+            generations=20,
+        ),
+    )
+}
+EXPERIMENTS["materials"] = EXPERIMENTS["materials-t1"]
+
+
+def list_experiments() -> list[str]:
+    """Names of the named experiments."""
+    return list(EXPERIMENTS)
+
+
+def get_experiment(name: str, **overrides: Any) -> Experiment:
+    """A named experiment, with optional field overrides.
+
+    Raises
+    ------
+    InvalidParameterError
+        If the name is unknown.
+    """
+    try:
+        exp = EXPERIMENTS[name]
+    except KeyError:
+        raise InvalidParameterError(
+            f"unknown experiment {name!r}; expected one of {list_experiments()}"
+        ) from None
+    return exp.replace(**overrides) if overrides else exp

@@ -1,0 +1,207 @@
+"""`Individual`: a CPPN genome, material genes, controller genes, age and lineage.
+
+The genome of the seed study (SEED_REFERENCE §2.4, §3.1, §3.2):
+
+* a :class:`~softgym.design.CPPN` drawing the voxel grid and choosing materials;
+* material genes: Young's modulus (Pa), density (kg/m^3) and CTE (1/°C) of
+  the evolvable materials 6-9 (material 9 is the counter-phase copy of 8);
+* controller genes: a :class:`~softgym.design.Controller` (temperature
+  amplitude, period, muscle CTE);
+* bookkeeping: ``age`` (generations survived, the age objective), ``id``
+  (unique in a run, increasing) and ``parent_id``.
+
+Evaluation results live on the individual too (``objectives``, ``trace``,
+``novelty``) so selection reads them directly.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from softgym.design import CPPN, MATERIAL_TREE_4, CompositionRules, Controller, default_palette
+from softgym.design.robot import RobotDesign
+
+__all__ = [
+    "INITIAL_MATERIAL_GENES",
+    "MATERIAL_GENE_IDS",
+    "Individual",
+]
+
+#: Material ids whose properties are genes (rows of ``Individual.materials``).
+MATERIAL_GENE_IDS: tuple[int, ...] = (6, 7, 8, 9)
+#: Initial material genes (SEED_REFERENCE §3.1): rows ids 6-9, columns (E Pa, density kg/m^3, CTE 1/°C).
+INITIAL_MATERIAL_GENES = np.array(
+    [
+        [5e6, 1e6, 0.0],
+        [5e8, 1e6, 0.0],
+        [5e6, 1e6, 0.05],
+        [5e6, 1e6, -0.05],
+    ]
+)
+INITIAL_MATERIAL_GENES.setflags(write=False)
+
+
+@dataclass(eq=False)
+class Individual:
+    """One robot genome of an evolutionary run.
+
+    Parameters
+    ----------
+    cppn : CPPN
+        Body and material-choice genome.
+    materials : ndarray of shape (4, 3), float64
+        Genes of materials 6, 7, 8, 9: columns Young's modulus (Pa),
+        density (kg/m^3), CTE (1/°C).
+    controller : Controller
+        Controller genes.
+    id : int
+        Unique id in the run (newer individuals have larger ids).
+    parent_id : int or None
+        Id of the parent (None for random individuals).
+    age : int
+        Generations of ancestry (the seed increments every individual's age
+        each generation; children inherit it; random newcomers start at 0).
+    objectives : dict of str to float
+        Evaluation results by metric name (filled by the evaluator).
+    trace : ndarray of shape (n_points, 4), optional
+        Centre-of-mass trace (x, y, z, t) in m and s, for novelty.
+    novelty : float, optional
+        Last novelty score (lower = more novel).
+    """
+
+    cppn: CPPN
+    materials: np.ndarray = field(default_factory=lambda: INITIAL_MATERIAL_GENES.copy())
+    controller: Controller = field(default_factory=Controller)
+    id: int = 0
+    parent_id: int | None = None
+    age: int = 0
+    objectives: dict[str, float] = field(default_factory=dict)
+    trace: np.ndarray | None = None
+    novelty: float | None = None
+    _grid: np.ndarray | None = field(default=None, repr=False)
+    _grid_shape: tuple[int, ...] | None = field(default=None, repr=False)
+
+    def __post_init__(self) -> None:
+        self.materials = np.array(self.materials, dtype=np.float64).reshape(4, 3)
+
+    # ------------------------------------------------------------------ phenotype
+    @classmethod
+    def random(
+        cls,
+        rng: np.random.Generator,
+        id: int,
+        shape: Sequence[int] = (6, 6, 6),
+        outputs: Sequence[str] = MATERIAL_TREE_4,
+        rules: CompositionRules | None = None,
+    ) -> Individual:
+        """A random valid individual (the seed's new and gen-0 individuals).
+
+        Parameters
+        ----------
+        rng : numpy.random.Generator
+        id : int
+        shape : (nx, ny, nz)
+            Grid the CPPN draws in.
+        outputs : sequence of str
+            CPPN outputs (:data:`~softgym.design.MATERIAL_TREE_4` or ``_8``).
+        rules : CompositionRules, optional
+            Validity (default :meth:`CompositionRules.seed`).
+        """
+        rules = CompositionRules.seed() if rules is None else rules
+        g = CPPN.random_valid(outputs, rng=rng, shape=tuple(shape), is_valid=rules)
+        return cls(cppn=g, id=int(id))
+
+    def grid(self, shape: Sequence[int] = (6, 6, 6)) -> np.ndarray:
+        """The material grid, ndarray of shape ``shape``, int8 (cached)."""
+        shape = tuple(int(s) for s in shape)
+        if self._grid is None or self._grid_shape != shape:
+            self._grid = self.cppn.to_grid(shape)
+            self._grid_shape = shape
+        return self._grid
+
+    def palette(self):
+        """The default palette with materials 6-9 set from the material genes."""
+        pal = default_palette()
+        for row, mid in zip(self.materials, MATERIAL_GENE_IDS):
+            pal = pal.with_changes(
+                mid, youngs_modulus=float(row[0]), density=float(row[1]), cte=float(row[2])
+            )
+        return pal
+
+    def design(self, shape: Sequence[int] = (6, 6, 6)) -> RobotDesign:
+        """The :class:`~softgym.design.RobotDesign` of this genome (not validated)."""
+        return RobotDesign(self.grid(shape), palette=self.palette(), controller=self.controller)
+
+    def phenotype_key(self, shape: Sequence[int] = (6, 6, 6)) -> str:
+        """Hash of what the simulator sees: grid, used materials' properties, controller.
+
+        Two individuals with the same key behave identically, so the second
+        is not simulated again (the seed's md5 phenotype cache, §2.3).
+        """
+        grid = self.grid(shape)
+        h = hashlib.sha256()
+        h.update(repr(grid.shape).encode())
+        h.update(np.ascontiguousarray(grid).tobytes())
+        used = sorted(int(v) for v in np.unique(grid) if v)
+        pal = self.palette()
+        c = self.controller
+        for mid in used:
+            m = pal[mid]
+            h.update(
+                repr(
+                    (mid, m.youngs_modulus, m.density, m.poisson, m.cte, m.mu_static, m.mu_kinetic)
+                ).encode()
+            )
+        h.update(repr((c.temp_amplitude, c.period, c.muscle_cte)).encode())
+        return h.hexdigest()
+
+    # ------------------------------------------------------------------ copies
+    def child(self, id: int) -> Individual:
+        """A copy with a new ``id``, this individual as parent, no evaluation results."""
+        return Individual(
+            cppn=self.cppn.copy(),
+            materials=self.materials.copy(),
+            controller=self.controller,
+            id=int(id),
+            parent_id=self.id,
+            age=self.age,
+        )
+
+    def value(self, name: str) -> float:
+        """An objective's value (``"age"`` reads the age)."""
+        if name == "age":
+            return float(self.age)
+        return float(self.objectives[name])
+
+    # ------------------------------------------------------------------ JSON
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (the trace is stored separately, in checkpoint arrays)."""
+        return {
+            "id": self.id,
+            "parent_id": self.parent_id,
+            "age": self.age,
+            "cppn": self.cppn.to_dict(),
+            "materials": self.materials.tolist(),
+            "controller": self.controller.to_dict(),
+            "objectives": dict(self.objectives),
+            "novelty": self.novelty,
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Individual:
+        """Inverse of :meth:`to_dict`."""
+        return cls(
+            cppn=CPPN.from_dict(data["cppn"]),
+            materials=np.asarray(data["materials"], dtype=np.float64),
+            controller=Controller.from_dict(data["controller"]),
+            id=int(data["id"]),
+            parent_id=None if data.get("parent_id") is None else int(data["parent_id"]),
+            age=int(data["age"]),
+            objectives={k: float(v) for k, v in data.get("objectives", {}).items()},
+            novelty=None if data.get("novelty") is None else float(data["novelty"]),
+        )

@@ -1,0 +1,36 @@
+import numpy as np
+import pytest
+from evolver_helpers import tiny
+
+from evolvers.distributed import DaskBatchFn, dask_client, split_batches
+from evolvers.evaluation import local_batch_fn
+from evolvers.genome import Individual
+from evolvers.runner import EvolutionRun, population_summary
+
+pytest.importorskip("distributed")
+
+
+def test_split_batches_covers_everything():
+    assert split_batches(31, 2) == [(0, 16), (16, 31)]
+    assert split_batches(3, 8) == [(0, 1), (1, 2), (2, 3)]
+
+
+def test_local_cluster_with_two_workers_equals_local(tmp_path):
+    exp = tiny("controller-pareto")
+    rng = np.random.default_rng(0)
+    designs = [Individual.random(rng, i, exp.shape).design(exp.shape).to_dict() for i in range(5)]
+    local = local_batch_fn(designs, exp.task())
+    with dask_client("local", n_workers=2, processes=False) as client:
+        fn = DaskBatchFn(client)
+        remote = fn(designs, exp.task())
+        assert len(client.nthreads()) == 2
+        for key in ("norm_final_dist", "max_xy_dist", "l_coefficient", "n_muscle", "diverged"):
+            np.testing.assert_array_equal(remote[key], local[key])
+        for a, b in zip(remote["traces"], local["traces"]):
+            np.testing.assert_array_equal(a, b)
+        run = EvolutionRun(
+            exp, tmp_path / "dask", seed=7, generations=1, figures=False, batch_fn=fn
+        )
+        pop_dask = run.run()
+    pop_local = EvolutionRun(exp, tmp_path / "local", seed=7, generations=1, figures=False).run()
+    assert population_summary(pop_dask) == population_summary(pop_local)

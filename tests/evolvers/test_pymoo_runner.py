@@ -1,0 +1,49 @@
+import numpy as np
+from evolver_helpers import tiny
+from pymoo.core.problem import Problem
+
+from evolvers.evaluation import Evaluator
+from evolvers.genome import Individual
+from evolvers.pymoo_runner import PymooRun, SoftbotProblem, constraint_values
+from evolvers.runner import population_summary
+from softgym.design import CompositionRules
+
+
+def test_problem_fills_minimised_F_and_feasible_G():
+    exp = tiny("obstacles", rules=CompositionRules.obstacles())
+    problem = SoftbotProblem(exp, Evaluator(exp))
+    assert isinstance(problem, Problem) and problem.n_obj == 3 and problem.n_ieq_constr == 5
+    rng = np.random.default_rng(0)
+    X = np.array(
+        [[Individual.random(rng, i, exp.shape, rules=exp.rules)] for i in range(2)], dtype=object
+    )
+    out = problem.evaluate(X, return_as_dictionary=True)
+    assert out["F"].shape == (2, 3) and out["G"].shape == (2, 5)
+    assert (out["G"] <= 0).all()  # valid robots are feasible
+    np.testing.assert_array_equal(out["F"][:, 0], [-x[0].objectives["max_xy_dist"] for x in X])
+    grid = np.zeros(exp.shape, dtype=np.int8)
+    grid[0, 0, 0] = 3
+    assert (constraint_values(grid, exp.rules) > 0).any()
+
+
+def test_pymoo_nsga2_runs_and_resumes_exactly(tmp_path):
+    exp = tiny("controller-pareto")
+    ref_run = PymooRun(exp, tmp_path / "a", seed=3, generations=2, figures=False)
+    ref = ref_run.run()
+    assert [r["generation"] for r in ref_run.rows] == [0, 1, 2]
+
+    class Crash(Exception):
+        pass
+
+    def crash(run, row):
+        if row["generation"] == 1:
+            raise Crash
+
+    try:
+        PymooRun(
+            exp, tmp_path / "b", seed=3, generations=2, figures=False, on_generation=crash
+        ).run()
+    except Crash:
+        pass
+    resumed = PymooRun(exp, tmp_path / "b", seed=3, generations=2, figures=False).run(resume=True)
+    assert population_summary(resumed) == population_summary(ref)

@@ -1,0 +1,94 @@
+import csv
+import json
+
+import pytest
+from evolver_helpers import tiny
+
+from evolvers.runner import EvolutionRun, population_summary
+from softgym.design import CompositionRules
+from softgym.exceptions import CheckpointError
+from softgym.io import list_checkpoints, load_checkpoint
+
+
+class Crash(RuntimeError):
+    pass
+
+
+def _crash_after(gen):
+    def cb(run, row):
+        if row["generation"] == gen:
+            raise Crash
+
+    return cb
+
+
+def test_run_folder_contents(tmp_path):
+    exp = tiny("controller-pareto")
+    run = EvolutionRun(exp, tmp_path / "r", seed=2, generations=2, figures=False)
+    pop = run.run()
+    out = tmp_path / "r"
+    assert len(pop) == exp.pop_size
+    cfg = json.loads((out / "config.json").read_text())
+    assert cfg["experiment"]["name"] == "controller-pareto" and cfg["seed"] == 2
+    rows = list(csv.DictReader((out / "log.csv").open()))
+    assert [int(r["generation"]) for r in rows] == [0, 1, 2]
+    for col in (
+        "norm_final_dist_best",
+        "norm_final_dist_median",
+        "norm_final_dist_mean",
+        "norm_final_dist_worst",
+        "n_muscle_best",
+        "evaluations",
+        "wall_time",
+    ):
+        assert col in rows[0]
+    assert int(rows[1]["evaluations"]) <= exp.pop_size + 1  # parents come from the cache
+    assert [p.name for p in list_checkpoints(out / "checkpoints")] == [
+        "ckpt-000000.json",
+        "ckpt-000001.json",
+        "ckpt-000002.json",
+    ]
+    best = json.loads((out / "best_designs.json").read_text())["best"]
+    assert best[0]["objectives"]["norm_final_dist"] == max(
+        b["objectives"]["norm_final_dist"] for b in best
+    )
+    assert (out / "best_design.json").exists() and (out / "final_population.json").exists()
+
+
+@pytest.mark.parametrize("name", ["obstacles", "novelty-archive", "materials-t1"])
+def test_interrupted_run_resumes_to_the_identical_result(tmp_path, name):
+    exp = tiny(name, rules=CompositionRules.seed())  # no bone required: keeps the test fast
+    ref = EvolutionRun(exp, tmp_path / "ref", seed=5, generations=3, figures=False).run()
+    broken = EvolutionRun(
+        exp, tmp_path / "b", seed=5, generations=3, figures=False, on_generation=_crash_after(1)
+    )
+    with pytest.raises(Crash):
+        broken.run()
+    resumed = EvolutionRun(exp, tmp_path / "b", seed=5, generations=3, figures=False)
+    pop = resumed.run(resume=True)
+    assert population_summary(pop) == population_summary(ref)
+    assert [r["generation"] for r in resumed.rows] == [0, 1, 2, 3]
+
+
+def test_corrupt_checkpoint_names_the_file_and_keeps_the_previous(tmp_path):
+    exp = tiny()
+    EvolutionRun(exp, tmp_path / "r", seed=1, generations=1, figures=False).run()
+    ckpts = list_checkpoints(tmp_path / "r" / "checkpoints")
+    text = ckpts[-1].read_text()
+    ckpts[-1].write_text(text[: len(text) // 2])  # truncated
+    with pytest.raises(CheckpointError, match="ckpt-000001.json"):
+        EvolutionRun(exp, tmp_path / "r", seed=1, generations=2, figures=False).run(resume=True)
+    state, _ = load_checkpoint(ckpts[-2])  # the previous good one is intact
+    assert state["generation"] == 0
+    npz = ckpts[-2].with_suffix(".npz")
+    npz.write_bytes(npz.read_bytes()[:100])
+    with pytest.raises(CheckpointError, match="ckpt-000000.npz"):
+        load_checkpoint(ckpts[-2])
+
+
+def test_resume_refuses_another_experiment(tmp_path):
+    EvolutionRun(tiny(), tmp_path / "r", seed=1, generations=0, figures=False).run()
+    with pytest.raises(CheckpointError, match="seed"):
+        EvolutionRun(tiny(), tmp_path / "r", seed=2, generations=1, figures=False).run(resume=True)
+    with pytest.raises(CheckpointError, match="already holds a run"):
+        EvolutionRun(tiny(), tmp_path / "r", seed=1, generations=1, figures=False).run()

@@ -1,0 +1,85 @@
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from softgym.cli import main
+
+TINY = ["--pop", "4", "--seconds", "1.5", "--shape", "4", "4", "4", "--quiet"]
+
+
+def test_simulate_still_works(tmp_path):
+    assert main(["simulate", "--seconds", "0.5", "--out", str(tmp_path)]) == 0
+    assert (tmp_path / "trajectory.png").exists()
+
+
+def test_evolve_writes_the_run_folder_and_replay_reproduces_it(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert main(["evolve", "--generations", "1", "--out", str(out), "--no-gif", *TINY]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["experiment"] == "controller-tournament" and summary["generations"] == 1
+    for name in (
+        "config.json",
+        "log.csv",
+        "log.jsonl",
+        "best_design.json",
+        "best_designs.json",
+        "figures/fitness_trend.png",
+        "figures/best_robot.png",
+        "figures/best_trajectory.png",
+    ):
+        assert (out / name).exists(), name
+    assert main(["replay", str(out), "--no-gif"]) == 0
+    rep = json.loads(capsys.readouterr().out)
+    assert rep["metrics"]["norm_final_dist"] == rep["recorded"]["norm_final_dist"]
+    assert main(["compare", str(out), str(out), "--out", str(tmp_path / "cmp.png")]) == 0
+    assert (tmp_path / "cmp.png").exists()
+    capsys.readouterr()
+    assert main(["experiments"]) == 0
+    assert "obstacles-attempt2" in capsys.readouterr().out
+    assert main(["evolve", "--experiment", "nope", "--out", str(tmp_path / "x"), *TINY]) == 2
+
+
+def _final(out: Path):
+    return json.loads((out / "final_population.json").read_text())
+
+
+def test_kill_9_then_resume_equals_uninterrupted(tmp_path):
+    args = [
+        "evolve",
+        "--experiment",
+        "controller-pareto",
+        "--generations",
+        "5",
+        "--seed",
+        "11",
+        "--no-figures",
+        *TINY,
+    ]
+    killed = tmp_path / "killed"
+    env = {**os.environ, "SOFTGYM_NUM_THREADS": "1"}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "softgym.cli", *args, "--out", str(killed)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        env=env,
+    )
+    ckpt = killed / "checkpoints" / "ckpt-000001.json"
+    deadline = time.time() + 120
+    while not ckpt.exists() and proc.poll() is None and time.time() < deadline:
+        time.sleep(0.005)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    if (killed / "final_population.json").exists():
+        pytest.skip("the run finished before it could be killed")
+    assert main([*args, "--out", str(killed), "--resume"]) == 0
+    ref = tmp_path / "ref"
+    assert main([*args, "--out", str(ref)]) == 0
+    assert _final(killed) == _final(ref)
+    rows = [json.loads(x) for x in (killed / "log.jsonl").read_text().splitlines()]
+    assert [r["generation"] for r in rows] == list(range(6))
