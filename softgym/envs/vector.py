@@ -1,0 +1,246 @@
+"""`SoftWalkerVectorEnv`: N walkers stepped together in one engine call.
+
+``gym.make_vec("SoftWalker-Flat-v0", num_envs=N)`` builds this class through
+the ids' ``vector_entry_point``: one :class:`~softgym.engine.Simulation` holds
+all N robots (their bodies may differ: the spaces depend on the grid only),
+so one :meth:`step` sets N sets of muscle temperatures and advances the whole
+batch with the engine's threads, without the GIL. A robot computes exactly
+what it computes in :class:`~softgym.envs.walker.SoftWalkerEnv` (both use the
+same task code, and a robot's physics does not depend on its batch).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from gymnasium import logger
+from gymnasium.vector import AutoresetMode, VectorEnv
+from gymnasium.vector.utils import batch_space
+
+from softgym.design.robot import RobotDesign
+from softgym.engine.config import SimConfig
+from softgym.engine.simulation import Simulation
+from softgym.envs.walker import (
+    _render_robot,
+    _WalkerBatch,
+    action_space,
+    load_design,
+    make_config,
+    observation_space,
+)
+from softgym.exceptions import InvalidParameterError
+from softgym.terrain import Terrain
+
+__all__ = ["SoftWalkerVectorEnv"]
+
+
+class SoftWalkerVectorEnv(VectorEnv):
+    """``num_envs`` soft walkers in one batched simulation.
+
+    Every sub-environment is a :class:`~softgym.envs.walker.SoftWalkerEnv`
+    (same spaces, rewards, info and episode rules; see its docstring); they
+    are stepped together. Autoreset follows Gymnasium's default
+    ``AutoresetMode.NEXT_STEP``: the step after a sub-environment terminates or
+    truncates ignores its action and returns its first observation of a new
+    episode, with reward 0 and both flags False.
+
+    Parameters
+    ----------
+    num_envs : int
+        Number of robots.
+    designs : sequence of RobotDesign or paths, optional
+        One design per robot (they may differ; each must fit ``grid_shape``).
+    design : RobotDesign or path, optional
+        One design for every robot (default: the embedded walker). Give
+        ``design`` or ``designs``, not both.
+    task, episode_seconds, control_dt, actuation, self_collision, grid_shape,
+    sim_config, terrain, render_mode, width, height
+        As for :class:`~softgym.envs.walker.SoftWalkerEnv`.
+    n_threads : int, optional
+        Engine threads (default: :func:`softgym.engine.default_num_threads`).
+    max_episode_steps : int, optional
+        Truncation in steps (``make_vec`` passes the id's registered 80);
+        episodes also end after ``episode_seconds``.
+
+    Notes
+    -----
+    All robots share the engine's clock. A robot reset while others go on
+    (after a divergence) restarts from its settled start state at the
+    current batch time; its control steps then cover the same durations but
+    may fall one engine step differently, so its trajectory matches a fresh
+    single env to the engine's time resolution rather than bit for bit.
+    When every robot ends its episode together (the usual truncation), the
+    whole batch is restored exactly.
+    """
+
+    metadata: dict[str, Any] = {
+        "render_modes": ["rgb_array"],
+        "render_fps": 20,
+        "autoreset_mode": AutoresetMode.NEXT_STEP,
+    }
+
+    def __init__(
+        self,
+        num_envs: int = 1,
+        designs: Sequence[RobotDesign | str | os.PathLike[str]] | None = None,
+        design: RobotDesign | str | os.PathLike[str] | None = None,
+        task: str = "flat",
+        episode_seconds: float = 4.0,
+        control_dt: float = 0.05,
+        actuation: str | None = None,
+        self_collision: bool | None = None,
+        grid_shape: Sequence[int] = (6, 6, 6),
+        sim_config: SimConfig | None = None,
+        terrain: Terrain | None = None,
+        render_mode: str | None = None,
+        width: int = 320,
+        height: int = 240,
+        n_threads: int | None = None,
+        max_episode_steps: int | None = None,
+    ) -> None:
+        num_envs = int(num_envs)
+        if num_envs < 1:
+            raise InvalidParameterError(f"num_envs must be >= 1, got {num_envs}")
+        if designs is not None and design is not None:
+            raise InvalidParameterError("give design (one for all robots) or designs, not both")
+        if designs is None:
+            one = load_design(design)
+            robots = [one] * num_envs
+        else:
+            robots = [load_design(d) for d in designs]
+            if len(robots) != num_envs:
+                raise InvalidParameterError(
+                    f"designs holds {len(robots)} designs for num_envs={num_envs}"
+                )
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise InvalidParameterError(
+                f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}"
+            )
+        config = make_config(sim_config, actuation, self_collision)
+        self._batch = _WalkerBatch(
+            robots,
+            task,
+            tuple(grid_shape),
+            control_dt,
+            episode_seconds,
+            max_episode_steps,
+            config,
+            None if terrain is None else [terrain] * num_envs,
+            n_threads,
+        )
+        b = self._batch
+        self.num_envs = num_envs
+        self.designs = robots
+        self.task = b.task
+        self.grid_shape = b.grid_shape
+        self.control_dt = b.control_dt
+        self.episode_seconds = b.episode_seconds
+        self.max_steps = b.max_steps
+        self.metadata = {**type(self).metadata, "render_fps": max(1, round(1.0 / b.control_dt))}
+        self.render_mode = render_mode
+        self.width, self.height = int(width), int(height)
+        self._renderer: Any = None
+        self.single_action_space = action_space(b.grid_shape)
+        self.action_space = batch_space(self.single_action_space, num_envs)
+        self.single_observation_space = observation_space(b.grid_shape)
+        self.observation_space = batch_space(self.single_observation_space, num_envs)
+        self._prev_done = np.zeros(num_envs, dtype=bool)
+        self._needs_reset = True
+
+    # ------------------------------------------------------------ properties
+    @property
+    def sim(self) -> Simulation:
+        """The engine's :class:`Simulation` holding every robot."""
+        return self._batch.sim
+
+    @property
+    def muscle_mask(self) -> np.ndarray:
+        """Ndarray of shape (num_envs, n_cells), bool: cells that drive a muscle (a copy)."""
+        return self._batch.muscle_mask.copy()
+
+    @property
+    def period(self) -> np.ndarray:
+        """Ndarray of shape (num_envs,): each robot's controller period (s)."""
+        return self._batch.period.copy()
+
+    # ------------------------------------------------------------------- API
+    def _infos(self, with_mask: bool = False) -> dict[str, Any]:
+        raw = self._batch.infos()
+        info: dict[str, Any] = {}
+        for key, value in raw.items():
+            info[key] = value
+            info[f"_{key}"] = np.ones(self.num_envs, dtype=bool)
+        if with_mask:
+            info["muscle_mask"] = self.muscle_mask
+            info["_muscle_mask"] = np.ones(self.num_envs, dtype=bool)
+        return info
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        """Start a new episode in every sub-environment.
+
+        Parameters
+        ----------
+        seed : int, optional
+            Seeds ``self.np_random`` (the dynamics have no randomness).
+        options : dict, optional
+            Unused.
+
+        Returns
+        -------
+        observations : ndarray of shape (num_envs, obs_size), float32
+        infos : dict of arrays of shape (num_envs, ...)
+        """
+        super().reset(seed=seed)
+        self._batch.reset_all()
+        self._prev_done[:] = False
+        self._needs_reset = False
+        return self._batch.observations(), self._infos(with_mask=True)
+
+    def step(
+        self, actions: Any
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        """Hold each robot's action for ``control_dt`` seconds, all in one engine call.
+
+        Parameters
+        ----------
+        actions : array_like of shape (num_envs, n_cells)
+            In [-1, 1] (finite values outside are clipped). NaN or infinity
+            anywhere raises :class:`~softgym.exceptions.InvalidActionError`
+            before any state changes.
+
+        Returns
+        -------
+        observations : ndarray of shape (num_envs, obs_size), float32
+        rewards : ndarray of shape (num_envs,), float64
+        terminations, truncations : ndarray of shape (num_envs,), bool
+        infos : dict of arrays of shape (num_envs,)
+        """
+        b = self._batch
+        a = b.validate_actions(actions)
+        if self._needs_reset:
+            raise RuntimeError("call reset() before step()")
+        restart = self._prev_done.copy()
+        live = ~restart
+        if live.any():
+            b.apply(a, live)
+            b.advance()
+        b.reset_robots(np.flatnonzero(restart))
+        reward, terminated, truncated, _ = b.update(live)
+        self._prev_done = terminated | truncated
+        return b.observations(), reward, terminated, truncated, self._infos()
+
+    def render(self) -> tuple[np.ndarray, ...] | None:
+        """One H x W x 3 uint8 frame per sub-environment (``render_mode="rgb_array"``)."""
+        if self.render_mode is None:
+            logger.warn("render() called without a render_mode; pass render_mode='rgb_array'")
+            return None
+        return tuple(_render_robot(self, r) for r in range(self.num_envs))
+
+    def close_extras(self, **kwargs: Any) -> None:
+        """Release the renderer (``close()`` may be called any number of times)."""
+        self._renderer = None

@@ -1,0 +1,25 @@
+"""Pictures of robots: headless RGB frames (NumPy only) and animated GIFs.
+
+:class:`VoxelRenderer` draws a robot's deformed voxels and its terrain into an
+``(height, width, 3)`` uint8 array without OpenGL or matplotlib; the
+environments' ``render_mode="rgb_array"`` uses it. :func:`save_gif` writes
+frames (or rollouts) to an animated GIF.
+"""
+
+from softgym.render.frames import (
+    OBSTACLE_COLOR,
+    VoxelRenderer,
+    quaternion_to_matrix,
+    render_rollout,
+    save_gif,
+    simulation_frames,
+)
+
+__all__ = [
+    "OBSTACLE_COLOR",
+    "VoxelRenderer",
+    "quaternion_to_matrix",
+    "render_rollout",
+    "save_gif",
+    "simulation_frames",
+]

@@ -1,0 +1,93 @@
+"""Registration, Gymnasium's env checker and the spaces of the SoftWalker ids."""
+
+import warnings
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import softgym
+from softgym.design import RobotDesign, default_walker
+from softgym.envs import ENV_IDS, SoftWalkerEnv, SoftWalkerVectorEnv
+
+IDS = sorted(ENV_IDS)
+
+
+def small_design() -> RobotDesign:
+    grid = np.zeros((4, 4, 4), dtype=np.int8)
+    grid[:2] = 3
+    grid[2:] = 4
+    grid[:, :, 3] = 2
+    return RobotDesign(grid)
+
+
+def test_import_softgym_registers_every_id():
+    assert "envs" in softgym.__all__
+    for env_id in IDS:
+        spec = gym.spec(env_id)
+        assert isinstance(spec.entry_point, str) and spec.entry_point.startswith("softgym.envs")
+        assert spec.vector_entry_point == "softgym.envs.vector:SoftWalkerVectorEnv"
+        assert spec.max_episode_steps == 80
+
+
+@pytest.mark.parametrize("env_id", IDS)
+def test_check_env_passes_without_warnings(env_id):
+    env = gym.make(env_id)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(env.unwrapped)
+    env.close()
+
+
+def test_make_without_arguments_gives_the_default_walker():
+    env = gym.make("SoftWalker-Flat-v0")
+    base = env.unwrapped
+    assert isinstance(base, SoftWalkerEnv)
+    assert base.design == default_walker()
+    assert base.max_steps == 80 and base.control_dt == 0.05
+    assert env.action_space.shape == (216,) and env.observation_space.shape == (1301,)
+    assert env.action_space.dtype == np.float32 and env.observation_space.dtype == np.float32
+    env.close()
+
+
+def test_close_twice_is_harmless():
+    env = gym.make("SoftWalker-Wall-v0", render_mode="rgb_array", episode_seconds=0.2)
+    env.reset(seed=0)
+    env.render()
+    env.close()
+    env.close()
+    venv = gym.make_vec("SoftWalker-Wall-v0", num_envs=2, episode_seconds=0.2)
+    venv.close()
+    venv.close()
+
+
+def test_spaces_depend_on_the_grid_not_the_body(tmp_path):
+    path = tmp_path / "small.json"
+    small_design().save(path)
+    a = gym.make("SoftWalker-Flat-v0")
+    b = gym.make("SoftWalker-Flat-v0", design=str(path))
+    assert b.unwrapped.design == small_design()
+    assert a.observation_space == b.observation_space
+    assert a.action_space == b.action_space
+    obs, info = b.reset(seed=0)
+    assert obs in b.observation_space
+    # cells outside the 4x4x4 body are empty: zero features, no muscle
+    cells = obs[: 6 * 216].reshape(6, 6, 6, 6)
+    assert not cells[4:].any() and not cells[:, 4:].any() and not cells[:, :, 4:].any()
+    assert info["muscle_mask"].reshape(6, 6, 6)[:4, :4, :3].all()
+    assert not info["muscle_mask"].reshape(6, 6, 6)[:, :, 3:].any()
+    c = gym.make("SoftWalker-Flat-v0", grid_shape=(4, 4, 4), design=small_design())
+    assert c.action_space.shape == (64,) and c.observation_space.shape == (6 * 64 + 5,)
+
+
+def test_make_vec_uses_the_batched_vector_env():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        venv = gym.make_vec("SoftWalker-Stairs-v0", num_envs=2, episode_seconds=0.2)
+    assert isinstance(venv, SoftWalkerVectorEnv)
+    assert venv.sim.n_robots == 2
+    assert venv.single_action_space == gym.make("SoftWalker-Stairs-v0").action_space
+    assert venv.action_space.shape == (2, 216)
+    assert venv.observation_space.shape == (2, 1301)
+    venv.close()
