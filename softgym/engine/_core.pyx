@@ -344,7 +344,7 @@ cdef inline float64_t _box_penetration(const float64_t* B, const float64_t* p, f
     # into the box B = (x0, y0, z0, x1, y1, z1); n gets the outward unit normal.
     cdef:
         float64_t cx, cy, cz, dx, dy, dz, d2, dist, depth
-        intp_t k
+        intp_t k, a
     if (p[0] + rad <= B[0] or p[0] - rad >= B[3] or p[1] + rad <= B[1]
             or p[1] - rad >= B[4] or p[2] + rad <= B[2] or p[2] - rad >= B[5]):
         return 0.0
@@ -369,21 +369,13 @@ cdef inline float64_t _box_penetration(const float64_t* B, const float64_t* p, f
     n[2] = 0.0
     depth = p[0] - B[0]
     k = 0
-    if B[3] - p[0] < depth:
-        depth = B[3] - p[0]
-        k = 1
-    if p[1] - B[1] < depth:
-        depth = p[1] - B[1]
-        k = 2
-    if B[4] - p[1] < depth:
-        depth = B[4] - p[1]
-        k = 3
-    if p[2] - B[2] < depth:
-        depth = p[2] - B[2]
-        k = 4
-    if B[5] - p[2] < depth:
-        depth = B[5] - p[2]
-        k = 5
+    for a in range(3):
+        if p[a] - B[a] < depth:
+            depth = p[a] - B[a]
+            k = 2 * a
+        if B[3 + a] - p[a] < depth:
+            depth = B[3 + a] - p[a]
+            k = 2 * a + 1
     n[k // 2] = 1.0 if k % 2 == 1 else -1.0
     return rad + depth
 

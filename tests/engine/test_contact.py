@@ -171,3 +171,16 @@ def test_obstacles_are_not_robot_mass():
     fenced = Simulation(body, terrain=Terrain.fence(center=(1, 1))).rollout()
     np.testing.assert_array_equal(flat.cm, fenced.cm)
     assert fenced.mass[0] == pytest.approx(8.0)
+
+
+def test_voxel_inside_a_box_is_pushed_out_through_the_nearest_face():
+    # A voxel whose centre ended 0.3 L inside a box's -x face leaves through it.
+    box = Terrain.from_boxes([Box((2, -1, 0), (6, 3, 3))])
+    sim = Simulation(Body.uniform(np.ones((1, 1, 1))), SimConfig(init_time=0.0), terrain=box)
+    state = sim.get_state()
+    state["pos"][0] = [2.3 * L, 0.5 * L, 1.5 * L]
+    sim.set_state(state)
+    sim.advance(0.05)
+    p = sim.positions(0)[0]
+    assert p[0] < 2 * L - 0.4 * L  # out through x0, not through the far faces
+    assert abs(p[1] - 0.5 * L) < 1e-9
