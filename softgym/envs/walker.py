@@ -235,6 +235,13 @@ class _WalkerBatch:
         self.done_diverged = np.zeros(n, dtype=bool)
         self._trace = np.zeros((n, self.max_steps + 1, 2))  # |dx|, |dy| (voxel lengths)
         self._colors: dict[int, np.ndarray] = {}
+        # batch-wide voxel -> (robot, cell) maps for the observations
+        self._voxel_robot = np.repeat(np.arange(n), [c.size for c in self.cells])
+        self._flat_cells = np.concatenate(
+            [r * self.n_cells + c for r, c in enumerate(self.cells)]
+        ).astype(np.intp)
+        self._feat_bound = np.array([OBS_POSITION_BOUND] * 3 + [OBS_VELOCITY_BOUND] * 3)
+        self._cell_buf = np.zeros((n * self.n_cells, 6))
 
     # ---------------------------------------------------------------- reset
     def _settle(self) -> None:
@@ -381,28 +388,28 @@ class _WalkerBatch:
         """Observation of every robot, ndarray of shape (n_robots, obs_size), float32."""
         sim = self.sim
         n, nc = self.n_robots, self.n_cells
-        obs = np.zeros((n, self.obs_size), dtype=np.float64)
+        obs = np.empty((n, self.obs_size), dtype=np.float32)
         cm = sim.center_of_mass()
         cm_vel = sim.momentum() / self.robot_mass[:, None]
         inv_l = 1.0 / self.L
-        cell_part = obs[:, : 6 * nc].reshape(n, nc, 6)
-        for r in range(n):
-            cells = self.cells[r]
-            cell_part[r, cells, 0:3] = (sim.positions(r) - cm[r]) * inv_l
-            cell_part[r, cells, 3:6] = (sim.velocities(r) - cm_vel[r]) * inv_l
-        np.clip(
-            cell_part[..., 0:3], -OBS_POSITION_BOUND, OBS_POSITION_BOUND, out=cell_part[..., 0:3]
-        )
-        np.clip(
-            cell_part[..., 3:6], -OBS_VELOCITY_BOUND, OBS_VELOCITY_BOUND, out=cell_part[..., 3:6]
-        )
+        # every voxel of the batch at once: (n_voxels, 6) features, scattered to their cells
+        feats = np.empty((self._flat_cells.size, 6))
+        feats[:, 0:3] = np.concatenate([sim.positions(r) for r in range(n)])
+        feats[:, 3:6] = np.concatenate([sim.velocities(r) for r in range(n)])
+        feats[:, 0:3] -= cm[self._voxel_robot]
+        feats[:, 3:6] -= cm_vel[self._voxel_robot]
+        feats *= inv_l
+        np.clip(feats, -self._feat_bound, self._feat_bound, out=feats)
+        cells = self._cell_buf  # empty cells stay zero; filled ones are all overwritten
+        cells[self._flat_cells] = feats
+        obs[:, : 6 * nc] = cells.reshape(n, 6 * nc)
         obs[:, 6 * nc : 6 * nc + 3] = np.clip(
             cm_vel * inv_l, -OBS_VELOCITY_BOUND, OBS_VELOCITY_BOUND
         )
         theta = 2.0 * np.pi * self.clock() / self.period
         obs[:, -2] = np.sin(theta)
         obs[:, -1] = np.cos(theta)
-        return obs.astype(np.float32)
+        return obs
 
     def l_coefficient(self) -> np.ndarray:
         """The seed's L coefficient of every robot over its episode so far (voxel lengths^2/s).
