@@ -62,12 +62,11 @@ _REASONS = {
     3: "out of memory for the self-collision candidates",
 }
 
-# state arrays that change while the simulation runs (checkpointed by get_state)
-_STATE = (
-    "pos", "vel", "quat", "angvel", "rot", "scale", "steps", "diverged", "diverged_time",
-    "diverged_code", "init_done", "cm_init", "trace_n", "trace_t", "trace_cm", "temp",
-    "use_temp", "ext_force",
-)  # fmt: skip
+# state arrays that change while the simulation runs (checkpointed by get_state):
+# per voxel, per robot, and the traces
+_VOXEL_STATE = ("pos", "vel", "quat", "angvel", "rot", "scale", "temp", "ext_force")
+_ROBOT_STATE = ("diverged", "diverged_time", "diverged_code", "init_done", "cm_init", "use_temp")
+_STATE = (*_VOXEL_STATE, *_ROBOT_STATE, "steps", "trace_n", "trace_t", "trace_cm")
 
 
 def default_num_threads() -> int:
@@ -657,7 +656,7 @@ class Simulation:
         return state
 
     def set_state(self, state: dict[str, np.ndarray]) -> None:
-        """Restore a state from :meth:`get_state` of an identical batch."""
+        """Restore a state from :meth:`get_state` of an identical batch (copied in)."""
         for k in _STATE:
             if k not in state:
                 raise InvalidParameterError(f"state is missing array {k!r}")
@@ -671,5 +670,42 @@ class Simulation:
                     f"state array {k!r} has shape {v.shape}, expected {cur.shape}"
                 )
         for k in _STATE:
-            self._a[k] = np.ascontiguousarray(np.asarray(state[k]), dtype=self._a[k].dtype)
+            self._a[k] = np.array(state[k], dtype=self._a[k].dtype, order="C", copy=True)
         self._t_target = float(state.get("t_target", 0.0))
+
+    def restore_robots(self, state: dict[str, np.ndarray], robots: Any) -> None:
+        """Put some robots back into their state from ``state``; the others go on.
+
+        The batch keeps one clock: each restored robot gets the voxel and
+        robot state it had in ``state`` (e.g. its settled start), its trace is
+        cleared, and its step count is set so that its time is the batch's
+        current time. Used by vector environments to reset one robot.
+
+        Parameters
+        ----------
+        state : dict of str to ndarray
+            From :meth:`get_state` of this batch.
+        robots : sequence of int
+            Robot indices.
+        """
+        ids = np.unique(np.asarray(robots, dtype=np.intp))
+        if ids.size == 0:
+            return
+        if ids[0] < 0 or ids[-1] >= self.n_robots:
+            raise IndexError(f"robot indices {ids.tolist()} out of range for {self.n_robots} robots")
+        missing = [k for k in _STATE if k not in state]
+        if missing:
+            raise InvalidParameterError(f"state is missing arrays {missing}")
+        a = self._a
+        off = a["vox_start"]
+        for k in _VOXEL_STATE:
+            src = np.asarray(state[k])
+            if src.shape != a[k].shape:
+                raise InvalidParameterError(f"state array {k!r} has shape {src.shape}, expected {a[k].shape}")
+            for r in ids:
+                s = slice(int(off[r]), int(off[r + 1]))
+                a[k][s] = src[s]
+        for k in _ROBOT_STATE:
+            a[k][ids] = np.asarray(state[k])[ids]
+        a["trace_n"][ids] = 0
+        a["steps"][ids] = np.ceil(self._t_target / a["dt"][ids] - 1e-9).astype(np.int64)

@@ -53,20 +53,6 @@ _L_TOLERANCE = 0.1
 # the engine's own centre-of-mass trace is not used (the env keeps one per control step);
 # a huge sampling interval keeps its buffers at constant size however long the env runs
 _NO_ENGINE_TRACE = 1.0e9
-# per-voxel and per-robot entries of Simulation.get_state() (partial resets)
-_VOXEL_KEYS = ("pos", "vel", "quat", "angvel", "rot", "scale", "temp", "ext_force")
-_ROBOT_KEYS = (
-    "diverged",
-    "diverged_time",
-    "diverged_code",
-    "init_done",
-    "cm_init",
-    "use_temp",
-    "trace_n",
-    "trace_t",
-    "trace_cm",
-)
-
 
 def load_design(design: RobotDesign | str | os.PathLike[str] | None) -> RobotDesign:
     """A design from a :class:`RobotDesign`, a path to its JSON file, or None (the default walker)."""
@@ -258,8 +244,8 @@ class _WalkerBatch:
         """Every robot back to its settled start state (the first call settles them)."""
         if self._settled is None:
             self._settle()
-        else:  # copies: Simulation.set_state adopts the arrays it is given
-            self.sim.set_state({k: v.copy() for k, v in self._settled.items()})
+        else:
+            self.sim.set_state(self._settled)
         self.steps[:] = 0
         self.metric_value[:] = 0.0
         # a robot that diverged while settling cannot run: its episodes end at the first step
@@ -274,39 +260,9 @@ class _WalkerBatch:
         if ids.size == self.n_robots or self._settled is None:
             self.reset_all()
             return
-        state = self.sim.get_state()
         init = self._settled
-        off = self.sim.voxel_offsets
-        n_vox = int(off[-1])
-        for key, value in state.items():
-            if key in ("t_target", "steps"):
-                continue
-            per_voxel = key in _VOXEL_KEYS
-            per_robot = key in _ROBOT_KEYS
-            if not (per_voxel or per_robot) and np.ndim(value) and n_vox != self.n_robots:
-                # an entry this env does not know: its leading axis tells what it indexes
-                per_voxel = value.shape[0] == n_vox and init[key].shape == value.shape
-                per_robot = value.shape[0] == self.n_robots and init[key].shape == value.shape
-            if per_voxel:
-                for r in ids:
-                    s = slice(int(off[r]), int(off[r + 1]))
-                    value[s] = init[key][s]
-            elif key in ("trace_t", "trace_cm"):
-                value[ids] = 0.0
-            elif per_robot:
-                value[ids] = init[key][ids]
-            else:
-                raise InvalidParameterError(
-                    f"cannot reset one robot of the batch: engine state {key!r} is neither "
-                    "per voxel nor per robot"
-                )
         # the batch shares one clock: a reset robot restarts from its settled state *now*
-        dt = self.sim.dt
-        t_target = float(state["t_target"])
-        state["steps"][ids] = np.maximum(
-            np.ceil(t_target / dt[ids] - 1e-9).astype(np.int64), state["steps"][ids]
-        )
-        self.sim.set_state(state)
+        self.sim.restore_robots(init, ids)
         self.steps[ids] = 0
         self.metric_value[ids] = 0.0
         self.done_diverged[ids] = init["diverged"][ids] != 0

@@ -111,3 +111,17 @@ def test_divergence_raises_on_request_naming_the_robot():
     assert err.value.robot == 1
     assert "robot 1" in str(err.value)
     assert isinstance(err.value, RuntimeError)
+
+
+def test_restore_robots_resets_one_robot_on_the_shared_clock():
+    bodies = [reference_robot(3), reference_robot(4)]
+    sim = Simulation(bodies)
+    start = sim.get_state()
+    sim.advance(1.3)
+    other = sim.positions(0).copy()
+    sim.restore_robots(start, [1])
+    np.testing.assert_array_equal(sim.positions(1), start["pos"][sim.voxel_offsets[1]:])
+    np.testing.assert_array_equal(sim.positions(0), other)
+    assert sim.time[1] == pytest.approx(1.3, abs=sim.dt[1])
+    start["pos"][:] = 0.0  # set_state / restore_robots copied: the sim is unaffected
+    assert np.abs(sim.positions(1)).max() > 0
