@@ -111,6 +111,6 @@ cdef struct Contacts:
     int32 stale              # 1: rebuild before the next use
 
 
-cdef int advance_robot(Batch* b, intp_t r, step_t target) noexcept nogil
+cdef int advance_robot(Batch* b, intp_t r, step_t target, Contacts* c) noexcept nogil
 cdef void robot_cm(Batch* b, intp_t r, float64_t* out) noexcept nogil
 cdef void robot_energy(Batch* b, intp_t r, float64_t* out) noexcept nogil

@@ -27,7 +27,7 @@
 from cython.parallel cimport prange, parallel
 from libc.math cimport sin, cos, sqrt, fabs, floor, M_PI
 from libc.stdint cimport int64_t
-from libc.stdlib cimport malloc, realloc, free, qsort
+from libc.stdlib cimport calloc, malloc, realloc, free, qsort
 from libc.string cimport memcpy, memset
 
 cimport numpy as cnp
@@ -710,22 +710,21 @@ cdef inline void _record(Batch* b, intp_t r) noexcept nogil:
         b.trace_n[r] += 1
 
 
-cdef int advance_robot(Batch* b, intp_t r, step_t target) noexcept nogil:
+cdef int advance_robot(Batch* b, intp_t r, step_t target, Contacts* c) noexcept nogil:
     """Step robot r until steps[r] == target, or until it diverges.
 
     Modifies in place every per-voxel state array of the robot, its step count,
-    traces and divergence flags. Returns a STATUS_* code.
+    traces and divergence flags, and its self-collision candidates ``c``
+    (kept between calls; the wrapper marks them stale when it moves voxels).
+    Returns a STATUS_* code.
     """
     cdef:
         int status = STATUS_OK
         intp_t vs = b.vox_start[r]
         intp_t ve = b.vox_start[r + 1]
         float64_t smax, dmax2 = 0.0
-        Contacts c
     if b.diverged[r]:
         return STATUS_OK
-    memset(&c, 0, sizeof(Contacts))
-    c.stale = 1
     if b.steps[r] == 0:
         _record(b, r)
     while b.steps[r] < target:
@@ -734,8 +733,8 @@ cdef int advance_robot(Batch* b, intp_t r, step_t target) noexcept nogil:
         status = _link_forces(b, r)
         if status == STATUS_OK and b.self_collision:
             if c.stale or smax > c.built_scale:
-                status = _rebuild_contacts(b, r, &c)
-            _collide(b, &c)
+                status = _rebuild_contacts(b, r, c)
+            _collide(b, c)
         if status == STATUS_OK:
             status = _integrate(b, r, c.ref if b.self_collision else NULL, &dmax2)
         if status != STATUS_OK:
@@ -752,10 +751,6 @@ cdef int advance_robot(Batch* b, intp_t r, step_t target) noexcept nogil:
                 c.stale = 1
         b.steps[r] += 1
         _record(b, r)
-    free(c.pairs)
-    free(c.cells)
-    free(c.row)
-    free(c.ref)
     return status
 
 
@@ -912,7 +907,43 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     return 0
 
 
-def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads):
+cdef class ContactCache:
+    """Self-collision candidate lists of a batch's robots, kept between calls.
+
+    Owned by a :class:`~softgym.engine.Simulation`; :meth:`invalidate` must be
+    called whenever voxels are moved from outside the kernel (set_state, reset).
+    Whether and when a list is rebuilt never changes results: a list always
+    holds every touching pair, in sorted order.
+    """
+
+    cdef Contacts* items
+    cdef intp_t n
+
+    def __cinit__(self, intp_t n_robots):
+        self.n = n_robots
+        self.items = <Contacts*> calloc(n_robots if n_robots > 0 else 1, sizeof(Contacts))
+        if self.items == NULL:
+            raise MemoryError("cannot allocate the self-collision cache")
+        self.invalidate()
+
+    def invalidate(self):
+        """Mark every robot's candidate list for a rebuild before its next use."""
+        cdef intp_t r
+        for r in range(self.n):
+            self.items[r].stale = 1
+
+    def __dealloc__(self):
+        cdef intp_t r
+        if self.items != NULL:
+            for r in range(self.n):
+                free(self.items[r].pairs)
+                free(self.items[r].cells)
+                free(self.items[r].row)
+                free(self.items[r].ref)
+            free(self.items)
+
+
+def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, ContactCache cache):
     """Advance every robot of a batch to its target step count.
 
     Parameters
@@ -935,12 +966,12 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads):
         intp_t n
     _bind(&b, arrays, settings)
     n = b.n_robots
-    if targets.shape[0] != n:
-        raise ValueError("targets must hold one step count per robot")
+    if targets.shape[0] != n or cache.n != n:
+        raise ValueError("targets and cache must hold one entry per robot")
     with nogil, parallel(num_threads=n_threads):
         # dynamic: robots of one batch differ in cost by 10x or more (bone shrinks dt)
         for r in prange(n, schedule="dynamic", chunksize=1):
-            advance_robot(&b, r, targets[r])
+            advance_robot(&b, r, targets[r], &cache.items[r])
 
 
 def compute_energy(dict arrays, dict settings, float64_t[:, ::1] out):

@@ -188,6 +188,7 @@ class Simulation:
         self.terrains = self._terrains(terrain)
         self._build()
         self._initial = {k: self._a[k].copy() for k in _STATE}
+        self._contacts = _core.ContactCache(self.n_robots)
         self._t_target = 0.0
 
     # ------------------------------------------------------------------ layout
@@ -581,7 +582,7 @@ class Simulation:
         targets = np.ceil(time / a["dt"] - 1e-9).astype(np.int64)
         targets = np.maximum(targets, a["steps"])
         before = a["diverged"].copy()
-        _core.advance(a, self._settings, targets, self.n_threads)
+        _core.advance(a, self._settings, targets, self.n_threads, self._contacts)
         if self.config.on_divergence == "raise":
             new = np.flatnonzero((a["diverged"] == 1) & (before == 0))
             if new.size:
@@ -648,6 +649,7 @@ class Simulation:
         for k, v in self._initial.items():
             self._a[k] = v.copy()
         self._t_target = 0.0
+        self._contacts.invalidate()
 
     def get_state(self) -> dict[str, np.ndarray]:
         """Copy of the full dynamic state (plain arrays, for checkpoints)."""
@@ -672,6 +674,7 @@ class Simulation:
         for k in _STATE:
             self._a[k] = np.array(state[k], dtype=self._a[k].dtype, order="C", copy=True)
         self._t_target = float(state.get("t_target", 0.0))
+        self._contacts.invalidate()
 
     def restore_robots(self, state: dict[str, np.ndarray], robots: Any) -> None:
         """Put some robots back into their state from ``state``; the others go on.
@@ -709,3 +712,4 @@ class Simulation:
             a[k][ids] = np.asarray(state[k])[ids]
         a["trace_n"][ids] = 0
         a["steps"][ids] = np.ceil(self._t_target / a["dt"][ids] - 1e-9).astype(np.int64)
+        self._contacts.invalidate()
