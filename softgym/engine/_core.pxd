@@ -74,6 +74,7 @@ cdef struct Batch:
     float64_t* mu_s          # (n_voxels,) static friction coefficient
     float64_t* mu_k          # (n_voxels,) kinetic friction coefficient
     flag_t* fixed            # (n_voxels,) 1: all six degrees of freedom fixed
+    flag_t* surface          # (n_voxels,) 1: misses a face bond (takes part in self-collision)
     intp_t* excl_start       # (n_voxels + 1,) CSR rows of voxels that never collide with voxel i
     intp_t* excl_idx         # (excl_start[-1],) their indices, sorted within each row
 

@@ -496,8 +496,8 @@ cdef inline int _integrate(Batch* b, intp_t r, const float64_t* ref,
 
 
 # ---------------------------------------------------------------------------
-# Self-collision (SEED_REFERENCE 1.7): voxels more than `collision_exclusion`
-# bond hops apart repel when their spherical envelopes, of diameter
+# Self-collision (SEED_REFERENCE 1.7): surface voxels more than
+# `collision_exclusion` bond hops apart repel when their spherical envelopes, of diameter
 # 1.5 x their actuated size, overlap: F = E_h L (0.75 (s1 + s2) - |d|) along d,
 # E_h the harmonic mean of their moduli; no damping, no friction. Candidate
 # pairs come from a spatial hash (cells of the candidate horizon) and are kept
@@ -553,7 +553,7 @@ cdef int _rebuild_contacts(Batch* b, intp_t r, Contacts* c) noexcept nogil:
         intp_t vs = b.vox_start[r]
         intp_t ve = b.vox_start[r + 1]
         intp_t n = ve - vs
-        intp_t i, j, k, m, pos_, n_row
+        intp_t i, j, k, m, pos_, n_row, n_surf
         int64_t ci, cj, ck, key
         int di, dj, dk
         float64_t L = b.L
@@ -589,15 +589,22 @@ cdef int _rebuild_contacts(Batch* b, intp_t r, Contacts* c) noexcept nogil:
             y0 = P[3 * i + 1]
         if P[3 * i + 2] < z0:
             z0 = P[3 * i + 2]
-    for k in range(n):
-        i = vs + k
+    # only surface voxels (missing a face bond) collide, as the seed intended:
+    # an interior voxel is shielded by its six bonded neighbours
+    n_surf = 0
+    for i in range(vs, ve):
+        if not b.surface[i]:
+            continue
         ci = <int64_t> floor((P[3 * i] - x0) * inv_cell) + 1
         cj = <int64_t> floor((P[3 * i + 1] - y0) * inv_cell) + 1
         ck = <int64_t> floor((P[3 * i + 2] - z0) * inv_cell) + 1
-        c.cells[k].key = (ci << (2 * CELL_BITS)) | (cj << CELL_BITS) | ck
-        c.cells[k].index = i
-    qsort(c.cells, n, sizeof(KeyIndex), _cmp_key_index)
+        c.cells[n_surf].key = (ci << (2 * CELL_BITS)) | (cj << CELL_BITS) | ck
+        c.cells[n_surf].index = i
+        n_surf += 1
+    qsort(c.cells, n_surf, sizeof(KeyIndex), _cmp_key_index)
     for i in range(vs, ve):
+        if not b.surface[i]:
+            continue
         ci = <int64_t> floor((P[3 * i] - x0) * inv_cell) + 1
         cj = <int64_t> floor((P[3 * i + 1] - y0) * inv_cell) + 1
         ck = <int64_t> floor((P[3 * i + 2] - z0) * inv_cell) + 1
@@ -606,8 +613,8 @@ cdef int _rebuild_contacts(Batch* b, intp_t r, Contacts* c) noexcept nogil:
             for dj in range(-1, 2):
                 for dk in range(-1, 2):
                     key = ((ci + di) << (2 * CELL_BITS)) | ((cj + dj) << CELL_BITS) | (ck + dk)
-                    pos_ = _lower_bound(c.cells, n, key)
-                    while pos_ < n and c.cells[pos_].key == key:
+                    pos_ = _lower_bound(c.cells, n_surf, key)
+                    while pos_ < n_surf and c.cells[pos_].key == key:
                         j = c.cells[pos_].index
                         pos_ += 1
                         if j <= i:
@@ -888,6 +895,7 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.mu_s = _f(a, "mu_s")
     b.mu_k = _f(a, "mu_k")
     b.fixed = <flag_t*> _p(a, "fixed")
+    b.surface = <flag_t*> _p(a, "surface")
     b.link_axis_count = <intp_t*> _p(a, "link_axis_count")
     b.excl_start = <intp_t*> _p(a, "excl_start")
     b.excl_idx = <intp_t*> _p(a, "excl_idx") if a["excl_idx"].shape[0] > 0 else NULL

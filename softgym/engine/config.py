@@ -52,7 +52,8 @@ class SimConfig:
         Seconds between centre-of-mass samples of the rollout (0.1: the seed's
         obstacle runs; its novelty runs use 0.5).
     self_collision : bool
-        Contact between voxels of one robot that are more than
+        Contact between surface voxels (missing a face bond; interior voxels
+        are shielded by their neighbours) of one robot that are more than
         ``collision_exclusion`` bond hops apart (the seed's law: spherical
         envelopes of diameter 1.5 voxels, penalty stiffness ``E L``, no
         damping, no friction). On in the seed's setup (True).

@@ -311,6 +311,8 @@ class Simulation:
             add(per_vox, "mu_k", body.mu_kinetic[mat])
             add(per_vox, "fixed", fixed)
             grid_index.append(idx)
+            degree = np.bincount(np.concatenate([v1, v2]), minlength=n)
+            add(per_vox, "surface", (degree < 6).astype(np.int8))
             ex_start, ex_idx = _hop_neighbours(n, v1, v2, cfg.collision_exclusion)
             add(per_vox, "excl_count", np.diff(ex_start))
             excl.append(ex_idx + vox_start[-1])
@@ -322,6 +324,7 @@ class Simulation:
         for name, parts in per_vox.items():
             a[name] = np.ascontiguousarray(np.concatenate(parts))
         a["fixed"] = a["fixed"].astype(np.int8)
+        a["surface"] = a["surface"].astype(np.int8)
         a["excl_start"] = np.concatenate([[0], np.cumsum(a.pop("excl_count"))]).astype(np.intp)
         a["excl_idx"] = np.ascontiguousarray(np.concatenate(excl), dtype=np.intp)
         boxes = [t.as_array(L) for t in self.terrains]
