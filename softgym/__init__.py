@@ -1,19 +1,27 @@
 """softgym: fast, faithful 3D voxel soft robots for evolution and reinforcement learning."""
 
-from softgym import envs, exceptions  # envs registers the SoftWalker-* ids
+from softgym import design, envs, exceptions, metrics  # envs registers the SoftWalker-* ids
+from softgym.design import Controller, RobotDesign, default_walker
 from softgym.engine import Body, Rollout, SimConfig, Simulation, openmp_enabled
 from softgym.evaluate import evaluate
+from softgym.terrain import Terrain
 
 __version__ = "0.1.0"
 
 __all__ = [
     "Body",
+    "Controller",
+    "RobotDesign",
     "Rollout",
     "SimConfig",
     "Simulation",
+    "Terrain",
     "__version__",
-    "evaluate",
+    "default_walker",
+    "design",
     "envs",
+    "evaluate",
     "exceptions",
+    "metrics",
     "openmp_enabled",
 ]
