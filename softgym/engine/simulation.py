@@ -683,9 +683,11 @@ class Simulation:
         """Put some robots back into their state from ``state``; the others go on.
 
         The batch keeps one clock: each restored robot gets the voxel and
-        robot state it had in ``state`` (e.g. its settled start), its trace is
-        cleared, and its step count is set so that its time is the batch's
-        current time. Used by vector environments to reset one robot.
+        robot state it had in ``state`` (e.g. its settled start) and a step
+        count that puts it at the batch's current time; its centre-of-mass
+        trace goes on at the batch's sampling times (samples before the
+        restore belong to its previous run). Used by vector environments to
+        reset one robot.
 
         Parameters
         ----------
@@ -713,6 +715,5 @@ class Simulation:
                 a[k][s] = src[s]
         for k in _ROBOT_STATE:
             a[k][ids] = np.asarray(state[k])[ids]
-        a["trace_n"][ids] = 0
         a["steps"][ids] = np.ceil(self._t_target / a["dt"][ids] - 1e-9).astype(np.int64)
         self._contacts.invalidate()
