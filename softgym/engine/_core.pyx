@@ -14,12 +14,19 @@
 #                          grow when actuated voxels shrink)
 #       twist             tau  = (z1 . y2 - y1 . z2) / 2  (y, z: the other lattice axes)
 #   with the Hermite beam element's moments M1 = -k_b (2 b1 + b2),
-#   M2 = -k_b (b1 + 2 b2), torsion +-k_t tau u, axial force -k_a e u on voxel 2
+#   M2 = -k_b (b1 + 2 b2), torsion +-k_t tau r, axial force -k_a e u on voxel 2
 #   and the shear force that balances the moments, r x (M1 + M2) / L.
 #   Damping uses the same forms with the deformation rates, so its power is
 #   never positive.
-# - floor: penalty normal force, collision damping and Coulomb friction
-#   (static threshold, kinetic coefficient) as the seed's engine.
+# - floor and terrain boxes: penalty normal force, collision damping and
+#   Coulomb friction (static threshold, kinetic coefficient) as the seed's
+#   floor, along the surface's normal;
+# - self-collision between surface voxels far apart in the lattice graph (the
+#   seed's spherical-envelope law), candidates from a per-robot spatial hash.
+#
+# The link forces come from a branch-free kernel over restrict pointers that
+# the compiler vectorises (gathers + SIMD), then are scattered in link order,
+# so results are deterministic and independent of threads and batching.
 #
 # The code walks flat arrays through raw pointers; bounds are checked by the
 # Python wrapper (simulation.py) once, never here.

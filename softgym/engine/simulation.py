@@ -26,6 +26,12 @@ The physics is the seed's engine (SEED_REFERENCE section 1), re-derived:
   half actuated size) minus ``zeta_c 2 sqrt(m E L) v_z`` (never pulling),
   static friction below ``mu_s N``, kinetic ``mu_k N`` against the sliding
   direction;
+* terrain boxes (:mod:`softgym.terrain`): the floor's laws along the
+  box's outward normal, on every face;
+* self-collision (``SimConfig.self_collision``): surface voxels more than
+  ``collision_exclusion`` bond hops apart repel when their envelopes of
+  diameter ``1.5 s`` overlap (the seed's law), candidates from a per-robot
+  spatial hash kept between calls;
 * time step ``dt_frac / (2 pi sqrt(max k_axial / m))`` per robot, so a stiff
   robot does not slow the others of its batch;
 * actuation: ``scale = L (1 + CTE T)``, ``T = dT sin(2 pi t / period + phase)``
