@@ -57,12 +57,9 @@ def _default_body():
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     from softgym.engine import SimConfig, Simulation
+    from softgym.metrics import norm_final_dist
+    from softgym.render.figures import plot_trajectory
 
     if args.design:
         from softgym.design import RobotDesign
@@ -77,9 +74,6 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     wall = time.perf_counter() - t0
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    L = rollout.voxel_size
-    trace = rollout.trace(0)
-    disp = (rollout.cm_final[0, :2] - rollout.cm_init[0, :2]) / L
     summary = {
         "seconds": args.seconds,
         "wall_seconds": wall,
@@ -87,25 +81,12 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         "dt": float(rollout.dt[0]),
         "n_voxels": int(rollout.voxel_offsets[1]),
         "voxel_steps_per_s": float(rollout.voxel_offsets[1] * rollout.steps[0] / wall),
-        "norm_final_dist": float(np.hypot(*disp)),
+        "norm_final_dist": float(norm_final_dist(rollout)[0]),
         "diverged": bool(rollout.diverged[0]),
     }
     (out / "summary.json").write_text(json.dumps(summary, indent=2))
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
-    ax1.plot(trace[:, 0] / L, trace[:, 1] / L, "-o", ms=2)
-    ax1.plot(trace[0, 0] / L, trace[0, 1] / L, "gs", label="start")
-    ax1.plot(trace[-1, 0] / L, trace[-1, 1] / L, "r^", label="end")
-    ax1.set(
-        xlabel="x (voxels)", ylabel="y (voxels)", title="centre of mass, top view", aspect="equal"
-    )
-    ax1.legend()
-    ax2.plot(trace[:, 3], trace[:, 2] / L)
-    ax2.axvline(rollout.init_time, color="k", ls=":", label="init time")
-    ax2.set(xlabel="t (s)", ylabel="z (voxels)", title="centre-of-mass height")
-    ax2.legend()
-    fig.tight_layout()
-    fig.savefig(out / "trajectory.png", dpi=120)
-    plt.close(fig)
+    plot_trajectory(rollout.trace(0), out / "trajectory.png", voxel_size=rollout.voxel_size,
+                    init_time=rollout.init_time)  # fmt: skip
     print(json.dumps(summary, indent=2))
     print(f"wrote {out / 'trajectory.png'} and {out / 'summary.json'}")
     return 0

@@ -44,6 +44,15 @@ def _plt():
     return plt
 
 
+def _save(fig: Any, path: str | os.PathLike[str]) -> Path:
+    """Write ``fig`` to ``path`` (folders created) and close it."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=110)
+    _plt().close(fig)
+    return path
+
+
 def read_log(run_dir: str | os.PathLike[str]) -> list[dict[str, Any]]:
     """The per-generation rows of a run folder's ``log.jsonl``."""
     path = Path(run_dir) / "log.jsonl"
@@ -84,11 +93,7 @@ def plot_fitness_trend(
         ax.set_title(title)
     ax.legend(loc="upper left")
     fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def plot_best_fitness(
@@ -113,11 +118,7 @@ def plot_best_fitness(
     ax.set_ylabel(ylabel)
     ax.legend(loc="upper left")
     fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def design_colors(design: Any) -> np.ndarray:
@@ -159,11 +160,7 @@ def plot_robot(design: Any, path: str | os.PathLike[str], title: str | None = No
     if title:
         ax.set_title(title)
     fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def plot_trajectory(
@@ -221,11 +218,7 @@ def plot_trajectory(
     if title:
         fig.suptitle(title)
     fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return _save(fig, path)
 
 
 def save_robot_gif(
