@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from engine_builders import kinetic_acceleration, settled_block, static_slip
 
 from softgym.engine import Body, SimConfig, Simulation
 
@@ -62,38 +63,19 @@ def test_free_fall_within_0_5_percent():
     assert drop == pytest.approx(9.81 * sim.time[0] ** 2 / 2, rel=5e-3)
 
 
-def _settled_block_on_floor(mu_s=1.0, mu_k=0.5):
-    # global damping off: the closed form has no drag
-    body = Body.uniform(np.ones((2, 2, 1)), mu_static=mu_s, mu_kinetic=mu_k)
-    sim = Simulation(body, SimConfig(init_time=0.0, global_damping=0.0))
-    sim.advance(0.5)  # settle on the floor
-    return sim
-
-
 def test_static_friction_holds_below_threshold():
-    # F < mu_s N: the block does not slide (< 1e-6 m in 1 s).
-    sim = _settled_block_on_floor()
-    m = sim.masses(0)[0]
-    x0 = sim.positions(0)[:, :2].copy()
-    sim.set_external_force(0, [0.9 * 1.0 * m * 9.81 * 0.8, 0.9 * 1.0 * m * 9.81 * 0.6, 0.0])
-    sim.advance(1.0)
-    assert np.abs(sim.positions(0)[:, :2] - x0).max() < 1e-6
+    # F = 0.9 mu_s N: the block does not slide (< 1e-6 m in 1 s).
+    assert static_slip(settled_block()) < 1e-6
 
 
 def test_kinetic_friction_acceleration_within_2_percent():
-    # F > mu_s N: a = (F - mu_k N) / m within 2 %.
+    # F = 1.5 mu_s N: a = (F - mu_k N) / m within 2 %.
     mu_s, mu_k = 1.0, 0.5
-    sim = _settled_block_on_floor(mu_s, mu_k)
+    sim = settled_block(mu_s, mu_k)
     m = sim.masses(0)[0]
     N = m * 9.81
     F = 1.5 * mu_s * N
-    sim.set_external_force(0, [F, 0.0, 0.0])
-    sim.advance(0.1)
-    v1, t1 = sim.velocities(0)[:, 0].mean(), sim.time[0]
-    sim.advance(0.4)
-    v2, t2 = sim.velocities(0)[:, 0].mean(), sim.time[0]
-    accel = (v2 - v1) / (t2 - t1)
-    assert accel == pytest.approx((F - mu_k * N) / m, rel=0.02)
+    assert kinetic_acceleration(sim, F) == pytest.approx((F - mu_k * N) / m, rel=0.02)
 
 
 def test_block_settles_on_floor_at_rest():

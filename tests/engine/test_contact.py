@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from engine_builders import reference_robot
+from engine_builders import kinetic_acceleration, reference_robot, settled_block, static_slip
 
 from softgym.engine import Body, SimConfig, Simulation
 from softgym.terrain import Box, Terrain
@@ -54,21 +54,12 @@ def test_robot_driven_into_a_wall_never_enters_it():
 
 def _block_on_platform(mu_s, mu_k):
     platform = Terrain.from_boxes([Box((-20, -20, 0), (40, 40, 2))])
-    body = Body.uniform(np.ones((2, 2, 1)), mu_static=mu_s, mu_kinetic=mu_k,
-                        origin=(0.0, 0.0, 2 * L))  # fmt: skip
-    sim = Simulation(body, SimConfig(init_time=0.0, global_damping=0.0), terrain=platform)
-    sim.advance(0.5)
-    return sim
+    return settled_block(mu_s, mu_k, terrain=platform, z0=2 * L)
 
 
 def test_static_friction_on_a_box_top_matches_the_floor():
     # F = 0.9 mu_s N: no sliding (< 1e-6 m in 1 s), as on the floor.
-    sim = _block_on_platform(1.0, 0.5)
-    m = sim.masses(0)[0]
-    x0 = sim.positions(0)[:, :2].copy()
-    sim.set_external_force(0, [0.9 * 9.81 * m * 0.6, 0.9 * 9.81 * m * 0.8, 0.0])
-    sim.advance(1.0)
-    assert np.abs(sim.positions(0)[:, :2] - x0).max() < 1e-6
+    assert static_slip(_block_on_platform(1.0, 0.5)) < 1e-6
 
 
 def test_kinetic_friction_on_a_box_top_matches_the_floor():
@@ -78,12 +69,7 @@ def test_kinetic_friction_on_a_box_top_matches_the_floor():
     m = sim.masses(0)[0]
     N = m * 9.81
     F = 1.5 * mu_s * N
-    sim.set_external_force(0, [F, 0.0, 0.0])
-    sim.advance(0.1)
-    v1, t1 = sim.velocities(0)[:, 0].mean(), sim.time[0]
-    sim.advance(0.3)
-    v2, t2 = sim.velocities(0)[:, 0].mean(), sim.time[0]
-    assert (v2 - v1) / (t2 - t1) == pytest.approx((F - mu_k * N) / m, rel=0.02)
+    assert kinetic_acceleration(sim, F) == pytest.approx((F - mu_k * N) / m, rel=0.02)
 
 
 def _c_shape_pulled_shut(self_collision):
