@@ -53,13 +53,24 @@ class DaskBatchFn:
     n_batches : int, optional
         Batches per generation (default: the cluster's total worker threads).
     retries : int
-        Times a failed batch (e.g. its worker died) is resubmitted.
+        Times a batch that raised is resubmitted. (A batch whose worker died
+        is recomputed on another worker by the scheduler itself.)
+    payload_fn : callable, optional
+        What runs a batch on a worker (default
+        :func:`softgym.evaluate.evaluate_payload`).
     """
 
-    def __init__(self, client: Any, n_batches: int | None = None, retries: int = 3) -> None:
+    def __init__(
+        self,
+        client: Any,
+        n_batches: int | None = None,
+        retries: int = 3,
+        payload_fn: Any = evaluate_payload,
+    ) -> None:
         self.client = client
         self.n_batches = n_batches
         self.retries = int(retries)
+        self.payload_fn = payload_fn
 
     def _default_batches(self) -> int:
         try:
@@ -73,7 +84,7 @@ class DaskBatchFn:
         # one engine thread per batch: workers already run batches in parallel
         task_dict = {**task.to_dict(), "n_threads": 1}
         payloads = [{"designs": designs[a:b], "task": task_dict} for a, b in slices]
-        futures = self.client.map(evaluate_payload, payloads, pure=False, retries=self.retries)
+        futures = self.client.map(self.payload_fn, payloads, pure=False, retries=self.retries)
         parts = self.client.gather(futures)
         return _merge(parts)
 
