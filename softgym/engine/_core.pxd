@@ -106,7 +106,6 @@ cdef struct Contacts:
     KeyIndex* cells          # (n_voxels_r,) voxels sorted by spatial-hash cell
     intp_t* row              # (n_voxels_r,) scratch: candidates of one voxel
     float64_t* ref           # (n_voxels_r, 3) positions when the list was built (m)
-    float64_t travel         # largest displacement of any voxel since the rebuild (m)
     float64_t margin         # horizon - largest contact envelope (m)
     float64_t built_scale    # largest voxel size when the list was built (m)
     int32 stale              # 1: rebuild before the next use

@@ -583,7 +583,6 @@ cdef int _rebuild_contacts(Batch* b, intp_t r, Contacts* c) noexcept nogil:
     h2 = horizon * horizon
     inv_cell = 1.0 / horizon
     c.built_scale = smax
-    c.travel = 0.0
     c.stale = 0
     c.n_pairs = 0
     x0 = P[3 * vs]
