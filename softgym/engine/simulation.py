@@ -232,7 +232,6 @@ class Simulation:
         link_start = [0]
         dts, masses, axis_counts, excl = [], [], [], []
         grid_index = []
-        self._grid_maps: list[np.ndarray] = []
 
         def add(store, name, value):
             store.setdefault(name, []).append(np.asarray(value))
@@ -243,7 +242,6 @@ class Simulation:
             n = idx.shape[0]
             vmap = np.full(grid.shape, -1, dtype=np.int64)
             vmap[tuple(idx.T)] = np.arange(n)
-            self._grid_maps.append(vmap)
             mat = grid[tuple(idx.T)]
             E = body.youngs_modulus[mat]
             rho = body.density[mat]
