@@ -27,46 +27,18 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
 __all__ = ["main"]
 
 log = logging.getLogger("softgym")
 
 
-def _default_body():
-    try:
-        from softgym.design import default_walker
-    except ImportError:  # pragma: no cover - the design layer ships with the package
-        default_walker = None
-    if default_walker is not None:
-        return default_walker()
-    from softgym.engine import Body
-
-    grid = np.ones((6, 6, 6), dtype=np.int32)
-    grid[3:] = 2
-    return Body(
-        grid=grid,
-        youngs_modulus=[0, 5e6, 5e6],
-        density=[0, 1e6, 1e6],
-        poisson=[0, 0.35, 0.35],
-        cte=[0, 0.01, -0.01],
-        mu_static=[0, 1, 1],
-        mu_kinetic=[0, 0.5, 0.5],
-    )
-
-
 def _cmd_simulate(args: argparse.Namespace) -> int:
+    from softgym.design import RobotDesign, default_walker
     from softgym.engine import SimConfig, Simulation
     from softgym.metrics import norm_final_dist
     from softgym.render.figures import plot_trajectory
 
-    if args.design:
-        from softgym.design import RobotDesign
-
-        robot = RobotDesign.load(args.design)
-    else:
-        robot = _default_body()
+    robot = RobotDesign.load(args.design) if args.design else default_walker()
     cfg = SimConfig(actuation=args.actuation, trace_interval=0.05)
     sim = Simulation([robot], cfg)
     t0 = time.perf_counter()
