@@ -527,6 +527,51 @@ class Simulation:
         self._a["temp"][s] = arr
         self._a["use_temp"][robot] = 1
 
+    def set_temperatures(self, temperature: Any, robots: Any = None) -> None:
+        """Per-voxel temperatures (degC) for many robots in one call.
+
+        Parameters
+        ----------
+        temperature : array_like of shape (n_voxels,)
+            One value per voxel of the whole batch, in voxel order (robot
+            ``i`` owns ``voxel_offsets[i]:voxel_offsets[i + 1]``).
+        robots : array_like of bool of shape (n_robots,) or of int, optional
+            The robots that take their values and switch to temperature
+            control (default all); the others keep theirs.
+
+        Raises
+        ------
+        InvalidActionError
+            On a wrong shape or a non-finite value; the state is unchanged.
+        """
+        arr = np.asarray(temperature, dtype=np.float64)
+        if arr.shape != (self.n_voxels,):
+            raise InvalidActionError(
+                f"temperatures must have shape ({self.n_voxels},) (one per voxel), got {arr.shape}"
+            )
+        if not np.isfinite(arr).all():
+            raise InvalidActionError("temperatures hold NaN or infinite values")
+        a = self._a
+        if robots is None:
+            a["temp"][:] = arr
+            a["use_temp"][:] = 1
+            return
+        sel = np.zeros(self.n_robots, dtype=bool)
+        sel[np.asarray(robots)] = True
+        voxels = np.repeat(sel, np.diff(a["vox_start"]))
+        a["temp"][voxels] = arr[voxels]
+        a["use_temp"][sel] = 1
+
+    @property
+    def all_positions(self) -> np.ndarray:
+        """Voxel centres (m) of the whole batch, shape (n_voxels, 3) (a copy)."""
+        return self._a["pos"].copy()
+
+    @property
+    def all_velocities(self) -> np.ndarray:
+        """Voxel velocities (m/s) of the whole batch, shape (n_voxels, 3) (a copy)."""
+        return self._a["vel"].copy()
+
     def set_external_force(self, robot: int, force: Any) -> None:
         """Apply a constant external force (N) to each voxel of one robot.
 

@@ -223,6 +223,7 @@ class _WalkerBatch:
         self._colors: dict[int, np.ndarray] = {}
         # batch-wide voxel -> (robot, cell) maps for the observations
         self._voxel_robot = np.repeat(np.arange(n), [c.size for c in self.cells])
+        self._voxel_is_muscle = np.concatenate(self.voxel_muscle)
         self._flat_cells = np.concatenate(
             [r * self.n_cells + c for r, c in enumerate(self.cells)]
         ).astype(np.intp)
@@ -290,12 +291,10 @@ class _WalkerBatch:
 
     def apply(self, actions: np.ndarray, active: np.ndarray | None = None) -> None:
         """Set every active robot's muscle temperatures ``action * dT`` (degC)."""
-        for r in range(self.n_robots):
-            if active is not None and not active[r]:
-                continue
-            temps = actions[r, self.cells[r]] * self.amplitude[r]
-            temps[~self.voxel_muscle[r]] = 0.0
-            self.sim.set_temperature(r, temps)
+        # every voxel of the batch at once: its cell's action times its robot's dT
+        temps = actions.reshape(-1)[self._flat_cells] * self.amplitude[self._voxel_robot]
+        temps[~self._voxel_is_muscle] = 0.0
+        self.sim.set_temperatures(temps, None if active is None else np.flatnonzero(active))
 
     def advance(self) -> None:
         """Advance the whole batch by one control step."""
@@ -350,8 +349,8 @@ class _WalkerBatch:
         inv_l = 1.0 / self.L
         # every voxel of the batch at once: (n_voxels, 6) features, scattered to their cells
         feats = np.empty((self._flat_cells.size, 6))
-        feats[:, 0:3] = np.concatenate([sim.positions(r) for r in range(n)])
-        feats[:, 3:6] = np.concatenate([sim.velocities(r) for r in range(n)])
+        feats[:, 0:3] = sim.all_positions
+        feats[:, 3:6] = sim.all_velocities
         feats[:, 0:3] -= cm[self._voxel_robot]
         feats[:, 3:6] -= cm_vel[self._voxel_robot]
         feats *= inv_l

@@ -126,3 +126,29 @@ def test_state_round_trip_resumes_bit_for_bit():
     assert np.array_equal(end.cm, other.cm)
     with pytest.raises(InvalidParameterError, match="missing"):
         again.set_state({"pos": state["pos"]})
+
+
+def test_batch_temperatures_match_per_robot_calls_and_reject_nan():
+    bodies = [reference_robot(3), reference_robot(2)]
+    cfg = SimConfig(actuation="symmetric")
+    one, many = Simulation(bodies, cfg), Simulation(bodies, cfg)
+    temps = np.linspace(-10.0, 10.0, one.n_voxels)
+    off = one.voxel_offsets
+    for r in range(2):
+        one.set_temperature(r, temps[off[r] : off[r + 1]])
+    many.set_temperatures(temps)
+    one.advance(0.2)
+    many.advance(0.2)
+    assert np.array_equal(one.all_positions, many.all_positions)
+    before = many.get_state()
+    bad = temps.copy()
+    bad[3] = np.inf
+    with pytest.raises(InvalidActionError):
+        many.set_temperatures(bad)
+    with pytest.raises(InvalidActionError, match="shape"):
+        many.set_temperatures(temps[:-1])
+    after = many.get_state()
+    assert all(np.array_equal(before[k], after[k]) for k in before)
+    # only robot 1 switches: robot 0 keeps its values
+    many.set_temperatures(np.zeros(many.n_voxels), robots=[1])
+    assert np.array_equal(many.get_state()["temp"][: off[1]], temps[: off[1]])
