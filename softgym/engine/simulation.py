@@ -726,6 +726,12 @@ class Simulation:
         for k in _STATE:
             self._a[k] = np.array(state[k], dtype=self._a[k].dtype, order="C", copy=True)
         self._t_target = float(state.get("t_target", 0.0))
+        self._state_changed()
+
+    def _state_changed(self) -> None:
+        # voxels were moved from outside the kernel: re-derive the rotation
+        # matrices from the quaternions and rebuild the contact candidates
+        _core.refresh_rotations(self._a["quat"], self._a["rot"])
         self._contacts.invalidate()
 
     def restore_robots(self, state: dict[str, np.ndarray], robots: Any) -> None:
@@ -765,4 +771,4 @@ class Simulation:
         for k in _ROBOT_STATE:
             a[k][ids] = np.asarray(state[k])[ids]
         a["steps"][ids] = np.ceil(self._t_target / a["dt"][ids] - 1e-9).astype(np.int64)
-        self._contacts.invalidate()
+        self._state_changed()
