@@ -157,9 +157,9 @@ def test_batch_temperatures_match_per_robot_calls_and_reject_nan():
 def test_set_state_derives_rotations_from_quaternions():
     # rot is derived state: a state whose quaternion says "twisted" is twisted
     sim = Simulation(Body.uniform(np.ones((2, 1, 1))), SimConfig(gravity=0.0, floor=False))
-    assert sim.energy()[0, 1] == 0.0
+    assert sim.energy()[0, 1] < 1e-20
     state = sim.get_state()
     angle = 0.2
     state["quat"][1] = [np.cos(angle / 2), 0.0, 0.0, np.sin(angle / 2)]  # bend about z
     sim.set_state(state)
-    assert sim.energy()[0, 1] > 0.0
+    assert sim.energy()[0, 1] > 1e-6
