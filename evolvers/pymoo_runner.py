@@ -321,19 +321,11 @@ class PymooRun(EvolutionRun):
         stats = algorithm.problem.last_stats
         wall = time.perf_counter() - self._t0
         self._t0 = time.perf_counter()
-        self.wall_total += wall
-        self.evaluations_total += stats.n_simulated
         off = [
             x[0] for x in (algorithm.off if algorithm.off is not None else algorithm.pop).get("X")
         ]
         self._update_hall_of_fame(off)
-        row = self._log_row(stats, wall)
-        self.rows.append(row)
-        self.checkpoint()
-        self._write_log()
-        self._write_best()
-        if self.on_generation is not None:
-            self.on_generation(self, row)
+        self._end_generation(stats, wall)
 
     # ------------------------------------------------------------------ checkpoints
     def checkpoint(self):

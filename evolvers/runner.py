@@ -307,16 +307,7 @@ class EvolutionRun:
             else:
                 stats = self._next_generation()
             self.generation += 1
-            wall = time.perf_counter() - t0
-            self.wall_total += wall
-            self.evaluations_total += stats.n_simulated
-            row = self._log_row(stats, wall)
-            self.rows.append(row)
-            self.checkpoint()
-            self._write_log()
-            self._write_best()
-            if self.on_generation is not None:
-                self.on_generation(self, row)
+            self._end_generation(stats, time.perf_counter() - t0)
         self.finish()
         return self.population
 
@@ -350,6 +341,18 @@ class EvolutionRun:
             "mean": float(values.mean()),
             "worst": float(values.min() if maximize else values.max()),
         }
+
+    def _end_generation(self, stats: EvalStats, wall: float) -> None:
+        """Book-keeping after a generation: totals, log row, checkpoint, files, callback."""
+        self.wall_total += wall
+        self.evaluations_total += stats.n_simulated
+        row = self._log_row(stats, wall)
+        self.rows.append(row)
+        self.checkpoint()
+        self._write_log()
+        self._write_best()
+        if self.on_generation is not None:
+            self.on_generation(self, row)
 
     def _log_row(self, stats: EvalStats, wall: float) -> dict[str, Any]:
         exp = self.experiment
