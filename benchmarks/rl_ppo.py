@@ -32,9 +32,9 @@ from softgym.controllers import Sinusoid
 ENV_ID = "SoftWalker-Flat-v0"
 
 
-def evaluate(policy, episodes: int, seed: int, control_dt: float) -> tuple[float, float]:
+def evaluate(policy, episodes: int, seed: int, env_kwargs: dict) -> tuple[float, float]:
     """Mean and std of the episode return of ``policy(obs) -> action``."""
-    env = gym.make(ENV_ID, control_dt=control_dt)
+    env = gym.make(ENV_ID, **env_kwargs)
     returns = []
     for ep in range(episodes):
         obs, _ = env.reset(seed=seed + ep)
@@ -49,39 +49,130 @@ def evaluate(policy, episodes: int, seed: int, control_dt: float) -> tuple[float
     return float(np.mean(returns)), float(np.std(returns))
 
 
+def sb3_vec_env(env_id: str, n_envs: int, seed: int, **kwargs):
+    """A Stable-Baselines3 ``VecEnv`` over the batched ``gym.make_vec`` env.
+
+    SB3 has its own vector API and asks users to adapt others to it (its
+    docs' EnvPool/ProcGen examples). All ``n_envs`` robots advance in one
+    engine call (the engine's threads, no subprocesses); the env runs in
+    Gymnasium's ``SAME_STEP`` autoreset mode, which is SB3's convention: the
+    end observation goes to ``infos[i]["terminal_observation"]``.
+    """
+    from gymnasium.vector import AutoresetMode
+    from stable_baselines3.common.vec_env import VecEnv
+
+    class SoftgymVecEnv(VecEnv):
+        def __init__(self) -> None:
+            self.venv = gym.make_vec(
+                env_id, num_envs=n_envs, autoreset_mode=AutoresetMode.SAME_STEP, **kwargs
+            )
+            super().__init__(
+                n_envs, self.venv.single_observation_space, self.venv.single_action_space
+            )
+            self._actions: np.ndarray | None = None
+            self._next_seed: int | None = seed
+
+        def reset(self):
+            obs, _ = self.venv.reset(seed=self._next_seed)
+            self._next_seed = None
+            return obs
+
+        def step_async(self, actions: np.ndarray) -> None:
+            self._actions = actions
+
+        def step_wait(self):
+            obs, rew, term, trunc, info = self.venv.step(self._actions)
+            done = term | trunc
+            infos: list[dict] = [{} for _ in range(self.num_envs)]
+            for i in np.flatnonzero(done):
+                infos[i]["terminal_observation"] = info["final_obs"][i]
+                infos[i]["TimeLimit.truncated"] = bool(trunc[i] and not term[i])
+            return obs, rew.astype(np.float32), done, infos
+
+        def close(self) -> None:
+            self.venv.close()
+
+        def get_attr(self, attr_name, indices=None):
+            return [getattr(self.venv, attr_name)] * len(self._get_indices(indices))
+
+        def set_attr(self, attr_name, value, indices=None) -> None:
+            raise AttributeError("SoftgymVecEnv: attributes are shared by the batch and read-only")
+
+        def env_method(self, method_name, *args, indices=None, **kwargs):
+            raise AttributeError("SoftgymVecEnv: sub-environments are not separate objects")
+
+        def env_is_wrapped(self, wrapper_class, indices=None):
+            return [False] * len(self._get_indices(indices))
+
+    return SoftgymVecEnv()
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--timesteps", type=int, default=20_000, help="PPO training budget (env steps)")
-    ap.add_argument("--n-envs", type=int, default=8, help="parallel envs for PPO (DummyVecEnv)")
+    ap.add_argument("--n-envs", type=int, default=16, help="robots stepped in parallel")
+    ap.add_argument(
+        "--vec",
+        choices=["batched", "dummy"],
+        default="batched",
+        help="batched: one engine call for all robots; dummy: SB3's DummyVecEnv of single envs",
+    )
     ap.add_argument("--episodes", type=int, default=5, help="evaluation episodes per policy")
     ap.add_argument("--control-dt", type=float, default=0.05, help="seconds per action")
+    ap.add_argument("--actuation", choices=["seed", "symmetric"], default=None)
+    ap.add_argument("--n-steps", type=int, default=128, help="rollout length per env per update")
+    ap.add_argument("--batch-size", type=int, default=512)
+    ap.add_argument("--n-epochs", type=int, default=10)
+    ap.add_argument("--lr", type=float, default=3e-4)
+    ap.add_argument("--gamma", type=float, default=0.99)
+    ap.add_argument(
+        "--log-std-init", type=float, default=-1.0, help="initial log std of the Gaussian policy"
+    )
+    ap.add_argument("--net-arch", type=int, nargs="+", default=[256, 256])
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--save", default=None, help="save the trained model (zip) and VecNormalize")
     ap.add_argument("--json", action="store_true", help="print one JSON object as the last line")
+    ap.add_argument("--verbose", action="store_true", help="SB3's training log every update")
     args = ap.parse_args(argv)
     try:
         import torch
         from stable_baselines3 import PPO
         from stable_baselines3.common.env_util import make_vec_env
-        from stable_baselines3.common.vec_env import VecNormalize
+        from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
     except ImportError:
         print("rl_ppo.py needs the rl extra: pip install -e '.[rl]'", file=sys.stderr)
         return 2
     torch.set_num_threads(1)
-    kw = {"control_dt": args.control_dt}
-    venv = VecNormalize(make_vec_env(ENV_ID, n_envs=args.n_envs, seed=args.seed, env_kwargs=kw))
+    kw: dict = {"control_dt": args.control_dt}
+    if args.actuation is not None:
+        kw["actuation"] = args.actuation
+    if args.vec == "batched":
+        base = VecMonitor(sb3_vec_env(ENV_ID, args.n_envs, args.seed, **kw))
+    else:
+        base = make_vec_env(ENV_ID, n_envs=args.n_envs, seed=args.seed, env_kwargs=kw)
+    venv = VecNormalize(base, gamma=args.gamma)
     model = PPO(
         "MlpPolicy",
         venv,
-        n_steps=256,
-        batch_size=256,
-        learning_rate=3e-4,
+        n_steps=args.n_steps,
+        batch_size=args.batch_size,
+        n_epochs=args.n_epochs,
+        learning_rate=args.lr,
+        gamma=args.gamma,
+        policy_kwargs={
+            "log_std_init": args.log_std_init,
+            "net_arch": list(args.net_arch),
+        },
         seed=args.seed,
-        verbose=0,
+        verbose=int(args.verbose),
     )
     t0 = time.perf_counter()
     model.learn(total_timesteps=args.timesteps)
     train_s = time.perf_counter() - t0
     venv.training = False
+    if args.save:
+        model.save(args.save)
+        venv.save(args.save + ".vecnormalize.pkl")
 
     def ppo_policy(obs, env):
         norm = venv.normalize_obs(obs[None])
@@ -95,20 +186,20 @@ def main(argv: list[str] | None = None) -> int:
     sinusoid = Sinusoid.from_env(probe)
     probe.close()
     results = {
-        "ppo": evaluate(ppo_policy, args.episodes, args.seed + 1000, args.control_dt),
-        "ppo_sampled": evaluate(ppo_sampled, args.episodes, args.seed + 1000, args.control_dt),
+        "ppo": evaluate(ppo_policy, args.episodes, args.seed + 1000, kw),
+        "ppo_sampled": evaluate(ppo_sampled, args.episodes, args.seed + 1000, kw),
         "random": evaluate(
             lambda obs, env: env.action_space.sample(),
             args.episodes,
             args.seed + 1000,
-            args.control_dt,
+            kw,
         ),
         "sinusoid": evaluate(
-            lambda obs, env: sinusoid(obs), args.episodes, args.seed + 1000, args.control_dt
+            lambda obs, env: sinusoid(obs), args.episodes, args.seed + 1000, kw
         ),
     }
     print(
-        f"PPO on {ENV_ID}: {args.timesteps} env steps ({args.n_envs} envs, control_dt "
+        f"PPO on {ENV_ID}: {args.timesteps} env steps ({args.n_envs} envs {args.vec}, control_dt "
         f"{args.control_dt} s) in {train_s:.0f} s ({args.timesteps / train_s:.0f} steps/s incl. "
         f"updates)",
         file=sys.stderr,

@@ -48,7 +48,7 @@ from typing import Any
 import numpy as np
 
 from softgym.engine import _core
-from softgym.engine._openmp import omp_max_threads
+from softgym.engine._openmp import openmp_enabled
 from softgym.engine.body import Body
 from softgym.engine.config import SimConfig
 from softgym.engine.rollout import Rollout
@@ -75,18 +75,39 @@ _ROBOT_STATE = ("diverged", "diverged_time", "diverged_code", "init_done", "cm_i
 _STATE = (*_VOXEL_STATE, *_ROBOT_STATE, "steps", "trace_n", "trace_t", "trace_cm")
 
 
+def _env_threads(name: str) -> int | None:
+    env = os.environ.get(name)
+    if not env:
+        return None
+    try:
+        # OMP_NUM_THREADS may list one count per nesting level: the first is ours
+        n = int(env.split(",")[0])
+    except ValueError:
+        raise InvalidParameterError(f"{name} must be an integer, got {env!r}") from None
+    if n < 1:
+        raise InvalidParameterError(f"{name} must be >= 1, got {n}")
+    return n
+
+
 def default_num_threads() -> int:
-    """Threads used when none is given: ``SOFTGYM_NUM_THREADS``, else OpenMP's default."""
-    env = os.environ.get("SOFTGYM_NUM_THREADS")
-    if env:
-        try:
-            n = int(env)
-        except ValueError:
-            raise InvalidParameterError(f"SOFTGYM_NUM_THREADS must be an integer, got {env!r}") from None
-        if n < 1:
-            raise InvalidParameterError(f"SOFTGYM_NUM_THREADS must be >= 1, got {n}")
-        return n
-    return max(1, omp_max_threads())
+    """Threads used when none is given.
+
+    ``SOFTGYM_NUM_THREADS`` if set, else ``OMP_NUM_THREADS``, else the CPUs
+    this process may run on; 1 in a build without OpenMP. It does not read
+    OpenMP's run-time setting: libraries sharing the process's OpenMP runtime
+    change it (``torch.set_num_threads(1)``, common in RL scripts, would
+    otherwise put the engine on one thread).
+    """
+    if not openmp_enabled():
+        return 1
+    for name in ("SOFTGYM_NUM_THREADS", "OMP_NUM_THREADS"):
+        n = _env_threads(name)
+        if n is not None:
+            return n
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # no affinity API (macOS, Windows)
+        return max(1, os.cpu_count() or 1)
 
 
 def as_body(obj: Any) -> Body:

@@ -64,6 +64,9 @@ class SoftWalkerVectorEnv(VectorEnv):
     max_episode_steps : int, optional
         Truncation in steps (``make_vec`` passes the id's registered 80);
         episodes also end after ``episode_seconds``.
+    autoreset_mode : AutoresetMode or str, optional
+        ``NEXT_STEP`` (default) or ``SAME_STEP``; ``DISABLED`` is not
+        supported (an ended robot has no state to go on from).
 
     Notes
     -----
@@ -100,7 +103,19 @@ class SoftWalkerVectorEnv(VectorEnv):
         height: int = 240,
         n_threads: int | None = None,
         max_episode_steps: int | None = None,
+        autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
     ) -> None:
+        try:
+            mode = AutoresetMode(autoreset_mode)
+        except ValueError:
+            raise InvalidParameterError(
+                f"autoreset_mode must be NEXT_STEP or SAME_STEP, got {autoreset_mode!r}"
+            ) from None
+        if mode not in (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP):
+            raise InvalidParameterError(
+                f"autoreset_mode must be NEXT_STEP or SAME_STEP, got {mode.name}"
+            )
+        self.autoreset_mode = mode
         num_envs = int(num_envs)
         if num_envs < 1:
             raise InvalidParameterError(f"num_envs must be >= 1, got {num_envs}")
@@ -139,7 +154,11 @@ class SoftWalkerVectorEnv(VectorEnv):
         self.control_dt = b.control_dt
         self.episode_seconds = b.episode_seconds
         self.max_steps = b.max_steps
-        self.metadata = {**type(self).metadata, "render_fps": max(1, round(1.0 / b.control_dt))}
+        self.metadata = {
+            **type(self).metadata,
+            "render_fps": max(1, round(1.0 / b.control_dt)),
+            "autoreset_mode": mode,
+        }
         self.render_mode = render_mode
         self.width, self.height = int(width), int(height)
         self._renderer: Any = None
@@ -231,8 +250,28 @@ class SoftWalkerVectorEnv(VectorEnv):
             b.advance()
         b.reset_robots(np.flatnonzero(restart))
         reward, terminated, truncated, _ = b.update(live)
-        self._prev_done = terminated | truncated
-        return b.observations(), reward, terminated, truncated, self._infos()
+        done = terminated | truncated
+        if self.autoreset_mode == AutoresetMode.NEXT_STEP or not done.any():
+            self._prev_done = done
+            return b.observations(), reward, terminated, truncated, self._infos()
+        # SAME_STEP: keep the end of the ended episodes, then restart those robots now
+        ended = np.flatnonzero(done)
+        end_obs = b.observations()
+        end_info = self._infos()
+        final_obs = np.full(self.num_envs, None, dtype=object)
+        for i in ended:
+            final_obs[i] = end_obs[i]
+        final_info = {k: v for k, v in end_info.items() if not k.startswith("_")}
+        final_info.update({f"_{k}": done.copy() for k in list(final_info)})
+        b.reset_robots(ended)
+        infos = self._infos()
+        infos.update(
+            final_obs=final_obs,
+            _final_obs=done.copy(),
+            final_info=final_info,
+            _final_info=done.copy(),
+        )
+        return b.observations(), reward, terminated, truncated, infos
 
     def render(self) -> tuple[np.ndarray, ...] | None:
         """One H x W x 3 uint8 frame per sub-environment (``render_mode="rgb_array"``)."""

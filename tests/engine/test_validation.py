@@ -163,3 +163,20 @@ def test_set_state_derives_rotations_from_quaternions():
     state["quat"][1] = [np.cos(angle / 2), 0.0, 0.0, np.sin(angle / 2)]  # bend about z
     sim.set_state(state)
     assert sim.energy()[0, 1] > 1e-6
+
+
+def test_default_threads_come_from_the_environment_not_openmp_state(monkeypatch):
+    from softgym.engine import default_num_threads, openmp_enabled
+
+    monkeypatch.delenv("SOFTGYM_NUM_THREADS", raising=False)
+    monkeypatch.setenv("OMP_NUM_THREADS", "3,1")
+    assert default_num_threads() == (3 if openmp_enabled() else 1)
+    monkeypatch.setenv("SOFTGYM_NUM_THREADS", "2")
+    assert default_num_threads() == (2 if openmp_enabled() else 1)
+    monkeypatch.setenv("SOFTGYM_NUM_THREADS", "two")
+    if openmp_enabled():
+        with pytest.raises(InvalidParameterError, match="SOFTGYM_NUM_THREADS"):
+            default_num_threads()
+    monkeypatch.delenv("SOFTGYM_NUM_THREADS")
+    monkeypatch.delenv("OMP_NUM_THREADS")
+    assert default_num_threads() >= 1

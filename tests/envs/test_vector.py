@@ -77,3 +77,48 @@ def test_a_diverged_robot_is_reset_alone():
     assert not info["diverged"][1] and trunc[1]
     # walker: diverges, is reset alone (reward 0, no flags), diverges again
     assert flags == [(True, False, True, 0.0), (False, False, False, 0.0), (True, False, True, 0.0)]
+
+
+def test_same_step_autoreset_matches_next_step():
+    from gymnasium.vector import AutoresetMode
+
+    ds = designs()
+    kw = {"num_envs": 3, "designs": ds, "episode_seconds": 0.15}
+    nxt = gym.make_vec("SoftWalker-Flat-v0", **kw)
+    same = gym.make_vec("SoftWalker-Flat-v0", autoreset_mode=AutoresetMode.SAME_STEP, **kw)
+    assert same.metadata["autoreset_mode"] == AutoresetMode.SAME_STEP
+    rng = np.random.default_rng(1)
+    actions = rng.uniform(-1, 1, (4, 3, 216)).astype(np.float32)
+    o_n, _ = nxt.reset(seed=0)
+    o_s, _ = same.reset(seed=0)
+    start = o_s.copy()
+    for k in range(3):
+        o_n, r_n, te_n, tr_n, i_n = nxt.step(actions[k])
+        o_s, r_s, te_s, tr_s, i_s = same.step(actions[k])
+        assert np.array_equal(r_n, r_s) and np.array_equal(tr_n, tr_s)
+        if k < 2:
+            assert np.array_equal(o_n, o_s) and "final_obs" not in i_s
+    # the third step ends every episode: SAME_STEP returns the fresh start at once,
+    # with the end observation and metrics NEXT_STEP returned, in final_obs/final_info
+    assert tr_s.all() and i_s["_final_obs"].all()
+    assert np.array_equal(o_s, start)
+    assert np.array_equal(np.stack(i_s["final_obs"]), o_n)
+    assert np.array_equal(i_s["final_info"]["norm_final_dist"], i_n["norm_final_dist"])
+    assert (i_s["norm_final_dist"] == 0).all()
+    # the next step acts at once (NEXT_STEP spends it on the reset)
+    o_s, r_s, *_ = same.step(actions[3])
+    assert not np.array_equal(o_s, start) and r_s.any()
+    nxt.close()
+    same.close()
+
+
+def test_autoreset_mode_disabled_is_refused():
+    import pytest
+    from gymnasium.vector import AutoresetMode
+
+    from softgym.exceptions import InvalidParameterError
+
+    with pytest.raises(InvalidParameterError, match="SAME_STEP"):
+        gym.make_vec("SoftWalker-Flat-v0", num_envs=2, autoreset_mode=AutoresetMode.DISABLED)
+    with pytest.raises(InvalidParameterError, match="autoreset_mode"):
+        gym.make_vec("SoftWalker-Flat-v0", num_envs=2, autoreset_mode="sometimes")
