@@ -107,6 +107,92 @@ def sb3_vec_env(env_id: str, n_envs: int, seed: int, **kwargs):
     return SoftgymVecEnv()
 
 
+def lattice_policy(grid_shape: tuple[int, int, int], width: int = 32):
+    """An SB3 ``ActorCriticPolicy`` sharing one small network across the lattice's cells.
+
+    The usual controller of the voxel-robot literature (one neural
+    controller per voxel with shared weights, e.g. Medvet et al. 2020; Huang
+    et al. 2020): each cell's action mean comes from the same MLP applied to
+    that cell's observation (its 6 features) with the global entries (CM
+    velocity, phase) and the cell's normalised lattice coordinates. The
+    value is an MLP of the mean cell embedding and the globals. A few
+    thousand weights instead of ~400k, and the policy fits any body on the
+    grid.
+    """
+    import torch as th
+    from stable_baselines3.common.policies import ActorCriticPolicy
+    from torch import nn
+
+    n_cells = int(np.prod(grid_shape))
+    coords = np.stack(
+        np.meshgrid(*[np.linspace(-1.0, 1.0, g) for g in grid_shape], indexing="ij"), axis=-1
+    ).reshape(n_cells, 3)
+    n_in = 6 + 5 + 3
+
+    class CellExtractor(nn.Module):
+        def __init__(self) -> None:
+            super().__init__()
+            self.latent_dim_pi = n_cells * width
+            self.latent_dim_vf = width
+            self.register_buffer("coords", th.as_tensor(coords, dtype=th.float32))
+            self.pi = nn.Sequential(nn.Linear(n_in, width), nn.Tanh(), nn.Linear(width, width), nn.Tanh())
+            self.vf_cell = nn.Sequential(nn.Linear(n_in, width), nn.Tanh())
+            self.vf = nn.Sequential(nn.Linear(width + 5, width), nn.Tanh())
+
+        def _cells(self, obs: th.Tensor) -> tuple[th.Tensor, th.Tensor]:
+            b = obs.shape[0]
+            glob = obs[:, 6 * n_cells :]
+            cell = obs[:, : 6 * n_cells].reshape(b, n_cells, 6)
+            x = th.cat(
+                [cell, glob[:, None, :].expand(b, n_cells, 5), self.coords.expand(b, n_cells, 3)],
+                dim=-1,
+            )
+            return x, glob
+
+        def forward_actor(self, obs: th.Tensor) -> th.Tensor:
+            x, _ = self._cells(obs)
+            return self.pi(x).reshape(obs.shape[0], -1)
+
+        def forward_critic(self, obs: th.Tensor) -> th.Tensor:
+            x, glob = self._cells(obs)
+            return self.vf(th.cat([self.vf_cell(x).mean(dim=1), glob], dim=-1))
+
+        def forward(self, obs: th.Tensor) -> tuple[th.Tensor, th.Tensor]:
+            return self.forward_actor(obs), self.forward_critic(obs)
+
+    class CellHead(nn.Module):
+        """The shared last layer: one action mean per cell from its embedding."""
+
+        def __init__(self) -> None:
+            super().__init__()
+            self.linear = nn.Linear(width, 1)
+            nn.init.orthogonal_(self.linear.weight, gain=0.01)
+            nn.init.zeros_(self.linear.bias)
+
+        def forward(self, latent: th.Tensor) -> th.Tensor:
+            return self.linear(latent.reshape(latent.shape[0], n_cells, width)).squeeze(-1)
+
+    class LatticePolicy(ActorCriticPolicy):
+        def __init__(self, *args, **kwargs) -> None:
+            kwargs["features_extractor_kwargs"] = {}
+            kwargs.pop("net_arch", None)
+            super().__init__(*args, **kwargs)
+
+        def _build_mlp_extractor(self) -> None:
+            self.mlp_extractor = CellExtractor()
+
+        def _build(self, lr_schedule) -> None:
+            super()._build(lr_schedule)
+            if self.use_sde:
+                raise ValueError("the lattice policy does not support gSDE")
+            self.action_net = CellHead()
+            self.optimizer = self.optimizer_class(
+                self.parameters(), lr=lr_schedule(1), **self.optimizer_kwargs
+            )
+
+    return LatticePolicy
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--timesteps", type=int, default=20_000, help="PPO training budget (env steps)")
@@ -128,9 +214,23 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument(
         "--log-std-init", type=float, default=-1.0, help="initial log std of the Gaussian policy"
     )
-    ap.add_argument("--net-arch", type=int, nargs="+", default=[256, 256])
+    ap.add_argument(
+        "--sde",
+        type=int,
+        default=None,
+        metavar="FREQ",
+        help="generalized state-dependent exploration, new noise every FREQ steps (-1: per rollout)",
+    )
+    ap.add_argument("--net-arch", type=int, nargs="+", default=[256, 256], help="MLP policy only")
+    ap.add_argument(
+        "--policy",
+        choices=["mlp", "lattice"],
+        default="mlp",
+        help="mlp: SB3's MlpPolicy; lattice: one small network shared by every cell",
+    )
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--save", default=None, help="save the trained model (zip) and VecNormalize")
+    ap.add_argument("--gif", default=None, help="write one episode of the trained policy to this GIF")
     ap.add_argument("--json", action="store_true", help="print one JSON object as the last line")
     ap.add_argument("--verbose", action="store_true", help="SB3's training log every update")
     args = ap.parse_args(argv)
@@ -151,23 +251,45 @@ def main(argv: list[str] | None = None) -> int:
     else:
         base = make_vec_env(ENV_ID, n_envs=args.n_envs, seed=args.seed, env_kwargs=kw)
     venv = VecNormalize(base, gamma=args.gamma)
+    policy_kwargs: dict = {"log_std_init": args.log_std_init}
+    if args.policy == "mlp":
+        policy: object = "MlpPolicy"
+        policy_kwargs["net_arch"] = list(args.net_arch)
+    else:
+        probe = gym.make(ENV_ID, **kw)
+        policy = lattice_policy(probe.unwrapped.grid_shape)
+        probe.close()
     model = PPO(
-        "MlpPolicy",
+        policy,
         venv,
         n_steps=args.n_steps,
         batch_size=args.batch_size,
         n_epochs=args.n_epochs,
         learning_rate=args.lr,
         gamma=args.gamma,
-        policy_kwargs={
-            "log_std_init": args.log_std_init,
-            "net_arch": list(args.net_arch),
-        },
+        use_sde=args.sde is not None,
+        sde_sample_freq=-1 if args.sde is None else args.sde,
+        policy_kwargs=policy_kwargs,
         seed=args.seed,
         verbose=int(args.verbose),
     )
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    curve: list[tuple[int, float]] = []
+
+    class Curve(BaseCallback):
+        """Mean training-episode return (last 100 episodes) after every rollout."""
+
+        def _on_step(self) -> bool:
+            return True
+
+        def _on_rollout_end(self) -> None:
+            eps = self.model.ep_info_buffer
+            if eps:
+                curve.append((self.num_timesteps, float(np.mean([e["r"] for e in eps]))))
+
     t0 = time.perf_counter()
-    model.learn(total_timesteps=args.timesteps)
+    model.learn(total_timesteps=args.timesteps, callback=Curve())
     train_s = time.perf_counter() - t0
     venv.training = False
     if args.save:
@@ -182,6 +304,19 @@ def main(argv: list[str] | None = None) -> int:
         norm = venv.normalize_obs(obs[None])
         return model.predict(norm, deterministic=False)[0][0]
 
+    if args.gif:
+        from softgym.render import save_gif
+
+        env = gym.make(ENV_ID, render_mode="rgb_array", **kw)
+        obs, _ = env.reset(seed=args.seed)
+        frames, done = [env.render()], False
+        while not done:
+            obs, _, term, trunc, _ = env.step(ppo_policy(obs, env))
+            frames.append(env.render())
+            done = term or trunc
+        save_gif(frames, args.gif, fps=env.metadata["render_fps"])
+        env.close()
+        print(f"wrote {args.gif} ({len(frames)} frames)", file=sys.stderr)
     probe = gym.make(ENV_ID, **kw)
     sinusoid = Sinusoid.from_env(probe)
     probe.close()
@@ -204,6 +339,13 @@ def main(argv: list[str] | None = None) -> int:
         f"updates)",
         file=sys.stderr,
     )
+    if curve:
+        marks = curve[:: max(1, len(curve) // 10)] + [curve[-1]]
+        print(
+            "training return (last 100 episodes): "
+            + ", ".join(f"{t // 1000}k {r:.3f}" for t, r in marks),
+            file=sys.stderr,
+        )
     print("mean episode return (NormFinalDist over 4 s, voxel lengths):", file=sys.stderr)
     for name, (mean, std) in results.items():
         print(f"  {name:<12} {mean:8.3f} +- {std:.3f}", file=sys.stderr)
@@ -213,6 +355,8 @@ def main(argv: list[str] | None = None) -> int:
                 {
                     "timesteps": args.timesteps,
                     "train_seconds": train_s,
+                    "actuation": args.actuation or "seed",
+                    "curve": curve,
                     **{k: v[0] for k, v in results.items()},
                 }
             )

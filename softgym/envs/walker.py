@@ -449,7 +449,9 @@ class SoftWalkerEnv(gym.Env):
     CTE) gets the temperature ``T = action * dT`` (degC), ``dT`` the design's
     controller amplitude (14 degC by default), so its size follows
     ``L (1 + CTE T)`` under the configured actuation law (``"seed"``: muscles
-    only contract; ``"symmetric"``: they also expand). Entries of empty and
+    only contract, and a command that would expand one keeps its last size,
+    the seed's rule, so only commands back towards 0 relax a contracted
+    muscle; ``"symmetric"``: they also expand). Entries of empty and
     passive cells are ignored (``env.muscle_mask`` and ``info["muscle_mask"]``
     of :meth:`reset` tell which count). Each action is held for
     ``control_dt`` seconds. ``action = sin(2 pi t / period)`` on every cell
