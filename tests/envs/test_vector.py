@@ -122,3 +122,32 @@ def test_autoreset_mode_disabled_is_refused():
         gym.make_vec("SoftWalker-Flat-v0", num_envs=2, autoreset_mode=AutoresetMode.DISABLED)
     with pytest.raises(InvalidParameterError, match="autoreset_mode"):
         gym.make_vec("SoftWalker-Flat-v0", num_envs=2, autoreset_mode="sometimes")
+
+
+def test_same_step_resets_a_diverged_robot_alone():
+    from gymnasium.vector import AutoresetMode
+
+    bone = RobotDesign(np.full((6, 6, 6), 2, dtype=np.int8))
+    cfg = SimConfig(max_strain=0.2, init_time=0.2)  # the walker diverges at its first step
+    kw = {"sim_config": cfg, "episode_seconds": 0.15}
+    venv = gym.make_vec(
+        "SoftWalker-Flat-v0",
+        num_envs=2,
+        designs=[default_walker(), bone],
+        autoreset_mode=AutoresetMode.SAME_STEP,
+        **kw,
+    )
+    single = gym.make("SoftWalker-Flat-v0", design=bone, **kw)
+    walker_start, _ = gym.make("SoftWalker-Flat-v0", **kw).reset(seed=0)
+    venv.reset(seed=0)
+    single.reset(seed=0)
+    ones = np.ones((2, 216), dtype=np.float32)
+    obs, r, term, trunc, info = venv.step(ones)
+    o1, r1, *_ = single.step(ones[1])
+    # the walker ended and restarted in the same step; the bone block went on
+    assert term[0] and not term[1] and not trunc.any()
+    assert list(info["_final_obs"]) == [True, False] and info["final_obs"][1] is None
+    assert info["final_info"]["diverged"][0] and info["_final_info"][0]
+    assert np.array_equal(obs[0], walker_start) and not info["diverged"][0]
+    assert np.array_equal(obs[1], o1) and r[1] == r1
+    venv.close()
