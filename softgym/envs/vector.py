@@ -65,7 +65,8 @@ class SoftWalkerVectorEnv(VectorEnv):
         Truncation in steps (``make_vec`` passes the id's registered 80);
         episodes also end after ``episode_seconds``.
     autoreset_mode : AutoresetMode or str, optional
-        ``NEXT_STEP`` (default) or ``SAME_STEP``; ``DISABLED`` is not
+        ``NEXT_STEP`` (default) or ``SAME_STEP`` (the enum, its value or its
+        name: ``"same_step"``); ``DISABLED`` is not
         supported (an ended robot has no state to go on from).
 
     Notes
@@ -108,9 +109,11 @@ class SoftWalkerVectorEnv(VectorEnv):
         try:
             mode = AutoresetMode(autoreset_mode)
         except ValueError:
+            mode = AutoresetMode.__members__.get(str(autoreset_mode).upper())  # "SAME_STEP"
+        if mode is None:
             raise InvalidParameterError(
                 f"autoreset_mode must be NEXT_STEP or SAME_STEP, got {autoreset_mode!r}"
-            ) from None
+            )
         if mode not in (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP):
             raise InvalidParameterError(
                 f"autoreset_mode must be NEXT_STEP or SAME_STEP, got {mode.name}"

@@ -87,6 +87,8 @@ def test_same_step_autoreset_matches_next_step():
     nxt = gym.make_vec("SoftWalker-Flat-v0", **kw)
     same = gym.make_vec("SoftWalker-Flat-v0", autoreset_mode=AutoresetMode.SAME_STEP, **kw)
     assert same.metadata["autoreset_mode"] == AutoresetMode.SAME_STEP
+    by_name = gym.make_vec("SoftWalker-Flat-v0", num_envs=1, autoreset_mode="same_step")
+    assert by_name.autoreset_mode == AutoresetMode.SAME_STEP
     rng = np.random.default_rng(1)
     actions = rng.uniform(-1, 1, (4, 3, 216)).astype(np.float32)
     o_n, _ = nxt.reset(seed=0)
