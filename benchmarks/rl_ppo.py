@@ -9,11 +9,20 @@ return (= NormFinalDist over the 4 s episode, in voxel lengths) of
 * :class:`softgym.controllers.Sinusoid` (the seed's open-loop drive sampled
   every control step).
 
+Training runs on the batched vector env (all robots in one engine call, on
+every core) through :func:`sb3_vec_env`, an SB3 ``VecEnv`` adapter; ``--vec
+dummy`` uses SB3's DummyVecEnv of single envs instead. ``--json`` adds the
+training curve; ``plot_rl.py`` draws it.
+
 Needs the ``rl`` extra (``pip install -e ".[rl]"``: torch pinned to 2.13.0,
 a CPU build from local disk on this machine kind; stable-baselines3). CI does
-not run it.
+not run it. Measured on 2 cores (``benchmarks/RESULTS.md``): 600k steps,
+about 20 minutes, walk 26 voxel lengths with ``--actuation symmetric``
+(sinusoid 9.0, random 0.08) and 0.10 under the seed's contraction-only law
+(sinusoid 0.50, random 0.03).
 
     python benchmarks/rl_ppo.py --timesteps 20000
+    python benchmarks/rl_ppo.py --timesteps 600000 --actuation symmetric --json --gif ppo.gif
 """
 
 from __future__ import annotations
@@ -237,6 +246,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         import torch
         from stable_baselines3 import PPO
+        from stable_baselines3.common.callbacks import BaseCallback
         from stable_baselines3.common.env_util import make_vec_env
         from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
     except ImportError:
@@ -273,8 +283,6 @@ def main(argv: list[str] | None = None) -> int:
         seed=args.seed,
         verbose=int(args.verbose),
     )
-    from stable_baselines3.common.callbacks import BaseCallback
-
     curve: list[tuple[int, float]] = []
 
     class Curve(BaseCallback):
