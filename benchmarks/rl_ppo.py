@@ -253,7 +253,8 @@ def main(argv: list[str] | None = None) -> int:
         print("rl_ppo.py needs the rl extra: pip install -e '.[rl]'", file=sys.stderr)
         return 2
     torch.set_num_threads(1)
-    kw: dict = {"control_dt": args.control_dt}
+    # the ids register an 80-step limit (4 s at 0.05 s): keep 4 s at any control_dt
+    kw: dict = {"control_dt": args.control_dt, "max_episode_steps": round(4.0 / args.control_dt)}
     if args.actuation is not None:
         kw["actuation"] = args.actuation
     if args.vec == "batched":

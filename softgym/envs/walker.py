@@ -18,7 +18,7 @@ from typing import Any
 
 import gymnasium as gym
 import numpy as np
-from gymnasium import spaces
+from gymnasium import logger, spaces
 
 from softgym.design.robot import RobotDesign, default_walker
 from softgym.engine.config import SimConfig
@@ -100,6 +100,24 @@ def task_terrain(task: str, design: RobotDesign) -> Terrain:
     raise InvalidParameterError(f"task must be one of {sorted(TASKS)}, got {task!r}")
 
 
+def warn_if_cut_short(limit: int | None, control_dt: float, episode_seconds: float) -> None:
+    """Warn when a step limit ends episodes before ``episode_seconds``.
+
+    The ids register ``max_episode_steps=80`` (4 s at the default 0.05 s per
+    step); with a finer ``control_dt`` that limit shortens the episode
+    unless ``max_episode_steps`` is passed too. ``make_vec`` hands the limit
+    to the vector env, which warns; ``gym.make`` applies it in a
+    ``TimeLimit`` wrapper the env cannot see (its docstring says so).
+    """
+    full = max(1, round(episode_seconds / control_dt))
+    if limit is not None and int(limit) < full:
+        logger.warn(
+            f"max_episode_steps={int(limit)} ends episodes after {int(limit) * control_dt:.4g} s "
+            f"of the {episode_seconds:.4g} s episode (control_dt={control_dt:.4g} s); pass "
+            f"max_episode_steps={full} for full episodes"
+        )
+
+
 def _check_positive(name: str, value: Any) -> float:
     try:
         v = float(value)
@@ -174,6 +192,7 @@ class _WalkerBatch:
                 raise InvalidParameterError(
                     f"max_episode_steps must be >= 1, got {max_episode_steps}"
                 )
+            warn_if_cut_short(max_episode_steps, self.control_dt, self.episode_seconds)
             n_steps = min(n_steps, int(max_episode_steps))
         self.max_steps = n_steps
         self.designs = list(designs)

@@ -130,3 +130,17 @@ def test_a_robot_that_diverges_while_settling_ends_at_its_first_step():
     assert info["diverged"] and obs in env.observation_space
     obs, r, term, trunc, info = env.step(np.zeros(216, dtype=np.float32))
     assert term and not trunc and r == 0.0 and info["diverged"]
+
+
+def test_a_step_limit_that_cuts_the_episode_short_warns():
+    import warnings
+
+    with pytest.warns(UserWarning, match="max_episode_steps=400"):
+        gym.make_vec("SoftWalker-Flat-v0", num_envs=2, control_dt=0.01)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        env = gym.make("SoftWalker-Flat-v0", control_dt=0.01, max_episode_steps=400)
+        env.reset(seed=0)
+        assert env.unwrapped.max_steps == 400
+        gym.make_vec("SoftWalker-Flat-v0", num_envs=2, control_dt=0.01, max_episode_steps=400)
+        gym.make("SoftWalker-Flat-v0").reset(seed=0)
