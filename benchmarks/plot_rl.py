@@ -44,7 +44,7 @@ def main(argv: list[str] | None = None) -> int:
         color = f"C{k}"
         steps = [c[0] / 1000 for c in run["curve"]]
         ret = [c[1] for c in run["curve"]]
-        label = f'PPO, actuation "{run.get("actuation", "seed")}"'
+        label = f'PPO, actuation "{run.get("actuation", "seed")}", control_dt {run.get("control_dt", 0.05)} s'
         ax.plot(steps, ret, color=color, label=label)
         ax.axhline(run["sinusoid"], color=color, ls=":", lw=1)
         ax.axhline(run["random"], color=color, ls="--", lw=0.8)

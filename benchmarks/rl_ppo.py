@@ -365,6 +365,7 @@ def main(argv: list[str] | None = None) -> int:
                     "timesteps": args.timesteps,
                     "train_seconds": train_s,
                     "actuation": args.actuation or "seed",
+                    "control_dt": args.control_dt,
                     "curve": curve,
                     **{k: v[0] for k, v in results.items()},
                 }
