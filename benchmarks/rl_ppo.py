@@ -262,14 +262,17 @@ def main(argv: list[str] | None = None) -> int:
     else:
         base = make_vec_env(ENV_ID, n_envs=args.n_envs, seed=args.seed, env_kwargs=kw)
     venv = VecNormalize(base, gamma=args.gamma)
+    # one single env tells the grid (lattice policy) and the period (sinusoid baseline)
+    probe = gym.make(ENV_ID, **kw)
+    sinusoid = Sinusoid.from_env(probe)
+    grid_shape = probe.unwrapped.grid_shape
+    probe.close()
     policy_kwargs: dict = {"log_std_init": args.log_std_init}
     if args.policy == "mlp":
         policy: object = "MlpPolicy"
         policy_kwargs["net_arch"] = list(args.net_arch)
     else:
-        probe = gym.make(ENV_ID, **kw)
-        policy = lattice_policy(probe.unwrapped.grid_shape)
-        probe.close()
+        policy = lattice_policy(grid_shape)
     model = PPO(
         policy,
         venv,
@@ -326,9 +329,6 @@ def main(argv: list[str] | None = None) -> int:
         save_gif(frames, args.gif, fps=env.metadata["render_fps"])
         env.close()
         print(f"wrote {args.gif} ({len(frames)} frames)", file=sys.stderr)
-    probe = gym.make(ENV_ID, **kw)
-    sinusoid = Sinusoid.from_env(probe)
-    probe.close()
     results = {
         "ppo": evaluate(ppo_policy, args.episodes, args.seed + 1000, kw),
         "ppo_sampled": evaluate(ppo_sampled, args.episodes, args.seed + 1000, kw),
