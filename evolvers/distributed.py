@@ -9,6 +9,9 @@ worker. A robot's result does not depend on its batch, so the results equal a
 local run bit for bit. A batch lost with its worker is recomputed by Dask on
 another worker (tasks are submitted with ``retries``).
 
+Dask is an optional extra: ``pip install "softgym[distributed]"``. Without it,
+:func:`dask_client` raises :class:`MissingExtraError` naming the extra.
+
 >>> from evolvers.distributed import dask_client
 >>> with dask_client("local", n_workers=2) as client:   # doctest: +SKIP
 ...     run = EvolutionRun(exp, "runs/x", batch_fn=DaskBatchFn(client))
@@ -22,9 +25,39 @@ from typing import Any
 
 import numpy as np
 
-from softgym.evaluate import Task, evaluate_payload
+from softgym.evaluate import evaluate_payload
+from softgym.exceptions import SoftGymError
+from softgym.tasks import Task
 
-__all__ = ["DaskBatchFn", "dask_client", "split_batches"]
+__all__ = [
+    "DaskBatchFn",
+    "MissingExtraError",
+    "dask_client",
+    "require_distributed",
+    "split_batches",
+]
+
+
+class MissingExtraError(SoftGymError, ImportError):
+    """An optional dependency is not installed; the message names the pip extra that brings it."""
+
+
+def require_distributed() -> Any:
+    """The ``distributed`` module (Dask's scheduler and workers).
+
+    Raises
+    ------
+    MissingExtraError
+        If Dask is not installed: ``pip install "softgym[distributed]"``.
+    """
+    try:
+        import distributed
+    except ImportError as exc:
+        raise MissingExtraError(
+            'Dask evaluation (--dask) needs the "distributed" extra: '
+            'pip install "softgym[distributed]"'
+        ) from exc
+    return distributed
 
 
 def split_batches(n: int, n_batches: int) -> list[tuple[int, int]]:
@@ -104,8 +137,14 @@ def dask_client(
     processes : bool
         LocalCluster workers as processes (True) or threads of this process
         (the engine releases the GIL, so threads run in parallel too).
+
+    Raises
+    ------
+    MissingExtraError
+        If Dask is not installed (``pip install "softgym[distributed]"``).
     """
-    from distributed import Client, LocalCluster
+    distributed = require_distributed()
+    Client, LocalCluster = distributed.Client, distributed.LocalCluster
 
     if address == "local":
         cluster = LocalCluster(

@@ -18,8 +18,9 @@ import numpy as np
 
 from evolvers.experiments import Experiment
 from evolvers.genome import Individual
-from softgym.evaluate import METRIC_KEYS, Task, evaluate
+from softgym.evaluate import METRIC_KEYS, evaluate
 from softgym.metrics import WORST_FITNESS, WORST_MINIMIZED
+from softgym.tasks import Task
 
 __all__ = [
     "FITNESS_METRICS",
@@ -140,7 +141,7 @@ class Evaluator:
     Parameters
     ----------
     experiment : Experiment
-        Gives the task (terrain, seconds, trace interval), the grid shape and the rules.
+        Gives the task (:meth:`Experiment.make_task`), the grid shape and the rules.
     batch_fn : callable, optional
         ``(design dicts, task) -> metrics`` (default :func:`local_batch_fn`:
         one local Simulation). :class:`evolvers.distributed.DaskBatchFn` spreads
@@ -159,7 +160,7 @@ class Evaluator:
         cache: PhenotypeCache | None = None,
     ) -> None:
         self.experiment = experiment
-        self.task = experiment.task(n_threads)
+        self.task = experiment.make_task(n_threads)
         self.batch_fn = batch_fn or local_batch_fn
         self.cache = PhenotypeCache() if cache is None else cache
         self.n_evaluations = 0

@@ -15,10 +15,12 @@ name                        variation              selection       objectives
 ``obstacles-attempt2``      CPPN + controller GA   tournament (2)  MaxXYDist (max)
 ==========================  =====================  ==============  ============================================
 
-``materials`` is an alias of ``materials-t1``. Obstacle experiments run in the
-seed's 1-voxel-high fence (10-voxel interior) with centre-of-mass samples every
-0.1 s; ``obstacles`` also applies the seed's composition constraints (>= 10 %
-tissue, >= 1 bone, >= 10 % muscle). Every experiment: 6x6x6 CPPN robots,
+``materials`` is an alias of ``materials-t1``. Obstacle experiments run on the
+``wall`` task (:mod:`softgym.tasks`: the seed's 1-voxel-high fence, 10-voxel
+interior) with centre-of-mass samples every 0.1 s; ``obstacles`` also applies
+the seed's composition constraints (>= 10 % tissue, >= 1 bone, >= 10 % muscle).
+Any experiment runs on another task with ``get_experiment(name, task="stairs")``
+(or a Terrain, or a terrain JSON file: ``softgym evolve --task FILE.json``). Every experiment: 6x6x6 CPPN robots,
 population 15, 15 children and 1 random newcomer per generation, 5 s simulated.
 """
 
@@ -30,8 +32,9 @@ from typing import Any
 
 from evolvers.selection import Objective
 from softgym.design import MATERIAL_TREE_4, MATERIAL_TREE_8, CompositionRules
-from softgym.evaluate import Task
 from softgym.exceptions import InvalidParameterError
+from softgym.tasks import Task, get_task
+from softgym.terrain import Terrain
 
 __all__ = ["EXPERIMENTS", "SELECTIONS", "Experiment", "get_experiment", "list_experiments"]
 
@@ -59,7 +62,11 @@ class Experiment:
         CPPN outputs: the 4-output tree, or the 8-output tree of materials evolution.
     rules : CompositionRules
         Validity of a body (enforced by generation and mutation; pymoo's G).
-    terrain : {"flat", "fence"}
+    task : str or Terrain
+        The world: a task name of :mod:`softgym.tasks` (``"flat"``, ``"wall"``,
+        ``"stairs"``; ``"fence"`` is read as ``"wall"``) or a custom
+        :class:`~softgym.terrain.Terrain` (a terrain JSON file's path is read
+        into one, so the run folder's config.json holds the whole world).
     seconds : float
         Simulated seconds per evaluation (5).
     trace_interval : float
@@ -85,7 +92,7 @@ class Experiment:
     evolve_materials: bool = False
     cppn_outputs: tuple[str, ...] = MATERIAL_TREE_4
     rules: CompositionRules = field(default_factory=CompositionRules.seed)
-    terrain: str = "flat"
+    task: str | Terrain = "flat"
     seconds: float = 5.0
     trace_interval: float = 0.1
     pop_size: int = 15
@@ -105,6 +112,8 @@ class Experiment:
         if not self.objectives:
             raise InvalidParameterError("an experiment needs at least one objective")
         object.__setattr__(self, "shape", tuple(int(s) for s in self.shape))
+        task = get_task(self.task)  # a name, alias, Terrain, or JSON file; raises if unknown
+        object.__setattr__(self, "task", task.terrain)
 
     @property
     def fitness(self) -> Objective:
@@ -117,10 +126,10 @@ class Experiment:
         names = [o.name for o in self.objectives if o.name != "age"] + list(self.logged)
         return tuple(dict.fromkeys(names))
 
-    def task(self, n_threads: int | None = None) -> Task:
-        """The :class:`~softgym.evaluate.Task` evaluations run."""
-        return Task(
-            terrain=self.terrain,
+    def make_task(self, n_threads: int | None = None) -> Task:
+        """The :class:`softgym.tasks.Task` evaluations run (the named task with this duration and sampling)."""
+        return get_task(
+            self.task,
             seconds=self.seconds,
             trace_interval=self.trace_interval,
             sim=dict(self.sim),
@@ -138,6 +147,8 @@ class Experiment:
             v = getattr(self, f.name)
             if f.name == "objectives":
                 v = [o.to_dict() for o in v]
+            elif isinstance(v, Terrain):
+                v = v.to_dict()
             elif f.name == "rules":
                 v = v.to_dict()
             elif isinstance(v, tuple):
@@ -147,8 +158,12 @@ class Experiment:
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Experiment:
-        """Inverse of :meth:`to_dict`."""
+        """Inverse of :meth:`to_dict` (also reads older run folders' ``terrain`` key)."""
         kw = dict(data)
+        if "terrain" in kw:  # before the task layer: "terrain": "flat" | "fence"
+            kw["task"] = kw.pop("terrain")
+        if isinstance(kw.get("task"), Mapping):
+            kw["task"] = Terrain.from_dict(dict(kw["task"]))
         kw["objectives"] = tuple(Objective(**o) for o in kw["objectives"])
         kw["rules"] = CompositionRules.from_dict(kw["rules"])
         for name in ("logged", "cppn_outputs", "shape"):
@@ -233,7 +248,7 @@ EXPERIMENTS: dict[str, Experiment] = {
             selection="pareto",
             evolve_controller=True,
             rules=CompositionRules.obstacles(),
-            terrain="fence",
+            task="wall",
             generations=80,
         ),
         Experiment(
@@ -242,7 +257,7 @@ EXPERIMENTS: dict[str, Experiment] = {
             (Objective("max_xy_dist", True), _ENERGY),
             logged=("l_coefficient",),
             selection="pareto",
-            terrain="fence",
+            task="wall",
             generations=20,
         ),
         Experiment(
@@ -252,7 +267,7 @@ EXPERIMENTS: dict[str, Experiment] = {
             logged=("l_coefficient", "n_muscle"),
             selection="tournament",
             evolve_controller=True,
-            terrain="fence",
+            task="wall",
             generations=20,
         ),
     )

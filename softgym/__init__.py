@@ -1,9 +1,10 @@
 """softgym: fast, faithful 3D voxel soft robots for evolution and reinforcement learning."""
 
-from softgym import design, envs, exceptions, metrics  # envs registers the SoftWalker-* ids
+from softgym import design, envs, exceptions, metrics, tasks  # envs registers the SoftWalker-* ids
 from softgym.design import Controller, RobotDesign, default_walker
 from softgym.engine import Body, Rollout, SimConfig, Simulation, openmp_enabled
 from softgym.evaluate import evaluate
+from softgym.tasks import Task, get_task
 from softgym.terrain import Terrain
 
 __version__ = "0.1.0"
@@ -15,6 +16,7 @@ __all__ = [
     "Rollout",
     "SimConfig",
     "Simulation",
+    "Task",
     "Terrain",
     "__version__",
     "default_walker",
@@ -22,6 +24,8 @@ __all__ = [
     "envs",
     "evaluate",
     "exceptions",
+    "get_task",
     "metrics",
     "openmp_enabled",
+    "tasks",
 ]

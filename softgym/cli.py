@@ -7,8 +7,9 @@ simulate
     centre-of-mass trajectory figure and a summary JSON.
 evolve
     Run one of the seed study's experiments (native loop, DEAP or pymoo),
-    locally or on Dask, into a resumable run folder with log, checkpoints,
-    best designs and figures.
+    on its task or another (``--task stairs|wall|flat|FILE.json``), locally or
+    on Dask, into a resumable run folder with log, checkpoints, best designs
+    and figures.
 replay
     Re-simulate the best robot of a run folder and render it (figures + GIF).
 compare
@@ -74,6 +75,8 @@ def _make_run(args: argparse.Namespace, batch_fn):
         overrides["shape"] = tuple(args.shape)
     if args.selection is not None:
         overrides["selection"] = args.selection
+    if args.task is not None:
+        overrides["task"] = args.task
     exp = get_experiment(args.experiment, **overrides)
     if args.backend == "deap":
         from evolvers.deap_runner import DeapRun as Run
@@ -97,12 +100,12 @@ def _cmd_evolve(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     with contextlib.ExitStack() as stack:
         batch_fn = None
-        if args.dask:
-            from evolvers.distributed import DaskBatchFn, dask_client
-
-            client = stack.enter_context(dask_client(args.dask, n_workers=args.workers))
-            batch_fn = DaskBatchFn(client)
         try:
+            if args.dask:
+                from evolvers.distributed import DaskBatchFn, dask_client
+
+                client = stack.enter_context(dask_client(args.dask, n_workers=args.workers))
+                batch_fn = DaskBatchFn(client)
             run = _make_run(args, batch_fn)
         except SoftGymError as exc:
             print(f"softgym evolve: {exc}", file=sys.stderr)
@@ -145,8 +148,9 @@ def _cmd_evolve(args: argparse.Namespace) -> int:
 
 
 def _cmd_replay(args: argparse.Namespace) -> int:
+    from evolvers.experiments import Experiment
     from softgym.design import RobotDesign
-    from softgym.evaluate import Task, evaluate, make_terrain
+    from softgym.evaluate import evaluate
     from softgym.exceptions import SoftGymError
     from softgym.render.figures import plot_robot, plot_trajectory, save_robot_gif
 
@@ -155,21 +159,17 @@ def _cmd_replay(args: argparse.Namespace) -> int:
         cfg = json.loads((run_dir / "config.json").read_text())
         design = RobotDesign.load(run_dir / "best_design.json")
         best = json.loads((run_dir / "best_designs.json").read_text())["best"][0]
-    except (OSError, ValueError, KeyError, SoftGymError) as exc:
+        experiment = Experiment.from_dict(cfg["experiment"])
+    except (OSError, ValueError, KeyError, TypeError, SoftGymError) as exc:
         print(f"softgym replay: {run_dir} is not a finished run folder ({exc})", file=sys.stderr)
         return 2
     exp = cfg["experiment"]
     seconds = float(exp["seconds"] if args.seconds is None else args.seconds)
-    task = Task(
-        terrain=exp["terrain"],
-        seconds=seconds,
-        trace_interval=exp["trace_interval"],
-        sim=exp.get("sim", {}),
-    )
+    task = experiment.make_task().replace(seconds=seconds)
     m = evaluate([design], task=task, traces=True)
     out = Path(args.out) if args.out else run_dir / "replay"
-    terrain = make_terrain(task.terrain, design.shape)
-    fine = evaluate([design], task=Task(**{**task.to_dict(), "trace_interval": 0.05}), traces=True)
+    terrain = task.terrain_for(design.shape)
+    fine = evaluate([design], task=task.replace(trace_interval=0.05), traces=True)
     paths = [
         plot_robot(design, out / "best_robot.png", title=f"best robot ({exp['name']})"),
         plot_trajectory(
@@ -242,10 +242,15 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument(
         "--dask",
         metavar="local|tcp://ADDRESS",
-        help="evaluate on Dask: a LocalCluster or an existing scheduler",
+        help='evaluate on Dask: a LocalCluster or an existing scheduler (pip install "softgym[distributed]")',
     )
     p.add_argument("--workers", type=int, default=2, help="LocalCluster workers (--dask local)")
     p.add_argument("--backend", choices=["native", "deap", "pymoo"], default="native")
+    p.add_argument(
+        "--task",
+        metavar="flat|wall|stairs|FILE.json",
+        help="the world (default: the experiment's): a task name or a terrain JSON file",
+    )
     p.add_argument("--seconds", type=float, help="simulated seconds per evaluation (default 5)")
     p.add_argument(
         "--shape", type=int, nargs=3, metavar=("NX", "NY", "NZ"), help="robot grid (default 6 6 6)"

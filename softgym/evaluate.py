@@ -3,8 +3,12 @@
 Any optimiser (CMA-ES, Nevergrad, evosax, pymoo, DEAP, your own loop) can
 score designs with one function: it batches every design into a single
 :class:`~softgym.engine.Simulation` (robots run in parallel and give the same
-result alone or in a batch), runs it for ``seconds`` of simulated time, and
-returns the seed's measures as arrays.
+result alone or in a batch), runs it for the task's ``seconds`` of simulated
+time, and returns the task's metrics (:meth:`softgym.tasks.Task.metrics`) and
+each design's composition as arrays. The task is anything
+:func:`softgym.tasks.get_task` reads: a name (``"flat"``, ``"wall"``,
+``"stairs"``), a :class:`~softgym.terrain.Terrain`, a terrain JSON file or a
+:class:`~softgym.tasks.Task`.
 
 >>> import softgym
 >>> from softgym.design import default_walker
@@ -15,18 +19,15 @@ returns the seed's measures as arrays.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass, field
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 
 from softgym.exceptions import InvalidParameterError
+from softgym.tasks import Task, TaskLike, get_task
 
-__all__ = ["TASKS", "Task", "estimated_cost", "evaluate", "evaluate_payload", "make_terrain"]
-
-#: Task names understood by :func:`evaluate`: flat ground, or the seed's 1-voxel fence.
-TASKS: tuple[str, ...] = ("flat", "fence")
+__all__ = ["METRIC_KEYS", "Task", "estimated_cost", "evaluate", "evaluate_payload"]
 
 #: Keys of the dict returned by :func:`evaluate` (traces come with ``traces=True``).
 METRIC_KEYS: tuple[str, ...] = (
@@ -41,81 +42,7 @@ METRIC_KEYS: tuple[str, ...] = (
     "n_bone",
     "n_tissue",
 )
-
-
-@dataclass(frozen=True)
-class Task:
-    """How designs are scored: the world, the duration and the sampling.
-
-    Parameters
-    ----------
-    terrain : {"flat", "fence"}
-        ``"flat"``: the floor alone. ``"fence"``: the seed's obstacle, a
-        1-voxel-high square fence with a 10-voxel interior centred on each
-        robot's footprint (:meth:`softgym.terrain.Terrain.fence`).
-    seconds : float
-        Simulated time (s) per robot; 5 in the seed (1 s settling included).
-    trace_interval : float
-        Seconds between centre-of-mass samples: 0.5 for the seed's novelty
-        runs, 0.1 for its obstacle runs (and the L coefficient).
-    sim : dict
-        Overrides of :class:`~softgym.engine.SimConfig` (e.g. ``{"actuation": "symmetric"}``).
-    n_threads : int, optional
-        OpenMP threads of the simulation (default: softgym's default).
-    """
-
-    terrain: str = "flat"
-    seconds: float = 5.0
-    trace_interval: float = 0.1
-    sim: dict[str, Any] = field(default_factory=dict)
-    n_threads: int | None = None
-
-    def __post_init__(self) -> None:
-        if self.terrain not in TASKS:
-            raise InvalidParameterError(f"unknown task {self.terrain!r}; expected one of {TASKS}")
-        if not (np.isfinite(self.seconds) and self.seconds > 0):
-            raise InvalidParameterError(f"seconds must be > 0, got {self.seconds!r}")
-        if not (np.isfinite(self.trace_interval) and self.trace_interval > 0):
-            raise InvalidParameterError(f"trace_interval must be > 0, got {self.trace_interval!r}")
-
-    def config(self):
-        """The :class:`~softgym.engine.SimConfig` of this task."""
-        from softgym.engine import SimConfig
-
-        return SimConfig(trace_interval=float(self.trace_interval), **dict(self.sim))
-
-    def to_dict(self) -> dict[str, Any]:
-        """JSON-ready dict."""
-        return asdict(self)
-
-    @classmethod
-    def from_dict(cls, data: Mapping[str, Any]) -> Task:
-        """Inverse of :meth:`to_dict`."""
-        return cls(**dict(data))
-
-
-def make_terrain(task: str, shape: Sequence[int]):
-    """The terrain of ``task`` for a robot grid of ``shape`` placed at the origin.
-
-    Parameters
-    ----------
-    task : {"flat", "fence"}
-    shape : (nx, ny, nz)
-        Grid shape; the fence is centred on the footprint ``(nx / 2, ny / 2)``.
-
-    Returns
-    -------
-    softgym.terrain.Terrain
-    """
-    from softgym.terrain import Terrain
-
-    if task == "flat":
-        return Terrain.flat()
-    if task == "fence":
-        nx, ny = int(shape[0]), int(shape[1])
-        inner = max(10.0, max(nx, ny) + 4.0)  # the seed's 2-voxel gap around a 6-wide robot
-        return Terrain.fence(inner=inner, center=(nx / 2.0, ny / 2.0))
-    raise InvalidParameterError(f"unknown task {task!r}; expected one of {TASKS}")
+_COUNTS = ("n_voxels", "n_muscle", "n_old_materials", "n_bone", "n_tissue")
 
 
 def estimated_cost(design: Any, voxel_size: float = 0.01) -> float:
@@ -163,7 +90,7 @@ def _as_design(obj: Any):
 
 def evaluate(
     designs: Any,
-    task: str | Task = "flat",
+    task: TaskLike = "flat",
     seconds: float | None = None,
     *,
     trace_interval: float | None = None,
@@ -171,19 +98,21 @@ def evaluate(
     n_threads: int | None = None,
     config: Any = None,
 ) -> dict[str, Any]:
-    """Simulate designs together and return the seed's metrics.
+    """Simulate designs together and return the task's metrics.
 
     Parameters
     ----------
     designs : RobotDesign, dict, or sequence of them
         Robots to score (a design's ``to_dict()`` is accepted). They may
         differ in shape, materials and controller.
-    task : {"flat", "fence"} or Task
-        The world (see :class:`Task`).
+    task : str, Terrain, path or Task
+        The world and its scoring (:func:`softgym.tasks.get_task`): ``"flat"``,
+        ``"wall"`` (alias ``"fence"``), ``"stairs"``, a custom
+        :class:`~softgym.terrain.Terrain` or its JSON file, or a Task.
     seconds : float, optional
-        Simulated time per robot (s); default 5 (the seed's), or the Task's.
+        Simulated time per robot (s); default the task's (5, the seed's).
     trace_interval : float, optional
-        Seconds between centre-of-mass samples (default 0.1, or the Task's).
+        Seconds between centre-of-mass samples (default the task's, 0.1).
     traces : bool
         Also return each robot's centre-of-mass trace from ``init_time`` on.
     n_threads : int, optional
@@ -207,7 +136,7 @@ def evaluate(
     --------
     Score a batch with any optimiser's candidates (here two copies)::
 
-        m = softgym.evaluate([d1, d2], task="fence", seconds=5.0)
+        m = softgym.evaluate([d1, d2], task="wall", seconds=5.0)
         fitness = m["max_xy_dist"]
     """
     from softgym.design import RobotDesign
@@ -215,10 +144,6 @@ def evaluate(
     if isinstance(designs, (RobotDesign, Mapping)):
         designs = [designs]
     designs = [_as_design(d) for d in designs]
-    if isinstance(task, str):
-        task = Task(terrain=task)
-    if not isinstance(task, Task):
-        raise InvalidParameterError(f"task must be a name or a Task, got {type(task).__name__}")
     changes: dict[str, Any] = {}
     if seconds is not None:
         changes["seconds"] = float(seconds)
@@ -226,52 +151,32 @@ def evaluate(
         changes["trace_interval"] = float(trace_interval)
     if n_threads is not None:
         changes["n_threads"] = int(n_threads)
-    if changes:
-        task = Task(**{**task.to_dict(), **changes})
+    task = get_task(task, **changes)
     n = len(designs)
     out: dict[str, Any] = {k: np.zeros(n) for k in METRIC_KEYS}
     out["diverged"] = np.zeros(n, dtype=bool)
-    for k in ("n_voxels", "n_muscle", "n_old_materials", "n_bone", "n_tissue"):
+    for k in _COUNTS:
         out[k] = np.zeros(n, dtype=np.int64)
     if traces:
         out["traces"] = [None] * n
     if n == 0:
         return out
     from softgym.engine import Simulation
-    from softgym.metrics import (
-        composition_counts,
-        l_coefficient_details,
-        max_xy_dist,
-        norm_final_dist,
-    )
+    from softgym.metrics import composition_counts
 
     cfg = task.config() if config is None else config.replace(trace_interval=task.trace_interval)
     # longest first: the kernel's dynamic schedule then balances the threads (results do not
     # depend on a robot's place in the batch, so the order is free)
     order = sorted(range(n), key=lambda i: -estimated_cost(designs[i], cfg.voxel_size))
     batch = [designs[i] for i in order]
-    terrains = [make_terrain(task.terrain, d.shape) for d in batch]
+    terrains = [task.terrain_for(d.shape) for d in batch]
     sim = Simulation(batch, config=cfg, n_threads=task.n_threads, terrain=terrains)
     rollout = _reorder(sim.run(task.seconds), np.argsort(order))
-    out["norm_final_dist"] = norm_final_dist(rollout)
-    out["max_xy_dist"] = max_xy_dist(rollout)
-    out["diverged"] = rollout.diverged.copy()
-    details = l_coefficient_details(rollout)
-    from softgym.metrics import WORST_FITNESS
-
-    out["l_coefficient"] = np.array(
-        [WORST_FITNESS if d is None else d.l_coefficient for d in details]
-    )
-    out["time_max_xy_dist"] = np.array(
-        [np.inf if d is None else d.time_max_xy_dist for d in details]
-    )
+    out.update(task.metrics(rollout))
     for i, d in enumerate(designs):
         c = composition_counts(d)
-        out["n_voxels"][i] = c.n_voxels
-        out["n_muscle"][i] = c.n_muscle
-        out["n_old_materials"][i] = c.n_old_materials
-        out["n_bone"][i] = c.n_bone
-        out["n_tissue"][i] = c.n_tissue
+        for k in _COUNTS:
+            out[k][i] = getattr(c, k)
     if traces:
         out["traces"] = [
             None if rollout.diverged[i] else rollout.trace(i, since=rollout.init_time)
@@ -281,7 +186,11 @@ def evaluate(
 
 
 def _reorder(rollout: Any, perm: np.ndarray) -> Any:
-    """The rollout with its robots taken in ``perm`` order (per-voxel arrays regrouped)."""
+    """The rollout with its robots taken in ``perm`` order (per-voxel arrays regrouped).
+
+    (The engine's knowledge of :class:`~softgym.engine.Rollout`'s fields; it
+    belongs in a ``Rollout.take(indices)`` of the engine.)
+    """
     from dataclasses import replace
 
     off = rollout.voxel_offsets
@@ -305,12 +214,11 @@ def evaluate_payload(payload: Mapping[str, Any]) -> dict[str, Any]:
     Parameters
     ----------
     payload : dict
-        ``{"designs": [design.to_dict(), ...], "task": Task.to_dict()}``.
+        ``{"designs": [design.to_dict(), ...], "task": Task.to_dict()}`` (or a task name).
 
     Returns
     -------
     dict
         :func:`evaluate`'s output with ``traces=True``, as lists and arrays.
     """
-    task = Task.from_dict(payload["task"])
-    return evaluate(list(payload["designs"]), task=task, traces=True)
+    return evaluate(list(payload["designs"]), task=get_task(payload["task"]), traces=True)

@@ -83,3 +83,32 @@ def test_kill_9_then_resume_equals_uninterrupted(tmp_path):
     assert _final(killed) == _final(ref)
     rows = [json.loads(x) for x in (killed / "log.jsonl").read_text().splitlines()]
     assert [r["generation"] for r in rows] == list(range(6))
+
+
+def test_evolve_on_stairs_and_on_a_terrain_file(tmp_path, capsys):
+    from softgym.terrain import Terrain
+
+    path = tmp_path / "boxes.json"
+    path.write_text(Terrain.from_boxes([((7, -3, 0), (8, 9, 1))], name="east_wall").to_json())
+    for task in ("stairs", str(path)):
+        out = tmp_path / f"run-{len(task)}"
+        args = ["evolve", "--generations", "0", "--task", task, "--no-figures", "--out", str(out)]
+        assert main([*args, *TINY]) == 0
+        cfg = json.loads((out / "config.json").read_text())
+        world = cfg["experiment"]["task"]
+        assert world == "stairs" if task == "stairs" else world["name"] == "east_wall"
+    capsys.readouterr()
+    assert main(["evolve", "--task", "lava", "--out", str(tmp_path / "x"), *TINY]) == 2
+    assert "unknown task 'lava'" in capsys.readouterr().err
+
+
+def test_dask_without_the_extra_names_it(tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)  # as if Dask were not installed
+    from evolvers.distributed import MissingExtraError, require_distributed
+
+    with pytest.raises(MissingExtraError, match=r"softgym\[distributed\]") as err:
+        require_distributed()
+    assert isinstance(err.value, ImportError)
+    args = ["evolve", "--dask", "local", "--generations", "0", "--out", str(tmp_path / "d")]
+    assert main([*args, *TINY]) == 2
+    assert 'pip install "softgym[distributed]"' in capsys.readouterr().err

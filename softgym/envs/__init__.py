@@ -8,36 +8,43 @@ id                         world                                       reward (p
 ``SoftWalker-Stairs-v0``   three rings, each one voxel higher          MaxXYDist progress
 =========================  ==========================================  =====================
 
+Every task of :data:`softgym.tasks.TASKS` gets an id (a task added with
+:func:`softgym.tasks.register_task` gets one at the next :func:`register_envs`).
 ``gym.make(id)`` gives a :class:`SoftWalkerEnv` (80 steps of 0.05 s);
 ``gym.make_vec(id, num_envs=N)`` a :class:`SoftWalkerVectorEnv` stepping all N
-robots in one engine call (``designs=[...]`` may differ).
+robots in one engine call (``designs=[...]`` may differ). ``task=`` also takes
+a Task, a Terrain or a terrain JSON file.
 """
 
 import gymnasium as gym
 
 from softgym.envs.vector import SoftWalkerVectorEnv
-from softgym.envs.walker import TASKS, SoftWalkerEnv
+from softgym.envs.walker import SoftWalkerEnv
+from softgym.tasks import TASKS
 
-__all__ = ["ENV_IDS", "TASKS", "SoftWalkerEnv", "SoftWalkerVectorEnv", "register_envs"]
+__all__ = ["ENV_IDS", "TASKS", "SoftWalkerEnv", "SoftWalkerVectorEnv", "env_id", "register_envs"]
 
-#: Registered ids -> task name.
-ENV_IDS: dict[str, str] = {
-    "SoftWalker-Flat-v0": "flat",
-    "SoftWalker-Wall-v0": "wall",
-    "SoftWalker-Stairs-v0": "stairs",
-}
+#: Registered ids -> task name (filled by :func:`register_envs`).
+ENV_IDS: dict[str, str] = {}
 
 #: Default episode: 4 s (the seed's fitness window) of 0.05 s control steps.
 MAX_EPISODE_STEPS = 80
 
 
+def env_id(task_name: str) -> str:
+    """The Gym id of a task name: ``"wall"`` -> ``"SoftWalker-Wall-v0"``."""
+    return f"SoftWalker-{task_name.replace('_', ' ').title().replace(' ', '')}-v0"
+
+
 def register_envs() -> None:
-    """Register the SoftWalker ids with Gymnasium (idempotent)."""
-    for env_id, task in ENV_IDS.items():
-        if env_id in gym.registry:
+    """Register an id for every task of :data:`softgym.tasks.TASKS` (idempotent)."""
+    for task in TASKS:
+        ENV_IDS.setdefault(env_id(task), task)
+    for eid, task in ENV_IDS.items():
+        if eid in gym.registry:
             continue
         gym.register(
-            id=env_id,
+            id=eid,
             entry_point="softgym.envs.walker:SoftWalkerEnv",
             vector_entry_point="softgym.envs.vector:SoftWalkerVectorEnv",
             max_episode_steps=MAX_EPISODE_STEPS,

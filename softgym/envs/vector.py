@@ -5,8 +5,8 @@ the ids' ``vector_entry_point``: one :class:`~softgym.engine.Simulation` holds
 all N robots (their bodies may differ: the spaces depend on the grid only),
 so one :meth:`step` sets N sets of muscle temperatures and advances the whole
 batch with the engine's threads, without the GIL. A robot computes exactly
-what it computes in :class:`~softgym.envs.walker.SoftWalkerEnv` (both use the
-same task code, and a robot's physics does not depend on its batch).
+what it computes in :class:`~softgym.envs.walker.SoftWalkerEnv` (both adapt a
+:class:`softgym.tasks.EpisodeBatch`, and a robot's physics does not depend on its batch).
 """
 
 from __future__ import annotations
@@ -21,17 +21,10 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
 from softgym.design.robot import RobotDesign
-from softgym.engine.config import SimConfig
-from softgym.engine.simulation import Simulation
-from softgym.envs.walker import (
-    _render_robot,
-    _WalkerBatch,
-    action_space,
-    load_design,
-    make_config,
-    observation_space,
-)
+from softgym.engine import SimConfig, Simulation
+from softgym.envs.walker import action_space, load_design, make_batch, observation_space
 from softgym.exceptions import InvalidParameterError
+from softgym.tasks import TaskLike
 from softgym.terrain import Terrain
 
 __all__ = ["SoftWalkerVectorEnv"]
@@ -57,8 +50,9 @@ class SoftWalkerVectorEnv(VectorEnv):
         One design for every robot (default: the embedded walker). Give
         ``design`` or ``designs``, not both.
     task, episode_seconds, control_dt, actuation, self_collision, grid_shape,
-    sim_config, terrain, render_mode, width, height
-        As for :class:`~softgym.envs.walker.SoftWalkerEnv`.
+    sim_config, terrain, render_mode, width, height, drive
+        As for :class:`~softgym.envs.walker.SoftWalkerEnv` (a ``terrain``
+        is the same world for every robot).
     n_threads : int, optional
         Engine threads (default: :func:`softgym.engine.default_num_threads`).
     max_episode_steps : int, optional
@@ -91,8 +85,8 @@ class SoftWalkerVectorEnv(VectorEnv):
         num_envs: int = 1,
         designs: Sequence[RobotDesign | str | os.PathLike[str]] | None = None,
         design: RobotDesign | str | os.PathLike[str] | None = None,
-        task: str = "flat",
-        episode_seconds: float = 4.0,
+        task: TaskLike = "flat",
+        episode_seconds: float | None = None,
         control_dt: float = 0.05,
         actuation: str | None = None,
         self_collision: bool | None = None,
@@ -105,6 +99,7 @@ class SoftWalkerVectorEnv(VectorEnv):
         n_threads: int | None = None,
         max_episode_steps: int | None = None,
         autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
+        drive: str = "action",
     ) -> None:
         try:
             mode = AutoresetMode(autoreset_mode)
@@ -137,18 +132,12 @@ class SoftWalkerVectorEnv(VectorEnv):
             raise InvalidParameterError(
                 f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}"
             )
-        config = make_config(sim_config, actuation, self_collision)
-        self._batch = _WalkerBatch(
-            robots,
-            task,
-            tuple(grid_shape),
-            control_dt,
-            episode_seconds,
-            max_episode_steps,
-            config,
-            None if terrain is None else [terrain] * num_envs,
-            n_threads,
-        )
+        self._batch = make_batch(
+            robots, task, terrain=terrain, episode_seconds=episode_seconds,
+            control_dt=control_dt, actuation=actuation, self_collision=self_collision,
+            grid_shape=grid_shape, sim_config=sim_config, n_threads=n_threads,
+            max_episode_steps=max_episode_steps, drive=drive,
+        )  # fmt: skip
         b = self._batch
         self.num_envs = num_envs
         self.designs = robots
@@ -281,7 +270,11 @@ class SoftWalkerVectorEnv(VectorEnv):
         if self.render_mode is None:
             logger.warn("render() called without a render_mode; pass render_mode='rgb_array'")
             return None
-        return tuple(_render_robot(self, r) for r in range(self.num_envs))
+        if self._renderer is None:
+            from softgym.render import VoxelRenderer  # lazy: envs import without the renderer
+
+            self._renderer = VoxelRenderer(self.width, self.height, voxel_size=self._batch.L)
+        return tuple(self._batch.render_frame(self._renderer, r) for r in range(self.num_envs))
 
     def close_extras(self, **kwargs: Any) -> None:
         """Release the renderer (``close()`` may be called any number of times)."""

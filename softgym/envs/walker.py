@@ -1,17 +1,16 @@
 """`SoftWalkerEnv`: a Gymnasium environment of one voxel soft robot walking.
 
-The physics is :class:`~softgym.engine.Simulation` (the batched engine); this
-module adds the task on top (dm_control's Physics / Task split): how actions
-become muscle temperatures, what is observed, the reward and when an episode
-ends. :class:`_WalkerBatch` holds that logic for a batch of robots in one
-Simulation; the single env drives a batch of one and
-:class:`softgym.envs.vector.SoftWalkerVectorEnv` a batch of N, so both compute
-exactly the same numbers for a robot.
+The physics is :class:`~softgym.engine.Simulation` (the batched engine), the
+task (terrain, duration, reward, metrics) is a :class:`softgym.tasks.Task`, and
+:class:`softgym.tasks.EpisodeBatch` runs it as control episodes (dm_control's
+Physics / Task / Environment split). This module only adapts a batch of one
+robot to Gymnasium's API (spaces, ``reset``/``step``/``render``);
+:class:`softgym.envs.vector.SoftWalkerVectorEnv` adapts a batch of N, so both
+compute exactly the same numbers for a robot.
 """
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Sequence
 from typing import Any
@@ -21,10 +20,18 @@ import numpy as np
 from gymnasium import logger, spaces
 
 from softgym.design.robot import RobotDesign, default_walker
-from softgym.engine.config import SimConfig
-from softgym.engine.simulation import Simulation
-from softgym.exceptions import InvalidActionError, InvalidDesignError, InvalidParameterError
-from softgym.metrics.fitness import WORST_FITNESS
+from softgym.engine import SimConfig, Simulation
+from softgym.exceptions import InvalidDesignError, InvalidParameterError
+from softgym.tasks import (
+    OBS_POSITION_BOUND,
+    OBS_VELOCITY_BOUND,
+    TASKS,
+    EpisodeBatch,
+    Task,
+    TaskLike,
+    get_task,
+    observation_size,
+)
 from softgym.terrain import Terrain
 
 __all__ = [
@@ -35,24 +42,16 @@ __all__ = [
     "action_space",
     "load_design",
     "make_config",
+    "make_batch",
     "observation_size",
     "observation_space",
-    "task_terrain",
+    "warn_if_cut_short",
 ]
 
-#: Task name -> metric whose per-step progress is the reward.
-TASKS: dict[str, str] = {"flat": "norm_final_dist", "wall": "max_xy_dist", "stairs": "max_xy_dist"}
-
-#: Observed positions relative to the centre of mass are clipped to +-this (voxel lengths).
-OBS_POSITION_BOUND = 50.0
-#: Observed velocities are clipped to +-this (voxel lengths per second).
-OBS_VELOCITY_BOUND = 500.0
-
-# tolerance of the L coefficient's "max reached" test (voxel lengths, the seed's 0.1)
-_L_TOLERANCE = 0.1
-# the engine's own centre-of-mass trace is not used (the env keeps one per control step);
-# a huge sampling interval keeps its buffers at constant size however long the env runs
+# the engine's own centre-of-mass trace is not used (the episode samples once per control
+# step); a huge sampling interval keeps its buffers at constant size however long the env runs
 _NO_ENGINE_TRACE = 1.0e9
+
 
 def load_design(design: RobotDesign | str | os.PathLike[str] | None) -> RobotDesign:
     """A design from a :class:`RobotDesign`, a path to its JSON file, or None (the default walker)."""
@@ -65,39 +64,6 @@ def load_design(design: RobotDesign | str | os.PathLike[str] | None) -> RobotDes
     raise InvalidDesignError(
         f"design must be a RobotDesign, a path to a design JSON file or None, got {type(design).__name__}"
     )
-
-
-def observation_size(grid_shape: Sequence[int]) -> int:
-    """Length of the observation vector for a grid: 6 per cell, CM velocity (3), phase (2)."""
-    return 6 * int(np.prod(grid_shape)) + 5
-
-
-def _footprint(design: RobotDesign) -> tuple[tuple[float, float], float]:
-    filled = np.argwhere(design.grid > 0)
-    lo = filled.min(axis=0)[:2]
-    hi = filled.max(axis=0)[:2] + 1
-    center = (float(lo[0] + hi[0]) / 2.0, float(lo[1] + hi[1]) / 2.0)
-    return center, float(max(hi - lo))
-
-
-def task_terrain(task: str, design: RobotDesign) -> Terrain:
-    """The default terrain of a task, centred on the design's footprint.
-
-    ``"flat"``: the floor. ``"wall"``: the seed's fence (1 voxel high and
-    thick, a 10-voxel interior: a 2-voxel gap around a 6-wide robot; wider
-    robots get a wider interior, their width + 4). ``"stairs"``: three
-    concentric rings, each 2 voxels wide and 1 voxel higher than the one
-    inside it (:meth:`Terrain.stairs`), around the same interior.
-    """
-    center, width = _footprint(design)
-    inner = max(10.0, width + 4.0)
-    if task == "flat":
-        return Terrain.flat()
-    if task == "wall":
-        return Terrain.fence(inner=inner, center=center)
-    if task == "stairs":
-        return Terrain.stairs(inner=inner, center=center)
-    raise InvalidParameterError(f"task must be one of {sorted(TASKS)}, got {task!r}")
 
 
 def warn_if_cut_short(limit: int | None, control_dt: float, episode_seconds: float) -> None:
@@ -118,23 +84,20 @@ def warn_if_cut_short(limit: int | None, control_dt: float, episode_seconds: flo
         )
 
 
-def _check_positive(name: str, value: Any) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(f"{name} must be a number, got {value!r}") from None
-    if not (math.isfinite(v) and v > 0):
-        raise InvalidParameterError(f"{name} must be finite and > 0, got {value!r}")
-    return v
-
-
 def make_config(
-    sim_config: SimConfig | None, actuation: str | None, self_collision: bool | None
+    sim_config: SimConfig | None,
+    actuation: str | None,
+    self_collision: bool | None,
+    task: Task | None = None,
 ) -> SimConfig:
-    """The env's engine settings: ``sim_config`` (the seed's by default) with overrides."""
+    """The env's engine settings: ``sim_config`` (the seed's by default), the task's ``sim``, overrides."""
+    if sim_config is not None and not isinstance(sim_config, SimConfig):
+        raise InvalidParameterError(
+            f"sim_config must be a SimConfig, got {type(sim_config).__name__}"
+        )
     cfg = SimConfig() if sim_config is None else sim_config
-    if not isinstance(cfg, SimConfig):
-        raise InvalidParameterError(f"sim_config must be a SimConfig, got {type(cfg).__name__}")
+    if task is not None:
+        cfg = task.config(cfg)
     changes: dict[str, Any] = {"trace_interval": _NO_ENGINE_TRACE}
     if actuation is not None:
         changes["actuation"] = actuation
@@ -143,301 +106,48 @@ def make_config(
     return cfg.replace(**changes)
 
 
-class _WalkerBatch:
-    """Task logic for N robots in one :class:`Simulation` (shared by the single and vector envs).
+def make_batch(
+    designs: list[RobotDesign],
+    task: TaskLike,
+    *,
+    terrain: Terrain | None,
+    episode_seconds: float | None,
+    control_dt: float,
+    actuation: str | None,
+    self_collision: bool | None,
+    grid_shape: Sequence[int],
+    sim_config: SimConfig | None,
+    n_threads: int | None,
+    max_episode_steps: int | None,
+    drive: str,
+) -> EpisodeBatch:
+    """The :class:`~softgym.tasks.EpisodeBatch` behind a SoftWalker env (the single and vector envs' shared set-up).
 
-    Parameters
-    ----------
-    designs : list of RobotDesign
-        One per robot; each must fit in ``grid_shape``.
-    task : {"flat", "wall", "stairs"}
-    grid_shape : tuple of 3 ints
-    control_dt, episode_seconds : float
-        Seconds per action and per episode.
-    max_episode_steps : int or None
-        Truncate after this many steps (the smaller of it and
-        ``round(episode_seconds / control_dt)``).
-    config : SimConfig
-    terrains : list of Terrain or None
-        One per robot (default: the task's, centred on each robot).
-    n_threads : int or None
-        Engine threads.
+    ``task`` is anything :func:`softgym.tasks.get_task` reads; ``terrain``
+    replaces its world for every robot; ``episode_seconds`` defaults to the
+    task's ``seconds`` minus the settling time (4 s for the seed's 5 s runs).
+    A ``max_episode_steps`` that cuts episodes short warns.
     """
-
-    def __init__(
-        self,
-        designs: list[RobotDesign],
-        task: str,
-        grid_shape: tuple[int, int, int],
-        control_dt: float,
-        episode_seconds: float,
-        max_episode_steps: int | None,
-        config: SimConfig,
-        terrains: list[Terrain] | None,
-        n_threads: int | None,
-    ) -> None:
-        if task not in TASKS:
-            raise InvalidParameterError(f"task must be one of {sorted(TASKS)}, got {task!r}")
-        self.task = task
-        self.metric = TASKS[task]
-        self.grid_shape = tuple(int(s) for s in grid_shape)
-        if len(self.grid_shape) != 3 or min(self.grid_shape) < 1:
-            raise InvalidParameterError(f"grid_shape must be 3 positive ints, got {grid_shape!r}")
-        self.n_cells = int(np.prod(self.grid_shape))
-        self.control_dt = _check_positive("control_dt", control_dt)
-        self.episode_seconds = _check_positive("episode_seconds", episode_seconds)
-        n_steps = max(1, round(self.episode_seconds / self.control_dt))
-        if max_episode_steps is not None:
-            if int(max_episode_steps) < 1:
-                raise InvalidParameterError(
-                    f"max_episode_steps must be >= 1, got {max_episode_steps}"
-                )
-            warn_if_cut_short(max_episode_steps, self.control_dt, self.episode_seconds)
-            n_steps = min(n_steps, int(max_episode_steps))
-        self.max_steps = n_steps
-        self.designs = list(designs)
-        for i, d in enumerate(self.designs):
-            if any(s > g for s, g in zip(d.shape, self.grid_shape)):
-                raise InvalidDesignError(
-                    f"design {i} of shape {d.shape} does not fit in grid_shape {self.grid_shape}"
-                )
-            if d.n_voxels == 0:
-                raise InvalidDesignError(f"design {i} has no voxels")
-        if terrains is None:
-            terrains = [task_terrain(task, d) for d in self.designs]
-        self.terrains = list(terrains)
-        self.config = config
-        self.sim = Simulation(
-            self.designs, config=config, n_threads=n_threads, terrain=self.terrains
-        )
-        n = self.n_robots = len(self.designs)
-        self.L = float(config.voxel_size)
-        self.settle_seconds = float(config.init_time)
-        # per-robot lattice bookkeeping
-        self.cells: list[np.ndarray] = []  # flat cell index of each voxel
-        self.voxel_muscle: list[np.ndarray] = []  # voxel has a non-zero CTE
-        self.muscle_mask = np.zeros((n, self.n_cells), dtype=bool)
-        self.filled_mask = np.zeros((n, self.n_cells), dtype=bool)
-        for r, d in enumerate(self.designs):
-            gi = self.sim.grid_index(r)
-            cells = np.ravel_multi_index(tuple(gi.T), self.grid_shape).astype(np.intp)
-            cte = self.sim.bodies[r].cte[d.grid[tuple(gi.T)]]
-            muscle = cte != 0.0
-            self.cells.append(cells)
-            self.voxel_muscle.append(muscle)
-            self.muscle_mask[r, cells] = muscle
-            self.filled_mask[r, cells] = True
-        self.amplitude = np.array(
-            [d.controller.temp_amplitude for d in self.designs], dtype=np.float64
-        )
-        self.period = np.array([d.controller.period for d in self.designs], dtype=np.float64)
-        self.robot_mass = np.array([self.sim.masses(r).sum() for r in range(n)])
-        self.obs_size = observation_size(self.grid_shape)
-        self._settled: dict[str, np.ndarray] | None = None
-        self.cm0 = np.zeros((n, 3))
-        self.steps = np.zeros(n, dtype=np.int64)
-        self.metric_value = np.zeros((n, 2))  # norm_final_dist, max_xy_dist
-        self.done_diverged = np.zeros(n, dtype=bool)
-        self._trace = np.zeros((n, self.max_steps + 1, 2))  # |dx|, |dy| (voxel lengths)
-        self._colors: dict[int, np.ndarray] = {}
-        # batch-wide voxel -> (robot, cell) maps for the observations
-        self._voxel_robot = np.repeat(np.arange(n), [c.size for c in self.cells])
-        self._voxel_is_muscle = np.concatenate(self.voxel_muscle)
-        self._flat_cells = np.concatenate(
-            [r * self.n_cells + c for r, c in enumerate(self.cells)]
-        ).astype(np.intp)
-        self._feat_bound = np.array([OBS_POSITION_BOUND] * 3 + [OBS_VELOCITY_BOUND] * 3)
-        self._cell_buf = np.zeros((n * self.n_cells, 6))
-
-    # ---------------------------------------------------------------- reset
-    def _settle(self) -> None:
-        sim = self.sim
-        sim.reset()
-        for r in range(self.n_robots):
-            sim.set_temperature(r, np.zeros(len(self.cells[r])))
-        if self.settle_seconds > 0:
-            sim.advance(self.settle_seconds)
-        self._settled = sim.get_state()
-        self.cm0 = sim.center_of_mass()
-
-    def reset_all(self) -> None:
-        """Every robot back to its settled start state (the first call settles them)."""
-        if self._settled is None:
-            self._settle()
-        else:
-            self.sim.set_state(self._settled)
-        self.steps[:] = 0
-        self.metric_value[:] = 0.0
-        # a robot that diverged while settling cannot run: its episodes end at the first step
-        self.done_diverged[:] = self._settled["diverged"] != 0
-        self._trace[:] = 0.0
-
-    def reset_robots(self, ids: np.ndarray) -> None:
-        """Put the robots ``ids`` back to their settled start; the others go on untouched."""
-        ids = np.asarray(ids, dtype=np.intp)
-        if ids.size == 0:
-            return
-        if ids.size == self.n_robots or self._settled is None:
-            self.reset_all()
-            return
-        init = self._settled
-        # the batch shares one clock: a reset robot restarts from its settled state *now*
-        self.sim.restore_robots(init, ids)
-        self.steps[ids] = 0
-        self.metric_value[ids] = 0.0
-        self.done_diverged[ids] = init["diverged"][ids] != 0
-        self._trace[ids] = 0.0
-
-    # ----------------------------------------------------------------- step
-    def validate_actions(self, actions: Any) -> np.ndarray:
-        """Actions as float64 (n_robots, n_cells), clipped to [-1, 1]; NaN/inf raise."""
-        try:
-            a = np.asarray(actions, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise InvalidActionError(
-                f"action must be numeric, got {type(actions).__name__}"
-            ) from None
-        want = (self.n_robots, self.n_cells)
-        if a.shape != want and a.size == self.n_robots * self.n_cells:
-            a = a.reshape(want)
-        if a.shape != want:
-            raise InvalidActionError(
-                f"action must have shape {want[1:] if self.n_robots == 1 else want}, got {np.shape(actions)}"
+    t = get_task(task)
+    if terrain is not None:
+        if not isinstance(terrain, Terrain):
+            raise InvalidParameterError(f"terrain must be a Terrain, got {type(terrain).__name__}")
+        t = t.replace(terrain=terrain)
+    config = make_config(sim_config, actuation, self_collision, t)
+    if episode_seconds is None:
+        episode_seconds = t.seconds - float(config.init_time)
+        if episode_seconds <= 0:
+            raise InvalidParameterError(
+                f"the task's {t.seconds} s do not outlast the settling time "
+                f"{config.init_time} s; pass episode_seconds"
             )
-        if not np.isfinite(a).all():
-            raise InvalidActionError("action holds NaN or infinite values; the state is unchanged")
-        return np.clip(a, -1.0, 1.0)
-
-    def apply(self, actions: np.ndarray, active: np.ndarray | None = None) -> None:
-        """Set every active robot's muscle temperatures ``action * dT`` (degC)."""
-        # every voxel of the batch at once: its cell's action times its robot's dT
-        temps = actions.reshape(-1)[self._flat_cells] * self.amplitude[self._voxel_robot]
-        temps[~self._voxel_is_muscle] = 0.0
-        self.sim.set_temperatures(temps, None if active is None else np.flatnonzero(active))
-
-    def advance(self) -> None:
-        """Advance the whole batch by one control step."""
-        self.sim.advance(self.control_dt)
-
-    def update(self, stepped: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Book-keeping after an advance for the robots ``stepped`` (bool mask).
-
-        Returns
-        -------
-        reward : ndarray of shape (n_robots,), float64
-        terminated, truncated : ndarray of shape (n_robots,), bool
-        diverged : ndarray of shape (n_robots,), bool
-        """
-        n = self.n_robots
-        reward = np.zeros(n)
-        terminated = np.zeros(n, dtype=bool)
-        truncated = np.zeros(n, dtype=bool)
-        diverged = self.sim.diverged
-        cm = self.sim.center_of_mass()
-        d = (cm[:, :2] - self.cm0[:, :2]) / self.L
-        new = np.column_stack([np.hypot(d[:, 0], d[:, 1]), np.abs(d).max(axis=1)])
-        col = 0 if self.metric == "norm_final_dist" else 1
-        live = stepped & ~self.done_diverged
-        newly_div = live & diverged
-        ok = live & ~diverged
-        reward[ok] = new[ok, col] - self.metric_value[ok, col]
-        # a diverged episode forfeits its progress: its return sums to 0
-        reward[newly_div] = 0.0 - self.metric_value[newly_div, col]
-        self.metric_value[ok] = new[ok]
-        self.done_diverged |= newly_div
-        self.steps[stepped] += 1
-        k = np.minimum(self.steps, self.max_steps)
-        rows = np.flatnonzero(ok)
-        self._trace[rows, k[rows]] = np.abs(d[rows])
-        terminated[stepped] = self.done_diverged[stepped]
-        truncated[stepped] = (self.steps[stepped] >= self.max_steps) & ~terminated[stepped]
-        return reward, terminated, truncated, self.done_diverged.copy()
-
-    # ------------------------------------------------------------ observing
-    def clock(self) -> np.ndarray:
-        """Each robot's time since it was placed (s): settling plus its episode's steps."""
-        return self.settle_seconds + self.steps * self.control_dt
-
-    def observations(self) -> np.ndarray:
-        """Observation of every robot, ndarray of shape (n_robots, obs_size), float32."""
-        sim = self.sim
-        n, nc = self.n_robots, self.n_cells
-        obs = np.empty((n, self.obs_size), dtype=np.float32)
-        cm = sim.center_of_mass()
-        cm_vel = sim.momentum() / self.robot_mass[:, None]
-        inv_l = 1.0 / self.L
-        # every voxel of the batch at once: (n_voxels, 6) features, scattered to their cells
-        feats = np.empty((self._flat_cells.size, 6))
-        feats[:, 0:3] = sim.all_positions
-        feats[:, 3:6] = sim.all_velocities
-        feats[:, 0:3] -= cm[self._voxel_robot]
-        feats[:, 3:6] -= cm_vel[self._voxel_robot]
-        feats *= inv_l
-        np.clip(feats, -self._feat_bound, self._feat_bound, out=feats)
-        cells = self._cell_buf  # empty cells stay zero; filled ones are all overwritten
-        cells[self._flat_cells] = feats
-        obs[:, : 6 * nc] = cells.reshape(n, 6 * nc)
-        obs[:, 6 * nc : 6 * nc + 3] = np.clip(
-            cm_vel * inv_l, -OBS_VELOCITY_BOUND, OBS_VELOCITY_BOUND
-        )
-        theta = 2.0 * np.pi * self.clock() / self.period
-        obs[:, -2] = np.sin(theta)
-        obs[:, -1] = np.cos(theta)
-        return obs
-
-    def l_coefficient(self) -> np.ndarray:
-        """The seed's L coefficient of every robot over its episode so far (voxel lengths^2/s).
-
-        ``MaxXYDist^2 / t_max``, ``t_max`` the first sampled time (one sample
-        per control step, from the episode start, counted from the robot's
-        placement so the settling second is included as in the seed) at which
-        either axis displacement was within 0.1 voxel of ``MaxXYDist``.
-        """
-        n = self.n_robots
-        m = self.metric_value[:, 1]
-        kmax = int(min(self.steps.max(), self.max_steps)) + 1
-        tr = self._trace[:, :kmax]
-        close = (np.abs(tr[..., 0] - m[:, None]) < _L_TOLERANCE) | (
-            np.abs(tr[..., 1] - m[:, None]) < _L_TOLERANCE
-        )
-        idx = np.arange(kmax)
-        times = self.settle_seconds + idx * self.control_dt
-        close &= (idx[None, :] <= np.minimum(self.steps, self.max_steps)[:, None]) & (times > 0)[
-            None, :
-        ]
-        first = np.argmax(close, axis=1)
-        t_max = np.where(close.any(axis=1), times[first], np.maximum(self.clock(), self.control_dt))
-        out = m * m / t_max
-        out[self.done_diverged] = WORST_FITNESS
-        return out[:n]
-
-    def infos(self) -> dict[str, np.ndarray]:
-        """Per-robot metrics: arrays of shape (n_robots,)."""
-        nfd = self.metric_value[:, 0].copy()
-        mxy = self.metric_value[:, 1].copy()
-        nfd[self.done_diverged] = WORST_FITNESS
-        mxy[self.done_diverged] = WORST_FITNESS
-        return {
-            "norm_final_dist": nfd,
-            "max_xy_dist": mxy,
-            "l_coefficient": self.l_coefficient(),
-            "diverged": self.done_diverged.copy(),
-            "time": self.clock(),
-        }
-
-    # ------------------------------------------------------------- rendering
-    def colors(self, r: int) -> np.ndarray:
-        """RGB colour (0-1) of each voxel of robot ``r`` from its palette, shape (n_voxels_r, 3)."""
-        if r in self._colors:
-            return self._colors[r]
-        d = self.designs[r]
-        gi = self.sim.grid_index(r)
-        mats = d.grid[tuple(gi.T)]
-        table = np.zeros((d.palette.max_id + 1, 3))
-        for k, mat in d.palette.items():
-            table[k] = mat.color[:3]
-        self._colors[r] = table[mats]
-        return self._colors[r]
+    batch = EpisodeBatch(
+        designs, t, grid_shape, control_dt, episode_seconds, max_episode_steps, config,
+        n_threads=n_threads, drive=drive,
+    )  # fmt: skip
+    if max_episode_steps is not None:
+        warn_if_cut_short(max_episode_steps, batch.control_dt, batch.episode_seconds)
+    return batch
 
 
 class SoftWalkerEnv(gym.Env):
@@ -475,7 +185,7 @@ class SoftWalkerEnv(gym.Env):
     of :meth:`reset` tell which count). Each action is held for
     ``control_dt`` seconds. ``action = sin(2 pi t / period)`` on every cell
     is the seed's open-loop drive sampled every control step
-    (:class:`softgym.controllers.Sinusoid`); with ``control_dt <= 0.005`` it
+    (:class:`softgym.policies.Sinusoid`); with ``control_dt <= 0.005`` it
     walks the engine's built-in sinusoid's distance to within 1 %, while the
     default 0.05 s (5 samples per 0.25 s period) changes the seed's gait.
 
@@ -533,10 +243,13 @@ class SoftWalkerEnv(gym.Env):
 
     ## Info
 
+    The task's metrics (:meth:`softgym.tasks.EpisodeBatch.metrics`, computed by
+    :func:`softgym.metrics.walk_metrics_from_arrays` like :func:`softgym.evaluate`'s):
     ``norm_final_dist``, ``max_xy_dist`` (voxel lengths, since the episode
     start), ``l_coefficient`` (the seed's ``MaxXYDist^2 / t_max``, from one
-    sample per control step), ``diverged`` (bool) and ``time`` (s since the
-    robot was placed). Diverged episodes report
+    centre-of-mass sample per control step, ``t_max`` the engine time of the
+    first sample within 0.1 voxel of ``MaxXYDist``), ``diverged`` (bool) and
+    ``time`` (s since the robot was placed). Diverged episodes report
     :data:`softgym.metrics.WORST_FITNESS` for the metrics, as the seed does.
     :meth:`reset`'s info also holds ``muscle_mask`` (bool, one per cell).
 
@@ -548,8 +261,11 @@ class SoftWalkerEnv(gym.Env):
     ```
 
     * ``design``: a :class:`~softgym.design.RobotDesign` or the path of its JSON file; None: the default walker.
-    * ``task``: ``"flat"``, ``"wall"`` or ``"stairs"`` (set by the id).
-    * ``episode_seconds``: controlled time per episode (4 s: the seed's fitness window).
+    * ``task``: a task name (``"flat"``, ``"wall"``, ``"stairs"``: set by the id), a
+      :class:`softgym.tasks.Task`, a :class:`~softgym.terrain.Terrain` or a terrain JSON file
+      (anything :func:`softgym.tasks.get_task` reads).
+    * ``episode_seconds``: controlled time per episode; default the task's ``seconds`` minus
+      the settling time (4 s: the seed's fitness window).
     * ``control_dt``: seconds each action is held (0.05 s, about 78 engine steps of the default walker).
     * ``actuation``: ``"seed"`` (muscles only contract) or ``"symmetric"``; None keeps ``sim_config``'s (the seed's).
     * ``self_collision``: voxel-voxel contact within the robot; None keeps ``sim_config``'s (on).
@@ -561,10 +277,18 @@ class SoftWalkerEnv(gym.Env):
       :class:`softgym.render.VoxelRenderer`); ``width``, ``height``: frame size (320 x 240).
     * ``n_threads``: engine threads (1: a single robot cannot use more).
     * ``max_episode_steps``: an extra cap on the steps per episode (None).
+    * ``drive``: ``"action"`` (default) or ``"controller"``: the design's own sinusoidal
+      controller drives the muscles as in :func:`softgym.evaluate` and the seed, and actions
+      are ignored (the open-loop baseline; with ``control_dt`` equal to the task's
+      ``trace_interval`` an episode reports exactly ``softgym.evaluate``'s metrics).
 
     ## Version History
 
-    * v0: initial version.
+    * v0: initial version. Since the task layer (issue 11): ``task`` also takes a Task,
+      Terrain or JSON file, ``episode_seconds`` defaults to the task's, the wall is centred on
+      the design's grid (as in ``softgym.evaluate``; the default walker fills its grid, so
+      its world is unchanged), ``l_coefficient`` uses the engine's sample times, and
+      ``drive="controller"`` was added.
     """
 
     metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 20}
@@ -572,8 +296,8 @@ class SoftWalkerEnv(gym.Env):
     def __init__(
         self,
         design: RobotDesign | str | os.PathLike[str] | None = None,
-        task: str = "flat",
-        episode_seconds: float = 4.0,
+        task: TaskLike = "flat",
+        episode_seconds: float | None = None,
         control_dt: float = 0.05,
         actuation: str | None = None,
         self_collision: bool | None = None,
@@ -585,6 +309,7 @@ class SoftWalkerEnv(gym.Env):
         height: int = 240,
         n_threads: int | None = 1,
         max_episode_steps: int | None = None,
+        drive: str = "action",
     ) -> None:
         super().__init__()
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
@@ -592,18 +317,12 @@ class SoftWalkerEnv(gym.Env):
                 f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}"
             )
         self.design = load_design(design)
-        config = make_config(sim_config, actuation, self_collision)
-        self._batch = _WalkerBatch(
-            [self.design],
-            task,
-            tuple(grid_shape),
-            control_dt,
-            episode_seconds,
-            max_episode_steps,
-            config,
-            None if terrain is None else [terrain],
-            n_threads,
-        )
+        self._batch = make_batch(
+            [self.design], task, terrain=terrain, episode_seconds=episode_seconds,
+            control_dt=control_dt, actuation=actuation, self_collision=self_collision,
+            grid_shape=grid_shape, sim_config=sim_config, n_threads=n_threads,
+            max_episode_steps=max_episode_steps, drive=drive,
+        )  # fmt: skip
         b = self._batch
         self.task = b.task
         self.grid_shape = b.grid_shape
@@ -720,7 +439,14 @@ class SoftWalkerEnv(gym.Env):
                 "render() called without a render_mode; pass render_mode='rgb_array' to gym.make"
             )
             return None
-        return _render_robot(self, 0)
+        return self._batch.render_frame(self._get_renderer(), 0)
+
+    def _get_renderer(self) -> Any:
+        if self._renderer is None:
+            from softgym.render import VoxelRenderer  # lazy: envs import without the renderer
+
+            self._renderer = VoxelRenderer(self.width, self.height, voxel_size=self._batch.L)
+        return self._renderer
 
     def close(self) -> None:
         """Release the renderer; harmless to call more than once."""
@@ -742,21 +468,3 @@ def observation_space(grid_shape: Sequence[int]) -> spaces.Box:
     high[6 * n : 6 * n + 3] = OBS_VELOCITY_BOUND
     high[-2:] = 1.0
     return spaces.Box(-high, high, dtype=np.float32)
-
-
-def _render_robot(env: Any, r: int) -> np.ndarray:
-    """Frame of robot ``r`` of an env's batch (the env's renderer is made on first use)."""
-    from softgym.render.frames import VoxelRenderer  # lazy: envs import without the renderer
-
-    b = env._batch
-    if env._renderer is None:
-        env._renderer = VoxelRenderer(env.width, env.height, voxel_size=b.L)
-    sim = b.sim
-    return env._renderer.render(
-        sim.positions(r),
-        sim.orientations(r),
-        sim.scales(r),
-        b.colors(r),
-        grid_index=sim.grid_index(r),
-        terrain=b.terrains[r],
-    )

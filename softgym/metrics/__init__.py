@@ -6,6 +6,8 @@ voxel lengths; diverged robots get :data:`WORST_FITNESS`.
 """
 
 from softgym.metrics.fitness import (
+    L_TOLERANCE,
+    WALK_METRICS,
     WORST_FITNESS,
     WORST_MINIMIZED,
     Composition,
@@ -14,10 +16,13 @@ from softgym.metrics.fitness import (
     l_coefficient,
     l_coefficient_details,
     l_coefficient_from_arrays,
+    l_coefficients_from_arrays,
     max_xy_dist,
     max_xy_dist_from_arrays,
     norm_final_dist,
     norm_final_dist_from_arrays,
+    walk_metrics,
+    walk_metrics_from_arrays,
 )
 from softgym.metrics.novelty import (
     NO_TRAJECTORY_NOVELTY,
@@ -31,7 +36,9 @@ from softgym.metrics.novelty import (
 )
 
 __all__ = [
+    "L_TOLERANCE",
     "NO_TRAJECTORY_NOVELTY",
+    "WALK_METRICS",
     "WORST_FITNESS",
     "WORST_MINIMIZED",
     "Composition",
@@ -43,6 +50,7 @@ __all__ = [
     "l_coefficient",
     "l_coefficient_details",
     "l_coefficient_from_arrays",
+    "l_coefficients_from_arrays",
     "max_xy_dist",
     "max_xy_dist_from_arrays",
     "norm_final_dist",
@@ -51,4 +59,6 @@ __all__ = [
     "similarity_matrix",
     "traces_from_rollout",
     "trajectory_vectors",
+    "walk_metrics",
+    "walk_metrics_from_arrays",
 ]

@@ -25,6 +25,8 @@ if TYPE_CHECKING:  # only for annotations: softgym.engine's __init__ loads compi
     from softgym.engine.rollout import Rollout
 
 __all__ = [
+    "L_TOLERANCE",
+    "WALK_METRICS",
     "WORST_FITNESS",
     "WORST_MINIMIZED",
     "Composition",
@@ -33,16 +35,23 @@ __all__ = [
     "l_coefficient",
     "l_coefficient_details",
     "l_coefficient_from_arrays",
+    "l_coefficients_from_arrays",
     "max_xy_dist",
     "max_xy_dist_from_arrays",
     "norm_final_dist",
     "norm_final_dist_from_arrays",
+    "walk_metrics",
+    "walk_metrics_from_arrays",
 ]
 
 #: Worst value of a maximised objective (the seed's ``-10e6``), given to invalid or diverged robots.
 WORST_FITNESS = -1e7
 #: Worst value of a minimised objective (the seed's ``+10e6``).
 WORST_MINIMIZED = 1e7
+#: Tolerance (voxel lengths) of the L coefficient's "maximum reached" test: the seed's 0.1.
+L_TOLERANCE = 0.1
+#: The walking measures every task reports (maximised; diverged robots get :data:`WORST_FITNESS`).
+WALK_METRICS: tuple[str, ...] = ("norm_final_dist", "max_xy_dist", "l_coefficient")
 
 
 def _positive(name: str, value: float) -> float:
@@ -125,21 +134,83 @@ class LCoefficient:
     l_coefficient: float
 
 
+def l_coefficients_from_arrays(
+    cm_init,
+    cm_final,
+    trace_cm,
+    trace_t,
+    voxel_size: float,
+    end_time,
+    valid=None,
+    tolerance: float = L_TOLERANCE,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Ev-SoftBots' L coefficient of many robots at once (the one implementation of it).
+
+    ``MaxXYDist = max(|x_end - x_0|, |y_end - y_0|) / L``; ``timeMaxReached``
+    is the first sample time ``t_k > 0`` with
+    ``| |x_k - x_0| / L - MaxXYDist | < tolerance`` or the same in y, else
+    ``end_time``; ``LCoefficient = MaxXYDist * (MaxXYDist / timeMaxReached)``
+    (``VX_SimGA.cpp``).
+
+    Parameters
+    ----------
+    cm_init, cm_final : array_like of shape (n, 3), float64
+        Centre of mass (m) at the reference time and at the end.
+    trace_cm : array_like of shape (n, k, 3), float64
+        Centre-of-mass samples (m), in time order.
+    trace_t : array_like of shape (n, k), float64
+        Their times (s, from t = 0).
+    voxel_size : float
+        Lattice dimension L (m).
+    end_time : array_like of shape (n,), float64
+        Time (s) at the end of each run, used when no sample qualifies; must be > 0
+        where that happens.
+    valid : array_like of shape (n, k), bool, optional
+        Samples that count (default all): e.g. ``t >= init_time``.
+    tolerance : float
+        In voxel lengths (:data:`L_TOLERANCE`, the seed's 0.1).
+
+    Returns
+    -------
+    l_coefficient : ndarray of shape (n,), float64
+        Voxel lengths^2 per second.
+    time_max_xy_dist : ndarray of shape (n,), float64
+        ``timeMaxReached`` (s).
+    """
+    L = _positive("voxel_size", voxel_size)
+    x0 = np.asarray(cm_init, dtype=np.float64).reshape(-1, 3)
+    n = x0.shape[0]
+    m = np.asarray(max_xy_dist_from_arrays(x0, np.reshape(cm_final, (-1, 3)), L)).reshape(n)
+    tc = np.asarray(trace_cm, dtype=np.float64).reshape(n, -1, 3)
+    tt = np.asarray(trace_t, dtype=np.float64).reshape(n, -1)
+    t_max = np.array(np.broadcast_to(np.asarray(end_time, dtype=np.float64), (n,)))
+    if tt.shape[1]:
+        with np.errstate(invalid="ignore"):  # frozen (diverged) robots may hold non-finite samples
+            dx = np.abs(tc[..., 0] - x0[:, 0, None]) / L
+            dy = np.abs(tc[..., 1] - x0[:, 1, None]) / L
+            close = (np.abs(dx - m[:, None]) < tolerance) | (np.abs(dy - m[:, None]) < tolerance)
+        close &= tt > 0  # t = 0 cannot be divided by
+        if valid is not None:
+            close &= np.asarray(valid, dtype=bool).reshape(n, -1)
+        hit = close.any(axis=1)
+        first = np.argmax(close, axis=1)
+        t_max = np.where(hit, tt[np.arange(n), first], t_max)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        speed = m / t_max
+    return m * speed, t_max
+
+
 def l_coefficient_from_arrays(
     cm_init,
     cm_final,
     trace,
     voxel_size: float,
     end_time: float,
-    tolerance: float = 0.1,
+    tolerance: float = L_TOLERANCE,
 ) -> LCoefficient:
     """Ev-SoftBots' L coefficient of one robot, exactly as ``VX_SimGA.cpp`` computes it.
 
-    ``MaxXYDist = max(|x_end - x_0|, |y_end - y_0|) / L``; ``timeMaxReached``
-    is the first trace time ``t_k`` with
-    ``| |x_k - x_0| / L - MaxXYDist | < tolerance`` or the same in y, else
-    ``end_time``; ``Speed = MaxXYDist / timeMaxReached`` and
-    ``LCoefficient = MaxXYDist * Speed``.
+    One robot of :func:`l_coefficients_from_arrays` (see it for the definition).
 
     Parameters
     ----------
@@ -161,19 +232,84 @@ def l_coefficient_from_arrays(
     """
     L = _positive("voxel_size", voxel_size)
     end_time = _positive("end_time", end_time)
-    x0 = np.asarray(cm_init, dtype=np.float64)
-    m = float(max_xy_dist_from_arrays(x0, cm_final, L))
+    m = float(max_xy_dist_from_arrays(cm_init, cm_final, L))
     tr = np.asarray(trace, dtype=np.float64).reshape(-1, 4) if np.size(trace) else np.zeros((0, 4))
-    t_max = end_time
-    if tr.shape[0]:
-        dx = np.abs(tr[:, 0] - x0[0]) / L
-        dy = np.abs(tr[:, 1] - x0[1]) / L
-        close = (np.abs(dx - m) < tolerance) | (np.abs(dy - m) < tolerance)
-        hit = np.flatnonzero(close & (tr[:, 3] > 0))  # t = 0 cannot be divided by
-        if hit.size:
-            t_max = float(tr[hit[0], 3])
-    speed = m / t_max
-    return LCoefficient(max_xy_dist=m, time_max_xy_dist=t_max, speed=speed, l_coefficient=m * speed)
+    lc, t_max = l_coefficients_from_arrays(
+        cm_init, cm_final, tr[None, :, :3], tr[None, :, 3], L, end_time, tolerance=tolerance
+    )
+    t = float(t_max[0])
+    return LCoefficient(max_xy_dist=m, time_max_xy_dist=t, speed=m / t, l_coefficient=float(lc[0]))
+
+
+def walk_metrics_from_arrays(
+    cm_init,
+    cm_final,
+    trace_cm,
+    trace_t,
+    voxel_size: float,
+    end_time,
+    diverged=None,
+    valid=None,
+    tolerance: float = L_TOLERANCE,
+) -> dict[str, np.ndarray]:
+    """The seed's walking measures of many robots from plain arrays.
+
+    Parameters
+    ----------
+    cm_init, cm_final, trace_cm, trace_t, voxel_size, end_time, valid, tolerance
+        As for :func:`l_coefficients_from_arrays`.
+    diverged : array_like of shape (n,), bool, optional
+        Robots that get :data:`WORST_FITNESS` (and an infinite ``time_max_xy_dist``).
+
+    Returns
+    -------
+    dict of str to ndarray of shape (n,)
+        ``norm_final_dist``, ``max_xy_dist`` (voxel lengths), ``l_coefficient``
+        (voxel lengths^2 / s), ``time_max_xy_dist`` (s) and ``diverged`` (bool).
+    """
+    x0 = np.asarray(cm_init, dtype=np.float64).reshape(-1, 3)
+    x1 = np.asarray(cm_final, dtype=np.float64).reshape(-1, 3)
+    n = x0.shape[0]
+    div = np.zeros(n, dtype=bool) if diverged is None else np.asarray(diverged, dtype=bool).copy()
+    with np.errstate(invalid="ignore"):
+        nfd = np.asarray(norm_final_dist_from_arrays(x0, x1, voxel_size), dtype=np.float64)
+        mxy = np.asarray(max_xy_dist_from_arrays(x0, x1, voxel_size), dtype=np.float64)
+    end = np.array(np.broadcast_to(np.asarray(end_time, dtype=np.float64), (n,)))
+    end[div] = 1.0  # never used: a diverged robot's measures are the worst
+    lc, t_max = l_coefficients_from_arrays(
+        x0, x1, trace_cm, trace_t, voxel_size, end, valid=valid, tolerance=tolerance
+    )
+    for values in (nfd, mxy, lc):
+        values[div] = WORST_FITNESS
+    t_max[div] = np.inf
+    return {
+        "norm_final_dist": nfd,
+        "max_xy_dist": mxy,
+        "l_coefficient": lc,
+        "time_max_xy_dist": t_max,
+        "diverged": div,
+    }
+
+
+def walk_metrics(rollout: Rollout, tolerance: float = L_TOLERANCE) -> dict[str, np.ndarray]:
+    """:func:`walk_metrics_from_arrays` of a rollout: samples from ``init_time`` on, ends at ``rollout.time``.
+
+    Returns
+    -------
+    dict of str to ndarray of shape (n_robots,)
+        ``norm_final_dist``, ``max_xy_dist``, ``l_coefficient``, ``time_max_xy_dist``, ``diverged``.
+    """
+    return walk_metrics_from_arrays(
+        rollout.cm_init,
+        rollout.cm_final,
+        rollout.cm,
+        rollout.times,
+        rollout.voxel_size,
+        rollout.time,
+        diverged=rollout.diverged,
+        valid=rollout.times >= rollout.init_time,
+        tolerance=tolerance,
+    )
 
 
 def _worst(values: np.ndarray, rollout: Rollout) -> np.ndarray:
@@ -209,30 +345,25 @@ def max_xy_dist(rollout: Rollout) -> np.ndarray:
     )
 
 
-def l_coefficient_details(rollout: Rollout, tolerance: float = 0.1) -> list[LCoefficient | None]:
+def l_coefficient_details(
+    rollout: Rollout, tolerance: float = L_TOLERANCE
+) -> list[LCoefficient | None]:
     """:class:`LCoefficient` of every robot (None for diverged robots).
 
     Uses the trace from ``rollout.init_time`` on and ``rollout.time`` as the end time.
     """
+    w = walk_metrics(rollout, tolerance)
     out: list[LCoefficient | None] = []
     for i in range(rollout.n_robots):
-        if rollout.diverged[i]:
+        if w["diverged"][i]:
             out.append(None)
             continue
-        out.append(
-            l_coefficient_from_arrays(
-                rollout.cm_init[i],
-                rollout.cm_final[i],
-                rollout.trace(i, since=rollout.init_time),
-                rollout.voxel_size,
-                float(rollout.time[i]),
-                tolerance,
-            )
-        )
+        m, t = float(w["max_xy_dist"][i]), float(w["time_max_xy_dist"][i])
+        out.append(LCoefficient(m, t, m / t, float(w["l_coefficient"][i])))
     return out
 
 
-def l_coefficient(rollout: Rollout, tolerance: float = 0.1) -> np.ndarray:
+def l_coefficient(rollout: Rollout, tolerance: float = L_TOLERANCE) -> np.ndarray:
     """The L coefficient of every robot; :data:`WORST_FITNESS` for diverged robots.
 
     Returns
@@ -240,13 +371,7 @@ def l_coefficient(rollout: Rollout, tolerance: float = 0.1) -> np.ndarray:
     ndarray of shape (n_robots,), float64
         ``MaxXYDist^2 / timeMaxReached`` (voxel lengths^2 per second).
     """
-    return np.array(
-        [
-            WORST_FITNESS if d is None else d.l_coefficient
-            for d in l_coefficient_details(rollout, tolerance)
-        ],
-        dtype=np.float64,
-    )
+    return walk_metrics(rollout, tolerance)["l_coefficient"]
 
 
 @dataclass(frozen=True)

@@ -276,7 +276,7 @@ def run_figures(
     """
     from softgym.design import RobotDesign
     from softgym.engine import Simulation
-    from softgym.evaluate import Task, make_terrain
+    from softgym.tasks import get_task
 
     run_dir = Path(run_dir)
     fig_dir = run_dir / "figures"
@@ -296,8 +296,9 @@ def run_figures(
         design, fig_dir / "best_robot.png", title=f"best robot ({exp['name']})"
     )
     secs = float(exp["seconds"] if seconds is None else seconds)
-    task = Task(terrain=exp["terrain"], seconds=secs, trace_interval=0.05, sim=exp.get("sim", {}))
-    terrain = make_terrain(task.terrain, design.shape)
+    world = exp.get("task", exp.get("terrain", "flat"))  # "terrain": run folders before tasks
+    task = get_task(world, seconds=secs, trace_interval=0.05, sim=exp.get("sim", {}))
+    terrain = task.terrain_for(design.shape)
     rollout = Simulation([design], config=task.config(), terrain=terrain).run(secs)
     out["best_trajectory"] = plot_trajectory(
         rollout.trace(0), fig_dir / "best_trajectory.png", rollout.voxel_size, rollout.init_time,

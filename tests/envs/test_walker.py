@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 
 import softgym  # noqa: F401  (registers the ids)
-from softgym.controllers import Sinusoid
 from softgym.design import default_walker
 from softgym.engine import SimConfig, Simulation
 from softgym.exceptions import InvalidActionError
 from softgym.metrics import norm_final_dist
+from softgym.policies import Sinusoid
 
 
 def rollout(env, actions, seed):

@@ -21,10 +21,10 @@ def test_local_cluster_with_two_workers_equals_local(tmp_path):
     exp = tiny("controller-pareto")
     rng = np.random.default_rng(0)
     designs = [Individual.random(rng, i, exp.shape).design(exp.shape).to_dict() for i in range(5)]
-    local = local_batch_fn(designs, exp.task())
+    local = local_batch_fn(designs, exp.make_task())
     with dask_client("local", n_workers=2, processes=False) as client:
         fn = DaskBatchFn(client)
-        remote = fn(designs, exp.task())
+        remote = fn(designs, exp.make_task())
         assert len(client.nthreads()) == 2
         for key in ("norm_final_dist", "max_xy_dist", "l_coefficient", "n_muscle", "diverged"):
             np.testing.assert_array_equal(remote[key], local[key])
@@ -62,13 +62,13 @@ def test_a_killed_workers_batch_is_recomputed(tmp_path, monkeypatch):
     exp = tiny("controller-pareto")
     rng = np.random.default_rng(1)
     designs = [Individual.random(rng, i, exp.shape).design(exp.shape).to_dict() for i in range(4)]
-    local = local_batch_fn(designs, exp.task())
+    local = local_batch_fn(designs, exp.make_task())
     marker = tmp_path / "killed"
     monkeypatch.setenv(_MARKER_ENV, str(marker))
     cloudpickle.register_pickle_by_value(sys.modules[__name__])
     try:
         with dask_client("local", n_workers=2, processes=True) as client:
-            remote = DaskBatchFn(client, payload_fn=_evaluate_or_die_once)(designs, exp.task())
+            remote = DaskBatchFn(client, payload_fn=_evaluate_or_die_once)(designs, exp.make_task())
     finally:
         cloudpickle.unregister_pickle_by_value(sys.modules[__name__])
     assert marker.exists()  # a worker really died

@@ -1,0 +1,56 @@
+"""Tasks: what a run of the engine means, shared by ``softgym.evaluate``, the envs and evolution.
+
+A :class:`Task` is a terrain + a duration + a sampling interval + the metrics
+it reports (:func:`softgym.metrics.walk_metrics`) + the reward an env derives
+from them. :data:`TASKS` holds the named ones (``flat``, ``wall``, ``stairs``;
+``fence`` is an alias of ``wall``); :func:`get_task` also reads a
+:class:`~softgym.terrain.Terrain`, a terrain JSON file or a Task's dict, so a
+custom world goes wherever a task name does. :class:`EpisodeBatch` runs a task
+as control episodes of N robots (what the Gymnasium envs adapt).
+
+>>> from softgym.tasks import get_task
+>>> get_task("fence").name, get_task("stairs").reward
+('wall', 'max_xy_dist')
+"""
+
+from softgym.tasks.episode import (
+    DRIVES,
+    OBS_POSITION_BOUND,
+    OBS_VELOCITY_BOUND,
+    EpisodeBatch,
+    observation_size,
+)
+from softgym.tasks.task import (
+    ALIASES,
+    LAYOUTS,
+    REWARDS,
+    TASKS,
+    Task,
+    TaskLike,
+    flat_layout,
+    get_task,
+    register_task,
+    stairs_layout,
+    task_names,
+    wall_layout,
+)
+
+__all__ = [
+    "ALIASES",
+    "DRIVES",
+    "LAYOUTS",
+    "OBS_POSITION_BOUND",
+    "OBS_VELOCITY_BOUND",
+    "REWARDS",
+    "TASKS",
+    "EpisodeBatch",
+    "Task",
+    "TaskLike",
+    "flat_layout",
+    "get_task",
+    "observation_size",
+    "register_task",
+    "stairs_layout",
+    "task_names",
+    "wall_layout",
+]

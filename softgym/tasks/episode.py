@@ -1,0 +1,410 @@
+"""A task run as control episodes: N robots in one Simulation, actions in, observations out.
+
+:class:`EpisodeBatch` is what the Gymnasium environments adapt (dm_control's
+Task half of an Environment): how actions become muscle temperatures, what is
+observed, the per-step reward (the progress of the task's reward metric) and
+the reported metrics, computed by :mod:`softgym.metrics` from the centre of
+mass sampled once per control step, and when an episode ends. The single env
+drives a batch of one, the vector env a batch of N, so both compute exactly the
+same numbers for a robot. Nothing here knows Gymnasium.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from softgym.design.robot import RobotDesign
+from softgym.engine import SimConfig, Simulation
+from softgym.exceptions import InvalidActionError, InvalidDesignError, InvalidParameterError
+from softgym.metrics import (
+    max_xy_dist_from_arrays,
+    norm_final_dist_from_arrays,
+    walk_metrics_from_arrays,
+)
+from softgym.tasks.task import Task
+from softgym.terrain import Terrain
+
+__all__ = [
+    "DRIVES",
+    "OBS_POSITION_BOUND",
+    "OBS_VELOCITY_BOUND",
+    "EpisodeBatch",
+    "observation_size",
+]
+
+#: Observed positions relative to the centre of mass are clipped to +-this (voxel lengths).
+OBS_POSITION_BOUND = 50.0
+#: Observed velocities are clipped to +-this (voxel lengths per second).
+OBS_VELOCITY_BOUND = 500.0
+#: What drives the muscles: the actions, or the design's own controller (actions ignored).
+DRIVES: tuple[str, ...] = ("action", "controller")
+
+
+def observation_size(grid_shape: Sequence[int]) -> int:
+    """Length of the observation vector for a grid: 6 per cell, CM velocity (3), phase (2)."""
+    return 6 * int(np.prod(grid_shape)) + 5
+
+
+def _positive(name: str, value: Any) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(f"{name} must be a number, got {value!r}") from None
+    if not (math.isfinite(v) and v > 0):
+        raise InvalidParameterError(f"{name} must be finite and > 0, got {value!r}")
+    return v
+
+
+class EpisodeBatch:
+    """A task's control episodes for N robots in one :class:`~softgym.engine.Simulation`.
+
+    Parameters
+    ----------
+    designs : list of RobotDesign
+        One per robot; each must fit in ``grid_shape``.
+    task : Task
+        Terrain (placed around each design's grid unless ``terrains`` is
+        given) and reward metric.
+    grid_shape : tuple of 3 ints
+        The lattice of actions and observations.
+    control_dt, episode_seconds : float
+        Seconds per action and per episode (after settling).
+    max_episode_steps : int or None
+        Truncate after this many steps (the smaller of it and
+        ``round(episode_seconds / control_dt)``).
+    config : SimConfig
+        Engine settings (its ``trace_interval`` is not used: the batch samples
+        the centre of mass once per control step).
+    terrains : list of Terrain or None
+        One per robot (default: the task's).
+    n_threads : int or None
+        Engine threads.
+    drive : {"action", "controller"}
+        ``"action"``: each step's action sets the muscle temperatures.
+        ``"controller"``: the design's own sinusoidal controller drives them,
+        as in :func:`softgym.evaluate` and the seed (actions are checked and
+        ignored): the open-loop baseline, whose episode reports exactly
+        :func:`softgym.evaluate`'s metrics when ``control_dt`` is the task's
+        ``trace_interval``.
+    """
+
+    def __init__(
+        self,
+        designs: list[RobotDesign],
+        task: Task,
+        grid_shape: Sequence[int],
+        control_dt: float,
+        episode_seconds: float,
+        max_episode_steps: int | None,
+        config: SimConfig,
+        terrains: list[Terrain] | None = None,
+        n_threads: int | None = None,
+        drive: str = "action",
+    ) -> None:
+        if not isinstance(task, Task):
+            raise InvalidParameterError(f"task must be a Task, got {type(task).__name__}")
+        if drive not in DRIVES:
+            raise InvalidParameterError(f"drive must be one of {DRIVES}, got {drive!r}")
+        self.task = task
+        self.drive = drive
+        self.metric = task.reward
+        self.grid_shape = tuple(int(s) for s in grid_shape)
+        if len(self.grid_shape) != 3 or min(self.grid_shape) < 1:
+            raise InvalidParameterError(f"grid_shape must be 3 positive ints, got {grid_shape!r}")
+        self.n_cells = int(np.prod(self.grid_shape))
+        self.control_dt = _positive("control_dt", control_dt)
+        self.episode_seconds = _positive("episode_seconds", episode_seconds)
+        n_steps = max(1, round(self.episode_seconds / self.control_dt))
+        if max_episode_steps is not None:
+            if int(max_episode_steps) < 1:
+                raise InvalidParameterError(
+                    f"max_episode_steps must be >= 1, got {max_episode_steps}"
+                )
+            n_steps = min(n_steps, int(max_episode_steps))
+        self.max_steps = n_steps
+        self.designs = list(designs)
+        for i, d in enumerate(self.designs):
+            if any(s > g for s, g in zip(d.shape, self.grid_shape)):
+                raise InvalidDesignError(
+                    f"design {i} of shape {d.shape} does not fit in grid_shape {self.grid_shape}"
+                )
+            if d.n_voxels == 0:
+                raise InvalidDesignError(f"design {i} has no voxels")
+        if terrains is None:
+            terrains = [task.terrain_for(d.shape) for d in self.designs]
+        self.terrains = list(terrains)
+        self.config = config
+        self.sim = Simulation(
+            self.designs, config=config, n_threads=n_threads, terrain=self.terrains
+        )
+        n = self.n_robots = len(self.designs)
+        self.L = float(config.voxel_size)
+        self.settle_seconds = float(config.init_time)
+        # per-robot lattice bookkeeping
+        self.cells: list[np.ndarray] = []  # flat cell index of each voxel
+        self.voxel_muscle: list[np.ndarray] = []  # voxel has a non-zero CTE
+        self.muscle_mask = np.zeros((n, self.n_cells), dtype=bool)
+        self.filled_mask = np.zeros((n, self.n_cells), dtype=bool)
+        for r, d in enumerate(self.designs):
+            gi = self.sim.grid_index(r)
+            cells = np.ravel_multi_index(tuple(gi.T), self.grid_shape).astype(np.intp)
+            cte = self.sim.bodies[r].cte[d.grid[tuple(gi.T)]]
+            muscle = cte != 0.0
+            self.cells.append(cells)
+            self.voxel_muscle.append(muscle)
+            self.muscle_mask[r, cells] = muscle
+            self.filled_mask[r, cells] = True
+        self.amplitude = np.array(
+            [d.controller.temp_amplitude for d in self.designs], dtype=np.float64
+        )
+        self.period = np.array([d.controller.period for d in self.designs], dtype=np.float64)
+        self.robot_mass = np.array([self.sim.masses(r).sum() for r in range(n)])
+        self.obs_size = observation_size(self.grid_shape)
+        self._settled: dict[str, np.ndarray] | None = None
+        self._settled_time = np.zeros(n)
+        self.cm0 = np.zeros((n, 3))
+        self.steps = np.zeros(n, dtype=np.int64)
+        self.metric_value = np.zeros((n, 2))  # norm_final_dist, max_xy_dist
+        self.done_diverged = np.zeros(n, dtype=bool)
+        # centre of mass (m) and time since placement (s) at the episode start and each step
+        self._trace_cm = np.zeros((n, self.max_steps + 1, 3))
+        self._trace_t = np.zeros((n, self.max_steps + 1))
+        self._time_offset = np.zeros(n)  # engine clock minus time since placement
+        self._colors: dict[int, np.ndarray] = {}
+        # batch-wide voxel -> (robot, cell) maps for the observations
+        self._voxel_robot = np.repeat(np.arange(n), [c.size for c in self.cells])
+        self._voxel_is_muscle = np.concatenate(self.voxel_muscle)
+        self._flat_cells = np.concatenate(
+            [r * self.n_cells + c for r, c in enumerate(self.cells)]
+        ).astype(np.intp)
+        self._feat_bound = np.array([OBS_POSITION_BOUND] * 3 + [OBS_VELOCITY_BOUND] * 3)
+        self._cell_buf = np.zeros((n * self.n_cells, 6))
+
+    # ---------------------------------------------------------------- reset
+    def _settle(self) -> None:
+        sim = self.sim
+        sim.reset()
+        if self.drive == "action":
+            for r in range(self.n_robots):
+                sim.set_temperature(r, np.zeros(len(self.cells[r])))
+        # (the design's controller holds the nominal sizes while settling, as idle muscles do)
+        if self.settle_seconds > 0:
+            sim.advance(self.settle_seconds)
+        self._settled = sim.get_state()
+        self._settled_time = sim.time
+        # the engine's own reference centre of mass (its first step after init_time), the one
+        # softgym.evaluate's metrics start from
+        self.cm0 = sim.rollout().cm_init
+
+    def _start_trace(self, ids: np.ndarray | slice) -> None:
+        self._trace_cm[ids] = 0.0
+        self._trace_t[ids] = 0.0
+        self._trace_cm[ids, 0] = self.cm0[ids]
+        self._trace_t[ids, 0] = self._settled_time[ids]
+
+    def reset_all(self) -> None:
+        """Every robot back to its settled start state (the first call settles them)."""
+        if self._settled is None:
+            self._settle()
+        else:
+            self.sim.set_state(self._settled)
+        self.steps[:] = 0
+        self.metric_value[:] = 0.0
+        # a robot that diverged while settling cannot run: its episodes end at the first step
+        self.done_diverged[:] = self._settled["diverged"] != 0
+        self._time_offset[:] = 0.0
+        self._start_trace(slice(None))
+
+    def reset_robots(self, ids: np.ndarray) -> None:
+        """Put the robots ``ids`` back to their settled start; the others go on untouched."""
+        ids = np.asarray(ids, dtype=np.intp)
+        if ids.size == 0:
+            return
+        if ids.size == self.n_robots or self._settled is None:
+            self.reset_all()
+            return
+        init = self._settled
+        # the batch shares one clock: a reset robot restarts from its settled state *now*
+        self.sim.restore_robots(init, ids)
+        self.steps[ids] = 0
+        self.metric_value[ids] = 0.0
+        self.done_diverged[ids] = init["diverged"][ids] != 0
+        self._time_offset[ids] = self.sim.time[ids] - self._settled_time[ids]
+        self._start_trace(ids)
+
+    # ----------------------------------------------------------------- step
+    def validate_actions(self, actions: Any) -> np.ndarray:
+        """Actions as float64 (n_robots, n_cells), clipped to [-1, 1]; NaN/inf raise."""
+        try:
+            a = np.asarray(actions, dtype=np.float64)
+        except (TypeError, ValueError):
+            raise InvalidActionError(
+                f"action must be numeric, got {type(actions).__name__}"
+            ) from None
+        want = (self.n_robots, self.n_cells)
+        if a.shape != want and a.size == self.n_robots * self.n_cells:
+            a = a.reshape(want)
+        if a.shape != want:
+            raise InvalidActionError(
+                f"action must have shape {want[1:] if self.n_robots == 1 else want}, got {np.shape(actions)}"
+            )
+        if not np.isfinite(a).all():
+            raise InvalidActionError("action holds NaN or infinite values; the state is unchanged")
+        return np.clip(a, -1.0, 1.0)
+
+    def apply(self, actions: np.ndarray, active: np.ndarray | None = None) -> None:
+        """Set every active robot's muscle temperatures ``action * dT`` (degC).
+
+        With ``drive="controller"`` the design's controller keeps the muscles.
+        """
+        if self.drive == "controller":
+            return
+        # every voxel of the batch at once: its cell's action times its robot's dT
+        temps = actions.reshape(-1)[self._flat_cells] * self.amplitude[self._voxel_robot]
+        temps[~self._voxel_is_muscle] = 0.0
+        self.sim.set_temperatures(temps, None if active is None else np.flatnonzero(active))
+
+    def advance(self) -> None:
+        """Advance the whole batch by one control step."""
+        self.sim.advance(self.control_dt)
+
+    def update(self, stepped: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Book-keeping after an advance for the robots ``stepped`` (bool mask).
+
+        Returns
+        -------
+        reward : ndarray of shape (n_robots,), float64
+            The progress of the task's reward metric (voxel lengths).
+        terminated, truncated : ndarray of shape (n_robots,), bool
+        diverged : ndarray of shape (n_robots,), bool
+        """
+        n = self.n_robots
+        reward = np.zeros(n)
+        terminated = np.zeros(n, dtype=bool)
+        truncated = np.zeros(n, dtype=bool)
+        diverged = self.sim.diverged
+        cm = self.sim.center_of_mass()
+        new = np.column_stack(
+            [
+                norm_final_dist_from_arrays(self.cm0, cm, self.L),
+                max_xy_dist_from_arrays(self.cm0, cm, self.L),
+            ]
+        )
+        col = 0 if self.metric == "norm_final_dist" else 1
+        live = stepped & ~self.done_diverged
+        newly_div = live & diverged
+        ok = live & ~diverged
+        reward[ok] = new[ok, col] - self.metric_value[ok, col]
+        # a diverged episode forfeits its progress: its return sums to 0
+        reward[newly_div] = 0.0 - self.metric_value[newly_div, col]
+        self.metric_value[ok] = new[ok]
+        self.done_diverged |= newly_div
+        self.steps[stepped] += 1
+        k = np.minimum(self.steps, self.max_steps)
+        rows = np.flatnonzero(ok)
+        self._trace_cm[rows, k[rows]] = cm[rows]
+        self._trace_t[rows, k[rows]] = self.sim.time[rows] - self._time_offset[rows]
+        terminated[stepped] = self.done_diverged[stepped]
+        truncated[stepped] = (self.steps[stepped] >= self.max_steps) & ~terminated[stepped]
+        return reward, terminated, truncated, self.done_diverged.copy()
+
+    # ------------------------------------------------------------ observing
+    def clock(self) -> np.ndarray:
+        """Each robot's time since it was placed (s): settling plus its episode's steps."""
+        return self.settle_seconds + self.steps * self.control_dt
+
+    def observations(self) -> np.ndarray:
+        """Observation of every robot, ndarray of shape (n_robots, obs_size), float32."""
+        sim = self.sim
+        n, nc = self.n_robots, self.n_cells
+        obs = np.empty((n, self.obs_size), dtype=np.float32)
+        cm = sim.center_of_mass()
+        cm_vel = sim.momentum() / self.robot_mass[:, None]
+        inv_l = 1.0 / self.L
+        # every voxel of the batch at once: (n_voxels, 6) features, scattered to their cells
+        feats = np.empty((self._flat_cells.size, 6))
+        feats[:, 0:3] = sim.all_positions
+        feats[:, 3:6] = sim.all_velocities
+        feats[:, 0:3] -= cm[self._voxel_robot]
+        feats[:, 3:6] -= cm_vel[self._voxel_robot]
+        feats *= inv_l
+        np.clip(feats, -self._feat_bound, self._feat_bound, out=feats)
+        cells = self._cell_buf  # empty cells stay zero; filled ones are all overwritten
+        cells[self._flat_cells] = feats
+        obs[:, : 6 * nc] = cells.reshape(n, 6 * nc)
+        obs[:, 6 * nc : 6 * nc + 3] = np.clip(
+            cm_vel * inv_l, -OBS_VELOCITY_BOUND, OBS_VELOCITY_BOUND
+        )
+        theta = 2.0 * np.pi * self.clock() / self.period
+        obs[:, -2] = np.sin(theta)
+        obs[:, -1] = np.cos(theta)
+        return obs
+
+    def metrics(self) -> dict[str, np.ndarray]:
+        """The task's metrics of every robot's episode so far (:func:`softgym.metrics.walk_metrics_from_arrays`).
+
+        The samples are the centre of mass at the episode start and after each
+        control step, timed from the robot's placement (settling included, as
+        in the seed); the end is the latest step.
+
+        Returns
+        -------
+        dict of str to ndarray of shape (n_robots,)
+            ``norm_final_dist``, ``max_xy_dist``, ``l_coefficient``,
+            ``time_max_xy_dist``, ``diverged``.
+        """
+        k = np.minimum(self.steps, self.max_steps)
+        kmax = int(k.max()) + 1
+        rows = np.arange(self.n_robots)
+        end = self._trace_t[rows, k]
+        return walk_metrics_from_arrays(
+            self.cm0,
+            self._trace_cm[rows, k],
+            self._trace_cm[:, :kmax],
+            self._trace_t[:, :kmax],
+            self.L,
+            np.maximum(end, self.control_dt),
+            diverged=self.done_diverged,
+            valid=np.arange(kmax)[None, :] <= k[:, None],
+        )
+
+    def infos(self) -> dict[str, np.ndarray]:
+        """Per-robot metrics and clock: arrays of shape (n_robots,)."""
+        m = self.metrics()
+        return {
+            "norm_final_dist": m["norm_final_dist"],
+            "max_xy_dist": m["max_xy_dist"],
+            "l_coefficient": m["l_coefficient"],
+            "diverged": m["diverged"],
+            "time": self.clock(),
+        }
+
+    # ------------------------------------------------------------- rendering
+    def colors(self, r: int) -> np.ndarray:
+        """RGB colour (0-1) of each voxel of robot ``r`` from its palette, shape (n_voxels_r, 3)."""
+        if r in self._colors:
+            return self._colors[r]
+        d = self.designs[r]
+        gi = self.sim.grid_index(r)
+        mats = d.grid[tuple(gi.T)]
+        table = np.zeros((d.palette.max_id + 1, 3))
+        for k, mat in d.palette.items():
+            table[k] = mat.color[:3]
+        self._colors[r] = table[mats]
+        return self._colors[r]
+
+    def render_frame(self, renderer: Any, r: int) -> np.ndarray:
+        """Robot ``r`` and its terrain drawn by ``renderer`` (a :class:`~softgym.render.VoxelRenderer`)."""
+        sim = self.sim
+        return renderer.render(
+            sim.positions(r),
+            sim.orientations(r),
+            sim.scales(r),
+            self.colors(r),
+            grid_index=sim.grid_index(r),
+            terrain=self.terrains[r],
+        )

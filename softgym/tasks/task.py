@@ -1,0 +1,344 @@
+"""A task: terrain + duration + sampling + the metrics it reports + the reward it derives.
+
+In the spirit of dm_control's Physics / Task / Environment split, the engine
+(:class:`~softgym.engine.Simulation`) is the physics, a :class:`Task` says what
+a run of it means, and :func:`softgym.evaluate` (optimisers) and the Gymnasium
+environments (RL) are two ways of running a task. Both get their task here, so
+a design scores the same on ``"wall"`` whichever way it is run.
+
+=========  ===============================================  ==============================
+name       terrain (voxel lengths, around the robot's grid)   reward (progress per step of)
+=========  ===============================================  ==============================
+flat       the floor alone                                  ``norm_final_dist``
+wall       the seed's fence: 1 voxel high and thick,        ``max_xy_dist``
+           a 10-voxel interior (``"fence"``: alias)
+stairs     three concentric rings, each 2 voxels wide and   ``max_xy_dist``
+           1 voxel higher than the one inside it
+=========  ===============================================  ==============================
+
+A custom world is a :class:`~softgym.terrain.Terrain` (or its JSON file),
+accepted wherever a task name is: ``softgym.evaluate(d, task=Terrain.stairs())``,
+``gym.make("SoftWalker-Flat-v0", task="my_boxes.json")``,
+``softgym evolve --task my_boxes.json``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, fields, replace
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from softgym.exceptions import InvalidParameterError, InvalidTerrainError
+from softgym.metrics import WALK_METRICS, walk_metrics
+from softgym.terrain import Terrain
+
+if TYPE_CHECKING:  # annotations only: softgym.engine's __init__ loads compiled code
+    from softgym.engine import Rollout, SimConfig
+
+__all__ = [
+    "ALIASES",
+    "LAYOUTS",
+    "REWARDS",
+    "TASKS",
+    "Task",
+    "TaskLike",
+    "flat_layout",
+    "get_task",
+    "register_task",
+    "stairs_layout",
+    "task_names",
+    "wall_layout",
+]
+
+#: Schema tag of :meth:`Task.to_dict`.
+SCHEMA = "softgym.task"
+
+#: Metrics whose per-step progress can be a reward: the walking measures of the final position.
+REWARDS: tuple[str, ...] = ("norm_final_dist", "max_xy_dist")
+
+
+def _around(shape: Sequence[int]) -> tuple[float, tuple[float, float]]:
+    """Interior side and centre of an obstacle ring around a robot grid of ``shape`` at the origin.
+
+    The seed's fence has a 10-voxel interior around its 6x6 workspace (a
+    2-voxel gap on every side); a wider grid keeps the 2-voxel gap.
+    """
+    nx, ny = int(shape[0]), int(shape[1])
+    return max(10.0, max(nx, ny) + 4.0), (nx / 2.0, ny / 2.0)
+
+
+def flat_layout(shape: Sequence[int]) -> Terrain:
+    """The floor alone (``shape`` is unused)."""
+    return Terrain.flat()
+
+
+def wall_layout(shape: Sequence[int]) -> Terrain:
+    """The seed's fence (1 voxel high and thick) centred on a robot grid of ``shape``."""
+    inner, center = _around(shape)
+    return Terrain.fence(inner=inner, center=center)
+
+
+def stairs_layout(shape: Sequence[int]) -> Terrain:
+    """Three rings, each 2 voxels wide and 1 voxel higher than the one inside it, around the grid."""
+    inner, center = _around(shape)
+    return Terrain.stairs(inner=inner, center=center)
+
+
+#: Terrains placed around each robot's grid (its corner at the origin): name -> builder(shape).
+LAYOUTS: dict[str, Callable[[Sequence[int]], Terrain]] = {
+    "flat": flat_layout,
+    "wall": wall_layout,
+    "stairs": stairs_layout,
+}
+
+#: Other names users know a task by (the seed's reports call the wall a fence).
+ALIASES: dict[str, str] = {"fence": "wall"}
+
+
+def _positive(name: str, value: Any) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(f"{name} must be a number, got {value!r}") from None
+    if not (math.isfinite(v) and v > 0):
+        raise InvalidParameterError(f"{name} must be finite and > 0, got {value!r}")
+    return v
+
+
+@dataclass(frozen=True)
+class Task:
+    """How a design is run and scored: the world, the duration, the sampling and the reward.
+
+    Parameters
+    ----------
+    terrain : str or Terrain
+        A layout placed around each robot's grid (``"flat"``, ``"wall"``,
+        ``"stairs"``; ``"fence"`` is read as ``"wall"``), or a
+        :class:`~softgym.terrain.Terrain` fixed in the world (voxel lengths,
+        the robot's grid corner at the origin).
+    seconds : float
+        Simulated time (s) per run, settling included (5 in the seed: 1 s
+        settling, then the 4 s fitness window; an env episode is the window).
+    trace_interval : float
+        Seconds between centre-of-mass samples (the L coefficient's
+        resolution): 0.5 for the seed's novelty runs, 0.1 otherwise.
+    sim : dict
+        Overrides of :class:`~softgym.engine.SimConfig` (e.g. ``{"actuation": "symmetric"}``).
+    n_threads : int, optional
+        OpenMP threads of the simulation (default: softgym's default).
+    reward : {"norm_final_dist", "max_xy_dist"}, optional
+        The metric whose per-step progress an environment rewards; default
+        ``norm_final_dist`` on flat ground, ``max_xy_dist`` (the seed's
+        obstacle fitness) with obstacles.
+
+    Notes
+    -----
+    Every task reports the same measures, :func:`softgym.metrics.walk_metrics`
+    of its rollout (:meth:`metrics`): ``norm_final_dist``, ``max_xy_dist``,
+    ``l_coefficient`` (:data:`~softgym.metrics.WALK_METRICS`), with
+    ``time_max_xy_dist`` and ``diverged``.
+    """
+
+    terrain: str | Terrain = "flat"
+    seconds: float = 5.0
+    trace_interval: float = 0.1
+    sim: dict[str, Any] = field(default_factory=dict)
+    n_threads: int | None = None
+    reward: str | None = None
+
+    def __post_init__(self) -> None:
+        terrain = self.terrain
+        if isinstance(terrain, str):
+            terrain = ALIASES.get(terrain, terrain)
+            if terrain not in LAYOUTS:
+                raise InvalidParameterError(
+                    f"unknown terrain layout {self.terrain!r}; expected one of "
+                    f"{sorted(LAYOUTS)}, a Terrain, or a registered task name through get_task()"
+                )
+        elif not isinstance(terrain, Terrain):
+            raise InvalidParameterError(
+                f"terrain must be a layout name or a Terrain, got {type(terrain).__name__}"
+            )
+        object.__setattr__(self, "terrain", terrain)
+        object.__setattr__(self, "seconds", _positive("seconds", self.seconds))
+        object.__setattr__(self, "trace_interval", _positive("trace_interval", self.trace_interval))
+        object.__setattr__(self, "sim", dict(self.sim))
+        if self.n_threads is not None:
+            object.__setattr__(self, "n_threads", int(self.n_threads))
+        reward = self.reward
+        if reward is None:
+            reward = "norm_final_dist" if terrain == "flat" else "max_xy_dist"
+        if reward not in REWARDS:
+            raise InvalidParameterError(f"reward must be one of {REWARDS}, got {reward!r}")
+        object.__setattr__(self, "reward", reward)
+
+    # ---------------------------------------------------------------- naming
+    @property
+    def name(self) -> str:
+        """The layout's name, or the custom terrain's."""
+        return self.terrain if isinstance(self.terrain, str) else self.terrain.name
+
+    @property
+    def metric_names(self) -> tuple[str, ...]:
+        """The fitness measures the task reports (:data:`softgym.metrics.WALK_METRICS`)."""
+        return WALK_METRICS
+
+    # ----------------------------------------------------------------- world
+    def terrain_for(self, shape: Sequence[int]) -> Terrain:
+        """The terrain of a robot whose grid of ``shape`` has its corner at the origin."""
+        if isinstance(self.terrain, Terrain):
+            return self.terrain
+        return LAYOUTS[self.terrain](shape)
+
+    def config(self, base: SimConfig | None = None) -> SimConfig:
+        """The engine settings: ``base`` (default the seed's) with ``sim`` and ``trace_interval``."""
+        from softgym.engine import SimConfig
+
+        cfg = SimConfig(**dict(self.sim)) if base is None else base.replace(**dict(self.sim))
+        return cfg.replace(trace_interval=float(self.trace_interval))
+
+    # --------------------------------------------------------------- scoring
+    def metrics(self, rollout: Rollout) -> dict[str, np.ndarray]:
+        """What the task reports of a rollout: :func:`softgym.metrics.walk_metrics`.
+
+        Returns
+        -------
+        dict of str to ndarray of shape (n_robots,)
+            ``norm_final_dist``, ``max_xy_dist``, ``l_coefficient``,
+            ``time_max_xy_dist``, ``diverged``.
+        """
+        return walk_metrics(rollout)
+
+    # ------------------------------------------------------------------ data
+    def replace(self, **changes: Any) -> Task:
+        """A copy with some fields changed."""
+        return replace(self, **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict (a custom terrain as its :meth:`Terrain.to_dict`)."""
+        out: dict[str, Any] = {"schema": SCHEMA}
+        for f in fields(self):
+            v = getattr(self, f.name)
+            out[f.name] = v.to_dict() if isinstance(v, Terrain) else v
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Task:
+        """Inverse of :meth:`to_dict`."""
+        kw = {k: v for k, v in dict(data).items() if k != "schema"}
+        unknown = sorted(set(kw) - {f.name for f in fields(cls)})
+        if unknown:
+            raise InvalidParameterError(f"unknown task fields {unknown}")
+        if isinstance(kw.get("terrain"), Mapping):
+            kw["terrain"] = Terrain.from_dict(dict(kw["terrain"]))
+        return cls(**kw)
+
+
+#: The named tasks: one name each (``"fence"`` is read as ``"wall"``, see :data:`ALIASES`).
+TASKS: dict[str, Task] = {name: Task(terrain=name) for name in LAYOUTS}
+
+#: What :func:`get_task` accepts: a name, a JSON file, a Terrain, a Task or its dict.
+TaskLike = str | os.PathLike | Terrain | Task | Mapping[str, Any]
+
+
+def task_names() -> list[str]:
+    """The registered task names (aliases excluded)."""
+    return list(TASKS)
+
+
+def register_task(name: str, task: Task | Terrain, *, overwrite: bool = False) -> Task:
+    """Add a named task (``register_envs()`` then gives it a Gym id).
+
+    Parameters
+    ----------
+    name : str
+        The task's one name.
+    task : Task or Terrain
+        A Terrain becomes ``Task(terrain=terrain)``.
+    overwrite : bool
+        Replace a task of the same name.
+
+    Returns
+    -------
+    Task
+    """
+    if not isinstance(name, str) or not name:
+        raise InvalidParameterError(f"a task name must be a non-empty string, got {name!r}")
+    if isinstance(task, Terrain):
+        task = Task(terrain=task)
+    if not isinstance(task, Task):
+        raise InvalidParameterError(f"expected a Task or a Terrain, got {type(task).__name__}")
+    if (name in TASKS or name in ALIASES) and not overwrite:
+        raise InvalidParameterError(f"a task named {name!r} exists; pass overwrite=True")
+    TASKS[name] = task
+    return task
+
+
+def _read_file(path: Path) -> Task:
+    try:
+        text = path.read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InvalidParameterError(f"cannot read the task file {str(path)!r}: {exc}") from None
+    import json
+
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise InvalidTerrainError(f"{path}: invalid JSON: {exc}") from None
+    return get_task(data)
+
+
+def get_task(spec: TaskLike, **overrides: Any) -> Task:
+    """The :class:`Task` of a name, a JSON file, a Terrain, a Task or a dict.
+
+    Parameters
+    ----------
+    spec : str, path, Terrain, Task or dict
+        A registered name (:func:`task_names`) or alias; the path of a
+        terrain JSON file (``Terrain.to_json``) or of a task JSON file
+        (``Task.to_dict``); a :class:`~softgym.terrain.Terrain`; a Task; a
+        dict of either.
+    **overrides
+        Task fields to change (``seconds``, ``trace_interval``, ``sim``...).
+
+    Returns
+    -------
+    Task
+
+    Raises
+    ------
+    InvalidParameterError
+        For an unknown name or an unreadable file.
+    InvalidTerrainError
+        For a malformed terrain.
+    """
+    if isinstance(spec, Task):
+        task = spec
+    elif isinstance(spec, Terrain):
+        task = Task(terrain=spec)
+    elif isinstance(spec, Mapping):
+        if spec.get("schema") == "softgym.terrain":
+            task = Task(terrain=Terrain.from_dict(dict(spec)))
+        else:
+            task = Task.from_dict(spec)
+    elif isinstance(spec, (str, os.PathLike)):
+        key = ALIASES.get(str(spec), str(spec))
+        if isinstance(spec, str) and key in TASKS:
+            task = TASKS[key]
+        elif str(spec).endswith(".json") or Path(spec).is_file():
+            task = _read_file(Path(spec))
+        else:
+            raise InvalidParameterError(
+                f"unknown task {str(spec)!r}; expected one of {task_names()} "
+                f"(aliases {sorted(ALIASES)}), a Terrain, or a terrain JSON file"
+            )
+    else:
+        raise InvalidParameterError(
+            f"a task is a name, a JSON file, a Terrain or a Task, got {type(spec).__name__}"
+        )
+    return task.replace(**overrides) if overrides else task
