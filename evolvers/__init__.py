@@ -5,10 +5,12 @@
 * :mod:`evolvers.selection`: the seed's Pareto (with age), NSGA-II, fitness tournament, AMSS novelty.
 * :class:`Evaluator` (:mod:`evolvers.evaluation`): batched, phenotype-cached evaluation.
 * :data:`EXPERIMENTS` (:mod:`evolvers.experiments`): the seed's scenarios by name.
-* Runners with run folders, checkpoints and exact resume: :class:`EvolutionRun`
-  (the seed's loop), :class:`~evolvers.deap_runner.DeapRun` (a DEAP toolbox),
-  :class:`~evolvers.pymoo_runner.PymooRun` (pymoo's NSGA2); Dask evaluation in
-  :mod:`evolvers.distributed`.
+* Drivers with exact resume, all writing their run folder through one
+  :class:`RunRecorder` (config, log, hall of fame, atomic checkpoints, figures):
+  :class:`EvolutionRun` (the seed's loop), :class:`~evolvers.deap_runner.DeapRun`
+  (the same loop on a DEAP toolbox), :class:`~evolvers.pymoo_runner.PymooRun`
+  (any pymoo algorithm through ask and tell: NSGA-II, NSGA-III, SMS-EMOA, GA...);
+  Dask evaluation in :mod:`evolvers.distributed` (``pip install "softgym[distributed]"``).
 
 The DEAP, pymoo and Dask modules are imported on demand (``from evolvers.deap_runner import DeapRun``).
 """
@@ -17,6 +19,7 @@ from evolvers.evaluation import Evaluator, PhenotypeCache
 from evolvers.experiments import EXPERIMENTS, Experiment, get_experiment, list_experiments
 from evolvers.genome import Individual
 from evolvers.operators import cx_arithmetic, make_children, mut_controller, mut_cppn, mut_materials
+from evolvers.recorder import RunRecorder
 from evolvers.runner import EvolutionRun
 from evolvers.selection import (
     Objective,
@@ -34,6 +37,7 @@ __all__ = [
     "Individual",
     "Objective",
     "PhenotypeCache",
+    "RunRecorder",
     "cx_arithmetic",
     "get_experiment",
     "list_experiments",

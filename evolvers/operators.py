@@ -30,6 +30,7 @@ __all__ = [
     "mut_controller",
     "mut_cppn",
     "mut_materials",
+    "set_counterphase",
 ]
 
 #: Gaussian sigma per controller gene (§3.2); bounds are :data:`softgym.design.CONTROLLER_BOUNDS`.
@@ -51,8 +52,14 @@ def _rng(rng: np.random.Generator | int | None) -> np.random.Generator:
     return rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
 
 
-def _counterphase(materials: np.ndarray) -> None:
-    """Material 9 := material 8 with the opposite CTE (in place)."""
+def set_counterphase(materials: np.ndarray) -> None:
+    """Material 9 := material 8 with the opposite CTE (in place).
+
+    Parameters
+    ----------
+    materials : ndarray of shape (4, 3), float64
+        Material genes (rows: ids 6-9; columns: Young's modulus, density, CTE).
+    """
     materials[3, 0] = materials[2, 0]
     materials[3, 1] = materials[2, 1]
     materials[3, 2] = -materials[2, 2]
@@ -111,7 +118,7 @@ def mut_materials(ind: Individual, rng: np.random.Generator | int | None) -> Ind
     m = ind.materials
     for row, col, sigma, lo, hi in MATERIAL_MUTATION:
         m[row, col] = min(max(m[row, col] + float(rng.normal(0.0, sigma)), lo), hi)
-    _counterphase(m)
+    set_counterphase(m)
     return ind
 
 
@@ -156,7 +163,7 @@ def cx_arithmetic(
                 child.materials[row] = (
                     parents[int(a)].materials[row] + parents[int(b)].materials[row]
                 ) / 2.0
-            _counterphase(child.materials)
+            set_counterphase(child.materials)
     return children
 
 

@@ -1,4 +1,4 @@
-"""The seed's experiments in pymoo's idiom: a Problem, custom operators, NSGA2 through ``minimize``.
+"""The seed's experiments in pymoo's idiom: a Problem, custom operators, any pymoo algorithm.
 
 * :class:`SoftbotProblem`: one object variable per solution (an
   :class:`~evolvers.genome.Individual`); the vectorised ``_evaluate`` scores the
@@ -10,44 +10,53 @@
   material genes, probability 0.4), :class:`SoftbotMutation` (CPPN mutation
   with validity retries + bounded Gaussian gene mutation) and
   :class:`SoftbotDuplicateElimination` (same phenotype hash).
-* :class:`PymooRun`: ``NSGA2(...)`` run by ``pymoo.optimize.minimize`` with a
-  :class:`~pymoo.core.callback.Callback` that logs and checkpoints every
-  generation; resume restores the population, its rank / crowding and the
-  algorithm's random state without pickle.
+* :class:`PymooRun`: a pymoo algorithm (``algorithm=``: NSGA-II by default,
+  ``"nsga3"``, ``"sms-emoa"``, ``"ga"``, or any pymoo algorithm class)
+  driven through pymoo's public ask-and-tell interface
+  (``algorithm.setup``, ``ask``, ``evaluator.eval``, ``tell``), with the same
+  run folder as every driver (:class:`~evolvers.recorder.RunRecorder`).
+  Resume is exact: the checkpoint holds every simulated result (the phenotype
+  cache), and the run replays its generations from the seed without
+  simulating (the algorithm's state is never reached into), then checks that
+  it reached the checkpointed population before it goes on.
 
-Differences from the seed's loop (inherent to NSGA2): survival is rank and
-crowding (whatever the experiment's ``selection``), no random newcomer joins
-each generation, the age objective is the age at evaluation, and novelty
-experiments score against an archive of past behaviours.
+Differences from the seed's loop (inherent to pymoo's algorithms): survival is
+the algorithm's (rank and crowding for NSGA-II, whatever the experiment's
+``selection``), no random newcomer joins each generation, the age objective is
+the age at evaluation, and novelty experiments score against an archive of
+past behaviours.
 """
 
 from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
-from pymoo.core.callback import Callback
+from pymoo.core.algorithm import Algorithm
 from pymoo.core.crossover import Crossover
 from pymoo.core.duplicate import ElementwiseDuplicateElimination
 from pymoo.core.mutation import Mutation
-from pymoo.core.population import Population
 from pymoo.core.problem import Problem
 from pymoo.core.sampling import Sampling
 
-from evolvers.evaluation import EvalStats, Evaluator, pack_traces, unpack_traces
+from evolvers.evaluation import BatchFn, EvalStats, Evaluator, PhenotypeCache, pack_traces
 from evolvers.experiments import Experiment
 from evolvers.genome import Individual
-from evolvers.operators import _counterphase, mut_controller, mut_cppn, mut_materials
-from evolvers.runner import EvolutionRun, population_summary
-from evolvers.selection import minimised_matrix
+from evolvers.operators import mut_controller, mut_cppn, mut_materials, set_counterphase
+from evolvers.recorder import RunRecorder, population_summary
+from evolvers.selection import Objective, minimised_matrix
 from softgym.design import CompositionRules, Controller
-from softgym.exceptions import CheckpointError
-from softgym.io import rng_state, save_checkpoint
+from softgym.exceptions import CheckpointError, InvalidParameterError
+from softgym.io import rng_state
 from softgym.metrics import NoveltyArchive
 
 __all__ = [
+    "ALGORITHMS",
+    "IdCounter",
     "PymooRun",
     "SoftbotCrossover",
     "SoftbotDuplicateElimination",
@@ -55,6 +64,7 @@ __all__ = [
     "SoftbotProblem",
     "SoftbotSampling",
     "constraint_values",
+    "make_algorithm",
     "n_constraints",
 ]
 
@@ -99,13 +109,14 @@ def constraint_values(grid: np.ndarray, rules: CompositionRules) -> np.ndarray:
     return np.asarray(g, dtype=np.float64)
 
 
-class _Ids:
-    """A shared id counter (part of the checkpointed state)."""
+class IdCounter:
+    """A shared id counter: ``ids()`` gives the next individual id (part of the checkpointed state)."""
 
     def __init__(self, start: int = 0) -> None:
         self.value = int(start)
 
     def __call__(self) -> int:
+        """The next id."""
         v = self.value
         self.value += 1
         return v
@@ -122,17 +133,25 @@ class SoftbotProblem(Problem):
     archive : NoveltyArchive, optional
         For novelty experiments: ``F`` is the k-nearest-neighbour AMSS
         similarity to the batch and the archive (minimised).
+    objectives : tuple of Objective, optional
+        The objectives in ``F`` (default the experiment's; its first alone
+        for a single-objective algorithm).
     """
 
     def __init__(
-        self, experiment: Experiment, evaluator: Evaluator, archive: NoveltyArchive | None = None
+        self,
+        experiment: Experiment,
+        evaluator: Evaluator,
+        archive: NoveltyArchive | None = None,
+        objectives: tuple[Objective, ...] | None = None,
     ) -> None:
         self.experiment = experiment
         self.evaluator = evaluator
         self.archive = archive
+        self.objectives = tuple(experiment.objectives if objectives is None else objectives)
         self.novelty = experiment.selection.startswith("novelty")
         self.last_stats = EvalStats()
-        n_obj = 1 if self.novelty else len(experiment.objectives)
+        n_obj = 1 if self.novelty else len(self.objectives)
         super().__init__(
             n_var=1, n_obj=n_obj, n_ieq_constr=n_constraints(experiment.rules), vtype=object
         )
@@ -147,7 +166,7 @@ class SoftbotProblem(Problem):
                 ind.novelty = float(s)
             out["F"] = np.asarray(scores, dtype=np.float64).reshape(-1, 1)
         else:
-            out["F"] = minimised_matrix(inds, self.experiment.objectives)
+            out["F"] = minimised_matrix(inds, self.objectives)
         exp = self.experiment
         out["G"] = np.array([constraint_values(ind.grid(exp.shape), exp.rules) for ind in inds])
 
@@ -197,7 +216,7 @@ class SoftbotCrossover(Crossover):
                 )
             if self.experiment.evolve_materials:
                 child.materials[:3] = (a.materials[:3] + b.materials[:3]) / 2.0
-                _counterphase(child.materials)
+                set_counterphase(child.materials)
             Q[0, k, 0] = child
         return Q
 
@@ -242,159 +261,268 @@ class SoftbotDuplicateElimination(ElementwiseDuplicateElimination):
         return a.X[0].phenotype_key(self.shape) == b.X[0].phenotype_key(self.shape)
 
 
-class _RunCallback(Callback):
-    def __init__(self, run: PymooRun) -> None:
-        super().__init__()
-        self.run = run
+def _nsga3(pop_size: int, n_obj: int, **operators: Any) -> Algorithm:
+    from pymoo.algorithms.moo.nsga3 import NSGA3
+    from pymoo.util.ref_dirs import get_reference_directions
 
-    def notify(self, algorithm) -> None:
-        self.run._after_generation(algorithm)
+    # about one reference direction per individual ("das-dennis" on the objective simplex)
+    p = 1
+    while math.comb(p + 1 + n_obj - 1, n_obj - 1) <= pop_size:
+        p += 1
+    ref_dirs = get_reference_directions("das-dennis", n_obj, n_partitions=p)
+    return NSGA3(ref_dirs=ref_dirs, pop_size=pop_size, **operators)
 
 
-class PymooRun(EvolutionRun):
-    """An experiment run with pymoo's NSGA2 through ``minimize`` (see the module docstring).
+def _named(name: str) -> Callable[..., Algorithm]:
+    if name == "nsga2":
+        from pymoo.algorithms.moo.nsga2 import NSGA2
 
-    Same run folder, log, figures and checkpoints as
-    :class:`~evolvers.runner.EvolutionRun`. ``generations`` counts the
+        return NSGA2
+    if name == "sms-emoa":
+        from pymoo.algorithms.moo.sms import SMSEMOA
+
+        return SMSEMOA
+    if name == "ga":
+        from pymoo.algorithms.soo.nonconvex.ga import GA
+
+        return GA
+    raise InvalidParameterError(f"unknown algorithm {name!r}; expected one of {ALGORITHMS}")
+
+
+#: Algorithms known by name (``"ga"`` is single-objective: it optimises the experiment's fitness).
+ALGORITHMS: tuple[str, ...] = ("nsga2", "nsga3", "sms-emoa", "ga")
+
+
+def make_algorithm(
+    algorithm: str | Callable[..., Algorithm],
+    experiment: Experiment,
+    ids: IdCounter,
+    n_obj: int,
+    **kwargs: Any,
+) -> Algorithm:
+    """A pymoo algorithm with the softbot operators, for ``experiment``.
+
+    Parameters
+    ----------
+    algorithm : str or callable
+        A name of :data:`ALGORITHMS`, or a pymoo algorithm class (or any
+        callable) that takes ``pop_size``, ``sampling``, ``crossover``,
+        ``mutation``, ``eliminate_duplicates`` and ``n_offsprings`` keywords
+        (NSGA2, NSGA3 with ``ref_dirs=`` in ``kwargs``, SMSEMOA, GA, ...).
+    experiment : Experiment
+    ids : IdCounter
+        The id source of new individuals.
+    n_obj : int
+        Objectives of the problem (NSGA-III's reference directions).
+    **kwargs
+        More keywords for the algorithm.
+
+    Returns
+    -------
+    pymoo.core.algorithm.Algorithm
+    """
+    exp = experiment
+    operators: dict[str, Any] = {
+        "sampling": SoftbotSampling(exp, ids),
+        "crossover": SoftbotCrossover(exp, ids),
+        "mutation": SoftbotMutation(exp, ids),
+        "eliminate_duplicates": SoftbotDuplicateElimination(exp),
+        "n_offsprings": exp.pop_size,
+        **kwargs,
+    }
+    if algorithm == "nsga3" and "ref_dirs" not in kwargs:
+        return _nsga3(exp.pop_size, n_obj, **operators)
+    factory = _named(algorithm) if isinstance(algorithm, str) else algorithm
+    if not callable(factory):
+        raise InvalidParameterError(
+            f"algorithm must be a name of {ALGORITHMS} or a pymoo algorithm class, got {algorithm!r}"
+        )
+    return factory(pop_size=exp.pop_size, **operators)
+
+
+def _algorithm_label(algorithm: Any) -> str:
+    if isinstance(algorithm, str):
+        return algorithm
+    return getattr(algorithm, "__name__", type(algorithm).__name__)
+
+
+class PymooRun:
+    """An experiment run with a pymoo algorithm through ask and tell (see the module docstring).
+
+    Same run folder, log, figures and checkpoints as every driver
+    (:class:`~evolvers.recorder.RunRecorder`). ``generations`` counts the
     generations after the initial population (pymoo's ``n_gen`` is one more).
+
+    Parameters
+    ----------
+    experiment, out, seed, generations, batch_fn, n_threads, on_generation, figures, gif
+        As for :class:`~evolvers.runner.EvolutionRun`.
+    algorithm : str or callable
+        ``"nsga2"`` (default), ``"nsga3"``, ``"sms-emoa"``, ``"ga"``
+        (single-objective, on the experiment's fitness), or a pymoo algorithm
+        class or factory (:func:`make_algorithm`); a fresh algorithm is built
+        for every :meth:`run`.
+    algorithm_kwargs : dict, optional
+        More keywords for the algorithm (e.g. NSGA-III's ``ref_dirs``).
+    single_objective : bool, optional
+        Optimise the fitness alone (default: True for ``"ga"``).
     """
 
     backend = "pymoo"
 
-    def _setup_backend(self) -> None:
-        self.ids = _Ids()
-        self.next_id = self.ids  # type: ignore[method-assign]
-        if self.experiment.selection.startswith("novelty") and self.archive is None:
-            self.archive = NoveltyArchive(k=self.experiment.pop_size, n_add=2, variant="normalized")
-        self._t0 = time.perf_counter()
-        self._resume_state: tuple[dict[str, Any], dict[str, np.ndarray]] | None = None
-
-    def _algorithm(self):
-        from pymoo.algorithms.moo.nsga2 import NSGA2
-
-        exp = self.experiment
-        return NSGA2(
-            pop_size=exp.pop_size,
-            n_offsprings=exp.pop_size,
-            sampling=SoftbotSampling(exp, self.ids),
-            crossover=SoftbotCrossover(exp, self.ids),
-            mutation=SoftbotMutation(exp, self.ids),
-            eliminate_duplicates=SoftbotDuplicateElimination(exp),
+    def __init__(
+        self,
+        experiment: Experiment,
+        out: str | Path,
+        seed: int = 0,
+        generations: int | None = None,
+        batch_fn: BatchFn | None = None,
+        n_threads: int | None = None,
+        on_generation: Callable[[PymooRun, dict[str, Any]], None] | None = None,
+        figures: bool = True,
+        gif: bool = True,
+        algorithm: str | Callable[..., Algorithm] = "nsga2",
+        algorithm_kwargs: dict[str, Any] | None = None,
+        single_objective: bool | None = None,
+    ) -> None:
+        self.experiment = experiment
+        self.out = Path(out)
+        self.seed = int(seed)
+        self.generations = experiment.generations if generations is None else int(generations)
+        if self.generations < 0:
+            raise InvalidParameterError(f"generations must be >= 0, got {self.generations}")
+        if isinstance(algorithm, str) and algorithm not in ALGORITHMS:
+            raise InvalidParameterError(
+                f"unknown algorithm {algorithm!r}; expected one of {ALGORITHMS}"
+            )
+        self.algorithm_spec = algorithm
+        self.algorithm_kwargs = dict(algorithm_kwargs or {})
+        self.single_objective = (
+            (algorithm == "ga") if single_objective is None else single_objective
         )
+        self.on_generation = on_generation
+        self.evaluator = Evaluator(experiment, batch_fn=batch_fn, n_threads=n_threads)
+        self.recorder = RunRecorder(
+            out, experiment, self.seed, self.backend, figures, gif,
+            extra_config={"algorithm": _algorithm_label(algorithm)},
+        )  # fmt: skip
+        self.ids = IdCounter()
+        self.archive: NoveltyArchive | None = None
+        self.algorithm: Algorithm | None = None
+        self.generation = -1
+        self.population: list[Individual] = []
 
-    def _problem(self) -> SoftbotProblem:
-        return SoftbotProblem(self.experiment, self.evaluator, self.archive)
+    # ------------------------------------------------------------------ the record
+    @property
+    def rows(self) -> list[dict[str, Any]]:
+        """The log rows so far (one per generation)."""
+        return self.recorder.rows
+
+    @property
+    def hall_of_fame(self) -> list[dict[str, Any]]:
+        """The best individuals so far (plain data, best first)."""
+        return self.recorder.hall_of_fame
+
+    @property
+    def evaluations_total(self) -> int:
+        """Simulations run so far."""
+        return self.recorder.evaluations_total
+
+    def best(self) -> Individual:
+        """The best individual found so far (by the first objective)."""
+        return self.recorder.best()
+
+    # ------------------------------------------------------------------ the loop
+    def _fresh(self) -> tuple[SoftbotProblem, Algorithm]:
+        exp = self.experiment
+        self.ids = IdCounter()
+        novelty = exp.selection.startswith("novelty")
+        self.archive = (
+            NoveltyArchive(k=exp.pop_size, n_add=2, variant="normalized") if novelty else None
+        )
+        objectives = exp.objectives[:1] if self.single_objective else exp.objectives
+        problem = SoftbotProblem(exp, self.evaluator, self.archive, objectives)
+        algorithm = make_algorithm(
+            self.algorithm_spec, exp, self.ids, problem.n_obj, **self.algorithm_kwargs
+        )
+        algorithm.setup(
+            problem, termination=("n_gen", self.generations + 1), seed=self.seed, verbose=False
+        )
+        self.generation = -1
+        return problem, algorithm
+
+    def _generation(self, problem: SoftbotProblem, algorithm: Algorithm) -> list[Individual]:
+        """One ask / evaluate / tell round; returns the evaluated infills."""
+        infills = algorithm.ask()
+        algorithm.evaluator.eval(problem, infills)
+        algorithm.tell(infills=infills)
+        self.generation += 1
+        self.population = [x[0] for x in algorithm.pop.get("X")]
+        return [x[0] for x in infills.get("X")]
+
+    def _replay(self, problem: SoftbotProblem, algorithm: Algorithm, state: dict[str, Any]) -> None:
+        """Re-run the checkpointed generations from the seed; every result comes from the cache."""
+        target = int(state["generation"])
+        counter = self.evaluator.n_evaluations
+        while self.generation < target:
+            self._generation(problem, algorithm)
+        self.evaluator.n_evaluations = counter
+        if population_summary(self.population) != state["population"] or self.ids.value != int(
+            state["next_id"]
+        ):
+            raise CheckpointError(
+                f"{self.recorder.checkpoint_dir}: replaying generations 0-{target} did not "
+                "reach the checkpointed population (another softgym, pymoo or algorithm?)"
+            )
 
     def run(self, resume: bool = False) -> list[Individual]:
-        """Run NSGA2 through ``minimize`` (or continue it from the last checkpoint)."""
-        from pymoo.optimize import minimize
+        """Run the algorithm (or continue it from the last checkpoint).
 
-        if not (resume and self.resume()):
-            self.start()
-        termination = ("n_gen", self.generations + 1)
-        problem = self._problem()
-        self._t0 = time.perf_counter()
-        if self.generation < 0:
-            minimize(
-                problem, self._algorithm(), termination, seed=self.seed,
-                callback=_RunCallback(self), verbose=False, copy_algorithm=False,
-            )  # fmt: skip
-        elif self.generation < self.generations:
-            algorithm = self._algorithm()
-            algorithm.setup(
-                problem,
-                termination=termination,
-                seed=self.seed,
-                callback=_RunCallback(self),
-                verbose=False,
-            )
-            self._restore_algorithm(algorithm)
-            algorithm.run()
-        self.finish()
+        Returns
+        -------
+        list of Individual
+            The final population.
+        """
+        loaded = self.recorder.resume(self.generations) if resume else None
+        if loaded is None:
+            self.recorder.start(self.generations)
+        problem, algorithm = self._fresh()
+        self.algorithm = algorithm
+        if loaded is not None:
+            state, arrays = loaded
+            try:
+                self.evaluator.cache = PhenotypeCache.from_arrays(arrays)
+                self.evaluator.n_evaluations = int(state.get("evaluations_counter", 0))
+                self._replay(problem, algorithm, state)
+            except (KeyError, TypeError, ValueError) as exc:
+                raise CheckpointError(
+                    f"{self.recorder.checkpoint_dir}: checkpoint content is invalid ({exc!r})"
+                ) from exc
+        while self.generation < self.generations:
+            t0 = time.perf_counter()
+            infills = self._generation(problem, algorithm)
+            self.recorder.update_hall_of_fame(infills, self.generation)
+            self._end_generation(algorithm, problem.last_stats, time.perf_counter() - t0)
+        self.recorder.finish(self.generation, self.population)
         return self.population
 
-    # ------------------------------------------------------------------ callback
-    def _after_generation(self, algorithm) -> None:
-        self.algorithm = algorithm
-        self.generation = int(algorithm.n_iter) - 1
-        self.population = [x[0] for x in algorithm.pop.get("X")]
-        stats = algorithm.problem.last_stats
-        wall = time.perf_counter() - self._t0
-        self._t0 = time.perf_counter()
-        off = [
-            x[0] for x in (algorithm.off if algorithm.off is not None else algorithm.pop).get("X")
-        ]
-        self._update_hall_of_fame(off)
-        self._end_generation(stats, wall)
-
-    # ------------------------------------------------------------------ checkpoints
-    def checkpoint(self):
-        """Population (genomes, F, G, CV, rank, crowding), RNG and counters; no pickle."""
-        alg = self.algorithm
-        pop = alg.pop
+    def _end_generation(self, algorithm: Algorithm, stats: EvalStats, wall: float) -> None:
+        pop = algorithm.pop
         data, lengths = pack_traces([ind.trace for ind in self.population])
         arrays = {
             "pop_traces": data, "pop_trace_len": lengths,
             "F": pop.get("F"), "G": pop.get("G"), "CV": pop.get("CV"),
-            "rank": np.asarray(pop.get("rank"), dtype=np.float64),
-            "crowding": np.asarray(pop.get("crowding"), dtype=np.float64),
             **self.evaluator.cache.to_arrays(),
         }  # fmt: skip
         state = {
-            "generation": self.generation,
-            "population": population_summary(self.population),
-            "rng": rng_state(alg.random_state),
+            "rng": rng_state(algorithm.random_state),
             "next_id": self.ids.value,
-            "rows": self.rows,
-            "hall_of_fame": self.hall_of_fame,
             "archive": None if self.archive is None else self.archive.to_dict(),
-            "evaluations_total": self.evaluations_total,
-            "n_eval": int(alg.evaluator.n_eval),
-            "wall_total": self.wall_total,
-            "python_random": None,
+            "n_eval": int(algorithm.evaluator.n_eval),
+            "evaluations_counter": self.evaluator.n_evaluations,
         }
-        return save_checkpoint(self.checkpoint_dir, self.generation, state, arrays, keep=3)
-
-    def _restore(self, state: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
-        try:
-            self.generation = int(state["generation"])
-            self.population = [Individual.from_dict(d) for d in state["population"]]
-            for ind, tr in zip(
-                self.population, unpack_traces(arrays["pop_traces"], arrays["pop_trace_len"])
-            ):
-                ind.trace = tr
-            self.ids.value = int(state["next_id"])
-            self.rows = list(state["rows"])
-            self.hall_of_fame = list(state["hall_of_fame"])
-            if state.get("archive") is not None:
-                self.archive = NoveltyArchive.from_dict(state["archive"])
-            self.evaluations_total = int(state["evaluations_total"])
-            self.wall_total = float(state["wall_total"])
-            from evolvers.evaluation import PhenotypeCache
-
-            self.evaluator.cache = PhenotypeCache.from_arrays(arrays)
-            self._resume_state = (state, arrays)
-        except (KeyError, TypeError, ValueError) as exc:
-            raise CheckpointError(
-                f"{self.checkpoint_dir}: checkpoint content is invalid ({exc!r})"
-            ) from exc
-
-    def _restore_algorithm(self, algorithm) -> None:
-        state, arrays = self._resume_state  # type: ignore[misc]
-        X = np.empty((len(self.population), 1), dtype=object)
-        for i, ind in enumerate(self.population):
-            X[i, 0] = ind
-        pop = Population.new("X", X)
-        pop.set("F", arrays["F"], "G", arrays["G"], "CV", arrays["CV"])
-        pop.set("rank", arrays["rank"].astype(int), "crowding", arrays["crowding"])
-        for ind in pop:
-            ind.evaluated = {"F", "G", "H", "CV"}
-        algorithm._initialize()
-        algorithm.pop = pop
-        algorithm.off = None
-        algorithm.is_initialized = True
-        algorithm.n_iter = self.generation + 2
-        algorithm.evaluator.n_eval = int(state["n_eval"])
-        algorithm.random_state.bit_generator.state = state["rng"]
-        algorithm._set_optimum()
-        self.algorithm = algorithm
+        row = self.recorder.end_generation(
+            self.generation, self.population, stats, wall, state, arrays
+        )
+        if self.on_generation is not None:
+            self.on_generation(self, row)

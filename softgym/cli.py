@@ -78,15 +78,18 @@ def _make_run(args: argparse.Namespace, batch_fn):
     if args.task is not None:
         overrides["task"] = args.task
     exp = get_experiment(args.experiment, **overrides)
+    extra = {}
     if args.backend == "deap":
         from evolvers.deap_runner import DeapRun as Run
     elif args.backend == "pymoo":
         from evolvers.pymoo_runner import PymooRun as Run
+
+        extra["algorithm"] = args.algorithm
     else:
         from evolvers.runner import EvolutionRun as Run
     return Run(
         exp, args.out, seed=args.seed, generations=args.generations, batch_fn=batch_fn,
-        n_threads=args.threads, figures=not args.no_figures, gif=not args.no_gif,
+        n_threads=args.threads, figures=not args.no_figures, gif=not args.no_gif, **extra,
     )  # fmt: skip
 
 
@@ -246,6 +249,12 @@ def main(argv: list[str] | None = None) -> int:
     )
     p.add_argument("--workers", type=int, default=2, help="LocalCluster workers (--dask local)")
     p.add_argument("--backend", choices=["native", "deap", "pymoo"], default="native")
+    p.add_argument(
+        "--algorithm",
+        choices=["nsga2", "nsga3", "sms-emoa", "ga"],
+        default="nsga2",
+        help="pymoo algorithm (--backend pymoo; ga optimises the first objective alone)",
+    )
     p.add_argument(
         "--task",
         metavar="flat|wall|stairs|FILE.json",

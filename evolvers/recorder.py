@@ -1,0 +1,373 @@
+"""The run folder of an evolutionary run, shared by every driver (native, DEAP, pymoo).
+
+A :class:`RunRecorder` owns what a run leaves on disk; a driver owns its search
+loop and hands the recorder each finished generation::
+
+    config.json            experiment, seed, backend (what resume checks), generations
+    log.csv, log.jsonl     one row per generation: best/median/mean/worst of
+                           every objective, evaluations, cache hits, wall time
+    checkpoints/           ckpt-NNNNNN.{json,npz}, atomic, versioned, no pickle
+    best_design.json       the best robot found (a RobotDesign file)
+    best_designs.json      hall of fame: genomes, designs and objectives
+    final_population.json  the last population
+    figures/               fitness trend, best robot, its trajectory, its GIF
+
+A checkpoint holds the recorder's state (log rows, hall of fame, totals) and
+whatever the driver adds (its random states, counters, the phenotype cache).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import logging
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from evolvers.evaluation import FITNESS_METRICS, EvalStats
+from evolvers.experiments import Experiment
+from evolvers.genome import Individual
+from softgym.exceptions import CheckpointError, InvalidParameterError
+from softgym.io import (
+    atomic_write_json,
+    atomic_write_text,
+    load_checkpoint,
+    read_json,
+    save_checkpoint,
+)
+
+__all__ = [
+    "HALL_OF_FAME_SIZE",
+    "RUN_SCHEMA",
+    "RunRecorder",
+    "log_row",
+    "population_summary",
+]
+
+log = logging.getLogger("evolvers")
+
+#: ``"schema"`` of a run's config.json.
+RUN_SCHEMA = "softgym.run"
+#: Best individuals kept in ``best_designs.json``.
+HALL_OF_FAME_SIZE = 5
+#: Checkpoints kept on disk (older ones are removed).
+KEEP_CHECKPOINTS = 3
+# the recorder's part of a checkpoint's state
+_RECORDER_KEYS = ("rows", "hall_of_fame", "evaluations_total", "wall_total")
+
+
+def population_summary(individuals: Sequence[Individual]) -> list[dict[str, Any]]:
+    """Comparable plain data of a population: ids, ages, genomes, objectives (no wall times)."""
+    return [ind.to_dict() for ind in individuals]
+
+
+def _direction(exp: Experiment, metric: str) -> bool:
+    """True if ``metric`` is better when larger."""
+    for o in exp.objectives:
+        if o.name == metric:
+            return o.maximize
+    return metric in FITNESS_METRICS
+
+
+def _stats_of(values: np.ndarray, maximize: bool) -> dict[str, float]:
+    if values.size == 0:
+        return {k: float("nan") for k in ("best", "median", "mean", "worst")}
+    return {
+        "best": float(values.max() if maximize else values.min()),
+        "median": float(np.median(values)),
+        "mean": float(values.mean()),
+        "worst": float(values.min() if maximize else values.max()),
+    }
+
+
+def log_row(
+    experiment: Experiment,
+    generation: int,
+    population: Sequence[Individual],
+    stats: EvalStats,
+    wall: float,
+    evaluations_total: int,
+    wall_total: float,
+) -> dict[str, Any]:
+    """One log row: counts of the generation's evaluation and statistics of every recorded metric."""
+    exp = experiment
+    row: dict[str, Any] = {
+        "generation": generation,
+        "evaluations": stats.n_simulated,
+        "evaluations_total": evaluations_total,
+        "cache_hits": stats.n_cached,
+        "invalid": stats.n_invalid,
+        "diverged": stats.n_diverged,
+        "bone_fraction": stats.n_bone / max(1, stats.n_individuals),
+        "wall_time": wall,
+        "wall_total": wall_total,
+    }
+    names = list(exp.metrics)
+    if any(o.name == "age" for o in exp.objectives):
+        names.append("age")
+    for m in names:
+        vals = np.array([ind.value(m) for ind in population], dtype=np.float64)
+        for k, v in _stats_of(vals, _direction(exp, m)).items():
+            row[f"{m}_{k}"] = v
+    if exp.selection.startswith("novelty"):
+        vals = np.array(
+            [ind.novelty for ind in population if ind.novelty is not None], dtype=np.float64
+        )
+        for k, v in _stats_of(vals, False).items():
+            row[f"novelty_{k}"] = v
+    return row
+
+
+class RunRecorder:
+    """Run folder, config, log, hall of fame, atomic checkpoints, best designs and figures.
+
+    Parameters
+    ----------
+    out : path
+        Run folder.
+    experiment : Experiment
+    seed : int
+    backend : str
+        The driver (``"native"``, ``"deap"``, ``"pymoo"``...); with the
+        experiment and the seed, what a resume must match.
+    figures, gif : bool
+        Write the figures (and the best robot's GIF) when the run finishes.
+    extra_config : dict, optional
+        More entries of config.json (e.g. the pymoo algorithm), also checked on resume.
+    """
+
+    def __init__(
+        self,
+        out: str | Path,
+        experiment: Experiment,
+        seed: int,
+        backend: str,
+        figures: bool = True,
+        gif: bool = True,
+        extra_config: Mapping[str, Any] | None = None,
+    ) -> None:
+        self.out = Path(out)
+        self.experiment = experiment
+        self.figures = figures
+        self.gif = gif
+        self.config: dict[str, Any] = {
+            "schema": RUN_SCHEMA,
+            "version": 1,
+            "experiment": experiment.to_dict(),
+            "seed": int(seed),
+            "backend": backend,
+            **dict(extra_config or {}),
+        }
+        self.rows: list[dict[str, Any]] = []
+        self.hall_of_fame: list[dict[str, Any]] = []
+        self.evaluations_total = 0
+        self.wall_total = 0.0
+
+    @property
+    def checkpoint_dir(self) -> Path:
+        """Folder of the checkpoints."""
+        return self.out / "checkpoints"
+
+    def _has_checkpoint(self) -> bool:
+        return self.checkpoint_dir.exists() and any(self.checkpoint_dir.glob("ckpt-*.json"))
+
+    # ------------------------------------------------------------------ opening
+    def start(self, generations: int) -> None:
+        """Create the run folder (refusing one that holds another run's checkpoints)."""
+        self.out.mkdir(parents=True, exist_ok=True)
+        if self._has_checkpoint():
+            raise CheckpointError(
+                f"{self.out}: the folder already holds a run; use resume (--resume) or another --out"
+            )
+        atomic_write_json(self.out / "config.json", {**self.config, "generations": generations})
+
+    def _same(self, key: str, recorded: Any) -> bool:
+        if key != "experiment":
+            return recorded == self.config[key]
+        try:  # read through Experiment: older folders spell some fields differently
+            return Experiment.from_dict(recorded).to_dict() == self.config[key]
+        except Exception:
+            return False
+
+    def resume(self, generations: int) -> tuple[dict[str, Any], dict[str, np.ndarray]] | None:
+        """Load the latest checkpoint of the run folder and the recorder's part of it.
+
+        Returns
+        -------
+        (state, arrays) or None
+            The checkpoint (for the driver to restore its part), or None if
+            the folder has no checkpoint yet (the run starts fresh).
+
+        Raises
+        ------
+        CheckpointError
+            If config.json names another experiment/seed/backend, or the
+            latest checkpoint is corrupt (the message names the file; the
+            previous checkpoints are still in ``checkpoints/``).
+        """
+        cfg_path = self.out / "config.json"
+        if not cfg_path.exists():
+            return None
+        cfg = read_json(cfg_path)
+        for key in self.config:
+            if key in ("schema", "version"):
+                continue
+            if not self._same(key, cfg.get(key)):
+                raise CheckpointError(
+                    f"{cfg_path}: the run was started with another {key} "
+                    f"({cfg.get(key)!r} != {self.config[key]!r})"
+                )
+        if not self._has_checkpoint():
+            return None
+        state, arrays = load_checkpoint(self.checkpoint_dir)
+        try:
+            self.rows = list(state["rows"])
+            self.hall_of_fame = list(state["hall_of_fame"])
+            self.evaluations_total = int(state["evaluations_total"])
+            self.wall_total = float(state["wall_total"])
+        except (KeyError, TypeError, ValueError) as exc:
+            raise CheckpointError(
+                f"{self.checkpoint_dir}: checkpoint content is invalid ({exc!r})"
+            ) from exc
+        atomic_write_json(cfg_path, {**self.config, "generations": generations})
+        return state, arrays
+
+    # ------------------------------------------------------------------ records
+    def update_hall_of_fame(self, individuals: Sequence[Individual], generation: int) -> None:
+        """Add evaluated individuals found in ``generation``; keep the best (by the fitness)."""
+        fit = self.experiment.fitness
+        known = {h["individual"]["id"] for h in self.hall_of_fame}
+        for ind in individuals:
+            if ind.id in known or not ind.objectives:
+                continue
+            self.hall_of_fame.append({"generation": int(generation), "individual": ind.to_dict()})
+            known.add(ind.id)
+        sign = -1.0 if fit.maximize else 1.0
+
+        def key(h: dict[str, Any]) -> tuple[float, int]:
+            d = h["individual"]
+            v = d["age"] if fit.name == "age" else d["objectives"][fit.name]
+            return (sign * float(v), int(d["id"]))
+
+        self.hall_of_fame.sort(key=key)
+        del self.hall_of_fame[HALL_OF_FAME_SIZE:]
+
+    def best(self) -> Individual:
+        """The best individual found so far (by the first objective)."""
+        if not self.hall_of_fame:
+            raise InvalidParameterError("the run has no evaluated individual yet")
+        return Individual.from_dict(self.hall_of_fame[0]["individual"])
+
+    def end_generation(
+        self,
+        generation: int,
+        population: Sequence[Individual],
+        stats: EvalStats,
+        wall: float,
+        state: Mapping[str, Any],
+        arrays: Mapping[str, np.ndarray],
+    ) -> dict[str, Any]:
+        """Book-keeping after a generation: totals, log row, checkpoint, log files, best designs.
+
+        Parameters
+        ----------
+        generation : int
+        population : sequence of Individual
+            The population after selection.
+        stats : EvalStats
+            What the generation's evaluation did.
+        wall : float
+            Its wall time (s).
+        state, arrays : dict
+            The driver's part of the checkpoint (random states, counters, caches).
+
+        Returns
+        -------
+        dict
+            The log row.
+        """
+        self.wall_total += wall
+        self.evaluations_total += stats.n_simulated
+        row = log_row(
+            self.experiment, generation, population, stats, wall,
+            self.evaluations_total, self.wall_total,
+        )  # fmt: skip
+        self.rows.append(row)
+        self.checkpoint(generation, population, state, arrays)
+        self.write_log()
+        self.write_best()
+        return row
+
+    def checkpoint(
+        self,
+        generation: int,
+        population: Sequence[Individual],
+        state: Mapping[str, Any],
+        arrays: Mapping[str, np.ndarray],
+    ) -> Path:
+        """Write a checkpoint (atomic; keeps the previous ones)."""
+        full = {
+            **dict(state),
+            "generation": int(generation),
+            "population": population_summary(population),
+            **{k: getattr(self, k) for k in _RECORDER_KEYS},
+        }
+        return save_checkpoint(
+            self.checkpoint_dir, generation, full, dict(arrays), keep=KEEP_CHECKPOINTS
+        )
+
+    def write_log(self) -> None:
+        """Write log.csv and log.jsonl (atomic)."""
+        if not self.rows:
+            return
+        keys: list[str] = []
+        for r in self.rows:
+            for k in r:
+                if k not in keys:
+                    keys.append(k)
+        buf = io.StringIO()
+        w = csv.DictWriter(buf, fieldnames=keys, lineterminator="\n")
+        w.writeheader()
+        for r in self.rows:
+            w.writerow({k: (repr(v) if isinstance(v, float) else v) for k, v in r.items()})
+        atomic_write_text(self.out / "log.csv", buf.getvalue())
+        atomic_write_text(self.out / "log.jsonl", "".join(json.dumps(r) + "\n" for r in self.rows))
+
+    def write_best(self) -> None:
+        """Write best_designs.json (the hall of fame) and best_design.json."""
+        if not self.hall_of_fame:
+            return
+        exp = self.experiment
+        entries = []
+        for h in self.hall_of_fame:
+            ind = Individual.from_dict(h["individual"])
+            entries.append(
+                {
+                    "generation": h["generation"],
+                    "id": ind.id,
+                    "objectives": ind.objectives,
+                    "design": ind.design(exp.shape).to_dict(),
+                    "genome": h["individual"],
+                }
+            )
+        atomic_write_json(self.out / "best_designs.json", {"experiment": exp.name, "best": entries})
+        atomic_write_json(self.out / "best_design.json", entries[0]["design"])
+
+    def finish(self, generation: int, population: Sequence[Individual]) -> None:
+        """Write the final population, the best designs and the figures."""
+        atomic_write_json(
+            self.out / "final_population.json",
+            {"generation": generation, "population": population_summary(population)},
+        )
+        self.write_best()
+        if self.figures:
+            try:
+                from softgym.render.figures import run_figures
+
+                run_figures(self.out, gif=self.gif)
+            except Exception:  # figures must never lose a finished run
+                log.exception("could not write the figures of %s", self.out)
