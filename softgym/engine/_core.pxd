@@ -26,6 +26,8 @@ cdef struct Batch:
     float64_t trace_interval # seconds between centre-of-mass samples
     int32 self_collision     # 1: contact between voxels more than the exclusion hops apart
     int32 actuation_mode     # 0: seed (contraction only, hold out-of-bounds); 1: symmetric
+    int32 model              # 0: seed (the seed engine's step, see _core.pyx); 1: corotational
+    float64_t bond_zeta      # the seed's BondDampingZ (model 0's finite-difference link damping)
     intp_t trace_capacity    # samples allocated per robot in trace_t / trace_cm
 
     # ---- per robot ----------------------------------------------------------
@@ -90,6 +92,16 @@ cdef struct Batch:
     float64_t* c_axial       # (n_links,) axial damping (N s/m)
     float64_t* c_torsion     # (n_links,) torsional damping (N m s/rad)
     float64_t* c_bend        # (n_links,) bending damping (N m s/rad)
+    # model 0 (seed) only:
+    float64_t* c_seed        # (n_links, 8) 2 sqrt(k m) damping constants of voxel 1 then voxel 2:
+                             #   a1 M, b2 FM, a2 I, b3 I (FM = M L / 2, I = M L^2 / 6)
+    flag_t* homog            # (n_links,) 1: both voxels of one material (voxel 2 gets -F1)
+    flag_t* link_sa          # (n_links,) 1: small-angle mode (state)
+    intp_t* seed_rank        # (n_voxels,) the voxel's index in the seed engine's order
+    float64_t* col_ref       # (n_voxels, 4) position and size at the last candidate rebuild (state)
+    float64_t* col_acc       # (n_robots,) the seed's displacement since that rebuild, in L (state)
+    float64_t* col_vmax      # (n_robots,) fastest voxel speed after the last step (state)
+    float64_t* link_last     # (n_links, 9) last Pos2, Angle1, Angle2 in the bond frame (state)
 
 
 # Self-collision candidates of one robot, rebuilt inside advance_robot (scratch

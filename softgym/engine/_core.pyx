@@ -32,7 +32,7 @@
 # Python wrapper (simulation.py) once, never here.
 
 from cython.parallel cimport prange, parallel
-from libc.math cimport sin, cos, sqrt, fabs, floor, M_PI
+from libc.math cimport sin, cos, acos, sqrt, fabs, floor, M_PI
 from libc.stdint cimport int64_t
 from libc.stdlib cimport calloc, malloc, realloc, free, qsort
 from libc.string cimport memcpy, memset
@@ -88,9 +88,12 @@ cdef inline float64_t _actuate(Batch* b, intp_t r) noexcept nogil:
         return smax
     if t < b.init_time:
         return smax  # nominal sizes until the settling time is over (scale starts at L)
-    w = 2.0 * M_PI / b.period[r]
-    s = sin(w * t)
-    c = cos(w * t)
+    if b.model == 0:
+        w = SEED_2PI_DRIVE * (t / b.period[r])  # the seed's sin(2 pi_f (t / T))
+    else:
+        w = 2.0 * M_PI / b.period[r] * t
+    s = sin(w)
+    c = cos(w)
     amp = b.temp_amp[r]
     for i in range(vs, ve):
         if b.cte[i] == 0.0:
@@ -294,6 +297,398 @@ cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
         moment[3 * j + 1] += o[8 * n + li]
         moment[3 * j + 2] += o[9 * n + li]
     return STATUS_OK
+
+
+
+# ---------------------------------------------------------------------------
+# Model 0, "seed": the step of the seed study's engine (evosoro's bundled
+# VoxCAD-era Voxelyze, SEED_REFERENCE section 1), written anew from its
+# documented behaviour and checked against that engine's output
+# (benchmarks/fidelity_seed.py):
+# - each link is a beam measured in the frame of its first voxel (the one on
+#   the negative side): rotate the relative position and voxel 2's
+#   orientation into voxel 1's frame (the link axis turned onto +x); while the
+#   relative rotation stays under ~1 degree, the transverse offset is under
+#   5 % of the axial distance and the extension under 30 % (with 10 %
+#   hysteresis on leaving) the "small-angle" beam applies (voxel 1's angle is
+#   zero, offsets taken along voxel 1's axes); otherwise the "large-angle"
+#   beam is measured from the chord (offsets zero, both ends' angles relative
+#   to it);
+# - link damping acts on finite differences of those bond-frame quantities
+#   (so it also sees the rate of the actuated rest length), and is skipped,
+#   with its memory left untouched, on a step where the link changed mode;
+# - a link between voxels of two materials gives voxel 2 its own damping
+#   (with voxel 2's mass); one of a single material gives voxel 2 exactly -F1;
+# - floor: normal force 2 E L pen without clamping, damping on top, friction
+#   bounded by mu 2 E L pen (damping excluded); static friction zeroes the
+#   in-plane force of a voxel whose in-plane velocity is exactly zero;
+# - orientations renormalised exactly and snapped to the identity when
+#   w >= 1; voxel sizes follow the drive at the end of the step (so the
+#   link forces of a step use the previous step's sizes);
+# - every voxel is a self-collision candidate (the seed's surface test is
+#   always true), the drive's 2 pi is the single-precision constant.
+
+cdef float64_t SEED_PI = 3.14159265358979         # the seed's PI macro
+cdef float64_t SEED_2PI_DRIVE = 2.0 * <float64_t> (<float> 3.1415926)
+cdef float64_t SMALL_ANGLE_RAD = 1.732e-2          # relative rotation of a small-angle link
+cdef float64_t HYSTERESIS = 1.1
+cdef float64_t SMALL_ANGLE_W = cos(0.5 * SMALL_ANGLE_RAD)
+cdef float64_t SMALLISH_ANGLE_W = cos(HYSTERESIS * SMALL_ANGLE_RAD * 0.5)
+cdef float64_t SLTHRESH_ACOS2SQRT = 1.0 - 0.9988 * 0.9988
+cdef float64_t DISCARD_ANGLE_RAD = 1.0e-7
+cdef float64_t SA_BOND_BEND_RAD = 0.05
+cdef float64_t SA_BOND_EXT_PERC = 1.30
+
+
+cdef inline void _qmul(const float64_t* a, const float64_t* c, float64_t* o) noexcept nogil:
+    # o = a c (o must not alias a or c)
+    o[0] = a[0] * c[0] - a[1] * c[1] - a[2] * c[2] - a[3] * c[3]
+    o[1] = a[0] * c[1] + a[1] * c[0] + a[2] * c[3] - a[3] * c[2]
+    o[2] = a[0] * c[2] - a[1] * c[3] + a[2] * c[0] + a[3] * c[1]
+    o[3] = a[0] * c[3] + a[1] * c[2] - a[2] * c[1] + a[3] * c[0]
+
+
+cdef inline void _qrot_inv(const float64_t* q, const float64_t* f, float64_t* o) noexcept nogil:
+    # o = q* f q: f expressed in the frame q (o must not alias f)
+    cdef float64_t tw, tx, ty, tz
+    tw = q[1] * f[0] + q[2] * f[1] + q[3] * f[2]
+    tx = q[0] * f[0] - q[2] * f[2] + q[3] * f[1]
+    ty = q[0] * f[1] + q[1] * f[2] - q[3] * f[0]
+    tz = q[0] * f[2] - q[1] * f[1] + q[2] * f[0]
+    o[0] = tw * q[1] + tx * q[0] + ty * q[3] - tz * q[2]
+    o[1] = tw * q[2] - tx * q[3] + ty * q[0] + tz * q[1]
+    o[2] = tw * q[3] + tx * q[2] - ty * q[1] + tz * q[0]
+
+
+cdef inline void _rotvec(const float64_t* q, float64_t* o) noexcept nogil:
+    # rotation vector of the unit quaternion q (angle from w, as the seed)
+    cdef float64_t sl = 1.0 - q[0] * q[0], w = q[0] if q[0] < 1.0 else 1.0, k
+    if sl <= 0.0:
+        o[0] = 0.0
+        o[1] = 0.0
+        o[2] = 0.0
+        return
+    if sl < SLTHRESH_ACOS2SQRT:
+        k = 2.0 * sqrt((2.0 - 2.0 * w) / sl)
+    else:
+        k = 2.0 * acos(w) / sqrt(sl)
+    o[0] = q[1] * k
+    o[1] = q[2] * k
+    o[2] = q[3] * k
+
+
+cdef inline void _to_pos_x(const float64_t* v, float64_t* q) noexcept nogil:
+    # q: the rotation (axis normal to x) that turns v onto +x
+    cdef float64_t yx, zx, l, nx, ny, nz, th, am, s
+    q[0] = 1.0
+    q[1] = 0.0
+    q[2] = 0.0
+    q[3] = 0.0
+    if v[0] == 0.0 and v[1] == 0.0 and v[2] == 0.0:
+        return
+    yx = v[1] / v[0]
+    zx = v[2] / v[0]
+    if yx < SMALL_ANGLE_RAD and yx > -SMALL_ANGLE_RAD and zx < SMALL_ANGLE_RAD and zx > -SMALL_ANGLE_RAD:
+        q[2] = 0.5 * zx
+        q[3] = -0.5 * yx
+        q[0] = 1.0 + 0.5 * (-q[2] * q[2] - q[3] * q[3])
+        return
+    l = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+    nx = v[0] / l
+    ny = v[1] / l
+    nz = v[2] / l
+    th = acos(nx)
+    if th > SEED_PI - DISCARD_ANGLE_RAD:
+        q[0] = 0.0
+        q[2] = 1.0
+        return
+    am = 1.0 / sqrt(nz * nz + ny * ny)
+    s = sin(0.5 * th)
+    q[0] = cos(0.5 * th)
+    q[2] = nz * am * s
+    q[3] = -ny * am * s
+
+
+cdef inline void _to_x(intp_t ax, float64_t* v) noexcept nogil:
+    # lattice axis ax turned onto +x (a proper rotation, as the seed's bond frame)
+    cdef float64_t t
+    if ax == 1:
+        t = v[0]
+        v[0] = v[1]
+        v[1] = -t
+    elif ax == 2:
+        t = v[0]
+        v[0] = v[2]
+        v[2] = -t
+
+
+cdef inline void _from_x(intp_t ax, float64_t* v) noexcept nogil:
+    # inverse of _to_x
+    cdef float64_t t
+    if ax == 1:
+        t = v[1]
+        v[1] = v[0]
+        v[0] = -t
+    elif ax == 2:
+        t = v[2]
+        v[2] = v[0]
+        v[0] = -t
+
+
+cdef inline void _perm_vec(intp_t ax, float64_t x, float64_t y, float64_t z, float64_t* o) noexcept nogil:
+    # o = the world vector (x, y, z) in the bond frame of a link along axis ax
+    # (the seed's ToXDirBond: +y or +z turned onto +x by a proper rotation)
+    if ax == 0:
+        o[0] = x
+        o[1] = y
+        o[2] = z
+    elif ax == 1:
+        o[0] = y
+        o[1] = -x
+        o[2] = z
+    else:
+        o[0] = z
+        o[1] = y
+        o[2] = -x
+
+
+cdef inline void _unperm_add(intp_t ax, const float64_t* R, const float64_t* v, float64_t sign,
+                             float64_t* out) noexcept nogil:
+    # out += sign * R P^T v: a bond-frame vector v back to the world through
+    # the inverse axis turn P^T and the voxel rotation R (row-major 3x3)
+    cdef float64_t x, y, z
+    if ax == 0:
+        x = v[0]
+        y = v[1]
+        z = v[2]
+    elif ax == 1:
+        x = -v[1]
+        y = v[0]
+        z = v[2]
+    else:
+        x = -v[2]
+        y = v[1]
+        z = v[0]
+    out[0] += sign * (R[0] * x + R[1] * y + R[2] * z)
+    out[1] += sign * (R[3] * x + R[4] * y + R[5] * z)
+    out[2] += sign * (R[6] * x + R[7] * y + R[8] * z)
+
+
+cdef int _links_seed(Batch* b, intp_t r) noexcept nogil:
+    # IN: positions, orientations, sizes, the links' mode and memory.
+    # OUT (accumulated): force, moment; the links' mode and memory.
+    # Quantities are those of the seed's bond frame (the link axis turned
+    # onto +x, voxel 1's orientation removed); rotations back to the world
+    # go through voxel 1's rotation matrix.
+    cdef:
+        intp_t li, i, j, ax, k
+        float64_t L = b.L
+        float64_t inv_dt = 1.0 / b.dt[r]
+        float64_t bz = 0.5 * b.bond_zeta
+        float64_t max_ext = b.max_strain * L
+        float64_t dx, dy, dz, lx, ly, lz, qw, qx, qy, qz
+        float64_t nq[4]
+        float64_t rq[4]
+        float64_t tq[4]
+        float64_t p[3]
+        float64_t P[3]
+        float64_t A1[3]
+        float64_t A2[3]
+        float64_t F1[3]
+        float64_t F2[3]
+        float64_t M1[3]
+        float64_t M2[3]
+        float64_t G[3]
+        float64_t RV[3]
+        float64_t RA1[3]
+        float64_t RA2[3]
+        float64_t RQ[9]
+        float64_t nom, st, ex, ka, kt, kb, b2, ca, cb2, ca2, cb3
+        float64_t len_, nx, ny, nz, th, rho, ch, sh, yx, zx
+        float64_t* last
+        const float64_t* cs
+        const float64_t* R1
+        const float64_t* q1
+        const float64_t* q2
+        int32 sa, changed, homog
+    for li in range(b.link_start[r], b.link_start[r + 1]):
+        i = b.v1[li]
+        j = b.v2[li]
+        ax = b.axis[li]
+        R1 = b.rot + 9 * i
+        q1 = b.quat + 4 * i
+        q2 = b.quat + 4 * j
+        dx = b.pos[3 * j] - b.pos[3 * i]
+        dy = b.pos[3 * j + 1] - b.pos[3 * i + 1]
+        dz = b.pos[3 * j + 2] - b.pos[3 * i + 2]
+        # relative position in voxel 1's frame, then in the bond frame
+        lx = R1[0] * dx + R1[3] * dy + R1[6] * dz
+        ly = R1[1] * dx + R1[4] * dy + R1[7] * dz
+        lz = R1[2] * dx + R1[5] * dy + R1[8] * dz
+        _perm_vec(ax, lx, ly, lz, p)
+        # voxel 2's orientation relative to voxel 1 (q1* q2), in the bond frame
+        qw = q1[0] * q2[0] + q1[1] * q2[1] + q1[2] * q2[2] + q1[3] * q2[3]
+        qx = q1[0] * q2[1] - q1[1] * q2[0] - q1[2] * q2[3] + q1[3] * q2[2]
+        qy = q1[0] * q2[2] + q1[1] * q2[3] - q1[2] * q2[0] - q1[3] * q2[1]
+        qz = q1[0] * q2[3] - q1[1] * q2[2] + q1[2] * q2[1] - q1[3] * q2[0]
+        nq[0] = qw
+        _perm_vec(ax, qx, qy, qz, nq + 1)
+        nom = 0.5 * (b.scale[i] + b.scale[j])
+        st = (fabs(p[2]) + fabs(p[1])) / p[0]
+        ex = p[0] / nom
+        sa = b.link_sa[li]
+        changed = 0
+        if not sa and nq[0] > SMALL_ANGLE_W and st < SA_BOND_BEND_RAD and ex < SA_BOND_EXT_PERC:
+            sa = 1
+            changed = 1
+        elif sa and (not (nq[0] > SMALLISH_ANGLE_W) or st > HYSTERESIS * SA_BOND_BEND_RAD
+                     or ex > HYSTERESIS * SA_BOND_EXT_PERC):
+            sa = 0
+            changed = 1
+        b.link_sa[li] = sa
+        if sa:
+            # small angle: voxel 1's frame, offsets along its axes
+            A1[0] = 0.0
+            A1[1] = 0.0
+            A1[2] = 0.0
+            _rotvec(nq, A2)
+            P[0] = p[0] - nom
+            P[1] = p[1]
+            P[2] = p[2]
+        else:
+            # large angle: the frame turned by rq onto the chord (axis normal to x)
+            rq[0] = 1.0
+            rq[1] = 0.0
+            rq[2] = 0.0
+            rq[3] = 0.0
+            A1[0] = 0.0
+            A1[1] = 0.0
+            A1[2] = 0.0
+            if not (p[0] == 0.0 and p[1] == 0.0 and p[2] == 0.0):
+                yx = p[1] / p[0]
+                zx = p[2] / p[0]
+                if (yx < SMALL_ANGLE_RAD and yx > -SMALL_ANGLE_RAD
+                        and zx < SMALL_ANGLE_RAD and zx > -SMALL_ANGLE_RAD):
+                    rq[2] = 0.5 * zx
+                    rq[3] = -0.5 * yx
+                    rq[0] = 1.0 + 0.5 * (-rq[2] * rq[2] - rq[3] * rq[3])
+                    _rotvec(rq, A1)
+                else:
+                    len_ = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2])
+                    nx = p[0] / len_
+                    ny = p[1] / len_
+                    nz = p[2] / len_
+                    th = acos(nx)
+                    if th > SEED_PI - DISCARD_ANGLE_RAD:
+                        rq[0] = 0.0
+                        rq[2] = 1.0
+                        _rotvec(rq, A1)
+                    else:
+                        rho = 1.0 / sqrt(nz * nz + ny * ny)
+                        ch = sqrt(0.5 * (1.0 + nx))  # cos(th / 2)
+                        sh = sqrt(0.5 * (1.0 - nx))  # sin(th / 2)
+                        rq[0] = ch
+                        rq[2] = nz * rho * sh
+                        rq[3] = -ny * rho * sh
+                        _rotvec(rq, A1)  # the seed's, with its acos approximation
+            _qmul(rq, nq, tq)
+            _rotvec(tq, A2)
+            P[0] = sqrt(dx * dx + dy * dy + dz * dz) - nom
+            P[1] = 0.0
+            P[2] = 0.0
+        if not (fabs(P[0]) <= max_ext):
+            return STATUS_STRAIN  # also catches NaN
+        ka = b.k_axial[li]
+        kt = b.k_torsion[li]
+        kb = b.k_bend[li]
+        b2 = 0.5 * ka * L
+        F1[0] = ka * P[0]
+        F1[1] = ka * P[1] - b2 * (A1[2] + A2[2])
+        F1[2] = ka * P[2] + b2 * (A1[1] + A2[1])
+        M1[0] = kt * (A1[0] - A2[0])
+        M1[1] = b2 * P[2] + kb * (2.0 * A1[1] + A2[1])
+        M1[2] = -b2 * P[1] + kb * (2.0 * A1[2] + A2[2])
+        M2[0] = -M1[0]
+        M2[1] = b2 * P[2] + kb * (A1[1] + 2.0 * A2[1])
+        M2[2] = -b2 * P[1] + kb * (A1[2] + 2.0 * A2[2])
+        homog = b.homog[li]
+        F2[0] = -F1[0]
+        F2[1] = -F1[1]
+        F2[2] = -F1[2]
+        if not changed:
+            last = b.link_last + 9 * li
+            cs = b.c_seed + 8 * li
+            for k in range(3):
+                RV[k] = (P[k] - last[k]) * inv_dt
+                RA1[k] = (A1[k] - last[3 + k]) * inv_dt
+                RA2[k] = (A2[k] - last[6 + k]) * inv_dt
+                last[k] = P[k]
+                last[3 + k] = A1[k]
+                last[6 + k] = A2[k]
+            ca = cs[0]
+            cb2 = cs[1]
+            ca2 = cs[2]
+            cb3 = cs[3]
+            F1[0] += bz * (ca * RV[0])
+            F1[1] += bz * (ca * RV[1] - cb2 * (RA1[2] + RA2[2]))
+            F1[2] += bz * (ca * RV[2] + cb2 * (RA1[1] + RA2[1]))
+            M1[0] += 0.5 * bz * (-ca2 * (RA2[0] - RA1[0]))
+            M1[1] += 0.5 * bz * (cb2 * RV[2] + cb3 * (2.0 * RA1[1] + RA2[1]))
+            M1[2] += 0.5 * bz * (-cb2 * RV[1] + cb3 * (2.0 * RA1[2] + RA2[2]))
+            ca = cs[4]
+            cb2 = cs[5]
+            ca2 = cs[6]
+            cb3 = cs[7]
+            if homog:
+                F2[0] = -F1[0]
+                F2[1] = -F1[1]
+                F2[2] = -F1[2]
+            else:
+                F2[0] += bz * (-ca * RV[0])
+                F2[1] += bz * (-ca * RV[1] + cb2 * (RA1[2] + RA2[2]))
+                F2[2] += bz * (-ca * RV[2] - cb2 * (RA1[1] + RA2[1]))
+            M2[0] += 0.5 * bz * (ca2 * (RA2[0] - RA1[0]))
+            M2[1] += 0.5 * bz * (cb2 * RV[2] + cb3 * (RA1[1] + 2.0 * RA2[1]))
+            M2[2] += 0.5 * bz * (-cb2 * RV[1] + cb3 * (RA1[2] + 2.0 * RA2[2]))
+        # back to the world: undo rq (large angle), the axis turn and voxel 1's rotation
+        if not sa:
+            _quat_matrix(rq, RQ)  # G = RQ^T v rotates by rq^-1
+            _mat_t_vec(RQ, F1, G)
+            _unperm_add(ax, R1, G, 1.0, b.force + 3 * i)
+            _mat_t_vec(RQ, F2, G)
+            _unperm_add(ax, R1, G, 1.0, b.force + 3 * j)
+            _mat_t_vec(RQ, M1, G)
+            _unperm_add(ax, R1, G, -1.0, b.moment + 3 * i)
+            _mat_t_vec(RQ, M2, G)
+            _unperm_add(ax, R1, G, -1.0, b.moment + 3 * j)
+        else:
+            _unperm_add(ax, R1, F1, 1.0, b.force + 3 * i)
+            _unperm_add(ax, R1, F2, 1.0, b.force + 3 * j)
+            _unperm_add(ax, R1, M1, -1.0, b.moment + 3 * i)
+            _unperm_add(ax, R1, M2, -1.0, b.moment + 3 * j)
+    return STATUS_OK
+
+
+cdef inline void _quat_matrix(const float64_t* q, float64_t* R) noexcept nogil:
+    # R = rotation matrix of q (normalised by its length: the seed's small-angle
+    # rq is not exactly unit, and its rotations scale by |q|^2)
+    cdef float64_t w = q[0], x = q[1], y = q[2], z = q[3]
+    cdef float64_t n2 = w * w + x * x + y * y + z * z
+    R[0] = n2 - 2.0 * (y * y + z * z)
+    R[1] = 2.0 * (x * y - w * z)
+    R[2] = 2.0 * (x * z + w * y)
+    R[3] = 2.0 * (x * y + w * z)
+    R[4] = n2 - 2.0 * (x * x + z * z)
+    R[5] = 2.0 * (y * z - w * x)
+    R[6] = 2.0 * (x * z - w * y)
+    R[7] = 2.0 * (y * z + w * x)
+    R[8] = n2 - 2.0 * (x * x + y * y)
+
+
+cdef inline void _mat_t_vec(const float64_t* R, const float64_t* v, float64_t* o) noexcept nogil:
+    o[0] = R[0] * v[0] + R[3] * v[1] + R[6] * v[2]
+    o[1] = R[1] * v[0] + R[4] * v[1] + R[7] * v[2]
+    o[2] = R[2] * v[0] + R[5] * v[1] + R[8] * v[2]
 
 
 cdef inline void _surface_contact(Batch* b, intp_t i, float64_t nx, float64_t ny, float64_t nz,
@@ -502,6 +897,133 @@ cdef inline int _integrate(Batch* b, intp_t r, const float64_t* ref,
     return STATUS_OK
 
 
+cdef inline void _seed_floor(Batch* b, intp_t i, float64_t dt, float64_t* f) noexcept nogil:
+    # The seed's floor (SEED_REFERENCE 1.6) on voxel i. IN/OUT: f, the voxel's
+    # force before the floor (its in-plane part decides static friction), and
+    # its velocity when kinetic friction stops it.
+    cdef:
+        float64_t* v = b.vel + 3 * i
+        float64_t pen = 0.5 * b.scale[i] - b.pos[3 * i + 2]
+        float64_t n, fd, vs
+        int32 stick = 0
+    if pen <= 0.0:
+        return
+    n = b.k_floor[i] * pen
+    fd = b.mu_k[i] * n
+    if v[0] == 0.0 and v[1] == 0.0:
+        if sqrt(f[0] * f[0] + f[1] * f[1]) < b.mu_s[i] * n:
+            stick = 1
+    else:
+        vs = sqrt(v[0] * v[0] + v[1] * v[1])
+        if fd * dt < b.mass[i] * vs:
+            f[0] -= fd * v[0] / vs
+            f[1] -= fd * v[1] / vs
+        else:
+            stick = 1
+            v[0] = 0.0
+            v[1] = 0.0
+    f[2] += n - b.c_floor[i] * v[2]
+    if stick:
+        f[0] = 0.0
+        f[1] = 0.0
+
+
+cdef inline int _integrate_seed(Batch* b, intp_t r, const float64_t* ref,
+                                float64_t* dmax2) noexcept nogil:
+    # Model 0's voxel update (the seed's EulerStep): as _integrate, with the
+    # seed's floor and exact quaternion renormalisation snapped to the identity
+    # at w >= 1. Terrain boxes use the common surface contact.
+    cdef:
+        intp_t i, k
+        float64_t dt = b.dt[r]
+        float64_t h, pen, cg, rd, d2, mx, my, mz
+        float64_t c0 = 0.0, c1 = 0.0, c2 = 0.0
+        float64_t wx, wy, wz, qw, qx, qy, qz, nq
+        float64_t f[3]
+        float64_t n[3]
+        float64_t* pos = b.pos
+        float64_t* vel = b.vel
+        float64_t* av = b.angvel
+        float64_t* qq
+        int32 has_floor = b.floor[r]
+        intp_t k0 = b.box_start[r]
+        intp_t k1 = b.box_start[r + 1]
+        intp_t vs = b.vox_start[r]
+    dmax2[0] = 0.0
+    for i in range(b.vox_start[r], b.vox_start[r + 1]):
+        if b.fixed[i]:
+            for k in range(3):
+                vel[3 * i + k] = 0.0
+                av[3 * i + k] = 0.0
+            _clear(b, i)
+            continue
+        cg = b.c_global[i]
+        f[0] = -cg * vel[3 * i] + b.force[3 * i] + b.ext_force[3 * i]
+        f[1] = -cg * vel[3 * i + 1] + b.force[3 * i + 1] + b.ext_force[3 * i + 1]
+        f[2] = -cg * vel[3 * i + 2] + b.force[3 * i + 2] + b.mass[i] * b.gravity + b.ext_force[3 * i + 2]
+        mx = b.moment[3 * i]
+        my = b.moment[3 * i + 1]
+        mz = b.moment[3 * i + 2]
+        _clear(b, i)
+        for k in range(k0, k1):
+            pen = _box_penetration(b.boxes + 6 * k, pos + 3 * i, 0.5 * b.scale[i], n)
+            if pen > 0.0:
+                _surface_contact(b, i, n[0], n[1], n[2], pen, dt, f)
+        if has_floor:
+            _seed_floor(b, i, dt, f)
+        h = dt * b.inv_mass[i]
+        vel[3 * i] += f[0] * h
+        vel[3 * i + 1] += f[1] * h
+        vel[3 * i + 2] += f[2] * h
+        pos[3 * i] += vel[3 * i] * dt
+        pos[3 * i + 1] += vel[3 * i + 1] * dt
+        pos[3 * i + 2] += vel[3 * i + 2] * dt
+        if not (fabs(pos[3 * i]) + fabs(pos[3 * i + 1]) + fabs(pos[3 * i + 2]) < RUNAWAY):
+            _clear_robot(b, r)
+            return STATUS_NONFINITE
+        if ref != NULL:
+            k = 3 * (i - vs)
+            if i == vs:
+                c0 = pos[3 * i] - ref[k]
+                c1 = pos[3 * i + 1] - ref[k + 1]
+                c2 = pos[3 * i + 2] - ref[k + 2]
+            d2 = ((pos[3 * i] - ref[k] - c0) ** 2 + (pos[3 * i + 1] - ref[k + 1] - c1) ** 2
+                  + (pos[3 * i + 2] - ref[k + 2] - c2) ** 2)
+            if d2 > dmax2[0]:
+                dmax2[0] = d2
+        h = dt * b.inv_inertia[i]
+        rd = b.rot_damp[i]
+        av[3 * i] = (av[3 * i] + mx * h) * rd
+        av[3 * i + 1] = (av[3 * i + 1] + my * h) * rd
+        av[3 * i + 2] = (av[3 * i + 2] + mz * h) * rd
+        wx = av[3 * i] * 0.5 * dt
+        wy = av[3 * i + 1] * 0.5 * dt
+        wz = av[3 * i + 2] * 0.5 * dt
+        qq = b.quat + 4 * i
+        qw = qq[0] - wx * qq[1] - wy * qq[2] - wz * qq[3]
+        qx = qq[1] + wx * qq[0] + wy * qq[3] - wz * qq[2]
+        qy = qq[2] + wy * qq[0] + wz * qq[1] - wx * qq[3]
+        qz = qq[3] + wz * qq[0] + wx * qq[2] - wy * qq[1]
+        nq = sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
+        if nq != 0.0:
+            nq = 1.0 / nq
+            qw = qw * nq
+            qx = qx * nq
+            qy = qy * nq
+            qz = qz * nq
+        if qw >= 1.0:
+            qw = 1.0
+            qx = 0.0
+            qy = 0.0
+            qz = 0.0
+        qq[0] = qw
+        qq[1] = qx
+        qq[2] = qy
+        qq[3] = qz
+        _rotation_matrix(qq, b.rot + 9 * i)
+    return STATUS_OK
+
+
 # ---------------------------------------------------------------------------
 # Self-collision (SEED_REFERENCE 1.7): surface voxels more than
 # `collision_exclusion` bond hops apart repel when their spherical envelopes, of diameter
@@ -651,6 +1173,118 @@ cdef int _rebuild_contacts(Batch* b, intp_t r, Contacts* c) noexcept nogil:
     return STATUS_OK
 
 
+cdef int _seed_candidates(Batch* b, intp_t r, Contacts* c, int32 snapshot) noexcept nogil:
+    # The seed's collision list (CalcL1Bonds with its horizon 2): surface voxel
+    # pairs more than the exclusion hops apart whose centres are closer than
+    # 3 L and than twice the size of the pair's first voxel in the seed's
+    # order, measured at the rebuild. snapshot: 1 copies the current positions
+    # and sizes into col_ref first (a rebuild); 0 rebuilds the list of the
+    # last rebuild from col_ref (after the state was restored).
+    cdef:
+        intp_t vs = b.vox_start[r]
+        intp_t ve = b.vox_start[r + 1]
+        intp_t n = ve - vs
+        intp_t i, j, k, m, pos_, n_row, n_surf, first
+        int64_t ci, cj, ck, key
+        int di, dj, dk
+        float64_t L = b.L
+        float64_t smax = 0.0, horizon, inv_cell, x0, y0, z0, dx, dy, dz, d2, act
+        float64_t* R = b.col_ref
+        intp_t* grown
+    if c.cells == NULL:
+        c.cells = <KeyIndex*> malloc(n * sizeof(KeyIndex))
+        c.row = <intp_t*> malloc(n * sizeof(intp_t))
+        c.ref = <float64_t*> malloc(3 * n * sizeof(float64_t))
+        if c.cells == NULL or c.row == NULL or c.ref == NULL:
+            return STATUS_MEMORY
+    if snapshot:
+        for i in range(vs, ve):
+            R[4 * i] = b.pos[3 * i]
+            R[4 * i + 1] = b.pos[3 * i + 1]
+            R[4 * i + 2] = b.pos[3 * i + 2]
+            R[4 * i + 3] = b.scale[i]
+    c.stale = 0
+    c.n_pairs = 0
+    c.built_scale = 1.0e300  # model 0 rebuilds on its own schedule, never for sizes
+    c.margin = 1.0e300
+    for i in range(vs, ve):
+        if R[4 * i + 3] > smax:
+            smax = R[4 * i + 3]
+    horizon = 2.0 * smax
+    if horizon > 3.0 * L:
+        horizon = 3.0 * L
+    if horizon <= 0.0:
+        return STATUS_OK
+    inv_cell = 1.0 / horizon
+    x0 = R[4 * vs]
+    y0 = R[4 * vs + 1]
+    z0 = R[4 * vs + 2]
+    for i in range(vs, ve):
+        if R[4 * i] < x0:
+            x0 = R[4 * i]
+        if R[4 * i + 1] < y0:
+            y0 = R[4 * i + 1]
+        if R[4 * i + 2] < z0:
+            z0 = R[4 * i + 2]
+    n_surf = 0
+    for i in range(vs, ve):
+        if not b.surface[i]:
+            continue
+        ci = <int64_t> floor((R[4 * i] - x0) * inv_cell) + 1
+        cj = <int64_t> floor((R[4 * i + 1] - y0) * inv_cell) + 1
+        ck = <int64_t> floor((R[4 * i + 2] - z0) * inv_cell) + 1
+        c.cells[n_surf].key = (ci << (2 * CELL_BITS)) | (cj << CELL_BITS) | ck
+        c.cells[n_surf].index = i
+        n_surf += 1
+    qsort(c.cells, n_surf, sizeof(KeyIndex), _cmp_key_index)
+    for i in range(vs, ve):
+        if not b.surface[i]:
+            continue
+        ci = <int64_t> floor((R[4 * i] - x0) * inv_cell) + 1
+        cj = <int64_t> floor((R[4 * i + 1] - y0) * inv_cell) + 1
+        ck = <int64_t> floor((R[4 * i + 2] - z0) * inv_cell) + 1
+        n_row = 0
+        for di in range(-1, 2):
+            for dj in range(-1, 2):
+                for dk in range(-1, 2):
+                    key = ((ci + di) << (2 * CELL_BITS)) | ((cj + dj) << CELL_BITS) | (ck + dk)
+                    pos_ = _lower_bound(c.cells, n_surf, key)
+                    while pos_ < n_surf and c.cells[pos_].key == key:
+                        j = c.cells[pos_].index
+                        pos_ += 1
+                        if j <= i:
+                            continue
+                        dx = R[4 * j] - R[4 * i]
+                        dy = R[4 * j + 1] - R[4 * i + 1]
+                        dz = R[4 * j + 2] - R[4 * i + 2]
+                        d2 = dx * dx + dy * dy + dz * dz
+                        if d2 >= 9.0 * L * L:
+                            continue
+                        first = i if b.seed_rank[i] < b.seed_rank[j] else j
+                        act = 2.0 * R[4 * first + 3]
+                        if d2 >= act * act:
+                            continue
+                        if _excluded(b, i, j):
+                            continue
+                        c.row[n_row] = j
+                        n_row += 1
+        if n_row == 0:
+            continue
+        qsort(c.row, n_row, sizeof(intp_t), _cmp_intp)
+        if c.n_pairs + n_row > c.capacity:
+            m = 2 * (c.n_pairs + n_row) + 64
+            grown = <intp_t*> realloc(c.pairs, 2 * m * sizeof(intp_t))
+            if grown == NULL:
+                return STATUS_MEMORY
+            c.pairs = grown
+            c.capacity = m
+        for k in range(n_row):
+            c.pairs[2 * c.n_pairs] = i
+            c.pairs[2 * c.n_pairs + 1] = c.row[k]
+            c.n_pairs += 1
+    return STATUS_OK
+
+
 cdef inline void _collide(Batch* b, Contacts* c) noexcept nogil:
     # OUT (accumulated): force of the touching candidate pairs.
     cdef:
@@ -723,6 +1357,53 @@ cdef inline void _record(Batch* b, intp_t r) noexcept nogil:
         b.trace_n[r] += 1
 
 
+cdef inline float64_t _max_speed(Batch* b, intp_t r) noexcept nogil:
+    # the fastest voxel speed of robot r (m/s)
+    cdef intp_t i
+    cdef float64_t v2, m = 0.0
+    for i in range(b.vox_start[r], b.vox_start[r + 1]):
+        v2 = b.vel[3 * i] * b.vel[3 * i] + b.vel[3 * i + 1] * b.vel[3 * i + 1] + b.vel[3 * i + 2] * b.vel[3 * i + 2]
+        if v2 > m:
+            m = v2
+    return sqrt(m)
+
+
+cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept nogil:
+    # advance_robot for model 0: links, contacts, voxels, then the drive at
+    # the step's start time sets the sizes the next step's links see
+    cdef:
+        int status = STATUS_OK
+        float64_t smax = 0.0, dmax2 = 0.0
+    while b.steps[r] < target:
+        if b.self_collision:
+            # the seed's schedule: rebuild once the fastest voxel may have
+            # covered half a voxel since the last rebuild
+            b.col_acc[r] += fabs(b.col_vmax[r] * b.dt[r] / b.L)
+            if b.col_acc[r] > 0.5:
+                status = _seed_candidates(b, r, c, 1)
+                b.col_acc[r] = 0.0
+            elif c.stale:
+                status = _seed_candidates(b, r, c, 0)
+        if status == STATUS_OK:
+            status = _links_seed(b, r)
+        if status == STATUS_OK and b.self_collision:
+            _collide(b, c)
+        if status == STATUS_OK:
+            status = _integrate_seed(b, r, NULL, &dmax2)
+        if status != STATUS_OK:
+            _clear_robot(b, r)
+            b.diverged[r] = 1
+            b.diverged_code[r] = status
+            b.diverged_time[r] = b.steps[r] * b.dt[r]
+            break
+        if b.self_collision:
+            b.col_vmax[r] = _max_speed(b, r)
+        smax = _actuate(b, r)
+        b.steps[r] += 1
+        _record(b, r)
+    return status
+
+
 cdef int advance_robot(Batch* b, intp_t r, step_t target, Contacts* c) noexcept nogil:
     """Step robot r until steps[r] == target, or until it diverges.
 
@@ -740,6 +1421,8 @@ cdef int advance_robot(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
         return STATUS_OK
     if b.steps[r] == 0:
         _record(b, r)
+    if b.model == 0:
+        return _advance_seed(b, r, target, c)
     while b.steps[r] < target:
         # force and moment scratch are zero here: _integrate clears them
         smax = _actuate(b, r)
@@ -858,6 +1541,8 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.trace_interval = s["trace_interval"]
     b.self_collision = s["self_collision"]
     b.actuation_mode = s["actuation_mode"]
+    b.model = s["model"]
+    b.bond_zeta = s["bond_zeta"]
     b.trace_capacity = a["trace_t"].shape[1]
     b.vox_start = <intp_t*> _p(a, "vox_start")
     b.link_start = <intp_t*> _p(a, "link_start")
@@ -901,6 +1586,10 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.mu_s = _f(a, "mu_s")
     b.mu_k = _f(a, "mu_k")
     b.fixed = <flag_t*> _p(a, "fixed")
+    b.seed_rank = <intp_t*> _p(a, "seed_rank")
+    b.col_ref = _f(a, "col_ref")
+    b.col_acc = _f(a, "col_acc")
+    b.col_vmax = _f(a, "col_vmax")
     b.surface = <flag_t*> _p(a, "surface")
     b.link_axis_count = <intp_t*> _p(a, "link_axis_count")
     b.excl_start = <intp_t*> _p(a, "excl_start")
@@ -918,6 +1607,10 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
         b.c_axial = _f(a, "c_axial")
         b.c_torsion = _f(a, "c_torsion")
         b.c_bend = _f(a, "c_bend")
+        b.c_seed = _f(a, "c_seed")
+        b.homog = <flag_t*> _p(a, "homog")
+        b.link_sa = <flag_t*> _p(a, "link_sa")
+        b.link_last = _f(a, "link_last")
     return 0
 
 

@@ -38,6 +38,19 @@ class SimConfig:
     init_time : float
         Settling time (s): the sinusoid starts and the fitness reference
         ``cm_init`` is taken after it (1.0).
+    model : {"seed", "corotational"}
+        The step. ``"seed"``: the seed study's own engine (links measured in
+        their first voxel's frame with its small-/large-angle switch,
+        finite-difference link damping, its floor and friction, sizes that
+        follow the drive one step late, every voxel a self-collision
+        candidate), which its results came from; checked against that
+        engine by ``benchmarks/fidelity_seed.py``. ``"corotational"``:
+        softgym's symmetric co-rotational beam (links measured in the
+        bisector frame of their two voxels, viscous damping on physical
+        rates, a floor that never pulls, only voxels missing a face bond
+        collide): mirror-symmetric bodies stay symmetric, energy is never
+        created by damping, and it is ~1.5x faster; use it for new work
+        that need not match the seed's numbers.
     actuation : {"seed", "symmetric"}
         ``"seed"``: a voxel's size follows ``L (1 + CTE T)`` only while it stays
         within ``[min_scale L, L]``, otherwise it keeps its previous size, so
@@ -75,6 +88,7 @@ class SimConfig:
     collision_damping: float = 0.8
     global_damping: float = 0.01
     init_time: float = 1.0
+    model: Literal["seed", "corotational"] = "seed"
     actuation: Literal["seed", "symmetric"] = "seed"
     min_scale: float = 0.1
     max_strain: float = 100.0
@@ -109,6 +123,7 @@ class SimConfig:
         check("min_scale", 0 < finite("min_scale") <= 1, "in (0, 1]")
         check("max_strain", finite("max_strain") > 0, "> 0")
         check("trace_interval", finite("trace_interval") > 0, "> 0 s")
+        check("model", self.model in ("seed", "corotational"), '"seed" or "corotational"')
         check("actuation", self.actuation in ("seed", "symmetric"), '"seed" or "symmetric"')
         check("on_divergence", self.on_divergence in ("flag", "raise"), '"flag" or "raise"')
         check("floor", isinstance(self.floor, (bool, int)), "a bool")
@@ -123,6 +138,11 @@ class SimConfig:
     def seed(cls, **overrides: Any) -> SimConfig:
         """The seed study's settings (the defaults), with optional overrides."""
         return cls(**overrides)
+
+    @classmethod
+    def corotational(cls, **overrides: Any) -> SimConfig:
+        """The seed's settings on softgym's symmetric co-rotational step (see ``model``)."""
+        return cls(**{"model": "corotational", **overrides})
 
     def replace(self, **changes: Any) -> SimConfig:
         """Return a copy with some settings changed (validated)."""

@@ -70,9 +70,13 @@ _REASONS = {
 
 # state arrays that change while the simulation runs (checkpointed by get_state):
 # per voxel, per robot, and the traces
-_VOXEL_STATE = ("pos", "vel", "quat", "angvel", "rot", "scale", "temp", "ext_force")
-_ROBOT_STATE = ("diverged", "diverged_time", "diverged_code", "init_done", "cm_init", "use_temp")
-_STATE = (*_VOXEL_STATE, *_ROBOT_STATE, "steps", "trace_n", "trace_t", "trace_cm")
+# col_ref: positions and sizes when the seed model last rebuilt its contact candidates
+_VOXEL_STATE = ("pos", "vel", "quat", "angvel", "rot", "scale", "temp", "ext_force", "col_ref")
+# col_acc / col_vmax: the seed model's displacement since that rebuild and last fastest voxel speed
+_ROBOT_STATE = ("diverged", "diverged_time", "diverged_code", "init_done", "cm_init", "use_temp",
+                "col_acc", "col_vmax")
+_LINK_STATE = ("link_sa", "link_last")  # the seed model's per-link mode and memory
+_STATE = (*_VOXEL_STATE, *_ROBOT_STATE, *_LINK_STATE, "steps", "trace_n", "trace_t", "trace_cm")
 
 
 def _env_threads(name: str) -> int | None:
@@ -310,16 +314,32 @@ class Simulation:
             add(per_link, "c_axial", zb * np.sqrt(k_axial * mr))
             add(per_link, "c_bend", 0.5 * zb * np.sqrt(k_bend * Ir))
             add(per_link, "c_torsion", 0.5 * zb * np.sqrt(k_torsion * Ir))
+            # the seed model's damping constants 2 sqrt(k m) for each end:
+            # (a1 M, b2 FM, a2 I, b3 I), b2 = E L^2 / 2, FM = M L / 2
+            b2 = 0.5 * k_axial * L
+            ends = []
+            for v in (v1, v2):
+                ends += [2.0 * np.sqrt(k_axial * m[v]), 2.0 * np.sqrt(b2 * 0.5 * m[v] * L),
+                         2.0 * np.sqrt(k_torsion * inertia[v]), 2.0 * np.sqrt(k_bend * inertia[v])]
+            add(per_link, "c_seed", np.stack(ends, axis=1).reshape(-1, 8))
+            add(per_link, "homog", (mat[v1] == mat[v2]).astype(np.int8))
             # time step: the seed's CalcMaxDt over this robot's links
             if v1.size:
                 w2 = np.max(np.maximum(k_axial / m[v1], k_axial / m[v2]))
             else:
                 w2 = np.max(E * L / m)
-            dt = cfg.dt_frac / (2.0 * math.pi * math.sqrt(w2))
+            # the seed's CalcMaxDt writes pi as 3.1415926
+            pi = 3.1415926 if cfg.model == "seed" else math.pi
+            dt = cfg.dt_frac / (2.0 * pi * math.sqrt(w2))
             dts.append(dt)
             masses.append(float(m.sum()))
             crit = 2.0 * np.sqrt(m * E * L)
-            pos = body.origin + (idx + 0.5) * L
+            if cfg.model == "seed":
+                # the seed's lattice positions carry its 1e-6 L offset in x and y
+                # (VX_Object::GetXYZ), which decides exact-zero tests downstream
+                pos = body.origin + L * ((idx + 0.5) + np.array([1e-6, 1e-6, 0.0]))
+            else:
+                pos = body.origin + (idx + 0.5) * L
             add(per_vox, "pos", pos)
             add(per_vox, "mass", m)
             add(per_vox, "inv_mass", 1.0 / m)
@@ -338,6 +358,10 @@ class Simulation:
             grid_index.append(idx)
             degree = np.bincount(np.concatenate([v1, v2]), minlength=n)
             add(per_vox, "surface", (degree < 6).astype(np.int8))
+            # the seed engine's voxel order (x fastest, then y, then z): it
+            # decides which voxel of a pair sets the seed's candidate horizon
+            nx, ny = grid.shape[0], grid.shape[1]
+            add(per_vox, "seed_rank", (idx[:, 0] + nx * (idx[:, 1] + ny * idx[:, 2])).astype(np.intp))
             ex_start, ex_idx = _hop_neighbours(n, v1, v2, cfg.collision_exclusion)
             add(per_vox, "excl_count", np.diff(ex_start))
             excl.append(ex_idx + vox_start[-1])
@@ -360,6 +384,10 @@ class Simulation:
             a[name] = np.ascontiguousarray(np.concatenate(parts))
         for name in ("v1", "v2"):
             a[name] = a[name].astype(np.intp)
+        a["c_seed"] = np.ascontiguousarray(a["c_seed"], dtype=np.float64).reshape(-1, 8)
+        a["homog"] = a["homog"].astype(np.int8)
+        a["link_sa"] = np.ones(a["v1"].shape[0], dtype=np.int8)  # links start in small-angle mode
+        a["link_last"] = np.zeros((a["v1"].shape[0], 9))
         a["axis"] = a["axis"].astype(np.int32)
         a["link_out"] = np.zeros((10, a["v1"].shape[0]))  # kernel scratch (rows: see _core.pyx)
         a["quat"] = np.zeros((n_vox, 4))
@@ -369,6 +397,10 @@ class Simulation:
         for name in ("vel", "angvel", "force", "moment", "ext_force"):
             a[name] = np.zeros((n_vox, 3))
         a["scale"] = np.full(n_vox, L)
+        a["seed_rank"] = a["seed_rank"].astype(np.intp)
+        a["col_ref"] = np.zeros((n_vox, 4))
+        a["col_acc"] = np.full(n_robots, np.inf)  # first step builds the candidates
+        a["col_vmax"] = np.zeros(n_robots)
         a["temp"] = np.zeros(n_vox)
         a["vox_start"] = np.asarray(vox_start, dtype=np.intp)
         a["link_start"] = np.asarray(link_start, dtype=np.intp)
@@ -399,6 +431,8 @@ class Simulation:
             "trace_interval": float(cfg.trace_interval),
             "self_collision": int(bool(cfg.self_collision)),
             "actuation_mode": 0 if cfg.actuation == "seed" else 1,
+            "model": 0 if cfg.model == "seed" else 1,
+            "bond_zeta": float(cfg.bond_damping),
         }
 
     # --------------------------------------------------------------- properties
@@ -791,5 +825,13 @@ class Simulation:
                 a[k][s] = src[s]
         for k in _ROBOT_STATE:
             a[k][ids] = np.asarray(state[k])[ids]
+        lo = a["link_start"]
+        for k in _LINK_STATE:
+            src = np.asarray(state[k])
+            if src.shape != a[k].shape:
+                raise InvalidParameterError(f"state array {k!r} has shape {src.shape}, expected {a[k].shape}")
+            for r in ids:
+                s = slice(int(lo[r]), int(lo[r + 1]))
+                a[k][s] = src[s]
         a["steps"][ids] = np.ceil(self._t_target / a["dt"][ids] - 1e-9).astype(np.int64)
         self._state_changed()
