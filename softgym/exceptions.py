@@ -9,6 +9,7 @@ from __future__ import annotations
 
 __all__ = [
     "CheckpointError",
+    "DesignFileError",
     "InvalidActionError",
     "InvalidDesignError",
     "InvalidParameterError",
@@ -28,6 +29,13 @@ class InvalidParameterError(SoftGymError, ValueError):
 
 class InvalidDesignError(SoftGymError, ValueError):
     """A robot design breaks a rule: shape, dtype, material ids, connectivity, composition."""
+
+
+class DesignFileError(InvalidDesignError, OSError):
+    """A design file cannot be read: missing, a folder, unreadable, not text, or too large.
+
+    Also an :class:`OSError`, so code that caught the builtin file errors keeps working.
+    """
 
 
 class InvalidTerrainError(SoftGymError, ValueError):

@@ -23,6 +23,7 @@ from softgym.design.cppn import (
 from softgym.design.material import (
     BONE_IDS,
     EVOLVABLE_BOUNDS,
+    MAX_ABS_CTE,
     MUSCLE_IDS,
     OBSTACLE_IDS,
     OLD_MATERIAL_IDS,
@@ -36,13 +37,25 @@ from softgym.design.material import (
 from softgym.design.robot import (
     DESIGN_SCHEMA,
     DESIGN_VERSION,
+    MAX_DESIGN_JSON_BYTES,
+    MAX_GRID_DIM,
+    MAX_GRID_VOXELS,
     CompositionRules,
     RobotDesign,
+    check_grid_shape,
     default_walker,
     label_components,
     largest_component_mask,
 )
-from softgym.design.vxa import VxaDocument, from_vxa, load_vxa, parse_vxa, save_vxa, to_vxa
+from softgym.design.vxa import (
+    MAX_VXA_BYTES,
+    VxaDocument,
+    from_vxa,
+    load_vxa,
+    parse_vxa,
+    save_vxa,
+    to_vxa,
+)
 
 __all__ = [
     "ACTIVATIONS",
@@ -56,6 +69,11 @@ __all__ = [
     "INPUT_NAMES",
     "MATERIAL_TREE_4",
     "MATERIAL_TREE_8",
+    "MAX_ABS_CTE",
+    "MAX_DESIGN_JSON_BYTES",
+    "MAX_GRID_DIM",
+    "MAX_GRID_VOXELS",
+    "MAX_VXA_BYTES",
     "MUSCLE_IDS",
     "MUTATIONS",
     "OBSTACLE_IDS",
@@ -69,6 +87,7 @@ __all__ = [
     "Palette",
     "RobotDesign",
     "VxaDocument",
+    "check_grid_shape",
     "cppn_inputs",
     "default_palette",
     "default_walker",

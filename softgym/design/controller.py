@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from numbers import Real
 from typing import Any, ClassVar
 
 from softgym.exceptions import InvalidDesignError, InvalidParameterError
@@ -23,6 +24,16 @@ CONTROLLER_BOUNDS: dict[str, tuple[float, float, str]] = {
     "period": (0.01, 0.75, "s"),
     "muscle_cte": (0.001, 0.04, "1/degC"),
 }
+
+
+def _number(name: str, raw: Any) -> float:
+    # a real number (int, float, numpy scalar); bools and strings are refused, not coerced
+    if isinstance(raw, (bool, str, bytes)) or not isinstance(raw, Real):
+        raise InvalidParameterError(f"controller {name} must be a number, got {raw!r}")
+    try:
+        return float(raw)
+    except (TypeError, ValueError, OverflowError):
+        raise InvalidParameterError(f"controller {name} must be a number, got {raw!r}") from None
 
 
 @dataclass(frozen=True)
@@ -53,13 +64,7 @@ class Controller:
 
     def __post_init__(self) -> None:
         for name, (lo, hi, unit) in CONTROLLER_BOUNDS.items():
-            raw = getattr(self, name)
-            try:
-                value = float(raw)
-            except (TypeError, ValueError):
-                raise InvalidParameterError(
-                    f"controller {name} must be a number, got {raw!r}"
-                ) from None
+            value = _number(name, getattr(self, name))
             if not (math.isfinite(value) and lo <= value <= hi):
                 raise InvalidParameterError(
                     f"controller {name} = {value} {unit} is outside the seed's bounds [{lo}, {hi}]"
@@ -83,7 +88,7 @@ class Controller:
         out = {}
         for name, raw in values.items():
             lo, hi, _ = CONTROLLER_BOUNDS[name]
-            v = float(raw)
+            v = _number(name, raw)
             if not math.isfinite(v):
                 raise InvalidParameterError(f"controller {name} must be finite, got {v}")
             out[name] = min(max(v, lo), hi)
@@ -125,5 +130,5 @@ class Controller:
             raise InvalidDesignError(f"a controller must be an object, got {type(data).__name__}")
         unknown = set(data) - set(CONTROLLER_BOUNDS)
         if unknown:
-            raise InvalidDesignError(f"unknown controller field(s) {sorted(unknown)}")
+            raise InvalidDesignError(f"unknown controller field(s) {sorted(map(str, unknown))}")
         return cls(**data)

@@ -42,7 +42,12 @@ import numpy as np
 
 from softgym.design.controller import Controller
 from softgym.design.material import Palette
-from softgym.design.robot import CompositionRules, RobotDesign, largest_component_mask
+from softgym.design.robot import (
+    CompositionRules,
+    RobotDesign,
+    check_grid_shape,
+    largest_component_mask,
+)
 from softgym.exceptions import InvalidDesignError, InvalidParameterError
 
 __all__ = [
@@ -145,13 +150,11 @@ def _inputs_cached(shape: tuple[int, int, int]) -> tuple[np.ndarray, ...]:
 
 
 def _check_shape(shape: Sequence[int]) -> tuple[int, int, int]:
+    # integers only, within the design grid caps (checked before any array is made)
     try:
-        s = tuple(int(v) for v in shape)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(f"shape must be 3 positive integers, got {shape!r}") from None
-    if len(s) != 3 or min(s) < 1:
-        raise InvalidParameterError(f"shape must be 3 positive integers, got {shape!r}")
-    return s  # type: ignore[return-value]
+        return check_grid_shape(shape, "CPPN shape")
+    except InvalidDesignError as exc:
+        raise InvalidParameterError(str(exc)) from None
 
 
 def cppn_inputs(shape: Sequence[int] = (6, 6, 6)) -> dict[str, np.ndarray]:
@@ -725,13 +728,25 @@ class CPPN:
             raise InvalidDesignError(
                 f"CPPN version {version} is newer than this softgym reads (up to {CPPN_VERSION}); upgrade softgym"
             )
+        outputs = data.get("outputs")
+        if not isinstance(outputs, list) or not all(isinstance(o, str) for o in outputs):
+            raise InvalidDesignError(f"CPPN outputs must be a list of names, got {outputs!r}")
         try:
-            g = cls(data["outputs"])
-        except (KeyError, InvalidParameterError) as exc:
-            raise InvalidDesignError(f"CPPN outputs are missing or invalid: {exc}") from exc
+            g = cls(outputs)
+        except InvalidParameterError as exc:
+            raise InvalidDesignError(f"CPPN outputs are invalid: {exc}") from exc
+        nodes, edges = data.get("nodes", []), data.get("edges", [])
+        if not isinstance(nodes, list) or not isinstance(edges, list):
+            raise InvalidDesignError("CPPN 'nodes' and 'edges' must be lists")
         g._edges = {}
-        for item in data.get("nodes", []):
+        for item in nodes:
+            if not isinstance(item, Mapping):
+                raise InvalidDesignError(f"CPPN node {item!r} is not an object")
             node, kind, act = item.get("id"), item.get("kind"), item.get("activation")
+            if not isinstance(node, (str, int)) or not isinstance(act, str):
+                raise InvalidDesignError(
+                    f"CPPN node {node!r} needs an int or str 'id' and a str 'activation'"
+                )
             if act not in ACTIVATIONS:
                 raise InvalidDesignError(f"CPPN node {node!r} has unknown activation {act!r}")
             if kind == "output" and node in g.outputs:
@@ -742,14 +757,16 @@ class CPPN:
                 g._act[node] = act
             else:
                 raise InvalidDesignError(f"CPPN node {node!r} of kind {kind!r} is not valid")
-        for item in data.get("edges", []):
-            try:
-                a, b, w = item
-                w = float(w)
-            except (TypeError, ValueError):
-                raise InvalidDesignError(
-                    f"CPPN link {item!r} is not [source, target, weight]"
-                ) from None
+        for item in edges:
+            if (
+                not isinstance(item, list)
+                or len(item) != 3
+                or not all(isinstance(v, (str, int)) for v in item[:2])
+                or isinstance(item[2], bool)
+                or not isinstance(item[2], (int, float))
+            ):
+                raise InvalidDesignError(f"CPPN link {item!r} is not [source, target, weight]")
+            a, b, w = item[0], item[1], float(item[2])
             if a not in g._act or b not in g._act:
                 raise InvalidDesignError(f"CPPN link {a!r} -> {b!r} names an unknown node")
             if g._kind(b) == "input" or g._kind(a) == "output":
@@ -769,9 +786,13 @@ class CPPN:
 
     @classmethod
     def from_json(cls, text: str | bytes) -> CPPN:
-        """Inverse of :meth:`to_json`."""
+        """Inverse of :meth:`to_json`; any malformed text raises :class:`InvalidDesignError`."""
+        if not isinstance(text, (str, bytes, bytearray)):
+            raise InvalidDesignError(
+                f"a CPPN's JSON must be str or bytes, got {type(text).__name__}"
+            )
         try:
             data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise InvalidDesignError(f"CPPN is not valid JSON: {exc}") from exc
+        except (ValueError, RecursionError) as exc:  # JSONDecodeError, UnicodeDecodeError...
+            raise InvalidDesignError(f"CPPN is not valid JSON: {exc!s:.200}") from None
         return cls.from_dict(data)

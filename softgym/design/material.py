@@ -31,13 +31,17 @@ import math
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, fields, replace
 from functools import lru_cache
+from numbers import Real
 from typing import Any
+
+import numpy as np
 
 from softgym.exceptions import InvalidDesignError, InvalidParameterError
 
 __all__ = [
     "BONE_IDS",
     "EVOLVABLE_BOUNDS",
+    "MAX_ABS_CTE",
     "MAX_MATERIAL_ID",
     "MUSCLE_IDS",
     "OBSTACLE_IDS",
@@ -53,6 +57,11 @@ __all__ = [
 #: Largest material id a design grid (int8) can hold.
 MAX_MATERIAL_ID = 127
 
+#: Largest ``|CTE|`` (1/°C) a material may have. Twice the seed's largest (0.05, material 8):
+#: at the controller's largest amplitude (20 °C) a voxel's rest size stays within
+#: ``L (1 +- 2)``. Larger values only make runaway actuation.
+MAX_ABS_CTE = 0.1
+
 #: Ids of muscle materials in the seed palette (Active_+, Active_-, New_Active_+, New_Active_-).
 MUSCLE_IDS: tuple[int, ...] = (3, 4, 8, 9)
 #: Ids of passive tissue (soft and hard, old and new).
@@ -65,11 +74,19 @@ OLD_MATERIAL_IDS: tuple[int, ...] = (1, 2, 3, 4)
 OBSTACLE_IDS: tuple[int, ...] = (5,)
 
 
+def _is_int(value: Any) -> bool:
+    """Whether ``value`` is an integer (Python or numpy), not a bool."""
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
 def _finite(name: str, value: Any) -> float:
+    # a real number: int, float or a numpy scalar; never a bool, a string or a container
+    if isinstance(value, (bool, str, bytes)) or not isinstance(value, Real):
+        raise InvalidParameterError(f"{name} must be a number, got {value!r}")
     try:
         v = float(value)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(f"{name} must be a number, got {value!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        raise InvalidParameterError(f"{name} must be a finite number, got {value!r}") from None
     if not math.isfinite(v):
         raise InvalidParameterError(f"{name} must be finite, got {v}")
     return v
@@ -79,9 +96,10 @@ def _finite(name: str, value: Any) -> float:
 class Material:
     """Physical properties of one voxel material.
 
-    Construction checks physical validity (positive modulus and density,
-    Poisson's ratio in [0, 0.5), non-negative friction, colour channels in
-    [0, 1]) and raises :class:`~softgym.exceptions.InvalidParameterError`
+    Construction checks physical validity (real numbers, not bools or
+    strings; positive modulus and density, Poisson's ratio in [0, 0.5),
+    ``|CTE| <= 0.1`` 1/°C, non-negative friction, colour channels in [0, 1])
+    and raises :class:`~softgym.exceptions.InvalidParameterError`
     otherwise. The evolutionary bounds of the materials GA are separate
     (:class:`MaterialBounds`).
 
@@ -96,8 +114,9 @@ class Material:
     poisson : float
         Poisson's ratio, in [0, 0.5).
     cte : float
-        Coefficient of thermal expansion (1/°C); 0 for passive tissue, the
-        sign selects the phase of a muscle.
+        Coefficient of thermal expansion (1/°C), in [-MAX_ABS_CTE, MAX_ABS_CTE]
+        (``MAX_ABS_CTE`` = 0.1); 0 for passive tissue, the sign selects the
+        phase of a muscle.
     mu_static, mu_kinetic : float
         Coulomb friction coefficients against the floor, >= 0.
     color : tuple of 3 or 4 floats
@@ -129,14 +148,26 @@ class Material:
             raise InvalidParameterError(f"{label}: density must be > 0 kg/m^3, got {rho}")
         if not 0.0 <= nu < 0.5:
             raise InvalidParameterError(f"{label}: poisson must lie in [0, 0.5), got {nu}")
+        if abs(cte) > MAX_ABS_CTE:
+            raise InvalidParameterError(
+                f"{label}: cte must lie in [-{MAX_ABS_CTE}, {MAX_ABS_CTE}] 1/degC, got {cte}"
+            )
         if mus < 0 or muk < 0:
             raise InvalidParameterError(
                 f"{label}: friction coefficients must be >= 0, got mu_static={mus}, mu_kinetic={muk}"
             )
-        try:
-            color = tuple(float(c) for c in self.color)
-        except (TypeError, ValueError):
-            raise InvalidParameterError(f"{label}: color must be 3 or 4 numbers") from None
+        raw_color = self.color
+        if isinstance(raw_color, (str, bytes)) or not isinstance(
+            raw_color, (tuple, list, np.ndarray)
+        ):
+            raise InvalidParameterError(
+                f"{label}: color must be a sequence of 3 or 4 numbers in [0, 1], got {raw_color!r}"
+            )
+        if len(raw_color) not in (3, 4):
+            raise InvalidParameterError(
+                f"{label}: color must be 3 or 4 numbers in [0, 1], got {len(raw_color)} values"
+            )
+        color = tuple(_finite(f"{label}: color channel", c) for c in raw_color)
         if len(color) == 3:
             color = (*color, 1.0)
         if len(color) != 4 or not all(math.isfinite(c) and 0.0 <= c <= 1.0 for c in color):
@@ -171,17 +202,19 @@ class Material:
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Material:
-        """Inverse of :meth:`to_dict`; unknown keys raise :class:`InvalidDesignError`."""
+        """Inverse of :meth:`to_dict`; unknown keys raise :class:`InvalidDesignError`.
+
+        Values out of range raise :class:`InvalidParameterError` (as the constructor does).
+        """
+        if not isinstance(data, Mapping):
+            raise InvalidDesignError(f"a material must be an object, got {type(data).__name__}")
         known = {f.name for f in fields(cls)}
         unknown = set(data) - known
         if unknown:
-            raise InvalidDesignError(f"unknown material field(s) {sorted(unknown)}")
+            raise InvalidDesignError(f"unknown material field(s) {sorted(map(str, unknown))}")
         if "name" not in data or "youngs_modulus" not in data:
             raise InvalidDesignError("a material needs at least 'name' and 'youngs_modulus'")
-        kw = dict(data)
-        if "color" in kw:
-            kw["color"] = tuple(kw["color"])
-        return cls(**kw)
+        return cls(**dict(data))
 
 
 @dataclass(frozen=True)
@@ -279,13 +312,18 @@ class Palette(Mapping[int, Material]):
     ) -> None:
         if isinstance(materials, Mapping):
             items = list(materials.items())
-        else:
+        elif isinstance(materials, (list, tuple)):
             items = list(enumerate(materials, start=1))
+        else:
+            raise InvalidDesignError(
+                "a palette takes a mapping of id to Material or a list of Materials, "
+                f"got {type(materials).__name__}"
+            )
         if not items:
             raise InvalidDesignError("a palette needs at least one material")
         table: dict[int, Material] = {}
         for key, mat in items:
-            if isinstance(key, bool) or not isinstance(key, int) or not 1 <= key <= MAX_MATERIAL_ID:
+            if not _is_int(key) or not 1 <= key <= MAX_MATERIAL_ID:
                 raise InvalidDesignError(
                     f"material ids must be integers in 1..{MAX_MATERIAL_ID} (0 is empty), got {key!r}"
                 )
@@ -298,7 +336,7 @@ class Palette(Mapping[int, Material]):
     def __getitem__(self, key: int) -> Material:
         try:
             return self._materials[key]
-        except KeyError:
+        except (KeyError, TypeError):  # TypeError: an unhashable key is never an id
             raise KeyError(
                 f"no material with id {key!r} in the palette (ids {list(self._ids)})"
             ) from None
@@ -378,6 +416,12 @@ class Palette(Mapping[int, Material]):
                 raise InvalidDesignError(f"palette entry {i} has no 'id'")
             data = dict(item)
             key = data.pop("id")
+            if not _is_int(key) or not 1 <= key <= MAX_MATERIAL_ID:
+                raise InvalidDesignError(
+                    f"palette entry {i}: 'id' must be an integer in 1..{MAX_MATERIAL_ID} "
+                    f"(0 is empty), got {key!r}"
+                )
+            key = int(key)
             if key in table:
                 raise InvalidDesignError(f"palette lists material id {key} twice")
             try:

@@ -20,6 +20,7 @@ import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields
 from functools import lru_cache
+from numbers import Real
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -33,7 +34,12 @@ from softgym.design.material import (
     Palette,
     default_palette,
 )
-from softgym.exceptions import InvalidDesignError
+from softgym.exceptions import (
+    DesignFileError,
+    InvalidDesignError,
+    InvalidParameterError,
+    SoftGymError,
+)
 
 if TYPE_CHECKING:  # importing softgym.engine.* runs softgym/engine/__init__ (compiled code)
     from softgym.engine.body import Body
@@ -41,8 +47,12 @@ if TYPE_CHECKING:  # importing softgym.engine.* runs softgym/engine/__init__ (co
 __all__ = [
     "DESIGN_SCHEMA",
     "DESIGN_VERSION",
+    "MAX_DESIGN_JSON_BYTES",
+    "MAX_GRID_DIM",
+    "MAX_GRID_VOXELS",
     "CompositionRules",
     "RobotDesign",
+    "check_grid_shape",
     "default_walker",
     "label_components",
     "largest_component_mask",
@@ -53,8 +63,65 @@ DESIGN_SCHEMA = "softgym.design"
 #: Newest design-file version this softgym writes and reads.
 DESIGN_VERSION = 1
 
+#: Largest side (cells) of a design grid along any axis.
+MAX_GRID_DIM = 1000
+#: Largest number of cells (nx * ny * nz) of a design grid: shapes are checked against it
+#: before anything is allocated (the engine holds ~1 KiB of state per voxel).
+MAX_GRID_VOXELS = 1_000_000
+#: Largest design JSON text (bytes) :meth:`RobotDesign.from_json` and :meth:`RobotDesign.load`
+#: read: a grid of MAX_GRID_VOXELS cells in the "ints" encoding fits.
+MAX_DESIGN_JSON_BYTES = 32 * 2**20
+
 # Migrations from version v to v + 1, applied in order on load: {v: callable(dict) -> dict}.
 _MIGRATIONS: dict[int, Any] = {}
+
+
+# --------------------------------------------------------------------------------------------
+# Grid shapes
+# --------------------------------------------------------------------------------------------
+
+
+def _is_int(value: Any) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
+def check_grid_shape(shape: Any, name: str = "grid shape") -> tuple[int, int, int]:
+    """Validate a grid shape before anything of that shape is allocated.
+
+    Parameters
+    ----------
+    shape : sequence of 3 ints
+        (nx, ny, nz). Integers only: ``6.5``, ``True`` and ``"6"`` are refused,
+        not rounded or coerced.
+    name : str
+        What the shape is, for the error message (``"grid_shape"``, ``"<X_Voxels>"``...).
+
+    Returns
+    -------
+    tuple of 3 int
+
+    Raises
+    ------
+    InvalidDesignError
+        Unless every side is an integer in 1..:data:`MAX_GRID_DIM` and the
+        product is at most :data:`MAX_GRID_VOXELS`.
+    """
+    if isinstance(shape, (str, bytes)) or not isinstance(shape, (Sequence, np.ndarray)):
+        raise InvalidDesignError(f"{name} must be 3 integers (nx, ny, nz), got {shape!r}")
+    dims = list(shape)
+    if len(dims) != 3 or not all(_is_int(v) for v in dims):
+        raise InvalidDesignError(f"{name} must be 3 integers (nx, ny, nz), got {shape!r}")
+    dims = [int(v) for v in dims]
+    if not all(1 <= v <= MAX_GRID_DIM for v in dims):
+        raise InvalidDesignError(
+            f"{name} {tuple(dims)}: each side must lie in 1..{MAX_GRID_DIM} cells"
+        )
+    if dims[0] * dims[1] * dims[2] > MAX_GRID_VOXELS:
+        raise InvalidDesignError(
+            f"{name} {tuple(dims)} has {dims[0] * dims[1] * dims[2]} cells, "
+            f"more than the cap of {MAX_GRID_VOXELS}"
+        )
+    return dims[0], dims[1], dims[2]
 
 
 # --------------------------------------------------------------------------------------------
@@ -189,6 +256,45 @@ class CompositionRules:
     tissue_ids: tuple[int, ...] = TISSUE_IDS
     bone_ids: tuple[int, ...] = BONE_IDS
 
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if "fraction" in f.name:
+                if isinstance(value, (bool, str)) or not isinstance(value, Real):
+                    raise InvalidParameterError(
+                        f"composition rule {f.name} must be a number in [0, 1], got {value!r}"
+                    )
+                if not 0.0 <= float(value) <= 1.0:
+                    raise InvalidParameterError(
+                        f"composition rule {f.name} must lie in [0, 1], got {value!r}"
+                    )
+                object.__setattr__(self, f.name, float(value))
+            elif f.name == "min_bone_voxels":
+                if not _is_int(value) or not 0 <= value <= MAX_GRID_VOXELS:
+                    raise InvalidParameterError(
+                        f"composition rule min_bone_voxels must be an integer in "
+                        f"0..{MAX_GRID_VOXELS}, got {value!r}"
+                    )
+                object.__setattr__(self, f.name, int(value))
+            elif f.name == "require_connected":
+                if not isinstance(value, (bool, np.bool_)):
+                    raise InvalidParameterError(
+                        f"composition rule require_connected must be a bool, got {value!r}"
+                    )
+                object.__setattr__(self, f.name, bool(value))
+            else:  # muscle_ids, tissue_ids, bone_ids
+                if isinstance(value, (str, bytes)) or not isinstance(value, (Sequence, np.ndarray)):
+                    raise InvalidParameterError(
+                        f"composition rule {f.name} must be a sequence of material ids, got {value!r}"
+                    )
+                ids = tuple(value)
+                if not all(_is_int(v) and 1 <= v <= MAX_MATERIAL_ID for v in ids):
+                    raise InvalidParameterError(
+                        f"composition rule {f.name} must hold material ids in 1..{MAX_MATERIAL_ID}, "
+                        f"got {value!r}"
+                    )
+                object.__setattr__(self, f.name, tuple(int(v) for v in ids))
+
     @classmethod
     def seed(cls) -> CompositionRules:
         """Evosoro's default (§2.8, §3.1): >= 30 % of the grid filled, >= 10 % of the grid muscle."""
@@ -288,7 +394,14 @@ class CompositionRules:
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> CompositionRules:
-        """Inverse of :meth:`to_dict`."""
+        """Inverse of :meth:`to_dict`; unknown keys raise :class:`InvalidParameterError`."""
+        if not isinstance(data, Mapping):
+            raise InvalidParameterError(
+                f"composition rules must be an object, got {type(data).__name__}"
+            )
+        unknown = set(data) - {f.name for f in fields(cls)}
+        if unknown:
+            raise InvalidParameterError(f"unknown composition rule(s) {sorted(map(str, unknown))}")
         kw = {k: tuple(v) if isinstance(v, list) else v for k, v in data.items()}
         return cls(**kw)
 
@@ -319,18 +432,16 @@ def _grid_to_json(grid: np.ndarray) -> dict[str, Any]:
 def _grid_from_json(data: Any) -> np.ndarray:
     if not isinstance(data, Mapping):
         raise InvalidDesignError("design 'grid' must be an object with 'shape' and 'layers'")
-    try:
-        nx, ny, nz = (int(v) for v in data["shape"])
-        layers = data["layers"]
-    except (KeyError, TypeError, ValueError):
-        raise InvalidDesignError("design 'grid' needs 'shape' [nx, ny, nz] and 'layers'") from None
+    if "shape" not in data or "layers" not in data:
+        raise InvalidDesignError("design 'grid' needs 'shape' [nx, ny, nz] and 'layers'")
+    # the shape is checked against the caps before the grid is allocated
+    nx, ny, nz = check_grid_shape(data["shape"], "design 'grid' shape")
+    layers = data["layers"]
     encoding = data.get("encoding", "digits")
     if encoding not in ("digits", "ints"):
         raise InvalidDesignError(
             f"unknown grid encoding {encoding!r} (expected 'digits' or 'ints')"
         )
-    if min(nx, ny, nz) < 1:
-        raise InvalidDesignError(f"grid shape must be positive, got {[nx, ny, nz]}")
     if not isinstance(layers, list) or len(layers) != nz:
         raise InvalidDesignError(
             f"grid has {len(layers) if isinstance(layers, list) else 'no'} layers, shape says nz = {nz}"
@@ -348,24 +459,21 @@ def _grid_from_json(data: Any) -> np.ndarray:
                     or not row.isascii()
                 ):
                     raise InvalidDesignError(
-                        f"grid row z={z} y={y} must be {nx} digits, got {row!r}"
+                        f"grid row z={z} y={y} must be {nx} digits, got {row!r}"[:200]
                     )
                 values = [int(c) for c in row]
             else:
                 if not isinstance(row, list) or len(row) != nx:
                     raise InvalidDesignError(f"grid row z={z} y={y} must be a list of {nx} ints")
+                # JSON ints only: 1.7, true and "1" are refused, not truncated or coerced
+                for x, v in enumerate(row):
+                    if type(v) is not int or not 0 <= v <= MAX_MATERIAL_ID:
+                        raise InvalidDesignError(
+                            f"grid cell x={x} y={y} z={z} must be an integer material id in "
+                            f"0..{MAX_MATERIAL_ID}, got {v!r}"[:200]
+                        )
                 values = row
-            try:
-                arr = np.asarray(values, dtype=np.int64)
-            except (TypeError, ValueError):
-                raise InvalidDesignError(
-                    f"grid row z={z} y={y} holds a non-integer: {row!r}"
-                ) from None
-            if arr.min() < 0 or arr.max() > MAX_MATERIAL_ID:
-                raise InvalidDesignError(
-                    f"grid row z={z} y={y} holds an id outside 0..{MAX_MATERIAL_ID}"
-                )
-            grid[:, y, z] = arr
+            grid[:, y, z] = values
     return grid
 
 
@@ -409,11 +517,15 @@ class RobotDesign:
     controller: Controller = field(default_factory=Controller)
 
     def __post_init__(self) -> None:
-        raw = np.asarray(self.grid)
+        try:
+            raw = np.asarray(self.grid)
+        except (TypeError, ValueError, OverflowError) as exc:  # ragged nesting, odd objects
+            raise InvalidDesignError(f"grid is not a 3-D array of material ids: {exc}") from None
         if raw.ndim != 3:
             raise InvalidDesignError(f"grid must be 3-D (nx, ny, nz), got shape {raw.shape}")
         if min(raw.shape) < 1:
             raise InvalidDesignError(f"grid has an empty dimension: shape {raw.shape}")
+        check_grid_shape(raw.shape, "grid shape")
         if raw.dtype == bool or not np.issubdtype(raw.dtype, np.integer):
             raise InvalidDesignError(f"grid must hold integer material ids, got dtype {raw.dtype}")
         if raw.min() < 0 or raw.max() > MAX_MATERIAL_ID:
@@ -646,11 +758,35 @@ class RobotDesign:
 
     @classmethod
     def from_json(cls, text: str | bytes) -> RobotDesign:
-        """Inverse of :meth:`to_json`; malformed JSON raises :class:`InvalidDesignError`."""
+        """Inverse of :meth:`to_json`.
+
+        Raises
+        ------
+        InvalidDesignError
+            If ``text`` is not str or bytes, longer than :data:`MAX_DESIGN_JSON_BYTES`,
+            not UTF-8, not JSON, nested too deeply, or not a valid design.
+        """
+        if not isinstance(text, (str, bytes, bytearray)):
+            raise InvalidDesignError(
+                f"a design's JSON must be str or bytes, got {type(text).__name__}"
+            )
+        if len(text) > MAX_DESIGN_JSON_BYTES:
+            raise InvalidDesignError(
+                f"design JSON of {len(text)} characters is larger than the cap of "
+                f"{MAX_DESIGN_JSON_BYTES} bytes"
+            )
         try:
+            if not isinstance(text, str):
+                text = bytes(text).decode("utf-8")
             data = json.loads(text)
+        except UnicodeDecodeError as exc:
+            raise InvalidDesignError(f"design file is not UTF-8 text: {exc}") from None
         except json.JSONDecodeError as exc:
-            raise InvalidDesignError(f"design file is not valid JSON: {exc}") from exc
+            raise InvalidDesignError(f"design file is not valid JSON: {exc}") from None
+        except ValueError as exc:  # e.g. an integer of more than 4300 digits
+            raise InvalidDesignError(f"design file holds an invalid JSON value: {exc}") from None
+        except RecursionError:
+            raise InvalidDesignError("design file is nested too deeply to be a design") from None
         return cls.from_dict(data)
 
     def save(self, path: str | os.PathLike[str]) -> None:
@@ -664,9 +800,44 @@ class RobotDesign:
 
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> RobotDesign:
-        """Read a design written by :meth:`save`."""
-        with open(os.fspath(path), encoding="utf-8") as fh:
-            return cls.from_json(fh.read())
+        """Read a design written by :meth:`save`.
+
+        Raises
+        ------
+        DesignFileError
+            Naming the file, if it is missing, a folder, unreadable, larger than
+            :data:`MAX_DESIGN_JSON_BYTES` or not UTF-8 text (also an ``OSError``).
+        InvalidDesignError
+            Naming the file, if its content is not a valid design.
+        """
+        path = os.fspath(path)
+        data = _read_capped(path, MAX_DESIGN_JSON_BYTES, "design")
+        try:
+            text = data.decode("utf-8")
+        except UnicodeDecodeError:
+            raise DesignFileError(f"design file {path!r} is not UTF-8 text") from None
+        try:
+            return cls.from_json(text)
+        except SoftGymError as exc:
+            raise InvalidDesignError(f"design file {path!r}: {exc}") from exc
+
+
+def _read_capped(path: str, cap: int, what: str) -> bytes:
+    """The bytes of ``path``; any problem raises :class:`DesignFileError` naming the file."""
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(cap + 1)
+    except FileNotFoundError:
+        raise DesignFileError(f"{what} file {path!r} does not exist") from None
+    except IsADirectoryError:
+        raise DesignFileError(f"{what} file {path!r} is a folder, not a file") from None
+    except OSError as exc:
+        raise DesignFileError(
+            f"{what} file {path!r} cannot be read: {exc.strerror or exc}"
+        ) from None
+    if len(data) > cap:
+        raise DesignFileError(f"{what} file {path!r} is larger than the cap of {cap} bytes")
+    return data
 
 
 def default_walker() -> RobotDesign:

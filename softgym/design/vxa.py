@@ -44,10 +44,21 @@ import numpy as np
 
 from softgym.design.controller import Controller
 from softgym.design.material import MAX_MATERIAL_ID, Material, Palette
-from softgym.design.robot import RobotDesign
+from softgym.design.robot import RobotDesign, _read_capped, check_grid_shape
 from softgym.exceptions import InvalidDesignError, InvalidParameterError
 
-__all__ = ["VxaDocument", "from_vxa", "load_vxa", "parse_vxa", "save_vxa", "to_vxa"]
+__all__ = [
+    "MAX_VXA_BYTES",
+    "VxaDocument",
+    "from_vxa",
+    "load_vxa",
+    "parse_vxa",
+    "save_vxa",
+    "to_vxa",
+]
+
+#: Largest ``.vxa`` text (bytes) read: a grid of MAX_GRID_VOXELS cells plus a full palette fits.
+MAX_VXA_BYTES = 32 * 2**20
 
 logger = logging.getLogger(__name__)
 
@@ -108,10 +119,16 @@ def _number(el: ET.Element | None, where: str, default: float | None = None) -> 
 
 
 def _int(el: ET.Element | None, where: str) -> int:
-    value = _number(el, where)
-    if value != int(value) or value < 1:
-        raise InvalidDesignError(f"{where} must be a positive integer, got {el.text!r}")  # type: ignore[union-attr]
-    return int(value)
+    # a count written as an integer ("6", not "6.5" or "6.0"); range checked by the caller
+    if el is None:
+        raise InvalidDesignError(f"VXA file is missing {where}")
+    text = (el.text or "").strip()
+    if not (text.isascii() and text.isdigit()) or len(text) > 9:
+        _number(el, where)  # "is not a number" / "is not finite" first
+        raise InvalidDesignError(
+            f"{where} must be a positive integer of at most 9 digits, got {text!r:.40}"
+        )
+    return int(text)
 
 
 def _parse_material(el: ET.Element) -> tuple[int, Material]:
@@ -171,6 +188,8 @@ def _parse_structure(structure: ET.Element) -> np.ndarray:
     nx = _int(structure.find("X_Voxels"), "<X_Voxels> of <Structure>")
     ny = _int(structure.find("Y_Voxels"), "<Y_Voxels> of <Structure>")
     nz = _int(structure.find("Z_Voxels"), "<Z_Voxels> of <Structure>")
+    # against the design caps before the grid (or anything of its size) is allocated
+    nx, ny, nz = check_grid_shape((nx, ny, nz), "<X_Voxels>, <Y_Voxels>, <Z_Voxels>")
     data = _find(structure, "Data", "<Structure>")
     layers = data.findall("Layer")
     if len(layers) != nz:
@@ -212,6 +231,12 @@ def parse_vxa(text: str | bytes) -> VxaDocument:
         a layer has the wrong length, the structure uses an id the palette
         lacks, or the thermal settings are out of the controller's bounds.
     """
+    if not isinstance(text, (str, bytes, bytearray)):
+        raise InvalidDesignError(f"VXA text must be str or bytes, got {type(text).__name__}")
+    if len(text) > MAX_VXA_BYTES:
+        raise InvalidDesignError(
+            f"VXA text of {len(text)} characters is larger than the cap of {MAX_VXA_BYTES} bytes"
+        )
     if isinstance(text, str):
         # A str with an encoding declaration is fine for ElementTree once encoded as UTF-8
         # with the declaration removed.
@@ -219,13 +244,18 @@ def parse_vxa(text: str | bytes) -> VxaDocument:
         if stripped.startswith("<?xml"):
             end = stripped.find("?>")
             stripped = stripped[end + 2 :] if end >= 0 else stripped
-        source: bytes = stripped.encode("utf-8")
+        try:
+            source: bytes = stripped.encode("utf-8")
+        except UnicodeEncodeError as exc:  # lone surrogates
+            raise InvalidDesignError(f"VXA text cannot be encoded: {exc}") from None
     else:
         source = bytes(text)
     try:
         root = ET.fromstring(source)
     except ET.ParseError as exc:
-        raise InvalidDesignError(f"malformed VXA XML: {exc}") from exc
+        raise InvalidDesignError(f"malformed VXA XML: {exc}") from None
+    except (RecursionError, ValueError, LookupError) as exc:  # e.g. an unknown encoding
+        raise InvalidDesignError(f"malformed VXA XML: {exc!s:.200}") from None
     if root.tag != "VXA":
         raise InvalidDesignError(
             f"not a VXA file: the root element is <{root.tag}>, expected <VXA>"
@@ -305,9 +335,22 @@ def from_vxa(text: str | bytes) -> RobotDesign:
 
 
 def load_vxa(path: str | os.PathLike[str]) -> RobotDesign:
-    """Read the :class:`RobotDesign` of a ``.vxa`` file; see :func:`parse_vxa`."""
-    with open(os.fspath(path), "rb") as fh:
-        return parse_vxa(fh.read()).design
+    """Read the :class:`RobotDesign` of a ``.vxa`` file; see :func:`parse_vxa`.
+
+    Raises
+    ------
+    DesignFileError
+        Naming the file, if it is missing, a folder, unreadable or larger than
+        :data:`MAX_VXA_BYTES` (also an ``OSError``).
+    InvalidDesignError
+        Naming the file, if its content is not a valid ``.vxa`` design.
+    """
+    path = os.fspath(path)
+    data = _read_capped(path, MAX_VXA_BYTES, "VXA")
+    try:
+        return parse_vxa(data).design
+    except InvalidDesignError as exc:
+        raise InvalidDesignError(f"VXA file {path!r}: {exc}") from exc
 
 
 # --------------------------------------------------------------------------------------------

@@ -80,7 +80,7 @@ def test_material_color_gets_alpha_and_dict_roundtrip():
 def test_material_bounds_clip_and_check():
     b = EVOLVABLE_BOUNDS
     assert b == MaterialBounds((5e6, 5e8), (1e3, 1e7), (0.001, 0.04))
-    muscle = Material("m", 1e9, density=10.0, cte=-0.5)
+    muscle = Material("m", 1e9, density=10.0, cte=-0.08)
     clipped = b.clip(muscle)
     assert (clipped.youngs_modulus, clipped.density, clipped.cte) == (5e8, 1e3, -0.04)
     tissue = Material("t", 1e6)
