@@ -20,16 +20,52 @@ import json
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
+from numbers import Real
 from typing import Any
 
 import numpy as np
 
 from softgym.exceptions import InvalidTerrainError
 
-__all__ = ["Box", "Terrain"]
+__all__ = ["MAX_BOXES", "MAX_COORDINATE", "MAX_TERRAIN_JSON_BYTES", "Box", "Terrain"]
 
 SCHEMA = "softgym.terrain"
 VERSION = 1
+
+#: Most boxes a terrain may hold (contact is checked for every voxel against every box).
+MAX_BOXES = 1000
+#: Largest ``|coordinate|`` of a box corner, in voxel lengths.
+MAX_COORDINATE = 1e6
+#: Largest terrain JSON text (bytes) :meth:`Terrain.from_json` reads.
+MAX_TERRAIN_JSON_BYTES = 4 * 2**20
+
+
+def _number(name: str, value: Any) -> float:
+    """A finite real number (int, float, numpy scalar); bools and strings are refused."""
+    if isinstance(value, (bool, str, bytes)) or not isinstance(value, Real):
+        raise InvalidTerrainError(f"{name} must be a number, got {value!r:.80}")
+    try:
+        v = float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise InvalidTerrainError(f"{name} must be a finite number, got {value!r:.80}") from None
+    if not math.isfinite(v):
+        raise InvalidTerrainError(f"{name} must be finite, got {v}")
+    return v
+
+
+def _point(name: str, value: Any, n: int = 3) -> tuple[float, ...]:
+    """``n`` finite coordinates within +-MAX_COORDINATE voxel lengths."""
+    if isinstance(value, (str, bytes)) or not isinstance(value, (Sequence, np.ndarray)):
+        raise InvalidTerrainError(f"{name} must be a sequence of {n} numbers, got {value!r:.80}")
+    if len(value) != n:
+        raise InvalidTerrainError(f"{name} needs {n} coordinates, got {len(value)}: {value!r:.80}")
+    out = tuple(_number(f"{name}[{k}]", v) for k, v in enumerate(value))
+    if any(abs(v) > MAX_COORDINATE for v in out):
+        raise InvalidTerrainError(
+            f"{name} = {out}: coordinates must lie in [-{MAX_COORDINATE:g}, {MAX_COORDINATE:g}] "
+            "voxel lengths"
+        )
+    return out
 
 
 @dataclass(frozen=True)
@@ -48,12 +84,8 @@ class Box:
     hi: tuple[float, float, float]
 
     def __post_init__(self) -> None:
-        lo = tuple(float(v) for v in self.lo)
-        hi = tuple(float(v) for v in self.hi)
-        if len(lo) != 3 or len(hi) != 3:
-            raise InvalidTerrainError(f"a box needs 3 coordinates per corner, got {self.lo}, {self.hi}")
-        if not all(math.isfinite(v) for v in lo + hi):
-            raise InvalidTerrainError(f"box corners must be finite, got {lo}, {hi}")
+        lo = _point("box corner lo", self.lo)
+        hi = _point("box corner hi", self.hi)
         if any(h - low <= 0 for low, h in zip(lo, hi)):
             raise InvalidTerrainError(f"box sizes must be > 0, got lo={lo} hi={hi}")
         object.__setattr__(self, "lo", lo)
@@ -89,8 +121,28 @@ class Terrain:
     meta: dict[str, Any] = field(default_factory=dict, compare=False)
 
     def __post_init__(self) -> None:
-        boxes = tuple(b if isinstance(b, Box) else Box(*b) for b in self.boxes)
-        object.__setattr__(self, "boxes", boxes)
+        if isinstance(self.boxes, (str, bytes)) or not isinstance(self.boxes, (Sequence, np.ndarray)):
+            raise InvalidTerrainError(f"terrain boxes must be a sequence, got {self.boxes!r:.80}")
+        if len(self.boxes) > MAX_BOXES:
+            raise InvalidTerrainError(
+                f"a terrain holds at most {MAX_BOXES} boxes, got {len(self.boxes)}"
+            )
+        boxes = []
+        for k, b in enumerate(self.boxes):
+            if isinstance(b, Box):
+                boxes.append(b)
+            elif isinstance(b, (tuple, list)) and len(b) == 2:
+                boxes.append(Box(*b))
+            else:
+                raise InvalidTerrainError(f"box {k} must be a Box or a (lo, hi) pair, got {b!r:.80}")
+        if not isinstance(self.floor, (bool, np.bool_)):
+            raise InvalidTerrainError(f"terrain floor must be a bool, got {self.floor!r:.80}")
+        if not isinstance(self.name, str):
+            raise InvalidTerrainError(f"terrain name must be a str, got {self.name!r:.80}")
+        if not isinstance(self.meta, dict):
+            raise InvalidTerrainError(f"terrain meta must be a dict, got {self.meta!r:.80}")
+        object.__setattr__(self, "boxes", tuple(boxes))
+        object.__setattr__(self, "floor", bool(self.floor))
 
     # ------------------------------------------------------------- builders
     @classmethod
@@ -139,8 +191,9 @@ class Terrain:
             the robot's footprint, (3, 3) for a 6x6 robot at the origin.
         """
         for name, v in (("inner", inner), ("height", height), ("thickness", thickness)):
-            if not (math.isfinite(v) and v > 0):
+            if not _number(f"fence {name}", v) > 0:
                 raise InvalidTerrainError(f"fence {name} must be > 0, got {v}")
+        center = _point("fence center", center, 2)
         boxes = cls._ring(center, inner, thickness, 0.0, height)
         meta = {"builder": "fence", "inner": inner, "height": height, "thickness": thickness,
                 "center": list(map(float, center))}  # fmt: skip
@@ -165,11 +218,21 @@ class Terrain:
         height ``step_height``, separated by gaps of ``ring_width`` (the seed's
         concentric fences of sides 12, 20, 26...).
         """
-        if int(n_rings) != n_rings or n_rings < 1:
-            raise InvalidTerrainError(f"n_rings must be a positive integer, got {n_rings}")
+        if (
+            isinstance(n_rings, (bool, np.bool_))
+            or not isinstance(n_rings, (int, np.integer))
+            or not 1 <= n_rings <= MAX_BOXES // 4
+        ):
+            raise InvalidTerrainError(
+                f"n_rings must be an integer in 1..{MAX_BOXES // 4} (4 boxes per ring, "
+                f"at most {MAX_BOXES} boxes), got {n_rings!r:.80}"
+            )
         for name, v in (("step_height", step_height), ("ring_width", ring_width), ("inner", inner)):
-            if not (math.isfinite(v) and v > 0):
+            if not _number(f"stairs {name}", v) > 0:
                 raise InvalidTerrainError(f"stairs {name} must be > 0, got {v}")
+        if not isinstance(equal_heights, (bool, np.bool_)):
+            raise InvalidTerrainError(f"stairs equal_heights must be a bool, got {equal_heights!r:.80}")
+        center = _point("stairs center", center, 2)
         boxes: list[Box] = []
         for i in range(int(n_rings)):
             if equal_heights:
@@ -221,22 +284,52 @@ class Terrain:
         if not isinstance(data, dict) or data.get("schema") != SCHEMA:
             raise InvalidTerrainError(f"not a softgym terrain (schema {SCHEMA!r} expected)")
         version = data.get("version")
-        if not isinstance(version, int) or version > VERSION or version < 1:
+        if isinstance(version, bool) or not isinstance(version, int) or not 1 <= version <= VERSION:
             raise InvalidTerrainError(
-                f"terrain file version {version!r} is not supported (this softgym reads 1..{VERSION})"
+                f"terrain file version {version!r:.40} is not supported (this softgym reads 1..{VERSION})"
             )
-        try:
-            boxes = tuple(Box(tuple(b["lo"]), tuple(b["hi"])) for b in data["boxes"])
-            return cls(boxes, bool(data.get("floor", True)), str(data.get("name", "boxes")),
-                       dict(data.get("meta", {})))  # fmt: skip
-        except (KeyError, TypeError) as exc:
-            raise InvalidTerrainError(f"malformed terrain: {exc!r}") from None
+        unknown = set(data) - {"schema", "version", "name", "floor", "boxes", "meta"}
+        if unknown:
+            raise InvalidTerrainError(f"unknown terrain field(s) {sorted(map(str, unknown))}")
+        raw_boxes = data.get("boxes")
+        if not isinstance(raw_boxes, list):
+            raise InvalidTerrainError(f"terrain 'boxes' must be a list, got {raw_boxes!r:.80}")
+        if len(raw_boxes) > MAX_BOXES:
+            raise InvalidTerrainError(
+                f"a terrain holds at most {MAX_BOXES} boxes, got {len(raw_boxes)}"
+            )
+        boxes = []
+        for k, b in enumerate(raw_boxes):
+            if not isinstance(b, dict) or set(b) != {"lo", "hi"}:
+                raise InvalidTerrainError(
+                    f"terrain box {k} must be an object with exactly 'lo' and 'hi', got {b!r:.80}"
+                )
+            try:
+                boxes.append(Box(b["lo"], b["hi"]))
+            except InvalidTerrainError as exc:
+                raise InvalidTerrainError(f"terrain box {k}: {exc}") from None
+        return cls(tuple(boxes), data.get("floor", True), data.get("name", "boxes"),
+                   data.get("meta", {}))  # fmt: skip
 
     @classmethod
-    def from_json(cls, text: str) -> Terrain:
-        """Parse :meth:`to_json` output."""
+    def from_json(cls, text: str | bytes) -> Terrain:
+        """Parse :meth:`to_json` output.
+
+        Raises
+        ------
+        InvalidTerrainError
+            If ``text`` is not str or bytes, larger than :data:`MAX_TERRAIN_JSON_BYTES`,
+            not UTF-8 JSON, nested too deeply, or not a valid terrain.
+        """
+        if not isinstance(text, (str, bytes, bytearray)):
+            raise InvalidTerrainError(f"terrain JSON must be str or bytes, got {type(text).__name__}")
+        if len(text) > MAX_TERRAIN_JSON_BYTES:
+            raise InvalidTerrainError(
+                f"terrain JSON of {len(text)} characters is larger than the cap of "
+                f"{MAX_TERRAIN_JSON_BYTES} bytes"
+            )
         try:
             data = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise InvalidTerrainError(f"terrain JSON is invalid: {exc}") from None
+        except (ValueError, RecursionError) as exc:  # JSONDecodeError, UnicodeDecodeError...
+            raise InvalidTerrainError(f"terrain JSON is invalid: {exc!s:.200}") from None
         return cls.from_dict(data)
