@@ -12,7 +12,13 @@ once both halves are complete. The JSON holds the SHA-256 of the npz and of
 its own state, so truncation or corruption of either file is detected and
 raises :class:`~softgym.exceptions.CheckpointError` naming the file. The
 previous ``keep - 1`` checkpoints stay on disk, so a bad latest checkpoint
-never destroys the last good one.
+never destroys the last good one: :func:`load_latest_intact` falls back to it
+and says so in one logged line.
+
+Reading never trusts the files: numpy bit generators are named from an
+allow-list (:data:`RNG_BIT_GENERATORS`), the array file must be an
+uncompressed npz whose array headers match their data sizes (checked before
+any array is allocated), and nothing is unpickled.
 """
 
 from __future__ import annotations
@@ -20,25 +26,31 @@ from __future__ import annotations
 import hashlib
 import io
 import json
+import logging
+import math
 import os
 import re
+import zipfile
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
-from softgym.exceptions import CheckpointError
+from softgym.exceptions import CheckpointError, InvalidParameterError
 
 __all__ = [
     "CHECKPOINT_SCHEMA",
     "CHECKPOINT_VERSION",
+    "RNG_BIT_GENERATORS",
+    "IntactCheckpoint",
     "atomic_write_bytes",
     "atomic_write_json",
     "atomic_write_text",
     "latest_checkpoint",
     "list_checkpoints",
     "load_checkpoint",
+    "load_latest_intact",
     "read_json",
     "rng_from_state",
     "rng_state",
@@ -53,6 +65,19 @@ CHECKPOINT_SCHEMA = "softgym.checkpoint"
 CHECKPOINT_VERSION = 1
 
 _NAME = re.compile(r"^ckpt-(\d{6,})\.json$")
+_NPZ_NAME = re.compile(r"^ckpt-\d{6,}\.npz$")
+
+#: The numpy bit generators a checkpoint may name, by name. Anything else in a
+#: checkpoint is refused: a name is never looked up in ``numpy.random``.
+RNG_BIT_GENERATORS: dict[str, type[np.random.BitGenerator]] = {
+    "MT19937": np.random.MT19937,
+    "PCG64": np.random.PCG64,
+    "PCG64DXSM": np.random.PCG64DXSM,
+    "Philox": np.random.Philox,
+    "SFC64": np.random.SFC64,
+}
+
+logger = logging.getLogger(__name__)
 
 
 def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
@@ -92,11 +117,17 @@ def read_json(path: str | os.PathLike[str]) -> Any:
     """Read a JSON file; a missing or malformed file raises :class:`CheckpointError` naming it."""
     path = Path(path)
     try:
-        return json.loads(path.read_text(encoding="utf-8"))
+        text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise CheckpointError(f"{path}: file not found") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise CheckpointError(f"{path}: corrupt or truncated JSON ({exc})") from exc
+    except UnicodeDecodeError as exc:
+        raise CheckpointError(f"{path}: corrupt file, not UTF-8 text ({exc})") from None
+    except OSError as exc:  # a folder, no permission...
+        raise CheckpointError(f"{path}: cannot be read ({exc.strerror or exc})") from None
+    try:
+        return json.loads(text)
+    except (ValueError, RecursionError) as exc:  # JSONDecodeError, too deep, huge ints
+        raise CheckpointError(f"{path}: corrupt or truncated JSON ({exc!s:.200})") from None
 
 
 def _sha256(data: bytes) -> str:
@@ -155,6 +186,10 @@ def save_checkpoint(
     Path
         The JSON file of the new checkpoint.
     """
+    if isinstance(step, bool) or not isinstance(step, (int, np.integer)) or step < 0:
+        raise InvalidParameterError(f"checkpoint step must be an integer >= 0, got {step!r}")
+    if isinstance(keep, bool) or not isinstance(keep, (int, np.integer)) or keep < 1:
+        raise InvalidParameterError(f"checkpoint keep must be an integer >= 1, got {keep!r}")
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     stem = f"ckpt-{int(step):06d}"
@@ -167,13 +202,17 @@ def save_checkpoint(
     npz_bytes = buf.getvalue()
     atomic_write_bytes(directory / f"{stem}.npz", npz_bytes)
     state = dict(state)
+    try:
+        state_digest = _state_digest(state)
+    except (TypeError, ValueError) as exc:
+        raise InvalidParameterError(f"checkpoint state is not plain JSON data: {exc}") from None
     doc = {
         "schema": CHECKPOINT_SCHEMA,
         "version": CHECKPOINT_VERSION,
         "step": int(step),
         "npz": f"{stem}.npz",
         "npz_sha256": _sha256(npz_bytes),
-        "state_sha256": _state_digest(state),
+        "state_sha256": state_digest,
         "state": state,
     }
     path = directory / f"{stem}.json"
@@ -230,23 +269,146 @@ def load_checkpoint(path: str | os.PathLike[str]) -> tuple[dict[str, Any], dict[
     state = doc.get("state")
     if not isinstance(state, dict) or _state_digest(state) != doc.get("state_sha256"):
         raise CheckpointError(f"{path}: checkpoint state is corrupt (checksum mismatch)")
-    npz_path = path.with_name(str(doc.get("npz")))
+    step = doc.get("step")
+    if isinstance(step, bool) or not isinstance(step, int) or step < 0:
+        raise CheckpointError(f"{path}: invalid checkpoint step {step!r:.40}")
+    npz_name = doc.get("npz")
+    if not isinstance(npz_name, str) or not _NPZ_NAME.match(npz_name):
+        # a plain ckpt-NNNNNN.npz beside the JSON: never a path to somewhere else
+        raise CheckpointError(f"{path}: invalid array file name {npz_name!r:.80}")
+    npz_path = path.with_name(npz_name)
     try:
         npz_bytes = npz_path.read_bytes()
     except FileNotFoundError:
         raise CheckpointError(
             f"{npz_path}: array file of checkpoint {path.name} is missing"
         ) from None
+    except OSError as exc:
+        raise CheckpointError(f"{npz_path}: cannot be read ({exc.strerror or exc})") from None
     if _sha256(npz_bytes) != doc.get("npz_sha256"):
         raise CheckpointError(f"{npz_path}: corrupt or truncated array file (checksum mismatch)")
+    _check_npz(npz_bytes, npz_path)
     try:
         with np.load(io.BytesIO(npz_bytes), allow_pickle=False) as z:
             arrays = {k: z[k] for k in z.files}
-    except (ValueError, OSError) as exc:  # pragma: no cover - the checksum catches this first
-        raise CheckpointError(f"{npz_path}: unreadable array file ({exc})") from exc
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:
+        raise CheckpointError(f"{npz_path}: unreadable array file ({exc!s:.200})") from None
     state = dict(state)
-    state["step"] = int(doc["step"])
+    state["step"] = step
     return state, arrays
+
+
+def _check_npz(npz_bytes: bytes, npz_path: Path) -> None:
+    """Refuse an npz whose members are compressed, pickled or claim more data than they hold.
+
+    Runs before :func:`numpy.load`, which allocates an array of the size its header
+    claims before reading the data.
+    """
+    try:
+        with zipfile.ZipFile(io.BytesIO(npz_bytes)) as zf:
+            for info in zf.infolist():
+                where = f"{npz_path}: member {info.filename!r:.60}"
+                if info.compress_type != zipfile.ZIP_STORED or not info.filename.endswith(".npy"):
+                    raise CheckpointError(f"{where} is not an uncompressed .npy array")
+                if info.file_size > len(npz_bytes):
+                    raise CheckpointError(f"{where} claims more bytes than the file holds")
+                with zf.open(info) as fh:
+                    version = np.lib.format.read_magic(fh)
+                    if version == (1, 0):
+                        shape, _, dtype = np.lib.format.read_array_header_1_0(fh)
+                    elif version == (2, 0):
+                        shape, _, dtype = np.lib.format.read_array_header_2_0(fh)
+                    else:
+                        raise CheckpointError(f"{where} has npy format {version}, not 1.0 or 2.0")
+                    header = fh.tell()
+                if dtype.hasobject:
+                    raise CheckpointError(f"{where} holds Python objects; checkpoints never pickle")
+                nbytes = math.prod(int(n) for n in shape) * dtype.itemsize
+                if nbytes != info.file_size - header:
+                    raise CheckpointError(
+                        f"{where}: header says {nbytes} bytes of data, the member holds "
+                        f"{info.file_size - header}"
+                    )
+    except CheckpointError:
+        raise
+    except (zipfile.BadZipFile, ValueError, OSError, EOFError, KeyError, TypeError) as exc:
+        raise CheckpointError(f"{npz_path}: unreadable array file ({exc!s:.200})") from None
+
+
+class IntactCheckpoint(NamedTuple):
+    """What :func:`load_latest_intact` found.
+
+    Attributes
+    ----------
+    state : dict
+        The JSON state, with ``"step"`` added (as :func:`load_checkpoint`).
+    arrays : dict of str to ndarray
+    path : Path
+        The checkpoint JSON that was loaded.
+    skipped : list of (Path, str)
+        Newer checkpoints that were corrupt, newest first, with the reason.
+    """
+
+    state: dict[str, Any]
+    arrays: dict[str, np.ndarray]
+    path: Path
+    skipped: list[tuple[Path, str]]
+
+    @property
+    def message(self) -> str | None:
+        """One line saying which checkpoints were skipped and which one was used; None if none."""
+        if not self.skipped:
+            return None
+        names = ", ".join(p.name for p, _ in self.skipped)
+        return (
+            f"skipped corrupt checkpoint(s) {names} ({self.skipped[0][1]}); "
+            f"resuming from {self.path.name} (step {self.state['step']})"
+        )
+
+
+def load_latest_intact(directory: str | os.PathLike[str]) -> IntactCheckpoint:
+    """The newest checkpoint of ``directory`` that verifies, skipping corrupt newer ones.
+
+    Each checkpoint holds the whole run state (generator states included), so
+    resuming from an older intact one and redoing the lost steps finishes
+    exactly like an uninterrupted run. When a newer checkpoint had to be
+    skipped, one line says so (logged as a warning on ``softgym.io``, and in
+    :attr:`IntactCheckpoint.message`). Nothing is deleted: the corrupt files
+    are overwritten when their step is saved again.
+
+    Parameters
+    ----------
+    directory : path
+        A folder of checkpoints written by :func:`save_checkpoint`.
+
+    Returns
+    -------
+    IntactCheckpoint
+        ``(state, arrays, path, skipped)``.
+
+    Raises
+    ------
+    CheckpointError
+        If the folder holds no checkpoint, or none of them is intact (the
+        message names each one and why).
+    """
+    directory = Path(directory)
+    ckpts = list_checkpoints(directory)
+    if not ckpts:
+        raise CheckpointError(f"{directory}: no checkpoint (ckpt-*.json) in this folder")
+    skipped: list[tuple[Path, str]] = []
+    for path in reversed(ckpts):
+        try:
+            state, arrays = load_checkpoint(path)
+        except CheckpointError as exc:
+            skipped.append((path, str(exc)))
+            continue
+        found = IntactCheckpoint(state, arrays, path, skipped)
+        if skipped:
+            logger.warning("%s", found.message)
+        return found
+    reasons = "; ".join(reason for _, reason in skipped)
+    raise CheckpointError(f"{directory}: no intact checkpoint among {len(ckpts)}: {reasons}")
 
 
 def _to_json(obj: Any) -> Any:
@@ -264,18 +426,49 @@ def _to_json(obj: Any) -> Any:
 
 
 def rng_state(rng: np.random.Generator) -> dict[str, Any]:
-    """JSON-ready state of a numpy Generator (its bit generator's ``state`` dict)."""
+    """JSON-ready state of a numpy Generator (its bit generator's ``state`` dict).
+
+    Raises
+    ------
+    InvalidParameterError
+        If the bit generator is not one of :data:`RNG_BIT_GENERATORS` (it could
+        not be restored).
+    """
+    if not isinstance(rng, np.random.Generator):
+        raise InvalidParameterError(f"expected a numpy Generator, got {type(rng).__name__}")
+    name = type(rng.bit_generator).__name__
+    if RNG_BIT_GENERATORS.get(name) is not type(rng.bit_generator):
+        raise InvalidParameterError(
+            f"bit generator {name} cannot be checkpointed; use one of {sorted(RNG_BIT_GENERATORS)}"
+        )
     return _to_json(rng.bit_generator.state)
 
 
 def rng_from_state(state: Mapping[str, Any]) -> np.random.Generator:
-    """A Generator restored from :func:`rng_state` (same bit generator kind)."""
-    name = state["bit_generator"]
-    bitgen_cls = getattr(np.random, name, None)
+    """A Generator restored from :func:`rng_state` (same bit generator kind).
+
+    The bit generator is named from :data:`RNG_BIT_GENERATORS` only.
+
+    Raises
+    ------
+    CheckpointError
+        If the state is not a mapping, names a bit generator outside the
+        allow-list, or does not fit that bit generator.
+    """
+    if not isinstance(state, Mapping):
+        raise CheckpointError(f"random generator state must be an object, got {state!r:.80}")
+    name = state.get("bit_generator")
+    bitgen_cls = RNG_BIT_GENERATORS.get(name) if isinstance(name, str) else None
     if bitgen_cls is None:
-        raise CheckpointError(f"unknown numpy bit generator {name!r} in checkpoint")
+        raise CheckpointError(
+            f"unknown numpy bit generator {name!r:.80} in checkpoint "
+            f"(expected one of {sorted(RNG_BIT_GENERATORS)})"
+        )
     bg = bitgen_cls()
-    bg.state = dict(state)
+    try:
+        bg.state = dict(state)
+    except (TypeError, ValueError, KeyError, IndexError, OverflowError) as exc:
+        raise CheckpointError(f"invalid {name} state in checkpoint: {exc!s:.200}") from None
     return np.random.Generator(bg)
 
 
@@ -288,7 +481,29 @@ def python_random_state(rnd: Any = None) -> list[Any]:
 
 
 def set_python_random_state(state: list[Any], rnd: Any = None) -> None:
-    """Inverse of :func:`python_random_state`."""
+    """Inverse of :func:`python_random_state`.
+
+    Raises
+    ------
+    CheckpointError
+        If ``state`` is not ``[version, [625 ints], gauss_next]`` as
+        :func:`python_random_state` writes it.
+    """
     import random
 
-    (rnd or random).setstate((state[0], tuple(state[1]), state[2]))
+    ok = (
+        isinstance(state, (list, tuple))
+        and len(state) == 3
+        and isinstance(state[1], (list, tuple))
+        and len(state[1]) == 625
+        and all(type(v) is int and 0 <= v < 2**32 for v in state[1])
+        and (state[2] is None or type(state[2]) is float)
+    )
+    if not ok:
+        raise CheckpointError(
+            "python random state in checkpoint must be [version, [625 ints], gauss_next]"
+        )
+    try:
+        (rnd or random).setstate((state[0], tuple(state[1]), state[2]))
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise CheckpointError(f"invalid python random state in checkpoint: {exc}") from None
