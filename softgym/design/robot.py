@@ -129,6 +129,11 @@ def check_grid_shape(shape: Any, name: str = "grid shape") -> tuple[int, int, in
 # --------------------------------------------------------------------------------------------
 
 
+#: Grids of at most this many cells are labelled by walking a cached neighbour table
+#: (fastest for the seed's 6x6x6); larger ones by a vectorised union-find.
+_SMALL_GRID = 4096
+
+
 @lru_cache(maxsize=32)
 def _neighbour_table(shape: tuple[int, int, int]) -> tuple[tuple[int, ...], ...]:
     """Face neighbours of each flat (C-order) index of a grid of ``shape``."""
@@ -163,9 +168,16 @@ def label_components(mask: np.ndarray) -> tuple[np.ndarray, list[int]]:
     sizes : list of int
         ``sizes[c - 1]`` is the number of voxels of component ``c``.
     """
-    mask = np.asarray(mask, dtype=bool)
+    try:
+        mask = np.asarray(mask, dtype=bool)
+    except (TypeError, ValueError) as exc:
+        raise InvalidDesignError(f"mask is not a 3-D boolean array: {exc}") from None
     if mask.ndim != 3:
         raise InvalidDesignError(f"mask must be 3-D, got shape {mask.shape}")
+    if mask.size > _SMALL_GRID:
+        # large grids: vectorised union-find, no per-shape table (same labels)
+        check_grid_shape(mask.shape, "mask shape")
+        return _label_components_union_find(mask)
     table = _neighbour_table(mask.shape)
     flat = mask.ravel().tolist()
     labels = [0] * len(flat)
@@ -186,6 +198,44 @@ def label_components(mask: np.ndarray) -> tuple[np.ndarray, list[int]]:
                     stack.append(q)
         sizes.append(n)
     return np.asarray(labels, dtype=np.int32).reshape(mask.shape), sizes
+
+
+def _label_components_union_find(mask: np.ndarray) -> tuple[np.ndarray, list[int]]:
+    """:func:`label_components` by union-find over face-adjacent pairs, in numpy.
+
+    Roots hook to the smaller flat index, so each component's root is its first
+    voxel in C order and numbering roots in order gives the same labels as the
+    table walk. Memory is O(n_voxels); no Python object per voxel.
+    """
+    shape = mask.shape
+    n = mask.size
+    idx = np.arange(n, dtype=np.intp).reshape(shape)
+    ps, qs = [], []
+    for axis in range(3):
+        a = np.moveaxis(idx, axis, 0)
+        m = np.moveaxis(mask, axis, 0)
+        both = m[:-1] & m[1:]
+        ps.append(a[:-1][both])
+        qs.append(a[1:][both])
+    p = np.concatenate(ps)
+    q = np.concatenate(qs)
+    parent = np.arange(n, dtype=np.intp)
+    while True:
+        rp, rq = parent[p], parent[q]
+        diff = rp != rq
+        if not diff.any():
+            break
+        np.minimum.at(parent, np.maximum(rp, rq)[diff], np.minimum(rp, rq)[diff])
+        while True:  # pointer jumping until every voxel points at its root
+            nxt = parent[parent]
+            if np.array_equal(nxt, parent):
+                break
+            parent = nxt
+    flat = mask.ravel()
+    _, inverse, counts = np.unique(parent[flat], return_inverse=True, return_counts=True)
+    labels = np.zeros(n, dtype=np.int32)
+    labels[flat] = inverse.astype(np.int32) + 1
+    return labels.reshape(shape), [int(c) for c in counts]
 
 
 def largest_component_mask(mask: np.ndarray) -> np.ndarray:

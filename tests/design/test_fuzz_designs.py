@@ -16,7 +16,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from softgym.design import CPPN, Controller, RobotDesign, default_walker
+from softgym.design import CPPN, CompositionRules, Controller, RobotDesign, default_walker
 from softgym.design.robot import MAX_GRID_DIM, MAX_GRID_VOXELS, check_grid_shape
 from softgym.exceptions import DesignFileError, InvalidDesignError, SoftGymError
 
@@ -311,3 +311,29 @@ def test_mutated_cppn_files_give_a_cppn_or_a_typed_error(text):
 def test_controller_from_design_is_strict():
     with pytest.raises(SoftGymError, match="must be a number"):
         Controller.clipped(period=[1])
+
+
+@FUZZ
+@given(
+    st.tuples(*[st.integers(1, 9)] * 3).flatmap(
+        lambda shape: st.lists(
+            st.booleans(), min_size=int(np.prod(shape)), max_size=int(np.prod(shape))
+        ).map(lambda bits: np.array(bits, dtype=bool).reshape(shape))
+    )
+)
+def test_union_find_labels_equal_the_table_walk(mask):
+    from softgym.design import robot
+
+    walked = robot.label_components(mask)  # small: the cached table walk
+    joined = robot._label_components_union_find(mask)  # what grids over 4096 cells use
+    assert np.array_equal(walked[0], joined[0]) and walked[1] == joined[1]
+
+
+def test_large_designs_are_labelled_without_a_per_voxel_table():
+    grid = np.ones((100, 100, 100), dtype=np.int8)
+    grid[50, :, :] = 0  # two slabs
+    design = RobotDesign(grid)
+    assert design.violations(CompositionRules()) == [
+        "connected: the voxels form 2 separate 6-connected bodies (sizes [500000, 490000]); "
+        "use largest_component()"
+    ]
