@@ -327,10 +327,13 @@ class Simulation:
             if v1.size:
                 w2 = np.max(np.maximum(k_axial / m[v1], k_axial / m[v2]))
             else:
-                w2 = np.max(E * L / m)
-            # the seed's CalcMaxDt writes pi as 3.1415926
-            pi = 3.1415926 if cfg.model == "seed" else math.pi
-            dt = cfg.dt_frac / (2.0 * pi * math.sqrt(w2))
+                # no link: the seed's CalcMaxDt falls back to max E / M (its units)
+                w2 = np.max(E / m) if cfg.model == "seed" else np.max(E * L / m)
+            if cfg.model == "seed":
+                # the seed's CalcMaxDt writes pi as 3.1415926 and its DtFrac is single precision
+                dt = float(np.float32(cfg.dt_frac)) / (2.0 * 3.1415926 * math.sqrt(w2))
+            else:
+                dt = cfg.dt_frac / (2.0 * math.pi * math.sqrt(w2))
             dts.append(dt)
             masses.append(float(m.sum()))
             crit = 2.0 * np.sqrt(m * E * L)

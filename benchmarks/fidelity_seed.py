@@ -1,0 +1,231 @@
+"""Fidelity of softgym's seed preset to the seed study's own engine (issue 16).
+
+Reads the committed oracle data (``benchmarks/data/seed_engine/*.json``, facts
+produced by the seed's engine; see the README there), runs the same robots in
+softgym and prints, per actuation regime:
+
+* the rank (Spearman) correlation of per-case medians of NormFinalDist,
+  softgym (its perturbed draws) against the oracle (the median of half of its
+  draws), and the same figure for the oracle's two halves against each other
+  (its self-agreement: the seed's engine does not agree with itself digit for
+  digit on sensitive bodies);
+* the median |log10 ratio| and the shares of cases within 2x and 3x;
+* the bodies one engine moves >= 1 voxel length and the other leaves under 0.01;
+* whether softgym reaches the issue's targets: rank correlation and the
+  within-2x share at least 90 % of the oracle's self-agreement, and no body
+  moved by one engine and left still by the other;
+
+and the micro-case trace errors (``micro.json``: softgym's centre of mass at the
+oracle's sample steps, as a fraction of the oracle's displacement scale).
+
+    python benchmarks/fidelity_seed.py                      # everything (~15 min on 2 cores)
+    python benchmarks/fidelity_seed.py --quick              # 12 cases per set
+    python benchmarks/fidelity_seed.py --model corotational # the pre-fidelity step, for the "before" table
+    python benchmarks/fidelity_seed.py --json               # last line: the figures as JSON
+
+Values under 0.01 voxel lengths are raised to 0.01 before ratios are taken (a
+body that stays put in both engines agrees, whatever its 1e-4 wobble).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+import fidelity_cases as fc  # noqa: E402
+
+from softgym.engine import SimConfig, Simulation  # noqa: E402
+from softgym.metrics import norm_final_dist  # noqa: E402
+
+DATA = HERE / "data" / "seed_engine"
+FLOOR = 0.01  # voxel lengths: smaller distances count as "stays put"
+MOVES = 1.0  # voxel lengths: a body "moves"
+ORACLE_HALVES = ((1, 2, 3), (4, 5, 6))  # perturbed oracle draws split in two halves
+
+
+# ------------------------------------------------------------------------ micro-cases
+def micro_trace(case: dict[str, Any], model: str = "seed") -> tuple[np.ndarray, np.ndarray]:
+    """softgym's centre of mass at the oracle's sample steps of a micro-case.
+
+    Returns ``(ours, oracle)``, each of shape (n_samples, 3) in metres.
+    """
+    from softgym.design.controller import Controller
+    from softgym.design.robot import RobotDesign
+
+    dT, period, cte = (fc.REGIMES[case["regime"]][k] for k in ("dT", "period", "cte"))
+    design = RobotDesign(np.asarray(case["grid"]), controller=Controller(dT, period, cte))
+    cfg = SimConfig(init_time=case["init_time"], model=model)
+    sim = Simulation([design], cfg, n_threads=1)
+    dt = float(sim.dt[0])
+    sim = Simulation([design], cfg.replace(trace_interval=dt), n_threads=1)
+    rollout = sim.run(case["sim_time"])
+    oracle = np.asarray(case["trace"], dtype=np.float64)
+    steps = np.rint(oracle[:, 3] / dt).astype(np.intp)  # the oracle samples at step times
+    steps = np.clip(steps, 0, rollout.cm.shape[1] - 1)
+    return rollout.cm[0, steps], oracle[:, :3]
+
+
+def micro_errors(model: str = "seed") -> dict[str, dict[str, Any]]:
+    """Per micro-case: max |softgym - oracle| over the samples, as a fraction of the
+    oracle's displacement scale (its largest range of x, y or z). The oracle prints 6
+    significant digits: half a unit of the last one is forgiven."""
+    data = json.loads((DATA / "micro.json").read_text())
+    out = {}
+    for name, case in data["cases"].items():
+        ours, oracle = micro_trace(case, model)
+        scale = float(np.ptp(oracle, axis=0).max())
+        err = float(np.maximum(np.abs(ours - oracle) - 5e-6 * np.abs(oracle), 0.0).max())
+        out[name] = {"max_err_m": err, "scale_m": scale, "rel": err / max(scale, 1e-12),
+                     "sensitive": bool(case["sensitive"])}
+    return out
+
+
+# --------------------------------------------------------------------------- bodies
+def _spearman(a: np.ndarray, b: np.ndarray) -> float:
+    ra = np.argsort(np.argsort(a, kind="stable"), kind="stable").astype(float)
+    rb = np.argsort(np.argsort(b, kind="stable"), kind="stable").astype(float)
+    if ra.std() == 0 or rb.std() == 0:
+        return float("nan")
+    return float(np.corrcoef(ra, rb)[0, 1])
+
+
+def agreement(x: np.ndarray, y: np.ndarray) -> dict[str, float]:
+    """Agreement figures of two arrays of per-case distances (voxel lengths)."""
+    x = np.maximum(np.asarray(x, float), FLOOR)
+    y = np.maximum(np.asarray(y, float), FLOOR)
+    lr = np.abs(np.log10(x / y))
+    moved_still = int(np.sum(((x >= MOVES) & (y <= FLOOR)) | ((y >= MOVES) & (x <= FLOOR))))
+    return {
+        "n": int(x.size),
+        "spearman": _spearman(x, y),
+        "median_abs_log10": float(np.median(lr)) if lr.size else float("nan"),
+        "within_2x": float(np.mean(lr <= math.log10(2))) if lr.size else float("nan"),
+        "within_3x": float(np.mean(lr <= math.log10(3))) if lr.size else float("nan"),
+        "moved_vs_still": moved_still,
+    }
+
+
+def load_oracle(sets: list[str]) -> tuple[list[Any], dict[tuple[str, str, int], float]]:
+    """The cases of the data files and their oracle NormFinalDist by (case, regime, draw)."""
+    cases, values = [], {}
+    for s in sets:
+        path = DATA / f"{s}.json"
+        if not path.exists():
+            continue
+        data = json.loads(path.read_text())
+        cases += fc.cases_from_data(data)
+        for rec in data["records"]:
+            v = rec.get("NormFinalDist")
+            values[(rec["case"], rec["regime"], int(rec["draw"]))] = (
+                float("nan") if rec.get("hung") or v is None else float(v))
+    return cases, values
+
+
+def run_softgym(cases: list[Any], draws: list[int], model: str, threads: int | None
+                ) -> dict[tuple[str, str, int], float]:
+    """softgym's NormFinalDist of every case, regime and draw, one batch per regime."""
+    out = {}
+    cfg = SimConfig(model=model)
+    for regime in fc.REGIMES:
+        jobs = [(c, d) for c in cases for d in draws if c.terrain == "flat"]
+        designs = [fc.case_design(c, regime, d) for c, d in jobs]
+        if not designs:
+            continue
+        sim = Simulation(designs, cfg, n_threads=threads)
+        r = sim.run(5.0)
+        nfd = norm_final_dist(r)
+        for (c, d), v, div in zip(jobs, nfd, r.diverged):
+            out[(c.name, regime, d)] = float("nan") if div else float(v)
+    return out
+
+
+def compare(cases, oracle, ours, draws) -> dict[str, Any]:
+    """Per regime: softgym vs the oracle's first half, and the oracle's halves vs each other."""
+    report = {}
+    for regime in fc.REGIMES:
+        rows = []
+        for c in cases:
+            if c.terrain != "flat":
+                continue
+            half_a = [oracle.get((c.name, regime, d), np.nan) for d in ORACLE_HALVES[0]]
+            half_b = [oracle.get((c.name, regime, d), np.nan) for d in ORACLE_HALVES[1]]
+            mine = [ours.get((c.name, regime, d), np.nan) for d in draws]
+            if np.isnan(half_a).any() or np.isnan(half_b).any() or np.isnan(mine).any():
+                continue  # missing oracle data or a hung/diverged run
+            rows.append((c.name, np.median(mine), np.median(half_a), np.median(half_b)))
+        if not rows:
+            continue
+        names, m, a, b = zip(*rows)
+        soft = agreement(np.array(m), np.array(a))
+        self_ = agreement(np.array(b), np.array(a))
+        targets = {
+            "spearman": soft["spearman"] >= 0.9 * self_["spearman"],
+            "within_2x": soft["within_2x"] >= 0.9 * self_["within_2x"],
+            "moved_vs_still": soft["moved_vs_still"] == 0,
+        }
+        worst = sorted(zip(np.abs(np.log10(np.maximum(m, FLOOR) / np.maximum(a, FLOOR))), names, m, a),
+                       reverse=True)[:5]
+        report[regime] = {"softgym_vs_oracle": soft, "oracle_vs_oracle": self_, "targets": targets,
+                          "worst": [{"case": n, "softgym": float(x), "oracle": float(y)}
+                                    for _, n, x, y in worst]}
+    return report
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--model", default="seed", choices=["seed", "corotational"])
+    ap.add_argument("--sets", default="structured,random")
+    ap.add_argument("--draws", type=int, default=3, help="perturbed softgym draws per case (>= 3)")
+    ap.add_argument("--quick", action="store_true", help="12 cases per set")
+    ap.add_argument("--threads", type=int, default=None)
+    ap.add_argument("--json", action="store_true")
+    a = ap.parse_args()
+    t0 = time.perf_counter()
+    sets = [s for s in a.sets.split(",") if s]
+    cases, oracle = load_oracle(sets)
+    if a.quick:
+        by_set: dict[str, list] = {}
+        for c in cases:
+            by_set.setdefault(c.set, []).append(c)
+        cases = [c for cs in by_set.values() for c in cs[:12]]
+    draws = list(range(1, a.draws + 1))
+    ours = run_softgym(cases, draws, a.model, a.threads)
+    report = {"model": a.model, "sets": sets, "draws": draws, "n_cases": len(cases),
+              "regimes": compare(cases, oracle, ours, draws), "micro": micro_errors(a.model)}
+    report["wall_s"] = time.perf_counter() - t0
+    print(f"softgym model {a.model!r} against the seed's engine: {len(cases)} cases "
+          f"({', '.join(sets)}), {len(draws)} softgym draws, oracle halves {ORACLE_HALVES}")
+    print(f"{'regime':8s} {'pair':18s} {'n':>4s} {'spearman':>9s} {'med|log10|':>10s} "
+          f"{'<=2x':>6s} {'<=3x':>6s} {'moved/still':>11s}")
+    for regime, r in report["regimes"].items():
+        for label, key in (("softgym vs oracle", "softgym_vs_oracle"), ("oracle vs oracle", "oracle_vs_oracle")):
+            f = r[key]
+            print(f"{regime:8s} {label:18s} {f['n']:4d} {f['spearman']:9.3f} {f['median_abs_log10']:10.3f} "
+                  f"{f['within_2x']:6.0%} {f['within_3x']:6.0%} {f['moved_vs_still']:11d}")
+        t = r["targets"]
+        print(f"{'':8s} targets: spearman >= 0.9 x self {'met' if t['spearman'] else 'MISSED'}, "
+              f"within 2x >= 0.9 x self {'met' if t['within_2x'] else 'MISSED'}, "
+              f"no moved/still mismatch {'met' if t['moved_vs_still'] else 'MISSED'}")
+    print("micro-cases (max |softgym - oracle| / the oracle's displacement scale):")
+    for name, m in report["micro"].items():
+        flag = "  (sensitive)" if m["sensitive"] else ""
+        ok = "ok" if m["rel"] <= 0.01 or m["sensitive"] else "OVER 1 %"
+        print(f"  {name:30s} {m['rel']:9.2e} of {m['scale_m'] * 1e3:7.2f} mm  {ok}{flag}")
+    print(f"wall time {report['wall_s']:.0f} s")
+    if a.json:
+        print(json.dumps(report))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
