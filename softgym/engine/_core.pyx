@@ -435,43 +435,362 @@ cdef inline void _from_x(intp_t ax, float64_t* v) noexcept nogil:
         v[0] = -t
 
 
-cdef inline void _perm_vec(intp_t ax, float64_t x, float64_t y, float64_t z, float64_t* o) noexcept nogil:
-    # o = the world vector (x, y, z) in the bond frame of a link along axis ax
-    # (the seed's ToXDirBond: +y or +z turned onto +x by a proper rotation)
-    if ax == 0:
-        o[0] = x
-        o[1] = y
-        o[2] = z
-    elif ax == 1:
-        o[0] = y
-        o[1] = -x
-        o[2] = z
-    else:
-        o[0] = z
-        o[1] = y
-        o[2] = -x
+cdef inline float64_t _rotvec_k(float64_t w) noexcept nogil:
+    # the seed's rotation vector of a unit quaternion (w, x, y, z) is k (x, y, z)
+    # (angle from w, with its acos approximation near the identity)
+    cdef float64_t sl = 1.0 - w * w
+    if sl <= 0.0:
+        return 0.0
+    if w > 1.0:
+        w = 1.0
+    if sl < SLTHRESH_ACOS2SQRT:
+        return 2.0 * sqrt((2.0 - 2.0 * w) / sl)
+    return 2.0 * acos(w) / sqrt(sl)
 
 
-cdef inline void _unperm_add(intp_t ax, const float64_t* R, const float64_t* v, float64_t sign,
-                             float64_t* out) noexcept nogil:
-    # out += sign * R P^T v: a bond-frame vector v back to the world through
-    # the inverse axis turn P^T and the voxel rotation R (row-major 3x3)
+cdef inline void _bond_to_world(const int ax, const float64_t* R, float64_t v0, float64_t v1,
+                                float64_t v2, float64_t* o) noexcept nogil:
+    # o = R P^T v: a bond-frame vector v back to the world through the inverse
+    # axis turn P^T (ax: a compile-time constant once inlined) and the voxel
+    # rotation R (row-major 3x3)
     cdef float64_t x, y, z
     if ax == 0:
-        x = v[0]
-        y = v[1]
-        z = v[2]
+        x = v0
+        y = v1
+        z = v2
     elif ax == 1:
-        x = -v[1]
-        y = v[0]
-        z = v[2]
+        x = -v1
+        y = v0
+        z = v2
     else:
-        x = -v[2]
-        y = v[1]
-        z = v[0]
-    out[0] += sign * (R[0] * x + R[1] * y + R[2] * z)
-    out[1] += sign * (R[3] * x + R[4] * y + R[5] * z)
-    out[2] += sign * (R[6] * x + R[7] * y + R[8] * z)
+        x = -v2
+        y = v1
+        z = v0
+    o[0] = R[0] * x + R[1] * y + R[2] * z
+    o[1] = R[3] * x + R[4] * y + R[5] * z
+    o[2] = R[6] * x + R[7] * y + R[8] * z
+
+
+cdef void _seed_geom(intp_t lo, intp_t hi, intp_t ax, cintp_rp v1, cintp_rp v2,
+                     cf64_rp pos, cf64_rp rot, cf64_rp quat, cf64_rp scale,
+                     f64_rp o_p0, f64_rp o_p1, f64_rp o_p2, f64_rp o_qw,
+                     f64_rp o_n1, f64_rp o_n2, f64_rp o_n3, f64_rp o_nom,
+                     f64_rp o_len, f64_rp o_st) noexcept nogil:
+    # Model 0's link geometry for links lo..hi, all along axis ax, without
+    # branches so the loop vectorises: the relative position p and voxel 2's
+    # orientation relative to voxel 1 (q1* q2 = (qw, n)), both in the bond
+    # frame (voxel 1's frame turned by the proper rotation P that takes the
+    # link axis onto +x, the seed's ToXDirBond: (x, y, z) -> (x, y, z),
+    # (y, -x, z), (z, y, -x) for ax 0, 1, 2); the nominal length, the chord
+    # length and the transverse ratio. Component c of a bond-frame vector is
+    # s_c times local component a_c (s = +-1: exact).
+    cdef:
+        intp_t li, i, j
+        intp_t a0 = ax
+        intp_t a1 = 0 if ax == 1 else 1
+        intp_t a2 = 0 if ax == 2 else 2
+        float64_t s1 = -1.0 if ax == 1 else 1.0
+        float64_t s2 = -1.0 if ax == 2 else 1.0
+        # n = W (qx, qy, qz): W's rows one-hot (x 1 + y 0 + z 0 = x exactly)
+        float64_t w00 = 1.0 if a0 == 0 else 0.0
+        float64_t w01 = 1.0 if a0 == 1 else 0.0
+        float64_t w02 = 1.0 if a0 == 2 else 0.0
+        float64_t w10 = s1 if a1 == 0 else 0.0
+        float64_t w11 = s1 if a1 == 1 else 0.0
+        float64_t w12 = s1 if a1 == 2 else 0.0
+        float64_t w20 = s2 if a2 == 0 else 0.0
+        float64_t w21 = s2 if a2 == 1 else 0.0
+        float64_t w22 = s2 if a2 == 2 else 0.0
+        float64_t dx, dy, dz, qw, qx, qy, qz, p0, p1, p2
+    for li in range(lo, hi):
+        i = v1[li]
+        j = v2[li]
+        dx = pos[3 * j] - pos[3 * i]
+        dy = pos[3 * j + 1] - pos[3 * i + 1]
+        dz = pos[3 * j + 2] - pos[3 * i + 2]
+        # relative position in voxel 1's frame (column a of its rotation . d)
+        p0 = rot[9 * i + a0] * dx + rot[9 * i + 3 + a0] * dy + rot[9 * i + 6 + a0] * dz
+        p1 = s1 * (rot[9 * i + a1] * dx + rot[9 * i + 3 + a1] * dy + rot[9 * i + 6 + a1] * dz)
+        p2 = s2 * (rot[9 * i + a2] * dx + rot[9 * i + 3 + a2] * dy + rot[9 * i + 6 + a2] * dz)
+        qw = (quat[4 * i] * quat[4 * j] + quat[4 * i + 1] * quat[4 * j + 1]
+              + quat[4 * i + 2] * quat[4 * j + 2] + quat[4 * i + 3] * quat[4 * j + 3])
+        qx = (quat[4 * i] * quat[4 * j + 1] - quat[4 * i + 1] * quat[4 * j]
+              - quat[4 * i + 2] * quat[4 * j + 3] + quat[4 * i + 3] * quat[4 * j + 2])
+        qy = (quat[4 * i] * quat[4 * j + 2] + quat[4 * i + 1] * quat[4 * j + 3]
+              - quat[4 * i + 2] * quat[4 * j] - quat[4 * i + 3] * quat[4 * j + 1])
+        qz = (quat[4 * i] * quat[4 * j + 3] - quat[4 * i + 1] * quat[4 * j + 2]
+              + quat[4 * i + 2] * quat[4 * j + 1] - quat[4 * i + 3] * quat[4 * j])
+        o_p0[li] = p0
+        o_p1[li] = p1
+        o_p2[li] = p2
+        o_qw[li] = qw
+        o_n1[li] = qx * w00 + qy * w01 + qz * w02
+        o_n2[li] = qx * w10 + qy * w11 + qz * w12
+        o_n3[li] = qx * w20 + qy * w21 + qz * w22
+        o_nom[li] = 0.5 * (scale[i] + scale[j])
+        o_len[li] = sqrt(dx * dx + dy * dy + dz * dz)
+        o_st[li] = (fabs(p2) + fabs(p1)) / p0
+
+
+cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
+                                  float64_t inv_dt) noexcept nogil:
+    # _links_seed for its links [lo, hi), all along axis ax (a compile-time
+    # constant once inlined). The bond frame is voxel 1's frame turned by the
+    # proper rotation P that takes the link axis onto +x (the seed's
+    # ToXDirBond): (x, y, z) -> (x, y, z), (y, -x, z), (z, y, -x) for ax 0, 1, 2.
+    cdef:
+        intp_t li, i, j
+        float64_t L = b.L
+        float64_t bz = 0.5 * b.bond_zeta
+        float64_t bzh = 0.5 * bz
+        float64_t max_ext = b.max_strain * L
+        # module constants as locals (the compiler cannot assume that stores
+        # through the force pointers leave globals alone)
+        float64_t sa_w = SMALL_ANGLE_W
+        float64_t sah_w = SMALLISH_ANGLE_W
+        float64_t sa_rad = SMALL_ANGLE_RAD
+        float64_t st_in = SA_BOND_BEND_RAD
+        float64_t ex_in = SA_BOND_EXT_PERC
+        float64_t st_out = HYSTERESIS * SA_BOND_BEND_RAD
+        float64_t ex_out = HYSTERESIS * SA_BOND_EXT_PERC
+        float64_t th_discard = SEED_PI - DISCARD_ANGLE_RAD
+        const float64_t* rot = b.rot
+        const intp_t* v1 = b.v1
+        const intp_t* v2 = b.v2
+        intp_t n = b.n_links
+        float64_t* o = b.link_out
+        float64_t* force = b.force
+        float64_t* moment = b.moment
+        flag_t* link_sa = b.link_sa
+        const flag_t* homog = b.homog
+        const float64_t* k_axial = b.k_axial
+        const float64_t* k_torsion = b.k_torsion
+        const float64_t* k_bend = b.k_bend
+        const float64_t* c_seed = b.c_seed
+        float64_t* link_last = b.link_last
+        float64_t qw, p0, p1, p2, n1, n2, n3
+        float64_t rw = 1.0, ry = 0.0, rz = 0.0, tw, tx, ty, tz, k
+        float64_t a1x, a1y, a1z, a2x, a2y, a2z, P0, P1, P2
+        float64_t f1x, f1y, f1z, m1x, m1y, m1z, f2x, f2y, f2z, m2x, m2y, m2z
+        float64_t vx, vy, vz, ra1x, ra1y, ra1z, ra2x, ra2y, ra2z
+        float64_t r0, r1, r2, r4, r5, r8, n2q, gx, gy, gz
+        float64_t nom, st, ex, ka, kt, kb, b2, ca, cb2, ca2, cb3
+        float64_t len_, nx, ny, nz, rho, ch, sh, yx, zx
+        float64_t w[3]
+        float64_t* last
+        float64_t* fo
+        float64_t* mo
+        const float64_t* cs
+        const float64_t* R1
+        int32 sa, changed, neg2
+    if hi <= lo:
+        return STATUS_OK
+    _seed_geom(lo, hi, ax, v1, v2, b.pos, rot, b.quat, b.scale, o, o + n, o + 2 * n,
+               o + 3 * n, o + 4 * n, o + 5 * n, o + 6 * n, o + 7 * n, o + 8 * n, o + 9 * n)
+    for li in range(lo, hi):
+        i = v1[li]
+        j = v2[li]
+        R1 = rot + 9 * i
+        p0 = o[li]
+        p1 = o[n + li]
+        p2 = o[2 * n + li]
+        qw = o[3 * n + li]
+        n1 = o[4 * n + li]
+        n2 = o[5 * n + li]
+        n3 = o[6 * n + li]
+        nom = o[7 * n + li]
+        st = o[9 * n + li]
+        ex = p0 / nom
+        sa = link_sa[li]
+        changed = 0
+        if not sa and qw > sa_w and st < st_in and ex < ex_in:
+            sa = 1
+            changed = 1
+        elif sa and (not (qw > sah_w) or st > st_out or ex > ex_out):
+            sa = 0
+            changed = 1
+        link_sa[li] = sa
+        a1x = 0.0
+        a1y = 0.0
+        a1z = 0.0
+        if sa:
+            # small angle: voxel 1's frame, offsets along its axes
+            k = _rotvec_k(qw)
+            a2x = n1 * k
+            a2y = n2 * k
+            a2z = n3 * k
+            P0 = p0 - nom
+            P1 = p1
+            P2 = p2
+        else:
+            # large angle: the frame turned by rq = (rw, 0, ry, rz) onto the
+            # chord (the seed's ToXDirBond of the relative position)
+            rw = 1.0
+            ry = 0.0
+            rz = 0.0
+            if not (p0 == 0.0 and p1 == 0.0 and p2 == 0.0):
+                yx = p1 / p0
+                zx = p2 / p0
+                if yx < sa_rad and yx > -sa_rad and zx < sa_rad and zx > -sa_rad:
+                    ry = 0.5 * zx
+                    rz = -0.5 * yx
+                    rw = 1.0 + 0.5 * (-ry * ry - rz * rz)
+                else:
+                    len_ = sqrt(p0 * p0 + p1 * p1 + p2 * p2)
+                    nx = p0 / len_
+                    ny = p1 / len_
+                    nz = p2 / len_
+                    # acos(nx) > pi - 1e-7 (acos(x) <= acos(-0.5) < 2.1 for x >= -0.5)
+                    if nx < -0.5 and acos(nx) > th_discard:
+                        rw = 0.0
+                        ry = 1.0
+                    else:
+                        rho = 1.0 / sqrt(nz * nz + ny * ny)
+                        ch = sqrt(0.5 * (1.0 + nx))  # cos(th / 2)
+                        sh = sqrt(0.5 * (1.0 - nx))  # sin(th / 2)
+                        rw = ch
+                        ry = nz * rho * sh
+                        rz = -ny * rho * sh
+                k = _rotvec_k(rw)  # the seed's, with its acos approximation
+                a1y = ry * k
+                a1z = rz * k
+            # tq = rq nq (rq's x part is zero)
+            tw = rw * qw - ry * n2 - rz * n3
+            tx = rw * n1 + ry * n3 - rz * n2
+            ty = rw * n2 + ry * qw + rz * n1
+            tz = rw * n3 - ry * n1 + rz * qw
+            k = _rotvec_k(tw)
+            a2x = tx * k
+            a2y = ty * k
+            a2z = tz * k
+            P0 = o[8 * n + li] - nom
+            P1 = 0.0
+            P2 = 0.0
+        if not (fabs(P0) <= max_ext):
+            return STATUS_STRAIN  # also catches NaN
+        ka = k_axial[li]
+        kt = k_torsion[li]
+        kb = k_bend[li]
+        b2 = 0.5 * ka * L
+        f1x = ka * P0
+        f1y = ka * P1 - b2 * (a1z + a2z)
+        f1z = ka * P2 + b2 * (a1y + a2y)
+        m1x = kt * (a1x - a2x)
+        m1y = b2 * P2 + kb * (2.0 * a1y + a2y)
+        m1z = -b2 * P1 + kb * (2.0 * a1z + a2z)
+        m2x = -m1x
+        f2x = -f1x
+        f2y = -f1y
+        f2z = -f1z
+        m2y = b2 * P2 + kb * (a1y + 2.0 * a2y)
+        m2z = -b2 * P1 + kb * (a1z + 2.0 * a2z)
+        # voxel 2 gets -F1 on a mode-change step and for a single material
+        neg2 = changed or homog[li]
+        if not changed:
+            last = link_last + 9 * li
+            cs = c_seed + 8 * li
+            vx = (P0 - last[0]) * inv_dt
+            vy = (P1 - last[1]) * inv_dt
+            vz = (P2 - last[2]) * inv_dt
+            ra1x = (a1x - last[3]) * inv_dt
+            ra1y = (a1y - last[4]) * inv_dt
+            ra1z = (a1z - last[5]) * inv_dt
+            ra2x = (a2x - last[6]) * inv_dt
+            ra2y = (a2y - last[7]) * inv_dt
+            ra2z = (a2z - last[8]) * inv_dt
+            last[0] = P0
+            last[1] = P1
+            last[2] = P2
+            last[3] = a1x
+            last[4] = a1y
+            last[5] = a1z
+            last[6] = a2x
+            last[7] = a2y
+            last[8] = a2z
+            ca = cs[0]
+            cb2 = cs[1]
+            ca2 = cs[2]
+            cb3 = cs[3]
+            f1x = f1x + bz * (ca * vx)
+            f1y = f1y + bz * (ca * vy - cb2 * (ra1z + ra2z))
+            f1z = f1z + bz * (ca * vz + cb2 * (ra1y + ra2y))
+            m1x = m1x + bzh * (-ca2 * (ra2x - ra1x))
+            m1y = m1y + bzh * (cb2 * vz + cb3 * (2.0 * ra1y + ra2y))
+            m1z = m1z + bzh * (-cb2 * vy + cb3 * (2.0 * ra1z + ra2z))
+            ca = cs[4]
+            cb2 = cs[5]
+            ca2 = cs[6]
+            cb3 = cs[7]
+            if not neg2:
+                f2x = f2x + bz * (-ca * vx)
+                f2y = f2y + bz * (-ca * vy + cb2 * (ra1z + ra2z))
+                f2z = f2z + bz * (-ca * vz - cb2 * (ra1y + ra2y))
+            m2x = m2x + bzh * (ca2 * (ra2x - ra1x))
+            m2y = m2y + bzh * (cb2 * vz + cb3 * (ra1y + 2.0 * ra2y))
+            m2z = m2z + bzh * (-cb2 * vy + cb3 * (ra1z + 2.0 * ra2z))
+        # back to the world: undo rq (large angle), the axis turn and voxel
+        # 1's rotation
+        if not sa:
+            # G = RQ^T v rotates by rq^-1 (RQ the matrix of rq, normalised by
+            # |rq|^2: the small-ratio rq is not exactly unit)
+            n2q = rw * rw + ry * ry + rz * rz
+            r0 = n2q - 2.0 * (ry * ry + rz * rz)
+            r1 = 2.0 * (rw * rz)   # RQ[3] = -RQ[1]
+            r2 = 2.0 * (rw * ry)   # RQ[2] = -RQ[6]
+            r4 = n2q - 2.0 * (rz * rz)
+            r5 = 2.0 * (ry * rz)   # RQ[5] = RQ[7]
+            r8 = n2q - 2.0 * (ry * ry)
+            gx = r0 * f1x + r1 * f1y - r2 * f1z
+            gy = -r1 * f1x + r4 * f1y + r5 * f1z
+            gz = r2 * f1x + r5 * f1y + r8 * f1z
+            f1x = gx
+            f1y = gy
+            f1z = gz
+            gx = r0 * m1x + r1 * m1y - r2 * m1z
+            gy = -r1 * m1x + r4 * m1y + r5 * m1z
+            gz = r2 * m1x + r5 * m1y + r8 * m1z
+            m1x = gx
+            m1y = gy
+            m1z = gz
+            gx = r0 * m2x + r1 * m2y - r2 * m2z
+            gy = -r1 * m2x + r4 * m2y + r5 * m2z
+            gz = r2 * m2x + r5 * m2y + r8 * m2z
+            m2x = gx
+            m2y = gy
+            m2z = gz
+            if not neg2:
+                gx = r0 * f2x + r1 * f2y - r2 * f2z
+                gy = -r1 * f2x + r4 * f2y + r5 * f2z
+                gz = r2 * f2x + r5 * f2y + r8 * f2z
+                f2x = gx
+                f2y = gy
+                f2z = gz
+        fo = force + 3 * i
+        _bond_to_world(ax, R1, f1x, f1y, f1z, w)
+        fo[0] += w[0]
+        fo[1] += w[1]
+        fo[2] += w[2]
+        fo = force + 3 * j
+        if neg2:
+            fo[0] -= w[0]
+            fo[1] -= w[1]
+            fo[2] -= w[2]
+        else:
+            _bond_to_world(ax, R1, f2x, f2y, f2z, w)
+            fo[0] += w[0]
+            fo[1] += w[1]
+            fo[2] += w[2]
+        mo = moment + 3 * i
+        _bond_to_world(ax, R1, m1x, m1y, m1z, w)
+        mo[0] -= w[0]
+        mo[1] -= w[1]
+        mo[2] -= w[2]
+        mo = moment + 3 * j
+        _bond_to_world(ax, R1, m2x, m2y, m2z, w)
+        mo[0] -= w[0]
+        mo[1] -= w[1]
+        mo[2] -= w[2]
+    return STATUS_OK
 
 
 cdef int _links_seed(Batch* b, intp_t r) noexcept nogil:
@@ -479,216 +798,19 @@ cdef int _links_seed(Batch* b, intp_t r) noexcept nogil:
     # OUT (accumulated): force, moment; the links' mode and memory.
     # Quantities are those of the seed's bond frame (the link axis turned
     # onto +x, voxel 1's orientation removed); rotations back to the world
-    # go through voxel 1's rotation matrix.
+    # go through voxel 1's rotation matrix. A robot's links are sorted by
+    # axis (x, then y, then z): each run gets a copy with the axis constant.
     cdef:
-        intp_t li, i, j, ax, k
-        float64_t L = b.L
+        intp_t lo = b.link_start[r]
+        intp_t hi = b.link_start[r + 1]
+        intp_t nx = b.link_axis_count[3 * r]
+        intp_t ny = b.link_axis_count[3 * r + 1]
         float64_t inv_dt = 1.0 / b.dt[r]
-        float64_t bz = 0.5 * b.bond_zeta
-        float64_t max_ext = b.max_strain * L
-        float64_t dx, dy, dz, lx, ly, lz, qw, qx, qy, qz
-        float64_t nq[4]
-        float64_t rq[4]
-        float64_t tq[4]
-        float64_t p[3]
-        float64_t P[3]
-        float64_t A1[3]
-        float64_t A2[3]
-        float64_t F1[3]
-        float64_t F2[3]
-        float64_t M1[3]
-        float64_t M2[3]
-        float64_t G[3]
-        float64_t RV[3]
-        float64_t RA1[3]
-        float64_t RA2[3]
-        float64_t RQ[9]
-        float64_t nom, st, ex, ka, kt, kb, b2, ca, cb2, ca2, cb3
-        float64_t len_, nx, ny, nz, th, rho, ch, sh, yx, zx
-        float64_t* last
-        const float64_t* cs
-        const float64_t* R1
-        const float64_t* q1
-        const float64_t* q2
-        int32 sa, changed, homog
-    for li in range(b.link_start[r], b.link_start[r + 1]):
-        i = b.v1[li]
-        j = b.v2[li]
-        ax = b.axis[li]
-        R1 = b.rot + 9 * i
-        q1 = b.quat + 4 * i
-        q2 = b.quat + 4 * j
-        dx = b.pos[3 * j] - b.pos[3 * i]
-        dy = b.pos[3 * j + 1] - b.pos[3 * i + 1]
-        dz = b.pos[3 * j + 2] - b.pos[3 * i + 2]
-        # relative position in voxel 1's frame, then in the bond frame
-        lx = R1[0] * dx + R1[3] * dy + R1[6] * dz
-        ly = R1[1] * dx + R1[4] * dy + R1[7] * dz
-        lz = R1[2] * dx + R1[5] * dy + R1[8] * dz
-        _perm_vec(ax, lx, ly, lz, p)
-        # voxel 2's orientation relative to voxel 1 (q1* q2), in the bond frame
-        qw = q1[0] * q2[0] + q1[1] * q2[1] + q1[2] * q2[2] + q1[3] * q2[3]
-        qx = q1[0] * q2[1] - q1[1] * q2[0] - q1[2] * q2[3] + q1[3] * q2[2]
-        qy = q1[0] * q2[2] + q1[1] * q2[3] - q1[2] * q2[0] - q1[3] * q2[1]
-        qz = q1[0] * q2[3] - q1[1] * q2[2] + q1[2] * q2[1] - q1[3] * q2[0]
-        nq[0] = qw
-        _perm_vec(ax, qx, qy, qz, nq + 1)
-        nom = 0.5 * (b.scale[i] + b.scale[j])
-        st = (fabs(p[2]) + fabs(p[1])) / p[0]
-        ex = p[0] / nom
-        sa = b.link_sa[li]
-        changed = 0
-        if not sa and nq[0] > SMALL_ANGLE_W and st < SA_BOND_BEND_RAD and ex < SA_BOND_EXT_PERC:
-            sa = 1
-            changed = 1
-        elif sa and (not (nq[0] > SMALLISH_ANGLE_W) or st > HYSTERESIS * SA_BOND_BEND_RAD
-                     or ex > HYSTERESIS * SA_BOND_EXT_PERC):
-            sa = 0
-            changed = 1
-        b.link_sa[li] = sa
-        if sa:
-            # small angle: voxel 1's frame, offsets along its axes
-            A1[0] = 0.0
-            A1[1] = 0.0
-            A1[2] = 0.0
-            _rotvec(nq, A2)
-            P[0] = p[0] - nom
-            P[1] = p[1]
-            P[2] = p[2]
-        else:
-            # large angle: the frame turned by rq onto the chord (axis normal to x)
-            rq[0] = 1.0
-            rq[1] = 0.0
-            rq[2] = 0.0
-            rq[3] = 0.0
-            A1[0] = 0.0
-            A1[1] = 0.0
-            A1[2] = 0.0
-            if not (p[0] == 0.0 and p[1] == 0.0 and p[2] == 0.0):
-                yx = p[1] / p[0]
-                zx = p[2] / p[0]
-                if (yx < SMALL_ANGLE_RAD and yx > -SMALL_ANGLE_RAD
-                        and zx < SMALL_ANGLE_RAD and zx > -SMALL_ANGLE_RAD):
-                    rq[2] = 0.5 * zx
-                    rq[3] = -0.5 * yx
-                    rq[0] = 1.0 + 0.5 * (-rq[2] * rq[2] - rq[3] * rq[3])
-                    _rotvec(rq, A1)
-                else:
-                    len_ = sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2])
-                    nx = p[0] / len_
-                    ny = p[1] / len_
-                    nz = p[2] / len_
-                    th = acos(nx)
-                    if th > SEED_PI - DISCARD_ANGLE_RAD:
-                        rq[0] = 0.0
-                        rq[2] = 1.0
-                        _rotvec(rq, A1)
-                    else:
-                        rho = 1.0 / sqrt(nz * nz + ny * ny)
-                        ch = sqrt(0.5 * (1.0 + nx))  # cos(th / 2)
-                        sh = sqrt(0.5 * (1.0 - nx))  # sin(th / 2)
-                        rq[0] = ch
-                        rq[2] = nz * rho * sh
-                        rq[3] = -ny * rho * sh
-                        _rotvec(rq, A1)  # the seed's, with its acos approximation
-            _qmul(rq, nq, tq)
-            _rotvec(tq, A2)
-            P[0] = sqrt(dx * dx + dy * dy + dz * dz) - nom
-            P[1] = 0.0
-            P[2] = 0.0
-        if not (fabs(P[0]) <= max_ext):
-            return STATUS_STRAIN  # also catches NaN
-        ka = b.k_axial[li]
-        kt = b.k_torsion[li]
-        kb = b.k_bend[li]
-        b2 = 0.5 * ka * L
-        F1[0] = ka * P[0]
-        F1[1] = ka * P[1] - b2 * (A1[2] + A2[2])
-        F1[2] = ka * P[2] + b2 * (A1[1] + A2[1])
-        M1[0] = kt * (A1[0] - A2[0])
-        M1[1] = b2 * P[2] + kb * (2.0 * A1[1] + A2[1])
-        M1[2] = -b2 * P[1] + kb * (2.0 * A1[2] + A2[2])
-        M2[0] = -M1[0]
-        M2[1] = b2 * P[2] + kb * (A1[1] + 2.0 * A2[1])
-        M2[2] = -b2 * P[1] + kb * (A1[2] + 2.0 * A2[2])
-        homog = b.homog[li]
-        F2[0] = -F1[0]
-        F2[1] = -F1[1]
-        F2[2] = -F1[2]
-        if not changed:
-            last = b.link_last + 9 * li
-            cs = b.c_seed + 8 * li
-            for k in range(3):
-                RV[k] = (P[k] - last[k]) * inv_dt
-                RA1[k] = (A1[k] - last[3 + k]) * inv_dt
-                RA2[k] = (A2[k] - last[6 + k]) * inv_dt
-                last[k] = P[k]
-                last[3 + k] = A1[k]
-                last[6 + k] = A2[k]
-            ca = cs[0]
-            cb2 = cs[1]
-            ca2 = cs[2]
-            cb3 = cs[3]
-            F1[0] += bz * (ca * RV[0])
-            F1[1] += bz * (ca * RV[1] - cb2 * (RA1[2] + RA2[2]))
-            F1[2] += bz * (ca * RV[2] + cb2 * (RA1[1] + RA2[1]))
-            M1[0] += 0.5 * bz * (-ca2 * (RA2[0] - RA1[0]))
-            M1[1] += 0.5 * bz * (cb2 * RV[2] + cb3 * (2.0 * RA1[1] + RA2[1]))
-            M1[2] += 0.5 * bz * (-cb2 * RV[1] + cb3 * (2.0 * RA1[2] + RA2[2]))
-            ca = cs[4]
-            cb2 = cs[5]
-            ca2 = cs[6]
-            cb3 = cs[7]
-            if homog:
-                F2[0] = -F1[0]
-                F2[1] = -F1[1]
-                F2[2] = -F1[2]
-            else:
-                F2[0] += bz * (-ca * RV[0])
-                F2[1] += bz * (-ca * RV[1] + cb2 * (RA1[2] + RA2[2]))
-                F2[2] += bz * (-ca * RV[2] - cb2 * (RA1[1] + RA2[1]))
-            M2[0] += 0.5 * bz * (ca2 * (RA2[0] - RA1[0]))
-            M2[1] += 0.5 * bz * (cb2 * RV[2] + cb3 * (RA1[1] + 2.0 * RA2[1]))
-            M2[2] += 0.5 * bz * (-cb2 * RV[1] + cb3 * (RA1[2] + 2.0 * RA2[2]))
-        # back to the world: undo rq (large angle), the axis turn and voxel 1's rotation
-        if not sa:
-            _quat_matrix(rq, RQ)  # G = RQ^T v rotates by rq^-1
-            _mat_t_vec(RQ, F1, G)
-            _unperm_add(ax, R1, G, 1.0, b.force + 3 * i)
-            _mat_t_vec(RQ, F2, G)
-            _unperm_add(ax, R1, G, 1.0, b.force + 3 * j)
-            _mat_t_vec(RQ, M1, G)
-            _unperm_add(ax, R1, G, -1.0, b.moment + 3 * i)
-            _mat_t_vec(RQ, M2, G)
-            _unperm_add(ax, R1, G, -1.0, b.moment + 3 * j)
-        else:
-            _unperm_add(ax, R1, F1, 1.0, b.force + 3 * i)
-            _unperm_add(ax, R1, F2, 1.0, b.force + 3 * j)
-            _unperm_add(ax, R1, M1, -1.0, b.moment + 3 * i)
-            _unperm_add(ax, R1, M2, -1.0, b.moment + 3 * j)
-    return STATUS_OK
-
-
-cdef inline void _quat_matrix(const float64_t* q, float64_t* R) noexcept nogil:
-    # R = rotation matrix of q (normalised by its length: the seed's small-angle
-    # rq is not exactly unit, and its rotations scale by |q|^2)
-    cdef float64_t w = q[0], x = q[1], y = q[2], z = q[3]
-    cdef float64_t n2 = w * w + x * x + y * y + z * z
-    R[0] = n2 - 2.0 * (y * y + z * z)
-    R[1] = 2.0 * (x * y - w * z)
-    R[2] = 2.0 * (x * z + w * y)
-    R[3] = 2.0 * (x * y + w * z)
-    R[4] = n2 - 2.0 * (x * x + z * z)
-    R[5] = 2.0 * (y * z - w * x)
-    R[6] = 2.0 * (x * z - w * y)
-    R[7] = 2.0 * (y * z + w * x)
-    R[8] = n2 - 2.0 * (x * x + y * y)
-
-
-cdef inline void _mat_t_vec(const float64_t* R, const float64_t* v, float64_t* o) noexcept nogil:
-    o[0] = R[0] * v[0] + R[3] * v[1] + R[6] * v[2]
-    o[1] = R[1] * v[0] + R[4] * v[1] + R[7] * v[2]
-    o[2] = R[2] * v[0] + R[5] * v[1] + R[8] * v[2]
+    if _seed_links_along(b, lo, lo + nx, 0, inv_dt) != STATUS_OK:
+        return STATUS_STRAIN
+    if _seed_links_along(b, lo + nx, lo + nx + ny, 1, inv_dt) != STATUS_OK:
+        return STATUS_STRAIN
+    return _seed_links_along(b, lo + nx + ny, hi, 2, inv_dt)
 
 
 cdef inline void _surface_contact(Batch* b, intp_t i, float64_t nx, float64_t ny, float64_t nz,
