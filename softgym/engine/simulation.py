@@ -679,20 +679,57 @@ class Simulation:
             raise InvalidParameterError(f"seconds must be finite and >= 0, got {seconds}")
         self.advance_to(self._t_target + seconds)
 
-    def advance_to(self, time: float) -> None:
-        """Advance every robot until its clock reaches ``time`` (s)."""
+    #: Work between two returns to Python in :meth:`advance_to`, in voxel-steps per
+    #: thread (about 0.1 s of wall time): signals (Ctrl-C) act within a fraction of a
+    #: second whatever the batch, and results do not depend on it.
+    chunk_voxel_steps: int = 1_000_000
+
+    def advance_to(self, time: float, progress: Any = None) -> None:
+        """Advance every robot until its clock reaches ``time`` (s).
+
+        The kernel runs in chunks of simulated time of about
+        :attr:`chunk_voxel_steps` voxel-steps per thread each; between two
+        chunks Python runs its signal handlers, so Ctrl-C raises
+        ``KeyboardInterrupt`` within a fraction of a second, leaving the batch
+        at the end of the last chunk (a later call goes on from there).
+        There is no Python work per step: the result is bit-identical to one
+        kernel call.
+
+        Parameters
+        ----------
+        time : float
+            Target time (s), not before the current one.
+        progress : callable, optional
+            ``progress(t)`` after each chunk, with the simulated time (s) reached.
+        """
         time = float(time)
         if not (math.isfinite(time) and time >= self._t_target):
             raise InvalidParameterError(
                 f"time must be finite and >= the current target {self._t_target}, got {time}"
             )
-        self._t_target = time
         self._ensure_trace_capacity(time + self._a["dt"].max())
         a = self._a
-        targets = np.ceil(time / a["dt"] - 1e-9).astype(np.int64)
-        targets = np.maximum(targets, a["steps"])
+        dt = a["dt"]
+        final = np.maximum(np.ceil(time / dt - 1e-9).astype(np.int64), a["steps"])
         before = a["diverged"].copy()
-        _core.advance(a, self._settings, targets, self.n_threads, self._contacts)
+        # simulated seconds per chunk = work per chunk / voxel-steps per simulated second
+        rate = float(np.sum(np.diff(a["vox_start"]) / dt))
+        threads = min(self.n_threads, self.n_robots)
+        chunk = max(1, int(self.chunk_voxel_steps)) * threads / max(rate, 1e-300)
+        t = self._t_target
+        while True:
+            t = min(time, t + chunk)
+            if t >= time:
+                targets = final
+            else:
+                targets = np.minimum(np.maximum(np.ceil(t / dt - 1e-9).astype(np.int64), a["steps"]), final)
+            _core.advance(a, self._settings, targets, self.n_threads, self._contacts)
+            # back in Python: a pending SIGINT raises KeyboardInterrupt here
+            self._t_target = t
+            if progress is not None:
+                progress(t)
+            if t >= time:
+                break
         if self.config.on_divergence == "raise":
             new = np.flatnonzero((a["diverged"] == 1) & (before == 0))
             if new.size:
