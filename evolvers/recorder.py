@@ -5,7 +5,9 @@ loop and hands the recorder each finished generation::
 
     config.json            experiment, seed, backend (what resume checks), generations
     log.csv, log.jsonl     one row per generation: best/median/mean/worst of
-                           every objective, evaluations, cache hits, wall time
+                           every objective, evaluations, cache hits, wall time,
+                           the best individual's genes and composition (top_*),
+                           repeated phenotypes, obstacle crossings (study_columns)
     checkpoints/           ckpt-NNNNNN.{json,npz}, atomic, versioned, no pickle
     best_design.json       the best robot found (a RobotDesign file)
     best_designs.json      hall of fame: genomes, designs and objectives
@@ -35,7 +37,7 @@ from softgym.exceptions import CheckpointError, InvalidParameterError
 from softgym.io import (
     atomic_write_json,
     atomic_write_text,
-    load_checkpoint,
+    load_latest_intact,
     read_json,
     save_checkpoint,
 )
@@ -45,7 +47,9 @@ __all__ = [
     "RUN_SCHEMA",
     "RunRecorder",
     "log_row",
+    "obstacle_footprint",
     "population_summary",
+    "study_columns",
 ]
 
 log = logging.getLogger("evolvers")
@@ -84,6 +88,100 @@ def _stats_of(values: np.ndarray, maximize: bool) -> dict[str, float]:
     }
 
 
+#: Composition counts of the generation's best individual copied into the log (``top_*``).
+_TOP_COUNTS = ("n_voxels", "n_muscle", "n_bone", "n_tissue", "n_old_materials")
+
+
+def obstacle_footprint(experiment: Experiment) -> tuple[float, float, float, float] | None:
+    """The xy extent ``(x0, x1, y0, y1)`` (voxel lengths) of the experiment's obstacles, or None.
+
+    A robot whose final centre of mass lies outside it has crossed every obstacle
+    (for the ``wall`` task: it is past the fence's outer face).
+    """
+    terrain = experiment.make_task().terrain_for(experiment.shape)
+    if not terrain.boxes:
+        return None
+    lo = np.array([b.lo for b in terrain.boxes], dtype=np.float64)
+    hi = np.array([b.hi for b in terrain.boxes], dtype=np.float64)
+    return (float(lo[:, 0].min()), float(hi[:, 0].max()), float(lo[:, 1].min()), float(hi[:, 1].max()))
+
+
+def _final_xy(ind: Individual, voxel_size: float) -> tuple[float, float]:
+    """Final centre-of-mass (x, y) in voxel lengths from the individual's trace (NaN without one)."""
+    tr = ind.trace
+    if tr is None or len(tr) == 0:
+        return (float("nan"), float("nan"))
+    return (float(tr[-1, 0]) / voxel_size, float(tr[-1, 1]) / voxel_size)
+
+
+def _crossed(xy: tuple[float, float], footprint: tuple[float, float, float, float]) -> bool:
+    x, y = xy
+    x0, x1, y0, y1 = footprint
+    return bool(x < x0 or x > x1 or y < y0 or y > y1)
+
+
+def _individual_columns(prefix: str, ind: Individual | None, metrics: Sequence[str]) -> dict[str, Any]:
+    nan = float("nan")
+    out: dict[str, Any] = {f"{prefix}_id": -1 if ind is None else ind.id}
+    for m in metrics:
+        out[f"{prefix}_{m}"] = nan if ind is None else float(ind.objectives.get(m, nan))
+    return out
+
+
+def study_columns(
+    experiment: Experiment, population: Sequence[Individual], stats: EvalStats
+) -> dict[str, Any]:
+    """Log columns a study report reads: the generation's best individual, composition, repeats, crossings.
+
+    ``top_*``: the best individual of the population (by the first objective):
+    its id, fitness measures, composition counts, genes
+    (:meth:`Individual.genes`) and final centre of mass (``top_final_x``,
+    ``top_final_y``, voxel lengths). ``muscle_fraction_median``: median share
+    of muscle voxels over the population's valid bodies. ``new_individuals``
+    and ``repeated_phenotypes``: individuals evaluated for the first time this
+    generation, and how many of them had a phenotype already simulated in the
+    run (:class:`~evolvers.evaluation.EvalStats`). On a task with obstacles:
+    ``crossed`` (individuals whose final centre of mass is outside the
+    obstacles' footprint, :func:`obstacle_footprint`), ``top_crossed``, and
+    ``crosser_*`` (the best of those, or id -1 and NaN).
+    """
+    exp = experiment
+    fit = exp.fitness if exp.fitness.name != "age" else None
+    name = fit.name if fit is not None else "norm_final_dist"
+    maximize = True if fit is None else fit.maximize
+    pop = [ind for ind in population if ind.objectives]
+    row: dict[str, Any] = {
+        "new_individuals": stats.n_new,
+        "repeated_phenotypes": stats.n_repeated,
+    }
+    fractions = [
+        ind.objectives["n_muscle"] / ind.objectives["n_voxels"]
+        for ind in pop
+        if ind.objectives.get("n_voxels", 0) > 0
+    ]
+    row["muscle_fraction_median"] = float(np.median(fractions)) if fractions else float("nan")
+    metrics = (*FITNESS_METRICS, *_TOP_COUNTS)
+    values = np.array([ind.value(name) for ind in pop], dtype=np.float64)
+    top = pop[int(np.argmax(values if maximize else -values))] if pop else None
+    row.update(_individual_columns("top", top, metrics))
+    if top is not None:
+        row.update({f"top_{k}": v for k, v in top.genes().items()})
+    voxel_size = exp.make_task().config().voxel_size
+    xy = _final_xy(top, voxel_size) if top is not None else (float("nan"), float("nan"))
+    row["top_final_x"], row["top_final_y"] = xy
+    footprint = obstacle_footprint(exp)
+    if footprint is not None:
+        crossers = [ind for ind in pop if _crossed(_final_xy(ind, voxel_size), footprint)]
+        row["crossed"] = len(crossers)
+        row["top_crossed"] = int(top is not None and _crossed(xy, footprint))
+        best = None
+        if crossers:
+            cv = np.array([ind.value(name) for ind in crossers], dtype=np.float64)
+            best = crossers[int(np.argmax(cv if maximize else -cv))]
+        row.update(_individual_columns("crosser", best, metrics))
+    return row
+
+
 def log_row(
     experiment: Experiment,
     generation: int,
@@ -119,6 +217,7 @@ def log_row(
         )
         for k, v in _stats_of(vals, False).items():
             row[f"novelty_{k}"] = v
+    row.update(study_columns(exp, population, stats))
     return row
 
 
@@ -194,7 +293,13 @@ class RunRecorder:
             return False
 
     def resume(self, generations: int) -> tuple[dict[str, Any], dict[str, np.ndarray]] | None:
-        """Load the latest checkpoint of the run folder and the recorder's part of it.
+        """Load the latest intact checkpoint of the run folder and the recorder's part of it.
+
+        If the newest checkpoint is corrupt (e.g. truncated by a kill), the
+        newest intact one is used instead and one warning line on the
+        ``softgym.io`` logger names the skipped file(s); the driver then redoes
+        the lost generations, which finishes exactly like an uninterrupted run
+        (:func:`softgym.io.load_latest_intact`).
 
         Returns
         -------
@@ -205,9 +310,9 @@ class RunRecorder:
         Raises
         ------
         CheckpointError
-            If config.json names another experiment/seed/backend, or the
-            latest checkpoint is corrupt (the message names the file; the
-            previous checkpoints are still in ``checkpoints/``).
+            If config.json names another experiment/seed/backend, or no
+            checkpoint in ``checkpoints/`` is intact (the message names each
+            file and why).
         """
         cfg_path = self.out / "config.json"
         if not cfg_path.exists():
@@ -223,7 +328,7 @@ class RunRecorder:
                 )
         if not self._has_checkpoint():
             return None
-        state, arrays = load_checkpoint(self.checkpoint_dir)
+        state, arrays, _, _ = load_latest_intact(self.checkpoint_dir)
         try:
             self.rows = list(state["rows"])
             self.hall_of_fame = list(state["hall_of_fame"])

@@ -1,9 +1,9 @@
 """kill -9, a corrupt latest checkpoint, resume: each backend finishes as if never interrupted.
 
 The run is killed with SIGKILL in a child process right after generation 2 is checkpointed;
-that checkpoint is then truncated. Resuming through :func:`softgym.io.load_latest_intact`
-(patched in where the run recorder loads its checkpoint, the one-line change issue 12 asks of
-the runners) falls back to generation 1, says so in one line, and redoes generation 2.
+that checkpoint is then truncated. Resuming (the run recorder loads through
+:func:`softgym.io.load_latest_intact`) falls back to generation 1, says so in one line, and
+redoes generation 2.
 """
 
 import json
@@ -16,12 +16,11 @@ import textwrap
 
 import pytest
 
-import evolvers.recorder as recorder
 from evolvers.deap_runner import DeapRun
 from evolvers.experiments import get_experiment
 from evolvers.pymoo_runner import PymooRun
 from evolvers.runner import EvolutionRun, population_summary
-from softgym.io import list_checkpoints, load_latest_intact
+from softgym.io import list_checkpoints
 
 RUNS = {
     "native": ("evolvers.runner", "EvolutionRun", EvolutionRun, "controller-tournament"),
@@ -37,7 +36,7 @@ def _comparable(rows):
 
 
 @pytest.mark.parametrize("backend", sorted(RUNS))
-def test_kill9_then_corrupt_latest_resumes_identically(tmp_path, backend, monkeypatch, caplog):
+def test_kill9_then_corrupt_latest_resumes_identically(tmp_path, backend, caplog):
     module, cls_name, cls, exp_name = RUNS[backend]
     exp = get_experiment(exp_name, **TINY)
     ref = cls(exp, tmp_path / "ref", seed=5, generations=3, figures=False)
@@ -67,7 +66,6 @@ def test_kill9_then_corrupt_latest_resumes_identically(tmp_path, backend, monkey
     text = ckpts[-1].read_text()
     ckpts[-1].write_text(text[: len(text) // 2])  # the newest checkpoint is corrupt
 
-    monkeypatch.setattr(recorder, "load_checkpoint", lambda d: load_latest_intact(d)[:2])
     with caplog.at_level(logging.WARNING, logger="softgym.io"):
         resumed = cls(exp, tmp_path / "b", seed=5, generations=3, figures=False)
         pop = resumed.run(resume=True)

@@ -1,5 +1,6 @@
 import csv
 import json
+import logging
 
 import pytest
 from evolver_helpers import tiny
@@ -70,20 +71,34 @@ def test_interrupted_run_resumes_to_the_identical_result(tmp_path, name):
     assert [r["generation"] for r in resumed.rows] == [0, 1, 2, 3]
 
 
-def test_corrupt_checkpoint_names_the_file_and_keeps_the_previous(tmp_path):
+def test_corrupt_checkpoint_names_the_file_and_keeps_the_previous(tmp_path, caplog):
+    # a corrupt newest checkpoint: resume falls back to the previous intact one, says so in
+    # one line naming both files, redoes the lost generation and ends as an uninterrupted run
     exp = tiny()
+    ref = EvolutionRun(exp, tmp_path / "ref", seed=1, generations=2, figures=False).run()
     EvolutionRun(exp, tmp_path / "r", seed=1, generations=1, figures=False).run()
     ckpts = list_checkpoints(tmp_path / "r" / "checkpoints")
     text = ckpts[-1].read_text()
     ckpts[-1].write_text(text[: len(text) // 2])  # truncated
-    with pytest.raises(CheckpointError, match="ckpt-000001.json"):
-        EvolutionRun(exp, tmp_path / "r", seed=1, generations=2, figures=False).run(resume=True)
-    state, _ = load_checkpoint(ckpts[-2])  # the previous good one is intact
-    assert state["generation"] == 0
-    npz = ckpts[-2].with_suffix(".npz")
+    with caplog.at_level(logging.WARNING, logger="softgym.io"):
+        run = EvolutionRun(exp, tmp_path / "r", seed=1, generations=2, figures=False)
+        pop = run.run(resume=True)
+    [line] = [r.getMessage() for r in caplog.records if r.name == "softgym.io"]
+    assert "ckpt-000001.json" in line and "resuming from ckpt-000000.json" in line
+    assert population_summary(pop) == population_summary(ref)
+    assert [r["generation"] for r in run.rows] == [0, 1, 2]
+    # a corrupt npz is named too; with no intact checkpoint left the resume stops, naming each
+    ckpts = list_checkpoints(tmp_path / "r" / "checkpoints")
+    npz = ckpts[0].with_suffix(".npz")
     npz.write_bytes(npz.read_bytes()[:100])
     with pytest.raises(CheckpointError, match="ckpt-000000.npz"):
-        load_checkpoint(ckpts[-2])
+        load_checkpoint(ckpts[0])
+    for path in ckpts[1:]:
+        path.write_text("{")
+    with pytest.raises(CheckpointError, match="no intact checkpoint") as info:
+        EvolutionRun(exp, tmp_path / "r", seed=1, generations=3, figures=False).run(resume=True)
+    assert all(path.name in str(info.value) for path in ckpts[1:])
+    assert "ckpt-000000.npz" in str(info.value)
 
 
 def test_resume_refuses_another_experiment(tmp_path):
