@@ -193,17 +193,23 @@ def _cmd_replay(args: argparse.Namespace) -> int:
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
+    from softgym.exceptions import CheckpointError
+    from softgym.io import read_json
     from softgym.render.figures import plot_best_fitness, read_log
 
     curves = {}
     metric = args.metric
     for d in args.run_dirs:
-        cfg = json.loads((Path(d) / "config.json").read_text())
-        label = f"{cfg['experiment']['name']} ({cfg['backend']}, seed {cfg['seed']})"
+        cfg_path = Path(d) / "config.json"
+        cfg = read_json(cfg_path)  # CheckpointError naming the file if missing or corrupt
+        try:
+            label = f"{cfg['experiment']['name']} ({cfg['backend']}, seed {cfg['seed']})"
+            if metric is None:
+                first = cfg["experiment"]["objectives"][0]["name"]
+                metric = first if first != "age" else "norm_final_dist"
+        except (KeyError, TypeError, IndexError) as exc:
+            raise CheckpointError(f"{cfg_path}: not a softgym run config ({exc!r})") from None
         curves[label] = read_log(d)
-        if metric is None:
-            first = cfg["experiment"]["objectives"][0]["name"]
-            metric = first if first != "age" else "norm_final_dist"
     path = plot_best_fitness(curves, metric, args.out, ylabel=f"Best {metric}")
     print(path)
     return 0
@@ -219,8 +225,16 @@ def _cmd_experiments(args: argparse.Namespace) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``softgym`` command."""
+    """Entry point of the ``softgym`` command.
+
+    A :class:`~softgym.exceptions.SoftGymError` or :class:`OSError` from a
+    subcommand prints one line, ``softgym <command>: <message>``, to stderr and
+    returns 2; ``softgym --debug <command> ...`` raises it instead (traceback).
+    """
     parser = argparse.ArgumentParser(prog="softgym", description=__doc__.split("\n")[0])
+    parser.add_argument(
+        "--debug", action="store_true", help="show the traceback of an error (before the command)"
+    )
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("simulate", help="simulate one robot and plot its trajectory")
     p.add_argument("--design", help="a RobotDesign JSON file (default: the embedded walker)")
@@ -292,7 +306,16 @@ def main(argv: list[str] | None = None) -> int:
     p.set_defaults(func=_cmd_experiments)
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
-    return int(args.func(args))
+    from softgym.exceptions import SoftGymError
+
+    try:
+        return int(args.func(args))
+    except (SoftGymError, OSError) as exc:  # bad input or a file problem: one line, exit 2
+        if args.debug:
+            raise
+        message = " ".join(str(exc).split()) or type(exc).__name__
+        print(f"softgym {args.command}: {message}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,0 +1,87 @@
+"""Bad input on the command line: one line on stderr and exit 2; ``--debug`` shows the traceback."""
+
+import os
+import sys
+
+import pytest
+
+from softgym.cli import main
+from softgym.exceptions import CheckpointError, InvalidDesignError, SoftGymError
+
+TINY = ["--pop", "4", "--seconds", "0.5", "--shape", "4", "4", "4", "--quiet", "--no-figures"]
+
+
+def _one_line_error(capsys, argv, command):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    lines = err.splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith(f"softgym {command}: ")
+    assert "Traceback" not in err
+    return lines[0]
+
+
+def test_simulate_bad_design_and_seconds(tmp_path, capsys):
+    missing = tmp_path / "missing.json"
+    assert str(missing) in _one_line_error(
+        capsys, ["simulate", "--design", str(missing)], "simulate"
+    )
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"grid": ')
+    assert str(bad) in _one_line_error(capsys, ["simulate", "--design", str(bad)], "simulate")
+    line = _one_line_error(
+        capsys, ["simulate", "--seconds", "-1", "--out", str(tmp_path)], "simulate"
+    )
+    assert "seconds" in line
+    with pytest.raises(InvalidDesignError):
+        main(["--debug", "simulate", "--design", str(bad)])
+
+
+def test_evolve_out_that_cannot_be_a_run_folder(tmp_path, capsys):
+    afile = tmp_path / "afile"
+    afile.write_text("not a folder")
+    for out in (afile, afile / "run"):  # an existing file, a path under a file
+        line = _one_line_error(capsys, ["evolve", "--out", str(out), *TINY], "evolve")
+        assert str(out) in line
+    assert afile.read_text() == "not a folder"
+    with pytest.raises(OSError):
+        main(["--debug", "evolve", "--out", str(afile / "run"), *TINY])
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="/proc refuses new folders")
+def test_evolve_out_in_an_unwritable_place(capsys):
+    out = "/proc/softgym-run"  # even root cannot create a folder here
+    assert out in _one_line_error(capsys, ["evolve", "--out", out, *TINY], "evolve")
+
+
+@pytest.mark.skipif(
+    not hasattr(os, "geteuid") or os.geteuid() == 0, reason="root ignores folder permissions"
+)
+def test_evolve_out_in_a_read_only_folder(tmp_path, capsys):
+    ro = tmp_path / "ro"
+    ro.mkdir(mode=0o500)
+    try:
+        out = ro / "run"
+        assert str(out) in _one_line_error(capsys, ["evolve", "--out", str(out), *TINY], "evolve")
+    finally:
+        ro.chmod(0o700)
+
+
+def test_compare_reads_config_through_read_json(tmp_path, capsys):
+    line = _one_line_error(capsys, ["compare", str(tmp_path / "nonexistent")], "compare")
+    assert str(tmp_path / "nonexistent" / "config.json") in line and "not found" in line
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "config.json").write_text('{"experiment": ')
+    assert str(run / "config.json") in _one_line_error(capsys, ["compare", str(run)], "compare")
+    (run / "config.json").write_text("[1, 2]")  # JSON, but not a run config
+    line = _one_line_error(capsys, ["compare", str(run)], "compare")
+    assert str(run / "config.json") in line and "not a softgym run config" in line
+    with pytest.raises(CheckpointError, match="config.json"):
+        main(["--debug", "compare", str(run)])
+
+
+def test_debug_flag_leaves_success_alone(capsys):
+    assert main(["--debug", "experiments"]) == 0
+    assert "controller-tournament" in capsys.readouterr().out
+    assert issubclass(CheckpointError, SoftGymError)
