@@ -355,8 +355,9 @@ class PymooRun:
 
     Parameters
     ----------
-    experiment, out, seed, generations, batch_fn, n_threads, on_generation, figures, gif
-        As for :class:`~evolvers.runner.EvolutionRun`.
+    experiment, out, seed, generations, batch_fn, n_threads, on_generation, figures, gif, progress
+        As for :class:`~evolvers.runner.EvolutionRun` (Ctrl-C raises
+        :class:`~evolvers.recorder.RunInterrupted` the same way).
     algorithm : str or callable
         ``"nsga2"`` (default), ``"nsga3"``, ``"sms-emoa"``, ``"ga"``
         (single-objective, on the experiment's fitness), or a pymoo algorithm
@@ -384,6 +385,7 @@ class PymooRun:
         algorithm: str | Callable[..., Algorithm] = "nsga2",
         algorithm_kwargs: dict[str, Any] | None = None,
         single_objective: bool | None = None,
+        progress: bool = True,
     ) -> None:
         self.experiment = experiment
         self.out = Path(out)
@@ -404,8 +406,12 @@ class PymooRun:
         self.evaluator = Evaluator(experiment, batch_fn=batch_fn, n_threads=n_threads)
         self.recorder = RunRecorder(
             out, experiment, self.seed, self.backend, figures, gif,
-            extra_config={"algorithm": _algorithm_label(algorithm)},
+            extra_config={"algorithm": _algorithm_label(algorithm)}, progress=progress,
         )  # fmt: skip
+        #: What :class:`~evolvers.recorder.RunInterrupted` tells the user to type.
+        self.resume_command = (
+            f"PymooRun(experiment, {str(self.out)!r}, seed={self.seed}).run(resume=True)"
+        )
         self.ids = IdCounter()
         self.archive: NoveltyArchive | None = None
         self.algorithm: Algorithm | None = None
@@ -498,11 +504,22 @@ class PymooRun:
                 raise CheckpointError(
                     f"{self.recorder.checkpoint_dir}: checkpoint content is invalid ({exc!r})"
                 ) from exc
-        while self.generation < self.generations:
-            t0 = time.perf_counter()
-            infills = self._generation(problem, algorithm)
-            self.recorder.update_hall_of_fame(infills, self.generation)
-            self._end_generation(algorithm, problem.last_stats, time.perf_counter() - t0)
+        self.recorder.open_progress(
+            self.generation,
+            self.generations,
+            f"{self.experiment.name} [pymoo {_algorithm_label(self.algorithm_spec)}]",
+        )
+        try:
+            while self.generation < self.generations:
+                t0 = time.perf_counter()
+                infills = self._generation(problem, algorithm)
+                self.recorder.update_hall_of_fame(infills, self.generation)
+                self._end_generation(algorithm, problem.last_stats, time.perf_counter() - t0)
+        except KeyboardInterrupt as exc:
+            done = len(self.recorder.rows) - 1
+            raise self.recorder.interrupted(done, self.resume_command) from exc
+        finally:
+            self.recorder.close_progress()
         self.recorder.finish(self.generation, self.population)
         return self.population
 

@@ -9,13 +9,20 @@ loop and hands the recorder each finished generation::
                            the best individual's genes and composition (top_*),
                            repeated phenotypes, obstacle crossings (study_columns)
     checkpoints/           ckpt-NNNNNN.{json,npz}, atomic, versioned, no pickle
-    best_design.json       the best robot found (a RobotDesign file)
+    best_design.json       the best robot found (a RobotDesign file) and
+    best_design.vxa        the same robot for VoxCAD / evosoro
     best_designs.json      hall of fame: genomes, designs and objectives
+    best_designs/          each of them as rank-K_id-N.json and .vxa
     final_population.json  the last population
     figures/               fitness trend, best robot, its trajectory, its GIF
 
 A checkpoint holds the recorder's state (log rows, hall of fame, totals) and
 whatever the driver adds (its random states, counters, the phenotype cache).
+
+The recorder also shows the run's progress (a tqdm bar over generations, off
+with ``progress=False``), logs one line per generation to the ``evolvers``
+logger, and turns a Ctrl-C into :class:`RunInterrupted`, which names the last
+checkpoint and the command that resumes.
 """
 
 from __future__ import annotations
@@ -24,6 +31,7 @@ import csv
 import io
 import json
 import logging
+import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -37,6 +45,7 @@ from softgym.exceptions import CheckpointError, InvalidParameterError
 from softgym.io import (
     atomic_write_json,
     atomic_write_text,
+    latest_checkpoint,
     load_latest_intact,
     read_json,
     save_checkpoint,
@@ -62,6 +71,75 @@ HALL_OF_FAME_SIZE = 5
 KEEP_CHECKPOINTS = 3
 # the recorder's part of a checkpoint's state
 _RECORDER_KEYS = ("rows", "hall_of_fame", "evaluations_total", "wall_total")
+
+
+class RunInterrupted(KeyboardInterrupt):
+    """A run stopped by Ctrl-C (or SIGTERM under the CLI); its last checkpoint is intact.
+
+    A ``KeyboardInterrupt``, so code that lets Ctrl-C through still does.
+
+    Attributes
+    ----------
+    out : Path
+        The run folder.
+    generation : int
+        The last finished (checkpointed) generation, -1 if none.
+    checkpoint : Path or None
+        Its checkpoint file.
+    resume : str
+        How to continue (a shell command or a Python call).
+    """
+
+    def __init__(self, out: Path, generation: int, checkpoint: Path | None, resume: str) -> None:
+        self.out = Path(out)
+        self.generation = int(generation)
+        self.checkpoint = checkpoint
+        self.resume = resume
+        where = (
+            f"generation {generation} is checkpointed in {checkpoint}"
+            if checkpoint is not None
+            else "no generation had finished"
+        )
+        super().__init__(f"interrupted: {where}; resume with: {resume}")
+
+
+def read_run_config(out: str | Path) -> dict[str, Any]:
+    """The config.json of a run folder (experiment, seed, backend, generations...).
+
+    Raises
+    ------
+    CheckpointError
+        If the folder holds no readable run config.
+    """
+    path = Path(out) / "config.json"
+    if not path.is_file():
+        raise CheckpointError(f"{out}: not a run folder (no config.json)")
+    cfg = read_json(path)
+    if not isinstance(cfg, dict) or not isinstance(cfg.get("experiment"), dict):
+        raise CheckpointError(f"{path}: not a softgym run config")
+    return cfg
+
+
+def config_difference(recorded: Any, given: Any, name: str = "") -> str | None:
+    """The first setting where two configs differ, as ``"name: recorded != given"``, or None."""
+    if isinstance(recorded, Mapping) and isinstance(given, Mapping):
+        for k in list(recorded) + [k for k in given if k not in recorded]:
+            diff = config_difference(
+                recorded.get(k), given.get(k), f"{name}.{k}" if name else str(k)
+            )
+            if diff is not None:
+                return diff
+        return None
+    if isinstance(recorded, (list, tuple)) and isinstance(given, (list, tuple)):
+        if len(recorded) == len(given):
+            for i, (a, b) in enumerate(zip(recorded, given)):
+                diff = config_difference(a, b, f"{name}[{i}]")
+                if diff is not None:
+                    return diff
+            return None
+    if recorded == given:
+        return None
+    return f"{name}: {recorded!r} (recorded) != {given!r}"
 
 
 def population_summary(individuals: Sequence[Individual]) -> list[dict[str, Any]]:
@@ -103,7 +181,12 @@ def obstacle_footprint(experiment: Experiment) -> tuple[float, float, float, flo
         return None
     lo = np.array([b.lo for b in terrain.boxes], dtype=np.float64)
     hi = np.array([b.hi for b in terrain.boxes], dtype=np.float64)
-    return (float(lo[:, 0].min()), float(hi[:, 0].max()), float(lo[:, 1].min()), float(hi[:, 1].max()))
+    return (
+        float(lo[:, 0].min()),
+        float(hi[:, 0].max()),
+        float(lo[:, 1].min()),
+        float(hi[:, 1].max()),
+    )
 
 
 def _final_xy(ind: Individual, voxel_size: float) -> tuple[float, float]:
@@ -120,7 +203,9 @@ def _crossed(xy: tuple[float, float], footprint: tuple[float, float, float, floa
     return bool(x < x0 or x > x1 or y < y0 or y > y1)
 
 
-def _individual_columns(prefix: str, ind: Individual | None, metrics: Sequence[str]) -> dict[str, Any]:
+def _individual_columns(
+    prefix: str, ind: Individual | None, metrics: Sequence[str]
+) -> dict[str, Any]:
     nan = float("nan")
     out: dict[str, Any] = {f"{prefix}_id": -1 if ind is None else ind.id}
     for m in metrics:
@@ -237,6 +322,8 @@ class RunRecorder:
         Write the figures (and the best robot's GIF) when the run finishes.
     extra_config : dict, optional
         More entries of config.json (e.g. the pymoo algorithm), also checked on resume.
+    progress : bool
+        Show a tqdm bar over the generations (on stderr).
     """
 
     def __init__(
@@ -248,11 +335,14 @@ class RunRecorder:
         figures: bool = True,
         gif: bool = True,
         extra_config: Mapping[str, Any] | None = None,
+        progress: bool = True,
     ) -> None:
         self.out = Path(out)
         self.experiment = experiment
         self.figures = figures
         self.gif = gif
+        self.progress = progress
+        self._bar: Any = None
         self.config: dict[str, Any] = {
             "schema": RUN_SCHEMA,
             "version": 1,
@@ -265,6 +355,7 @@ class RunRecorder:
         self.hall_of_fame: list[dict[str, Any]] = []
         self.evaluations_total = 0
         self.wall_total = 0.0
+        self.generations: int | None = None
 
     @property
     def checkpoint_dir(self) -> Path:
@@ -282,6 +373,7 @@ class RunRecorder:
             raise CheckpointError(
                 f"{self.out}: the folder already holds a run; use resume (--resume) or another --out"
             )
+        self.generations = generations
         atomic_write_json(self.out / "config.json", {**self.config, "generations": generations})
 
     def _same(self, key: str, recorded: Any) -> bool:
@@ -322,9 +414,16 @@ class RunRecorder:
             if key in ("schema", "version"):
                 continue
             if not self._same(key, cfg.get(key)):
+                recorded = cfg.get(key)
+                if key == "experiment" and isinstance(recorded, dict):
+                    try:
+                        recorded = Experiment.from_dict(recorded).to_dict()
+                    except Exception:  # an unreadable record: compare it as it is
+                        pass
+                diff = config_difference(recorded, self.config[key], key)
                 raise CheckpointError(
-                    f"{cfg_path}: the run was started with another {key} "
-                    f"({cfg.get(key)!r} != {self.config[key]!r})"
+                    f"{self.out} was started with another {diff or key}; "
+                    "resume with the run's own settings (softgym evolve --out DIR --resume)"
                 )
         if not self._has_checkpoint():
             return None
@@ -338,8 +437,60 @@ class RunRecorder:
             raise CheckpointError(
                 f"{self.checkpoint_dir}: checkpoint content is invalid ({exc!r})"
             ) from exc
+        self.generations = generations
         atomic_write_json(cfg_path, {**self.config, "generations": generations})
         return state, arrays
+
+    # ------------------------------------------------------------------ progress
+    def open_progress(self, generation: int, generations: int, desc: str) -> None:
+        """Start the progress bar at ``generation`` (the last finished one) of ``generations``."""
+        self.close_progress()
+        if not self.progress:
+            return
+        from tqdm.auto import tqdm
+
+        self._bar = tqdm(
+            total=generations + 1, initial=generation + 1, desc=desc, unit="gen",
+            dynamic_ncols=True, leave=True,
+        )  # fmt: skip
+
+    def close_progress(self) -> None:
+        """Close the progress bar (if any)."""
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
+
+    def _report(self, row: Mapping[str, Any], generations: int | None) -> None:
+        fit = self.experiment.fitness
+        best = row.get(f"{fit.name}_best", float("nan"))
+        of = "" if generations is None else f"/{generations}"
+        log.info(
+            "%s generation %d%s: best %s %.4g, %d simulated (%d in all), %.1f s",
+            self.out, row["generation"], of, fit.name, best, row["evaluations"],
+            row["evaluations_total"], row["wall_time"],
+        )  # fmt: skip
+        if self._bar is not None:
+            self._bar.n = int(row["generation"]) + 1
+            if isinstance(best, float) and math.isfinite(best):
+                self._bar.set_postfix(best=f"{best:.3f}", evals=row["evaluations_total"],
+                                      refresh=False)  # fmt: skip
+            self._bar.refresh()
+
+    def interrupted(self, generation: int, resume: str) -> RunInterrupted:
+        """Close the bar, log where the run stopped and return the :class:`RunInterrupted` to raise.
+
+        Parameters
+        ----------
+        generation : int
+            The last finished (checkpointed) generation, -1 if none.
+        resume : str
+            The command (or call) that resumes.
+        """
+        self.close_progress()
+        ckpt = latest_checkpoint(self.checkpoint_dir) if self.checkpoint_dir.exists() else None
+        exc = RunInterrupted(self.out, generation, ckpt, resume)
+        log.warning("%s: %s", self.out, exc)
+        return exc
 
     # ------------------------------------------------------------------ records
     def update_hall_of_fame(self, individuals: Sequence[Individual], generation: int) -> None:
@@ -405,6 +556,7 @@ class RunRecorder:
         self.checkpoint(generation, population, state, arrays)
         self.write_log()
         self.write_best()
+        self._report(row, self.generations)
         return row
 
     def checkpoint(
@@ -461,9 +613,37 @@ class RunRecorder:
             )
         atomic_write_json(self.out / "best_designs.json", {"experiment": exp.name, "best": entries})
         atomic_write_json(self.out / "best_design.json", entries[0]["design"])
+        self._write_design_files(entries)
+
+    def _write_design_files(self, entries: list[dict[str, Any]]) -> None:
+        """best_design.vxa and best_designs/rank-K_id-N.{json,vxa} (stale ones removed)."""
+        from softgym.design import RobotDesign
+        from softgym.design.vxa import to_vxa
+
+        folder = self.out / "best_designs"
+        folder.mkdir(exist_ok=True)
+        keep = set()
+        for rank, e in enumerate(entries, start=1):
+            stem = f"rank-{rank}_id-{e['id']}"
+            keep.update({f"{stem}.json", f"{stem}.vxa"})
+            atomic_write_json(folder / f"{stem}.json", e["design"])
+            try:
+                text = to_vxa(
+                    RobotDesign.from_dict(e["design"]), sim_time=float(self.experiment.seconds)
+                )
+            except Exception as exc:  # a design VoxCAD cannot hold must not stop the run
+                log.warning("%s: no .vxa for design %s (%s)", self.out, e["id"], exc)
+                continue
+            atomic_write_text(folder / f"{stem}.vxa", text)
+            if rank == 1:
+                atomic_write_text(self.out / "best_design.vxa", text)
+        for old in folder.glob("rank-*"):
+            if old.name not in keep:
+                old.unlink(missing_ok=True)
 
     def finish(self, generation: int, population: Sequence[Individual]) -> None:
         """Write the final population, the best designs and the figures."""
+        self.close_progress()
         atomic_write_json(
             self.out / "final_population.json",
             {"generation": generation, "population": population_summary(population)},

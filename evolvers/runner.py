@@ -32,7 +32,7 @@ from evolvers.evaluation import (
 from evolvers.experiments import Experiment
 from evolvers.genome import Individual
 from evolvers.operators import make_children
-from evolvers.recorder import RUN_SCHEMA, RunRecorder, population_summary
+from evolvers.recorder import RUN_SCHEMA, RunInterrupted, RunRecorder, population_summary
 from evolvers.selection import (
     sel_fitness_tournament,
     sel_novelty,
@@ -48,7 +48,7 @@ from softgym.io import (
 )
 from softgym.metrics import NoveltyArchive
 
-__all__ = ["RUN_SCHEMA", "EvolutionRun", "population_summary"]
+__all__ = ["RUN_SCHEMA", "EvolutionRun", "RunInterrupted", "population_summary"]
 
 
 class EvolutionRun:
@@ -76,6 +76,16 @@ class EvolutionRun:
         Write figures (and the GIF) at the end.
     gif : bool
         Also render the best robot's GIF.
+    progress : bool
+        Show a tqdm bar over the generations (each generation is also logged
+        to the ``evolvers`` logger at INFO).
+
+    Raises
+    ------
+    RunInterrupted
+        From :meth:`run` on Ctrl-C (a ``KeyboardInterrupt``; the simulations
+        stop within a fraction of a second): it names the last checkpoint
+        and :attr:`resume_command`.
     """
 
     backend = "native"
@@ -91,6 +101,7 @@ class EvolutionRun:
         on_generation: Callable[[EvolutionRun, dict[str, Any]], None] | None = None,
         figures: bool = True,
         gif: bool = True,
+        progress: bool = True,
     ) -> None:
         self.experiment = experiment
         self.out = Path(out)
@@ -104,7 +115,11 @@ class EvolutionRun:
         self.figures = figures
         self.gif = gif
         self.evaluator = Evaluator(experiment, batch_fn=batch_fn, n_threads=n_threads)
-        self.recorder = RunRecorder(out, experiment, self.seed, self.backend, figures, gif)
+        self.recorder = RunRecorder(
+            out, experiment, self.seed, self.backend, figures, gif, progress=progress
+        )
+        #: What :class:`RunInterrupted` tells the user to type (the CLI puts its command here).
+        self.resume_command = f"{type(self).__name__}(experiment, {str(self.out)!r}, seed={self.seed}).run(resume=True)"
         self.rng = np.random.default_rng(self.seed)
         self.generation = -1
         self.population: list[Individual] = []
@@ -260,15 +275,23 @@ class EvolutionRun:
         """
         if not (resume and self.resume()):
             self.start()
-        while self.generation < self.generations:
-            t0 = time.perf_counter()
-            if self.generation < 0:
-                stats = self._generation_zero()
-                self.recorder.update_hall_of_fame(self.population, 0)
-            else:
-                stats = self._next_generation()
-            self.generation += 1
-            self._end_generation(stats, time.perf_counter() - t0)
+        self.recorder.open_progress(
+            self.generation, self.generations, f"{self.experiment.name} [{self.backend}]"
+        )
+        try:
+            while self.generation < self.generations:
+                t0 = time.perf_counter()
+                if self.generation < 0:
+                    stats = self._generation_zero()
+                    self.recorder.update_hall_of_fame(self.population, 0)
+                else:
+                    stats = self._next_generation()
+                self.generation += 1
+                self._end_generation(stats, time.perf_counter() - t0)
+        except KeyboardInterrupt as exc:
+            raise self.recorder.interrupted(self.generation, self.resume_command) from exc
+        finally:
+            self.recorder.close_progress()
         self.finish()
         return self.population
 
