@@ -127,6 +127,11 @@ class EvalStats:
     n_invalid: int = 0
     n_diverged: int = 0
     n_bone: int = 0
+    #: Individuals not evaluated before this call (children, newcomers; parents are not).
+    n_new: int = 0
+    #: New, valid individuals whose phenotype was already simulated earlier in the run
+    #: (or twice in this call): the seed's "patterns loop".
+    n_repeated: int = 0
 
 
 def _worst_objectives() -> dict[str, float]:
@@ -177,6 +182,8 @@ class Evaluator:
         stats = EvalStats(n_individuals=len(individuals))
         todo: dict[str, list[Individual]] = {}
         for ind in individuals:
+            new = not ind.objectives  # parents carry their results; children and newcomers do not
+            stats.n_new += int(new)
             grid = ind.grid(exp.shape)
             if exp.rules.violations(grid):
                 ind.objectives = _worst_objectives()
@@ -186,6 +193,7 @@ class Evaluator:
             if (grid == 2).any():
                 stats.n_bone += 1
             key = ind.phenotype_key(exp.shape)
+            stats.n_repeated += int(new and (key in self.cache or key in todo))
             if key in self.cache:
                 obj, tr = self.cache.get(key)
                 ind.objectives = dict(obj)

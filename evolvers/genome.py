@@ -178,6 +178,27 @@ class Individual:
             return float(self.age)
         return float(self.objectives[name])
 
+    def genes(self) -> dict[str, float]:
+        """The real-valued genes as flat named values (log columns, study reports).
+
+        Returns
+        -------
+        dict of str to float
+            ``temp_amplitude`` (°C), ``period`` (s), ``muscle_cte`` (1/°C) of the
+            controller, and ``m{id}_youngs_modulus`` (Pa), ``m{id}_density``
+            (kg/m^3), ``m{id}_cte`` (1/°C) of each evolvable material id 6-9.
+        """
+        c = self.controller
+        out = {
+            "temp_amplitude": float(c.temp_amplitude),
+            "period": float(c.period),
+            "muscle_cte": float(c.muscle_cte),
+        }
+        for mid, row in zip(MATERIAL_GENE_IDS, self.materials):
+            for name, v in zip(("youngs_modulus", "density", "cte"), row):
+                out[f"m{mid}_{name}"] = float(v)
+        return out
+
     # ------------------------------------------------------------------ JSON
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (the trace is stored separately, in checkpoint arrays)."""
