@@ -3,23 +3,30 @@
 :class:`VoxelRenderer` draws a robot's deformed voxels and its terrain into an
 ``(height, width, 3)`` uint8 array without OpenGL or matplotlib; the
 environments' ``render_mode="rgb_array"`` uses it. :func:`save_gif` writes
-frames (or rollouts) to an animated GIF.
+frames (or rollouts) to an animated GIF, :func:`save_video` to an MP4 (the
+``video`` extra); :func:`simulation_frames` overlays time and distance.
 """
 
 from softgym.render.frames import (
     OBSTACLE_COLOR,
+    MissingVideoExtraError,
     VoxelRenderer,
+    overlay_text,
     quaternion_to_matrix,
     render_rollout,
     save_gif,
+    save_video,
     simulation_frames,
 )
 
 __all__ = [
     "OBSTACLE_COLOR",
+    "MissingVideoExtraError",
     "VoxelRenderer",
+    "overlay_text",
     "quaternion_to_matrix",
     "render_rollout",
     "save_gif",
+    "save_video",
     "simulation_frames",
 ]

@@ -4,13 +4,18 @@
   per generation (the report's Fig. 1).
 * :func:`plot_best_fitness`: best fitness per generation of several runs
   (the report's Fig. 4).
+* :func:`plot_compare`: runs grouped by configuration (seeds), the median
+  of their best fitness per generation with the interquartile band.
+* :func:`plot_pareto_front`: the final population of a multi-objective run
+  in objective space, its non-dominated front highlighted.
 * :func:`plot_robot`: a design as matplotlib voxels coloured by material.
 * :func:`plot_trajectory`: a centre-of-mass trace, top view and height.
-* :func:`save_robot_gif`: a GIF of a design moving (frames from
-  :mod:`softgym.render.frames`).
+* :func:`save_robot_gif`: a GIF (or, for ``.mp4``, a video) of a design
+  moving, time and distance overlaid (frames from :mod:`softgym.render.frames`).
 * :func:`run_figures`: all of the above for a run folder.
 
 Every function writes a file and returns its path; matplotlib runs headless (Agg).
+Axes carry units (:func:`metric_label`).
 """
 
 from __future__ import annotations
@@ -24,15 +29,51 @@ from typing import Any
 import numpy as np
 
 __all__ = [
+    "METRIC_LABELS",
     "design_colors",
+    "metric_label",
     "plot_best_fitness",
+    "plot_compare",
     "plot_fitness_trend",
+    "plot_pareto_front",
     "plot_robot",
     "plot_trajectory",
     "read_log",
     "run_figures",
     "save_robot_gif",
+    "trace_interval_for",
 ]
+
+#: Axis labels (with units) of the recorded metrics.
+METRIC_LABELS: dict[str, str] = {
+    "norm_final_dist": "NormFinalDist (voxel lengths)",
+    "max_xy_dist": "MaxXYDist (voxel lengths)",
+    "l_coefficient": "L coefficient (voxel lengths$^2$/s)",
+    "time_max_xy_dist": "time of MaxXYDist (s)",
+    "age": "age (generations)",
+    "novelty": "novelty (AMSS distance, voxel lengths)",
+    "bone_fraction": "robots with bone (fraction)",
+    "evaluations_total": "simulations (count)",
+    "wall_total": "wall time (s)",
+}
+
+
+def metric_label(metric: str) -> str:
+    """Axis label of a metric, with its unit (the metric's name if it is unknown)."""
+    return METRIC_LABELS.get(metric, metric)
+
+
+def trace_interval_for(design: Any, default: float = 0.01) -> float:
+    """Centre-of-mass sampling interval (s) fine enough to show a design's gait.
+
+    At least 20 samples per actuation period (``design.controller.period``),
+    and never coarser than ``default``: a coarser trace aliases against the
+    gait and draws a wrong height curve.
+    """
+    period = getattr(getattr(design, "controller", None), "period", None)
+    if period is None or not period > 0:
+        return float(default)
+    return float(min(default, period / 20.0))
 
 
 def _plt():
@@ -48,7 +89,7 @@ def _save(fig: Any, path: str | os.PathLike[str]) -> Path:
     """Write ``fig`` to ``path`` (folders created) and close it."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=110, bbox_inches="tight", pad_inches=0.1)  # no clipped labels
     _plt().close(fig)
     return path
 
@@ -64,7 +105,7 @@ def plot_fitness_trend(
     metric: str,
     path: str | os.PathLike[str],
     title: str | None = None,
-    ylabel: str = "Fitness",
+    ylabel: str | None = None,
 ) -> Path:
     """Average, best, worst and median of ``metric`` per generation (report Fig. 1).
 
@@ -87,8 +128,8 @@ def plot_fitness_trend(
         ("median", "median"),
     ):
         ax.plot(gens, [r[f"{metric}_{stat}"] for r in rows], label=label)
-    ax.set_xlabel("Generations")
-    ax.set_ylabel(ylabel)
+    ax.set_xlabel("generation")
+    ax.set_ylabel(ylabel or metric_label(metric))
     if title:
         ax.set_title(title)
     ax.legend(loc="upper left")
@@ -100,7 +141,7 @@ def plot_best_fitness(
     curves: Mapping[str, Sequence[Mapping[str, Any]]],
     metric: str,
     path: str | os.PathLike[str],
-    ylabel: str = "Best fitness",
+    ylabel: str | None = None,
 ) -> Path:
     """Best ``metric`` per generation of several runs, one line each (report Fig. 4).
 
@@ -114,9 +155,125 @@ def plot_best_fitness(
     fig, ax = plt.subplots(figsize=(6.4, 4.8))
     for label, rows in curves.items():
         ax.plot([r["generation"] for r in rows], [r[f"{metric}_best"] for r in rows], label=label)
-    ax.set_xlabel("Generation")
-    ax.set_ylabel(ylabel)
+    ax.set_xlabel("generation")
+    ax.set_ylabel(ylabel or f"best {metric_label(metric)}")
     ax.legend(loc="upper left")
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def plot_compare(
+    groups: Mapping[str, Sequence[Sequence[Mapping[str, Any]]]],
+    metric: str,
+    path: str | os.PathLike[str],
+    stat: str = "best",
+    title: str | None = None,
+) -> Path:
+    """Runs grouped by configuration: median of ``metric`` per generation and the IQR band.
+
+    Parameters
+    ----------
+    groups : mapping of label to list of log rows lists
+        One entry per configuration, holding the logs of its runs (seeds).
+        A group of one run is drawn as a plain line.
+    metric : str
+        Logged metric, e.g. ``"norm_final_dist"``.
+    path : path
+    stat : str
+        Which per-generation statistic of each run: ``"best"`` (default),
+        ``"median"``, ``"mean"`` or ``"worst"``.
+
+    Notes
+    -----
+    Runs of a group may have different lengths: each generation's median and
+    quartiles use the runs that reached it (the legend gives the count).
+    """
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(7.0, 4.8))
+    key = f"{metric}_{stat}"
+    for i, (label, runs) in enumerate(groups.items()):
+        color = f"C{i % 10}"
+        n_gen = max((len(rows) for rows in runs), default=0)
+        table = np.full((len(runs), n_gen), np.nan)
+        for r, rows in enumerate(runs):
+            for k, row in enumerate(rows):
+                table[r, k] = float(row.get(key, np.nan))
+        gens = np.arange(n_gen)
+        have = np.isfinite(table).any(axis=0)
+        if not have.any():
+            continue
+        med = np.full(n_gen, np.nan)
+        q1 = np.full(n_gen, np.nan)
+        q3 = np.full(n_gen, np.nan)
+        med[have] = np.nanmedian(table[:, have], axis=0)
+        q1[have], q3[have] = np.nanpercentile(table[:, have], [25, 75], axis=0)
+        n = len(runs)
+        ax.plot(gens, med, color=color,
+                label=f"{label} (median of {n} runs)" if n > 1 else label)  # fmt: skip
+        if n > 1:
+            ax.fill_between(gens, q1, q3, color=color, alpha=0.25, lw=0)
+    ax.set_xlabel("generation")
+    ax.set_ylabel(f"{stat} {metric_label(metric)}")
+    if title:
+        ax.set_title(title)
+    if any(len(r) > 1 for r in groups.values()):
+        ax.text(0.99, 0.01, "bands: interquartile range over seeds", transform=ax.transAxes,
+                ha="right", va="bottom", fontsize=7, color="0.3")  # fmt: skip
+    ax.legend(loc="upper left", fontsize=8)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def _non_dominated(F: np.ndarray) -> np.ndarray:
+    """Mask of the rows of ``F`` (minimised objectives) that no other row dominates."""
+    n = len(F)
+    keep = np.ones(n, dtype=bool)
+    for i in range(n):
+        dominated = np.all(F <= F[i], axis=1) & np.any(F < F[i], axis=1)
+        keep[i] = not dominated.any()
+    return keep
+
+
+def plot_pareto_front(
+    objectives: np.ndarray,
+    names: Sequence[str],
+    maximize: Sequence[bool],
+    path: str | os.PathLike[str],
+    title: str | None = None,
+) -> Path:
+    """A population in objective space, its non-dominated front highlighted.
+
+    Parameters
+    ----------
+    objectives : ndarray of shape (n_individuals, n_objectives), float64
+        Objective values as recorded (maximised ones not negated).
+    names : sequence of str
+        Objective names (axis labels with units from :func:`metric_label`).
+    maximize : sequence of bool
+        Direction of each objective.
+    path : path
+
+    With two objectives one panel; with more, one panel per pair.
+    """
+    plt = _plt()
+    F = np.asarray(objectives, dtype=np.float64)
+    if F.ndim != 2 or F.shape[1] != len(names) or len(names) < 2:
+        raise ValueError(f"need (n, >= 2) objectives matching names, got {F.shape} and {names}")
+    ok = np.isfinite(F).all(axis=1)
+    F = F[ok]
+    sign = np.where(np.asarray(maximize, dtype=bool), -1.0, 1.0)
+    front = _non_dominated(F * sign) if len(F) else np.zeros(0, dtype=bool)
+    pairs = [(i, j) for i in range(len(names)) for j in range(i + 1, len(names))]
+    fig, axes = plt.subplots(1, len(pairs), figsize=(4.6 * len(pairs), 4.2), squeeze=False)
+    for ax, (i, j) in zip(axes[0], pairs):
+        ax.scatter(F[~front, i], F[~front, j], s=18, color="0.6", label="dominated")
+        pts = F[front][np.argsort(F[front, i])]
+        ax.plot(pts[:, i], pts[:, j], "o-", color="C3", ms=5, lw=1, label="non-dominated")
+        arrow = {True: " (max)", False: " (min)"}
+        ax.set_xlabel(metric_label(names[i]) + arrow[bool(maximize[i])])
+        ax.set_ylabel(metric_label(names[j]) + arrow[bool(maximize[j])])
+        ax.legend(fontsize=7)
+    fig.suptitle(title or f"final population: {int(front.sum())} non-dominated of {len(F)}")
     fig.tight_layout()
     return _save(fig, path)
 
@@ -229,10 +386,12 @@ def save_robot_gif(
     fps: float = 10.0,
     config: Any = None,
 ) -> Path:
-    """Simulate ``design`` and write a GIF of it moving.
+    """Simulate ``design`` and write a GIF (or an MP4 for a ``.mp4`` path) of it moving.
 
     Frames come from :func:`softgym.render.frames.simulation_frames` (a NumPy
-    software renderer), written by :func:`softgym.render.frames.save_gif`.
+    software renderer; simulated time and distance overlaid), written by
+    :func:`softgym.render.frames.save_gif`, or :func:`~softgym.render.frames.save_video`
+    (the ``video`` extra) for ``.mp4``.
 
     Parameters
     ----------
@@ -247,7 +406,7 @@ def save_robot_gif(
     config : SimConfig, optional
     """
     from softgym.engine import Simulation
-    from softgym.render.frames import save_gif, simulation_frames
+    from softgym.render.frames import save_gif, save_video, simulation_frames
 
     sim = Simulation([design], config=config, terrain=terrain)
     gi = sim.grid_index(0)
@@ -257,7 +416,10 @@ def save_robot_gif(
     frames = simulation_frames(sim, seconds, fps=fps, colors=colors)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    save_gif(frames, path, fps=fps)
+    if path.suffix.lower() == ".mp4":
+        save_video(frames, path, fps=fps)
+    else:
+        save_gif(frames, path, fps=fps)
     return path
 
 
@@ -272,7 +434,9 @@ def run_figures(
     Returns
     -------
     dict of str to Path
-        ``fitness_trend``, ``best_robot``, ``best_trajectory`` and ``best_gif``.
+        ``fitness_trend``, ``pareto_front`` (runs with two objectives or
+        more), ``best_robot``, ``best_trajectory`` (sampled at least 20 times
+        per gait period, :func:`trace_interval_for`) and ``best_gif``.
     """
     from softgym.design import RobotDesign
     from softgym.engine import Simulation
@@ -289,7 +453,21 @@ def run_figures(
     if rows:
         out["fitness_trend"] = plot_fitness_trend(
             rows, metric, fig_dir / "fitness_trend.png",
-            title=f"{exp['name']}: {metric} (voxel lengths)",
+            title=f"{exp['name']}: {metric}",
+        )  # fmt: skip
+    objectives = exp["objectives"]
+    final = run_dir / "final_population.json"
+    if len(objectives) >= 2 and final.is_file():
+        pop = json.loads(final.read_text())["population"]
+        names = [o["name"] for o in objectives]
+        F = np.array(
+            [[d["age"] if n == "age" else d["objectives"].get(n, np.nan) for n in names]
+             for d in pop if d.get("objectives")],
+            dtype=np.float64,
+        ).reshape(-1, len(names))  # fmt: skip
+        out["pareto_front"] = plot_pareto_front(
+            F, names, [bool(o["maximize"]) for o in objectives], fig_dir / "pareto_front.png",
+            title=f"{exp['name']}: final population, generation {json.loads(final.read_text())['generation']}",
         )  # fmt: skip
     design = RobotDesign.load(run_dir / "best_design.json")
     out["best_robot"] = plot_robot(
@@ -297,7 +475,9 @@ def run_figures(
     )
     secs = float(exp["seconds"] if seconds is None else seconds)
     world = exp.get("task", exp.get("terrain", "flat"))  # "terrain": run folders before tasks
-    task = get_task(world, seconds=secs, trace_interval=0.05, sim=exp.get("sim", {}))
+    task = get_task(
+        world, seconds=secs, trace_interval=trace_interval_for(design), sim=exp.get("sim", {})
+    )
     terrain = task.terrain_for(design.shape)
     rollout = Simulation([design], config=task.config(), terrain=terrain).run(secs)
     out["best_trajectory"] = plot_trajectory(

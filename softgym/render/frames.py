@@ -7,7 +7,8 @@ follows the robot, to a parallelogram. Faces towards the camera that are not
 shared with a lattice neighbour are filled with a depth test (a z-buffer, so
 large terrain boxes and small voxels never sort wrongly), flat-shaded by
 their normal and outlined. The floor is a checkerboard computed per pixel.
-:func:`save_gif` writes frames to an animated GIF with Pillow.
+:func:`save_gif` writes frames to an animated GIF with Pillow, :func:`save_video`
+to an MP4 with imageio and imageio-ffmpeg (the ``video`` extra).
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from softgym.exceptions import InvalidParameterError
+from softgym.exceptions import InvalidParameterError, SoftGymError
 
 if TYPE_CHECKING:  # annotations only: softgym.engine loads compiled code
     from softgym.engine.rollout import Rollout
@@ -28,12 +29,20 @@ if TYPE_CHECKING:  # annotations only: softgym.engine loads compiled code
 
 __all__ = [
     "OBSTACLE_COLOR",
+    "MissingVideoExtraError",
     "VoxelRenderer",
+    "overlay_text",
     "quaternion_to_matrix",
     "render_rollout",
     "save_gif",
+    "save_video",
     "simulation_frames",
 ]
+
+
+class MissingVideoExtraError(SoftGymError, ImportError):
+    """Video output needs the ``video`` extra: ``pip install "softgym[video]"``."""
+
 
 #: Colour of terrain boxes (the seed's obstacle material, id 5).
 OBSTACLE_COLOR = (1.0, 0.784, 0.0)
@@ -417,6 +426,30 @@ def render_rollout(
     )
 
 
+def overlay_text(frame: np.ndarray, lines: Sequence[str]) -> np.ndarray:
+    """``frame`` with ``lines`` of text in its top-left corner, dark on a light band.
+
+    Parameters
+    ----------
+    frame : ndarray of shape (height, width, 3), uint8
+    lines : sequence of str
+
+    Returns
+    -------
+    ndarray of shape (height, width, 3), uint8
+        A new frame (the input is not modified).
+    """
+    from PIL import Image, ImageDraw
+
+    img = Image.fromarray(np.ascontiguousarray(frame, dtype=np.uint8))
+    draw = ImageDraw.Draw(img, "RGBA")
+    text = "\n".join(lines)
+    box = draw.multiline_textbbox((6, 4), text)
+    draw.rectangle((box[0] - 3, box[1] - 2, box[2] + 3, box[3] + 2), fill=(255, 255, 255, 190))
+    draw.multiline_text((6, 4), text, fill=(20, 20, 20, 255))
+    return np.asarray(img)
+
+
 def simulation_frames(
     sim: Simulation,
     seconds: float,
@@ -424,11 +457,15 @@ def simulation_frames(
     robot: int = 0,
     renderer: VoxelRenderer | None = None,
     colors: np.ndarray | Sequence[float] | None = None,
+    overlay: bool = True,
 ) -> list[np.ndarray]:
     """Advance ``sim`` by ``seconds`` and return a frame of ``robot`` every ``1 / fps`` s.
 
     The first frame is the state before advancing. The robot's terrain
-    (``sim.terrains[robot]``) is drawn with it.
+    (``sim.terrains[robot]``) is drawn with it. With ``overlay``, each frame
+    shows the simulated time (s) and the distance (voxel lengths) of the
+    robot's centre of mass, in the floor plane, from where it stood at the
+    start.
 
     Returns
     -------
@@ -439,9 +476,11 @@ def simulation_frames(
     r = renderer or VoxelRenderer(voxel_size=sim.config.voxel_size)
     terrain = sim.terrains[robot]
     gi = sim.grid_index(robot)
+    L = float(sim.config.voxel_size)
+    start = sim.center_of_mass()[robot, :2].copy()
 
     def frame() -> np.ndarray:
-        return r.render(
+        img = r.render(
             sim.positions(robot),
             sim.orientations(robot),
             sim.scales(robot),
@@ -449,6 +488,10 @@ def simulation_frames(
             grid_index=gi,
             terrain=terrain,
         )
+        if not overlay:
+            return img
+        d = float(np.linalg.norm(sim.center_of_mass()[robot, :2] - start)) / L
+        return overlay_text(img, [f"t = {float(sim.time[robot]):5.2f} s", f"d = {d:5.2f} voxels"])
 
     frames = [frame()]
     n = int(math.floor(seconds * fps + 1e-9))
@@ -456,6 +499,70 @@ def simulation_frames(
         sim.advance(1.0 / fps)
         frames.append(frame())
     return frames
+
+
+def save_video(
+    frames: Iterable[np.ndarray],
+    path: str | os.PathLike[str],
+    fps: float = 20.0,
+    quality: float = 7.0,
+) -> int:
+    """Write frames to an MP4 (H.264) video through imageio and imageio-ffmpeg.
+
+    Parameters
+    ----------
+    frames : iterable of ndarray of shape (height, width, 3), uint8
+        E.g. :func:`simulation_frames`, or ``env.render()`` frames.
+    path : str or path-like
+        Output file (``.mp4``); written to a temporary name, then renamed.
+    fps : float
+        Frames per second.
+    quality : float
+        imageio's quality, 0-10.
+
+    Returns
+    -------
+    int
+        Number of frames written.
+
+    Raises
+    ------
+    MissingVideoExtraError
+        If imageio or imageio-ffmpeg is missing (``pip install "softgym[video]"``).
+    """
+    if not (math.isfinite(fps) and fps > 0):
+        raise InvalidParameterError(f"fps must be > 0, got {fps}")
+    try:
+        import imageio.v2 as imageio
+        import imageio_ffmpeg  # noqa: F401  (the ffmpeg binary imageio writes with)
+    except ImportError as exc:
+        raise MissingVideoExtraError(
+            f"save_video needs imageio and imageio-ffmpeg ({exc.name} is missing): "
+            'pip install "softgym[video]"'
+        ) from None
+    path = os.fspath(path)
+    tmp = f"{path}.tmp{os.getpid()}.mp4"
+    n = 0
+    # macro_block_size 1 keeps any frame size (H.264 wants even sizes: pad below)
+    with imageio.get_writer(tmp, fps=fps, codec="libx264", quality=quality,
+                            macro_block_size=1, pixelformat="yuv420p") as w:  # fmt: skip
+        for k, f in enumerate(frames):
+            arr = np.asarray(f)
+            if arr.ndim != 3 or arr.shape[2] != 3:
+                raise InvalidParameterError(
+                    f"frame {k} must have shape (height, width, 3), got {arr.shape}"
+                )
+            arr = np.clip(arr, 0, 255).astype(np.uint8)
+            h, w_ = arr.shape[:2]
+            if h % 2 or w_ % 2:
+                arr = np.pad(arr, ((0, h % 2), (0, w_ % 2), (0, 0)), mode="edge")
+            w.append_data(arr)
+            n += 1
+    if n == 0:
+        os.unlink(tmp)
+        raise InvalidParameterError("save_video needs at least one frame")
+    os.replace(tmp, path)
+    return n
 
 
 def save_gif(
