@@ -22,12 +22,27 @@ from gymnasium.vector.utils import batch_space
 
 from softgym.design.robot import RobotDesign
 from softgym.engine import SimConfig, Simulation
-from softgym.envs.walker import action_space, load_design, make_batch, observation_space
+from softgym.envs.walker import (
+    action_space,
+    check_render_options,
+    load_design,
+    make_batch,
+    observation_space,
+)
 from softgym.exceptions import InvalidParameterError
 from softgym.tasks import TaskLike
 from softgym.terrain import Terrain
 
 __all__ = ["SoftWalkerVectorEnv"]
+
+
+def _show(value: Any) -> str:
+    # repr for an error message: short, and safe for ints beyond repr's 4300 digits
+    try:
+        text = repr(value)
+    except ValueError:
+        text = f"<{type(value).__name__} too large to print>"
+    return text if len(text) <= 80 else text[:77] + "..."
 
 
 class SoftWalkerVectorEnv(VectorEnv):
@@ -56,8 +71,9 @@ class SoftWalkerVectorEnv(VectorEnv):
     n_threads : int, optional
         Engine threads (default: :func:`softgym.engine.default_num_threads`).
     max_episode_steps : int, optional
-        Truncation in steps (``make_vec`` passes the id's registered 80);
-        episodes also end after ``episode_seconds``.
+        Truncation in steps (``make_vec`` passes the id's registered 80): an
+        int >= 1, not a bool or float; episodes also end after
+        ``episode_seconds``.
     autoreset_mode : AutoresetMode or str, optional
         ``NEXT_STEP`` (default) or ``SAME_STEP`` (the enum, its value or its
         name: ``"same_step"``); ``DISABLED`` is not
@@ -103,35 +119,42 @@ class SoftWalkerVectorEnv(VectorEnv):
     ) -> None:
         try:
             mode = AutoresetMode(autoreset_mode)
-        except ValueError:
-            mode = AutoresetMode.__members__.get(str(autoreset_mode).upper())  # "SAME_STEP"
+        except (ValueError, TypeError):
+            mode = None
+            if isinstance(autoreset_mode, str):  # "SAME_STEP", "same_step"
+                mode = AutoresetMode.__members__.get(autoreset_mode.upper())
         if mode is None:
             raise InvalidParameterError(
-                f"autoreset_mode must be NEXT_STEP or SAME_STEP, got {autoreset_mode!r}"
+                f"autoreset_mode must be NEXT_STEP or SAME_STEP, got {_show(autoreset_mode)}"
             )
         if mode not in (AutoresetMode.NEXT_STEP, AutoresetMode.SAME_STEP):
             raise InvalidParameterError(
                 f"autoreset_mode must be NEXT_STEP or SAME_STEP, got {mode.name}"
             )
         self.autoreset_mode = mode
+        ok = isinstance(num_envs, (int, np.integer)) and not isinstance(num_envs, (bool, np.bool_))
+        if not ok or num_envs < 1:
+            raise InvalidParameterError(f"num_envs must be an integer >= 1, got {_show(num_envs)}")
         num_envs = int(num_envs)
-        if num_envs < 1:
-            raise InvalidParameterError(f"num_envs must be >= 1, got {num_envs}")
         if designs is not None and design is not None:
             raise InvalidParameterError("give design (one for all robots) or designs, not both")
         if designs is None:
             one = load_design(design)
             robots = [one] * num_envs
         else:
-            robots = [load_design(d) for d in designs]
-            if len(robots) != num_envs:
+            if isinstance(designs, (str, bytes, os.PathLike)) or not isinstance(
+                designs, (Sequence, np.ndarray)
+            ):
                 raise InvalidParameterError(
-                    f"designs holds {len(robots)} designs for num_envs={num_envs}"
+                    f"designs must be a list of designs or paths, one per robot, "
+                    f"got {type(designs).__name__}"
                 )
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise InvalidParameterError(
-                f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}"
-            )
+            if len(designs) != num_envs:  # checked before any file is read
+                raise InvalidParameterError(
+                    f"designs holds {len(designs)} designs for num_envs={num_envs}"
+                )
+            robots = [load_design(d) for d in designs]
+        size = check_render_options(render_mode, width, height)
         self._batch = make_batch(
             robots, task, terrain=terrain, episode_seconds=episode_seconds,
             control_dt=control_dt, actuation=actuation, self_collision=self_collision,
@@ -152,7 +175,7 @@ class SoftWalkerVectorEnv(VectorEnv):
             "autoreset_mode": mode,
         }
         self.render_mode = render_mode
-        self.width, self.height = int(width), int(height)
+        self.width, self.height = size
         self._renderer: Any = None
         self.single_action_space = action_space(b.grid_shape)
         self.action_space = batch_space(self.single_action_space, num_envs)
@@ -219,10 +242,13 @@ class SoftWalkerVectorEnv(VectorEnv):
 
         Parameters
         ----------
-        actions : array_like of shape (num_envs, n_cells)
-            In [-1, 1] (finite values outside are clipped). NaN or infinity
-            anywhere raises :class:`~softgym.exceptions.InvalidActionError`
-            before any state changes.
+        actions : array_like of shape (num_envs, n_cells), int or float
+            In [-1, 1] (finite values outside are clipped). Exactly this
+            shape (even for ``num_envs=1``; another shape is not reshaped) and
+            a real dtype (complex, bool, object and strings are refused). A
+            refused action, or NaN or infinity anywhere, raises
+            :class:`~softgym.exceptions.InvalidActionError` before any state
+            changes.
 
         Returns
         -------

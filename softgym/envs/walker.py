@@ -32,6 +32,7 @@ from softgym.tasks import (
     get_task,
     observation_size,
 )
+from softgym.tasks.episode import MAX_STEPS_PER_EPISODE
 from softgym.terrain import Terrain
 
 __all__ = [
@@ -39,7 +40,9 @@ __all__ = [
     "OBS_VELOCITY_BOUND",
     "TASKS",
     "SoftWalkerEnv",
+    "MAX_FRAME_SIDE",
     "action_space",
+    "check_render_options",
     "load_design",
     "make_config",
     "make_batch",
@@ -51,6 +54,19 @@ __all__ = [
 # the engine's own centre-of-mass trace is not used (the episode samples once per control
 # step); a huge sampling interval keeps its buffers at constant size however long the env runs
 _NO_ENGINE_TRACE = 1.0e9
+
+#: Largest rendered frame side (pixels): a frame is width x height x 3 bytes.
+MAX_FRAME_SIDE = 4096
+RENDER_MODES: tuple[str, ...] = ("rgb_array",)
+
+
+def _show(value: Any) -> str:
+    # repr for an error message: short, and safe for ints beyond repr's 4300 digits
+    try:
+        text = repr(value)
+    except ValueError:
+        text = f"<{type(value).__name__} too large to print>"
+    return text if len(text) <= 80 else text[:77] + "..."
 
 
 def load_design(design: RobotDesign | str | os.PathLike[str] | None) -> RobotDesign:
@@ -66,6 +82,33 @@ def load_design(design: RobotDesign | str | os.PathLike[str] | None) -> RobotDes
     )
 
 
+def _is_int(value: Any) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
+def check_render_options(render_mode: Any, width: Any, height: Any) -> tuple[int, int]:
+    """Check an env's ``render_mode`` (None or ``"rgb_array"``) and frame size; return (width, height).
+
+    Raises
+    ------
+    InvalidParameterError
+        Unless ``render_mode`` is None or one of ``RENDER_MODES`` and
+        ``width``, ``height`` are ints (not bools) in 1..:data:`MAX_FRAME_SIDE` pixels.
+    """
+    if render_mode is not None and not (
+        isinstance(render_mode, str) and render_mode in RENDER_MODES
+    ):
+        raise InvalidParameterError(
+            f"render_mode must be None or one of {list(RENDER_MODES)}, got {_show(render_mode)}"
+        )
+    for name, value in (("width", width), ("height", height)):
+        if not _is_int(value) or not 1 <= value <= MAX_FRAME_SIDE:
+            raise InvalidParameterError(
+                f"{name} must be an integer in 1..{MAX_FRAME_SIDE} pixels, got {_show(value)}"
+            )
+    return int(width), int(height)
+
+
 def warn_if_cut_short(limit: int | None, control_dt: float, episode_seconds: float) -> None:
     """Warn when a step limit ends episodes before ``episode_seconds``.
 
@@ -75,7 +118,8 @@ def warn_if_cut_short(limit: int | None, control_dt: float, episode_seconds: flo
     to the vector env, which warns; ``gym.make`` applies it in a
     ``TimeLimit`` wrapper the env cannot see (its docstring says so).
     """
-    full = max(1, round(episode_seconds / control_dt))
+    # (an episode has at most MAX_STEPS_PER_EPISODE steps; the ratio may be huge, even inf)
+    full = max(1, round(min(episode_seconds / control_dt, MAX_STEPS_PER_EPISODE)))
     if limit is not None and int(limit) < full:
         logger.warn(
             f"max_episode_steps={int(limit)} ends episodes after {int(limit) * control_dt:.4g} s "
@@ -90,7 +134,15 @@ def make_config(
     self_collision: bool | None,
     task: Task | None = None,
 ) -> SimConfig:
-    """The env's engine settings: ``sim_config`` (the seed's by default), the task's ``sim``, overrides."""
+    """The env's engine settings: ``sim_config`` (the seed's by default), the task's ``sim``, overrides.
+
+    ``self_collision`` must be None or a bool (``"yes"`` or ``1`` is refused with
+    :class:`~softgym.exceptions.InvalidParameterError`, not read as true).
+    """
+    if self_collision is not None and not isinstance(self_collision, (bool, np.bool_)):
+        raise InvalidParameterError(
+            f"self_collision must be None, True or False, got {_show(self_collision)}"
+        )
     if sim_config is not None and not isinstance(sim_config, SimConfig):
         raise InvalidParameterError(
             f"sim_config must be a SimConfig, got {type(sim_config).__name__}"
@@ -128,6 +180,10 @@ def make_batch(
     task's ``seconds`` minus the settling time (4 s for the seed's 5 s runs).
     A ``max_episode_steps`` that cuts episodes short warns.
     """
+    if n_threads is not None and (not _is_int(n_threads) or n_threads < 1):
+        raise InvalidParameterError(
+            f"n_threads must be None or an integer >= 1, got {_show(n_threads)}"
+        )
     t = get_task(task)
     if terrain is not None:
         if not isinstance(terrain, Terrain):
@@ -189,8 +245,12 @@ class SoftWalkerEnv(gym.Env):
     walks the engine's built-in sinusoid's distance to within 1 %, while the
     default 0.05 s (5 samples per 0.25 s period) changes the seed's gait.
 
-    Finite actions outside [-1, 1] are clipped; an action holding NaN or
-    infinity, or of the wrong shape, raises
+    An action must be an array (or nested list) of real numbers of shape
+    exactly ``(nx * ny * nz,)``: another shape of the same size (e.g. the grid
+    shape) is refused, not reshaped, and so are complex, bool, object and
+    string dtypes; ints and floats of any precision are read as float64.
+    Finite values outside [-1, 1] are clipped to it (documented, not an
+    error). A refused action, or one holding NaN or infinity, raises
     :class:`~softgym.exceptions.InvalidActionError` before the state is touched.
 
     ## Observation Space
@@ -268,15 +328,23 @@ class SoftWalkerEnv(gym.Env):
       the settling time (4 s: the seed's fitness window).
     * ``control_dt``: seconds each action is held (0.05 s, about 78 engine steps of the default walker).
     * ``actuation``: ``"seed"`` (muscles only contract) or ``"symmetric"``; None keeps ``sim_config``'s (the seed's).
-    * ``self_collision``: voxel-voxel contact within the robot; None keeps ``sim_config``'s (on).
-    * ``grid_shape``: the lattice the spaces are built on; the design must fit in it (placed at its corner).
+    * ``self_collision``: voxel-voxel contact within the robot, a bool; None keeps ``sim_config``'s (on).
+    * ``grid_shape``: the lattice the spaces are built on, 3 ints (each 1..1000, at most 10^6
+      cells; floats such as 6.5 are refused); the design must fit in it (placed at its corner).
     * ``sim_config``: a :class:`~softgym.engine.SimConfig` (default the seed's). Its
       ``trace_interval`` is ignored: the env keeps its own centre-of-mass samples.
     * ``terrain``: a :class:`~softgym.terrain.Terrain` replacing the task's.
     * ``render_mode``: None or ``"rgb_array"`` (an H x W x 3 uint8 frame, see
-      :class:`softgym.render.VoxelRenderer`); ``width``, ``height``: frame size (320 x 240).
-    * ``n_threads``: engine threads (1: a single robot cannot use more).
-    * ``max_episode_steps``: an extra cap on the steps per episode (None).
+      :class:`softgym.render.VoxelRenderer`); ``width``, ``height``: frame size (320 x 240),
+      ints in 1..4096 pixels.
+    * ``n_threads``: engine threads, None or an int >= 1 (1: a single robot cannot use more).
+    * ``max_episode_steps``: an extra cap on the steps per episode: None or an int in
+      1..:data:`softgym.tasks.episode.MAX_STEPS_PER_EPISODE` (not a bool or a float), checked
+      by the env. ``gym.make(id, max_episode_steps=...)`` is different: Gymnasium consumes it
+      for its ``TimeLimit`` wrapper (``-1`` removes the wrapper; Gymnasium raises its own
+      TypeError or ValueError for other bad values) and the env never receives it; pass it as
+      ``gym.make(id, max_episode_steps=k)`` for the wrapper, and the env's own cap through
+      ``SoftWalkerEnv(max_episode_steps=k)`` or ``make_vec``.
     * ``drive``: ``"action"`` (default) or ``"controller"``: the design's own sinusoidal
       controller drives the muscles as in :func:`softgym.evaluate` and the seed, and actions
       are ignored (the open-loop baseline; with ``control_dt`` equal to the task's
@@ -312,10 +380,7 @@ class SoftWalkerEnv(gym.Env):
         drive: str = "action",
     ) -> None:
         super().__init__()
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise InvalidParameterError(
-                f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}"
-            )
+        size = check_render_options(render_mode, width, height)
         self.design = load_design(design)
         self._batch = make_batch(
             [self.design], task, terrain=terrain, episode_seconds=episode_seconds,
@@ -331,7 +396,7 @@ class SoftWalkerEnv(gym.Env):
         self.max_steps = b.max_steps
         self.metadata = {**type(self).metadata, "render_fps": max(1, round(1.0 / b.control_dt))}
         self.render_mode = render_mode
-        self.width, self.height = int(width), int(height)
+        self.width, self.height = size
         self._renderer: Any = None
         self.action_space = action_space(b.grid_shape)
         self.observation_space = observation_space(b.grid_shape)
@@ -404,8 +469,9 @@ class SoftWalkerEnv(gym.Env):
 
         Parameters
         ----------
-        action : array_like of shape (n_cells,)
-            In [-1, 1] (finite values outside are clipped).
+        action : array_like of shape (n_cells,), int or float
+            In [-1, 1] (finite values outside are clipped); exactly this
+            shape, a real dtype (see the class docstring).
 
         Returns
         -------
@@ -414,11 +480,11 @@ class SoftWalkerEnv(gym.Env):
         Raises
         ------
         InvalidActionError
-            If the action has the wrong shape or holds NaN or infinity (the
-            state is unchanged).
+            If the action has the wrong shape or dtype or holds NaN or
+            infinity (the state is unchanged).
         """
         b = self._batch
-        a = b.validate_actions(action)
+        a = b.validate_actions(action, single=True)
         if self._needs_reset:
             raise gym.error.ResetNeeded("call reset() before step()")
         b.apply(a)

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from softgym.design.robot import RobotDesign
+from softgym.design import MAX_GRID_DIM, RobotDesign, check_grid_shape
 from softgym.engine import SimConfig, Simulation
 from softgym.exceptions import InvalidActionError, InvalidDesignError, InvalidParameterError
 from softgym.metrics import (
@@ -30,6 +30,7 @@ from softgym.terrain import Terrain
 
 __all__ = [
     "DRIVES",
+    "MAX_STEPS_PER_EPISODE",
     "OBS_POSITION_BOUND",
     "OBS_VELOCITY_BOUND",
     "EpisodeBatch",
@@ -42,6 +43,9 @@ OBS_POSITION_BOUND = 50.0
 OBS_VELOCITY_BOUND = 500.0
 #: What drives the muscles: the actions, or the design's own controller (actions ignored).
 DRIVES: tuple[str, ...] = ("action", "controller")
+#: Most control steps an episode may have: its centre-of-mass samples are allocated up front
+#: (32 bytes a step per robot, so 32 MB per robot at the cap).
+MAX_STEPS_PER_EPISODE = 1_000_000
 
 
 def observation_size(grid_shape: Sequence[int]) -> int:
@@ -49,14 +53,50 @@ def observation_size(grid_shape: Sequence[int]) -> int:
     return 6 * int(np.prod(grid_shape)) + 5
 
 
+def _show(value: Any) -> str:
+    # repr for an error message: short, and safe for ints beyond repr's 4300 digits
+    try:
+        text = repr(value)
+    except ValueError:
+        text = f"<{type(value).__name__} too large to print>"
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def _is_real(value: Any) -> bool:
+    # int or float (Python or NumPy); bools, strings and complex numbers are not numbers here
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, (bool, np.bool_)
+    )
+
+
 def _positive(name: str, value: Any) -> float:
     try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(f"{name} must be a number, got {value!r}") from None
+        v = float(value) if _is_real(value) else math.nan
+    except OverflowError:  # an int beyond float64
+        v = math.inf
     if not (math.isfinite(v) and v > 0):
-        raise InvalidParameterError(f"{name} must be finite and > 0, got {value!r}")
+        raise InvalidParameterError(f"{name} must be a finite number > 0 (s), got {_show(value)}")
     return v
+
+
+def _check_max_episode_steps(value: Any) -> int | None:
+    """``max_episode_steps`` as an int in 1..MAX_STEPS_PER_EPISODE, or None (no extra cap).
+
+    Raises
+    ------
+    InvalidParameterError
+        For a bool, a float (``1.5`` is not rounded, nor ``2.0`` accepted), a
+        string, or an int out of range.
+    """
+    if value is None:
+        return None
+    ok = isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+    if not ok or not 1 <= value <= MAX_STEPS_PER_EPISODE:
+        raise InvalidParameterError(
+            f"max_episode_steps must be None or an integer in 1..{MAX_STEPS_PER_EPISODE}, "
+            f"got {_show(value)}"
+        )
+    return int(value)
 
 
 class EpisodeBatch:
@@ -70,12 +110,18 @@ class EpisodeBatch:
         Terrain (placed around each design's grid unless ``terrains`` is
         given) and reward metric.
     grid_shape : tuple of 3 ints
-        The lattice of actions and observations.
+        The lattice of actions and observations: integers (not floats or
+        bools), each in 1..:data:`softgym.design.MAX_GRID_DIM`, at most
+        :data:`softgym.design.MAX_GRID_VOXELS` cells
+        (:func:`softgym.design.check_grid_shape`).
     control_dt, episode_seconds : float
-        Seconds per action and per episode (after settling).
+        Seconds per action and per episode (after settling): finite numbers
+        > 0, not bools or strings; the episode has at most
+        :data:`MAX_STEPS_PER_EPISODE` control steps.
     max_episode_steps : int or None
         Truncate after this many steps (the smaller of it and
-        ``round(episode_seconds / control_dt)``).
+        ``round(episode_seconds / control_dt)``): an int in
+        1..:data:`MAX_STEPS_PER_EPISODE`, not a bool or float.
     config : SimConfig
         Engine settings (its ``trace_interval`` is not used: the batch samples
         the centre of mass once per control step).
@@ -107,24 +153,33 @@ class EpisodeBatch:
     ) -> None:
         if not isinstance(task, Task):
             raise InvalidParameterError(f"task must be a Task, got {type(task).__name__}")
-        if drive not in DRIVES:
-            raise InvalidParameterError(f"drive must be one of {DRIVES}, got {drive!r}")
+        if not isinstance(drive, str) or drive not in DRIVES:
+            raise InvalidParameterError(f"drive must be one of {DRIVES}, got {_show(drive)}")
         self.task = task
         self.drive = drive
         self.metric = task.reward
-        self.grid_shape = tuple(int(s) for s in grid_shape)
-        if len(self.grid_shape) != 3 or min(self.grid_shape) < 1:
-            raise InvalidParameterError(f"grid_shape must be 3 positive ints, got {grid_shape!r}")
+        try:  # integers only, within the design grid caps, before anything is allocated
+            self.grid_shape = check_grid_shape(grid_shape, "grid_shape")
+        except InvalidDesignError as exc:
+            raise InvalidParameterError(str(exc)) from None
+        except ValueError:  # the design check's message could not print an int of > 4300 digits
+            raise InvalidParameterError(
+                f"grid_shape must be 3 integers (nx, ny, nz), each in 1..{MAX_GRID_DIM}"
+            ) from None
         self.n_cells = int(np.prod(self.grid_shape))
         self.control_dt = _positive("control_dt", control_dt)
         self.episode_seconds = _positive("episode_seconds", episode_seconds)
-        n_steps = max(1, round(self.episode_seconds / self.control_dt))
-        if max_episode_steps is not None:
-            if int(max_episode_steps) < 1:
-                raise InvalidParameterError(
-                    f"max_episode_steps must be >= 1, got {max_episode_steps}"
-                )
-            n_steps = min(n_steps, int(max_episode_steps))
+        cap = _check_max_episode_steps(max_episode_steps)
+        ratio = self.episode_seconds / self.control_dt  # finite or inf, never NaN
+        if cap is None and not ratio < MAX_STEPS_PER_EPISODE + 0.5:
+            raise InvalidParameterError(
+                f"episode_seconds / control_dt = {ratio:.4g} control steps, more than the cap of "
+                f"{MAX_STEPS_PER_EPISODE} (MAX_STEPS_PER_EPISODE); pass a larger control_dt, a "
+                f"shorter episode_seconds or max_episode_steps"
+            )
+        n_steps = max(1, round(min(ratio, MAX_STEPS_PER_EPISODE)))
+        if cap is not None:
+            n_steps = min(n_steps, cap)
         self.max_steps = n_steps
         self.designs = list(designs)
         for i, d in enumerate(self.designs):
@@ -237,23 +292,50 @@ class EpisodeBatch:
         self._start_trace(ids)
 
     # ----------------------------------------------------------------- step
-    def validate_actions(self, actions: Any) -> np.ndarray:
-        """Actions as float64 (n_robots, n_cells), clipped to [-1, 1]; NaN/inf raise."""
-        try:
-            a = np.asarray(actions, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise InvalidActionError(
-                f"action must be numeric, got {type(actions).__name__}"
-            ) from None
-        want = (self.n_robots, self.n_cells)
-        if a.shape != want and a.size == self.n_robots * self.n_cells:
-            a = a.reshape(want)
-        if a.shape != want:
-            raise InvalidActionError(
-                f"action must have shape {want[1:] if self.n_robots == 1 else want}, got {np.shape(actions)}"
+    def validate_actions(self, actions: Any, single: bool = False) -> np.ndarray:
+        """Check the actions of a step and return them as float64, clipped to [-1, 1].
+
+        Parameters
+        ----------
+        actions : array_like of shape (n_robots, n_cells), or (n_cells,) if ``single``
+            Real numbers (an int or float dtype once NumPy has made an array
+            of them): complex, bool, object and string arrays are refused,
+            not converted. The shape must be exactly the one above: an array
+            of the right size but another shape is refused, not reshaped.
+            Finite values outside [-1, 1] are clipped to it.
+        single : bool
+            The action of a single env (a batch of one robot), of shape (n_cells,).
+
+        Returns
+        -------
+        ndarray of shape (n_robots, n_cells), float64
+            A new array (``actions`` is not modified).
+
+        Raises
+        ------
+        InvalidActionError
+            For another dtype or shape, or NaN or infinite values; nothing has
+            been changed.
+        """
+        want = (self.n_cells,) if single else (self.n_robots, self.n_cells)
+        if single and self.n_robots != 1:
+            raise InvalidParameterError(
+                f"single=True needs a batch of 1 robot, not {self.n_robots}"
             )
+        accepted = f"real numbers of shape {want}, in [-1, 1] (finite values outside are clipped)"
+        try:
+            a = np.asarray(actions)
+        except (TypeError, ValueError, OverflowError) as exc:  # ragged lists...
+            raise InvalidActionError(f"action must be {accepted}; got {exc!s:.200}") from None
+        if a.dtype.kind not in "iuf":  # b bool, c complex, O object, U/S strings, M/m times...
+            raise InvalidActionError(f"action must be {accepted}, got dtype {a.dtype}")
+        if a.shape != want:
+            raise InvalidActionError(f"action must be {accepted}, got shape {a.shape}")
+        a = a.astype(np.float64).reshape(self.n_robots, self.n_cells)
         if not np.isfinite(a).all():
-            raise InvalidActionError("action holds NaN or infinite values; the state is unchanged")
+            raise InvalidActionError(
+                f"action holds NaN or infinite values (must be {accepted}); the state is unchanged"
+            )
         return np.clip(a, -1.0, 1.0)
 
     def apply(self, actions: np.ndarray, active: np.ndarray | None = None) -> None:
