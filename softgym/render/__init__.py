@@ -4,7 +4,8 @@
 ``(height, width, 3)`` uint8 array without OpenGL or matplotlib; the
 environments' ``render_mode="rgb_array"`` uses it. :func:`save_gif` writes
 frames (or rollouts) to an animated GIF, :func:`save_video` to an MP4 (the
-``video`` extra); :func:`simulation_frames` overlays time and distance.
+``video`` extra); :func:`simulation_frames` overlays time and distance;
+:func:`write_viewer` writes a self-contained interactive 3D HTML viewer (plotly).
 """
 
 from softgym.render.frames import (
@@ -18,6 +19,7 @@ from softgym.render.frames import (
     save_video,
     simulation_frames,
 )
+from softgym.render.viewer import write_viewer
 
 __all__ = [
     "OBSTACLE_COLOR",
@@ -29,4 +31,5 @@ __all__ = [
     "save_gif",
     "save_video",
     "simulation_frames",
+    "write_viewer",
 ]
