@@ -54,7 +54,9 @@ def test_frames_overlay_time_and_distance():
 
 
 def test_save_video_writes_an_mp4(tmp_path):
-    pytest.importorskip("imageio_ffmpeg", reason='needs the video extra: pip install "softgym[video]"')
+    pytest.importorskip(
+        "imageio_ffmpeg", reason='needs the video extra: pip install "softgym[video]"'
+    )
     import imageio.v3 as iio
 
     frames = [np.full((41, 63, 3), 20 * k, dtype=np.uint8) for k in range(6)]  # odd sizes
