@@ -1,0 +1,474 @@
+"""A study: the seed report's scenarios re-run over many seeds, each an ordinary run folder.
+
+The seed report ran every scenario once. A :class:`Study` names a set of
+:class:`Scenario` s (an experiment of :mod:`evolvers.experiments`, a number of
+generations and of seeds); :func:`plan` expands it into one :class:`RunSpec`
+per scenario and seed, and :func:`run_study` runs them::
+
+    OUT/study.json                      what was asked (scenarios, seeds, overrides)
+    OUT/<scenario>/scenario.json        the scenario (the report groups runs by it)
+    OUT/<scenario>/seed-<k>/            an ordinary run folder (config, log, checkpoints,
+                                        best designs), made by EvolutionRun
+
+Each run is an :class:`~evolvers.runner.EvolutionRun` started with
+``resume=True``: a complete run (its log reaches the asked generation and its
+final population is written) is skipped, an interrupted one continues from its
+last checkpoint (bit for bit as if never stopped), a missing one starts. So a
+study is resumed by running the same command again, and a larger
+``--generations`` extends finished runs. Runs go in parallel, one per Dask
+worker (a LocalCluster of ``workers`` processes, or an existing scheduler's
+workers: ``pip install "softgym[distributed]"``); a run lost with its worker is
+resubmitted and resumes from its checkpoint.
+
+The report (:mod:`evolvers.study_report`, ``softgym study report RUNS``) is
+written from the run folders alone.
+
+================================  ======================  =====  =====  ==============================
+scenario                          experiment              gens   seeds  claims (report section)
+================================  ======================  =====  =====  ==============================
+``materials-t1``                  materials-t1            300    5      III-A, Fig. 1
+``materials-t2``                  materials-t2            50     10     III-A
+``novelty``                       novelty                 200    5      III-B
+``novelty-archive``               novelty-archive         200    5      III-B ("patterns loop")
+``basic-200``                     basic                   200    5      III-B (fitness-based reference)
+``basic``                         basic                   40     10     III-C, Fig. 4
+``controller-tournament``         controller-tournament   40     10     III-C, Fig. 4
+``controller-pareto``             controller-pareto       40     10     III-C, Fig. 4
+``obstacles-attempt1``            obstacles-attempt1      80     5      III-D attempt 1
+``obstacles-attempt2``            obstacles-attempt2      80     5      III-D attempt 2
+``obstacles``                     obstacles               120    10     III-D final setup
+================================  ======================  =====  =====  ==============================
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import time
+import uuid
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from evolvers.experiments import Experiment, get_experiment
+from softgym.exceptions import InvalidParameterError, SoftGymError
+from softgym.io import atomic_write_json
+
+__all__ = [
+    "SEED_REPORT",
+    "STUDIES",
+    "STUDY_SCHEMA",
+    "RunSpec",
+    "Scenario",
+    "Study",
+    "get_study",
+    "plan",
+    "run_one",
+    "run_status",
+    "run_study",
+]
+
+log = logging.getLogger("evolvers")
+
+#: ``"schema"`` of a study's study.json and scenario.json.
+STUDY_SCHEMA = "softgym.study"
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One line of a study: an experiment run for some generations over some seeds.
+
+    Parameters
+    ----------
+    name : str
+        The scenario's name (its folder under the study's root).
+    experiment : str
+        A named experiment (:data:`evolvers.experiments.EXPERIMENTS`).
+    generations : int
+        Generations after generation 0.
+    seeds : int
+        Number of seeds (0, 1, ..., seeds - 1).
+    description : str
+        What the scenario tests.
+    overrides : dict
+        :class:`~evolvers.experiments.Experiment` field overrides.
+    """
+
+    name: str
+    experiment: str
+    generations: int
+    seeds: int
+    description: str = ""
+    overrides: Mapping[str, Any] = field(default_factory=dict)
+
+    def make_experiment(self, **overrides: Any) -> Experiment:
+        """The experiment with the scenario's overrides, then ``overrides``."""
+        return get_experiment(self.experiment, **{**dict(self.overrides), **overrides})
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict."""
+        return {
+            "name": self.name,
+            "experiment": self.experiment,
+            "generations": int(self.generations),
+            "seeds": int(self.seeds),
+            "description": self.description,
+            "overrides": dict(self.overrides),
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Scenario:
+        """Inverse of :meth:`to_dict`."""
+        return cls(
+            name=str(data["name"]),
+            experiment=str(data["experiment"]),
+            generations=int(data["generations"]),
+            seeds=int(data["seeds"]),
+            description=str(data.get("description", "")),
+            overrides=dict(data.get("overrides", {})),
+        )
+
+
+@dataclass(frozen=True)
+class Study:
+    """A named set of scenarios."""
+
+    name: str
+    scenarios: tuple[Scenario, ...]
+
+    def __getitem__(self, name: str) -> Scenario:
+        for s in self.scenarios:
+            if s.name == name:
+                return s
+        raise InvalidParameterError(
+            f"study {self.name!r} has no scenario {name!r}; expected one of {self.names}"
+        )
+
+    @property
+    def names(self) -> list[str]:
+        """The scenario names, in order."""
+        return [s.name for s in self.scenarios]
+
+
+#: The seed report's claims (SEED_REFERENCE §3.9; issue 15): >= 10 seeds for the Fig. 4 trio,
+#: materials T2 and the obstacle final setup, >= 5 for the long runs and the obstacle attempts.
+SEED_REPORT = Study(
+    "seed-report",
+    (
+        Scenario("materials-t1", "materials-t1", 300, 5,
+                 "materials evolution, treatment 1 (report Fig. 1, 300 generations)"),
+        Scenario("materials-t2", "materials-t2", 50, 10,
+                 "materials evolution, treatment 2: also fewer voxels (50 generations)"),
+        Scenario("novelty", "novelty", 200, 5,
+                 "novelty search within the generation (200 generations)"),
+        Scenario("novelty-archive", "novelty-archive", 200, 5,
+                 "novelty search with an archive of past behaviours (the 'patterns loop')"),
+        Scenario("basic-200", "basic", 200, 5,
+                 "fitness-based reference for novelty: the basic Pareto run over 200 generations"),
+        Scenario("basic", "basic", 40, 10, "basic evolution (report Fig. 4)"),
+        Scenario("controller-tournament", "controller-tournament", 40, 10,
+                 "controller evolution, fitness tournament (report Fig. 4)"),
+        Scenario("controller-pareto", "controller-pareto", 40, 10,
+                 "controller evolution, Pareto on distance and muscles (report Fig. 4)"),
+        Scenario("obstacles-attempt1", "obstacles-attempt1", 80, 5,
+                 "wall, attempt 1: default controller, Pareto on MaxXYDist and muscles"),
+        Scenario("obstacles-attempt2", "obstacles-attempt2", 80, 5,
+                 "wall, attempt 2: controller evolution, fitness tournament on MaxXYDist"),
+        Scenario("obstacles", "obstacles", 120, 10,
+                 "wall, final setup: MaxXYDist, L coefficient, age, composition rules"),
+    ),
+)  # fmt: skip
+
+#: Named studies.
+STUDIES: dict[str, Study] = {SEED_REPORT.name: SEED_REPORT}
+
+
+def get_study(name: str) -> Study:
+    """A named study (:data:`STUDIES`)."""
+    try:
+        return STUDIES[name]
+    except KeyError:
+        raise InvalidParameterError(
+            f"unknown study {name!r}; expected one of {sorted(STUDIES)}"
+        ) from None
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """One run of a study: a scenario's experiment, a seed, generations and a folder.
+
+    Plain data (:meth:`to_dict`), so it travels to a Dask worker as JSON-ready values.
+    """
+
+    scenario: str
+    experiment: Experiment
+    seed: int
+    generations: int
+    out: Path
+    n_threads: int | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict."""
+        return {
+            "scenario": self.scenario,
+            "experiment": self.experiment.to_dict(),
+            "seed": int(self.seed),
+            "generations": int(self.generations),
+            "out": str(self.out),
+            "n_threads": self.n_threads,
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> RunSpec:
+        """Inverse of :meth:`to_dict`."""
+        return cls(
+            scenario=str(data["scenario"]),
+            experiment=Experiment.from_dict(data["experiment"]),
+            seed=int(data["seed"]),
+            generations=int(data["generations"]),
+            out=Path(data["out"]),
+            n_threads=None if data.get("n_threads") is None else int(data["n_threads"]),
+        )
+
+    @property
+    def cost(self) -> float:
+        """A rough relative cost (simulated robot-seconds) for scheduling longest first."""
+        e = self.experiment
+        n_vox = e.shape[0] * e.shape[1] * e.shape[2]
+        return (self.generations + 1) * (e.pop_size + e.n_random) * e.seconds * n_vox
+
+
+def plan(
+    out: str | Path,
+    study: str | Study = "seed-report",
+    scenarios: Iterable[str] | None = None,
+    seeds: int | None = None,
+    generations: int | None = None,
+    first_seed: int = 0,
+    n_threads: int | None = None,
+    **overrides: Any,
+) -> list[RunSpec]:
+    """The runs of a study, one per scenario and seed.
+
+    Parameters
+    ----------
+    out : path
+        The study's root folder.
+    study : str or Study
+    scenarios : iterable of str, optional
+        Scenario names (default: all of the study's).
+    seeds, generations : int, optional
+        Override every scenario's number of seeds / generations.
+    first_seed : int
+        Seeds are ``first_seed, first_seed + 1, ...``.
+    n_threads : int, optional
+        OpenMP threads of each run's simulations.
+    **overrides
+        Experiment field overrides for every scenario (e.g. ``pop_size``,
+        ``seconds``, ``shape`` for a small test study).
+
+    Raises
+    ------
+    InvalidParameterError
+        For an unknown study or scenario, or seeds/generations below 1 / 0.
+    """
+    st = get_study(study) if isinstance(study, str) else study
+    chosen = [st[name] for name in scenarios] if scenarios else list(st.scenarios)
+    if seeds is not None and seeds < 1:
+        raise InvalidParameterError(f"seeds must be >= 1, got {seeds}")
+    if generations is not None and generations < 0:
+        raise InvalidParameterError(f"generations must be >= 0, got {generations}")
+    root = Path(out)
+    specs = []
+    for sc in chosen:
+        exp = sc.make_experiment(**overrides)
+        n = sc.seeds if seeds is None else int(seeds)
+        gens = sc.generations if generations is None else int(generations)
+        for k in range(first_seed, first_seed + n):
+            specs.append(RunSpec(sc.name, exp, k, gens, root / sc.name / f"seed-{k}", n_threads))
+    return specs
+
+
+def _last_generation(run_dir: Path) -> int:
+    path = run_dir / "log.jsonl"
+    if not path.exists():
+        return -1
+    last = -1
+    for line in path.read_text().splitlines():
+        if line.strip():
+            try:
+                last = int(json.loads(line)["generation"])
+            except (ValueError, KeyError, TypeError):
+                return -1
+    return last
+
+
+def run_status(run_dir: str | Path, generations: int) -> str:
+    """``"complete"``, ``"partial"`` (a checkpoint to resume) or ``"new"``.
+
+    Complete: ``final_population.json`` exists and the log reaches ``generations``.
+    """
+    run_dir = Path(run_dir)
+    last = _last_generation(run_dir)
+    if (run_dir / "final_population.json").exists() and last >= generations:
+        return "complete"
+    ckpts = run_dir / "checkpoints"
+    if ckpts.exists() and any(ckpts.glob("ckpt-*.json")):
+        return "partial"
+    return "new"
+
+
+def run_one(spec: Mapping[str, Any] | RunSpec) -> dict[str, Any]:
+    """Run (or resume, or skip) one run of a study; the function a Dask worker calls.
+
+    Returns
+    -------
+    dict
+        ``scenario``, ``seed``, ``out``, ``status`` (``"skipped"``: already
+        complete; ``"ran"``; ``"resumed"``; ``"failed"`` with ``error``),
+        ``generation`` reached and ``wall`` seconds.
+    """
+    from evolvers.runner import EvolutionRun
+
+    spec = spec if isinstance(spec, RunSpec) else RunSpec.from_dict(spec)
+    out = {"scenario": spec.scenario, "seed": spec.seed, "out": str(spec.out)}
+    before = run_status(spec.out, spec.generations)
+    if before == "complete":
+        return {**out, "status": "skipped", "generation": _last_generation(spec.out), "wall": 0.0}
+    t0 = time.perf_counter()
+    try:
+        run = EvolutionRun(
+            spec.experiment, spec.out, seed=spec.seed, generations=spec.generations,
+            n_threads=spec.n_threads, figures=False, gif=False, progress=False,
+        )  # fmt: skip
+        run.run(resume=True)
+    except SoftGymError as exc:
+        return {
+            **out, "status": "failed", "error": f"{type(exc).__name__}: {exc}",
+            "generation": _last_generation(spec.out), "wall": time.perf_counter() - t0,
+        }  # fmt: skip
+    return {
+        **out,
+        "status": "resumed" if before == "partial" else "ran",
+        "generation": run.generation,
+        "wall": time.perf_counter() - t0,
+    }
+
+
+def _write_manifest(root: Path, study: str, specs: Sequence[RunSpec]) -> None:
+    scenarios: dict[str, dict[str, Any]] = {}
+    for s in specs:
+        d = scenarios.setdefault(
+            s.scenario,
+            {
+                "schema": STUDY_SCHEMA,
+                "study": study,
+                "name": s.scenario,
+                "experiment": s.experiment.to_dict(),
+                "generations": s.generations,
+                "seeds": [],
+            },
+        )
+        d["seeds"].append(s.seed)
+    for name, d in scenarios.items():
+        folder = root / name
+        folder.mkdir(parents=True, exist_ok=True)
+        atomic_write_json(folder / "scenario.json", d)
+    atomic_write_json(
+        root / "study.json",
+        {
+            "schema": STUDY_SCHEMA,
+            "study": study,
+            "scenarios": {n: {"generations": d["generations"], "seeds": d["seeds"]}
+                          for n, d in scenarios.items()},
+        },
+    )  # fmt: skip
+
+
+def run_study(
+    specs: Sequence[RunSpec],
+    workers: int = 1,
+    scheduler: str | None = None,
+    study: str = "seed-report",
+    on_result: Callable[[dict[str, Any]], None] | None = None,
+) -> list[dict[str, Any]]:
+    """Run a study's runs: skip complete ones, resume interrupted ones, start the rest.
+
+    Parameters
+    ----------
+    specs : sequence of RunSpec
+        From :func:`plan` (all under one root folder).
+    workers : int
+        Runs at a time. 1 runs them one after the other in this process (no
+        Dask needed); more starts a Dask LocalCluster of that many one-thread
+        worker processes, one run per worker.
+    scheduler : str, optional
+        A Dask scheduler address (``tcp://host:8786``): its workers run the
+        runs (``workers`` is then ignored).
+    study : str
+        The study's name (recorded in study.json).
+    on_result : callable, optional
+        Called with each run's result (:func:`run_one`) as it finishes.
+
+    Returns
+    -------
+    list of dict
+        The results of :func:`run_one`, longest runs first.
+
+    Raises
+    ------
+    MissingExtraError
+        If parallel runs are asked for without Dask installed.
+    """
+    if not specs:
+        return []
+    roots = {s.out.parent.parent for s in specs}
+    for root in roots:
+        _write_manifest(root, study, [s for s in specs if s.out.parent.parent == root])
+    ordered = sorted(specs, key=lambda s: -s.cost)
+    results: list[dict[str, Any]] = []
+
+    def done(res: dict[str, Any]) -> None:
+        results.append(res)
+        if res["status"] == "failed":
+            log.warning("%s seed %s failed: %s", res["scenario"], res["seed"], res["error"])
+        if on_result is not None:
+            on_result(res)
+
+    def failed(s: RunSpec, exc: BaseException) -> dict[str, Any]:
+        log.error("%s seed %s raised", s.scenario, s.seed, exc_info=exc)
+        return {
+            "scenario": s.scenario, "seed": s.seed, "out": str(s.out), "status": "failed",
+            "error": f"{type(exc).__name__}: {exc}", "generation": _last_generation(s.out),
+            "wall": float("nan"),
+        }  # fmt: skip
+
+    if scheduler is None and workers <= 1:
+        for s in ordered:
+            try:
+                res = run_one(s)
+            except Exception as exc:  # a bug in one run must not stop the others
+                res = failed(s, exc)
+            done(res)
+        return results
+
+    from evolvers.distributed import dask_client, require_distributed
+
+    distributed = require_distributed()
+    one_thread = [replace(s, n_threads=1) if s.n_threads is None else s for s in ordered]
+    tag = uuid.uuid4().hex[:8]
+    with dask_client(scheduler or "local", n_workers=workers) as client:
+        futures = {
+            client.submit(
+                run_one, s.to_dict(), pure=False, retries=2, key=f"{s.scenario}-seed-{s.seed}-{tag}"
+            ): s
+            for s in one_thread
+        }
+        for fut in distributed.as_completed(list(futures)):
+            try:
+                res = fut.result()
+            except Exception as exc:
+                res = failed(futures[fut], exc)
+            done(res)
+    return results
