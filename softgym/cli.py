@@ -17,6 +17,10 @@ compare
     report's Fig. 4).
 experiments
     List the named experiments.
+study
+    Run the seed report's scenarios over many seeds, each a resumable run
+    folder (seeds in parallel on Dask); ``study report RUNS`` writes the
+    claim-by-claim report and its figures.
 """
 
 from __future__ import annotations
@@ -224,6 +228,133 @@ def _cmd_experiments(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_study(args: argparse.Namespace) -> int:
+    if getattr(args, "study_command", None) == "report":
+        return _cmd_study_report(args)
+    from evolvers.study import get_study, plan, run_status, run_study
+    from softgym.exceptions import SoftGymError
+
+    overrides = {}
+    if args.pop is not None:
+        overrides["pop_size"] = args.pop
+    if args.seconds is not None:
+        overrides["seconds"] = args.seconds
+    if args.shape is not None:
+        overrides["shape"] = tuple(args.shape)
+    names = [n for item in (args.scenarios or []) for n in item.split(",") if n]
+    try:
+        study = get_study(args.study)
+        specs = plan(
+            args.out, study, scenarios=names or None, seeds=args.seeds,
+            generations=args.generations, first_seed=args.first_seed, n_threads=args.threads,
+            **overrides,
+        )  # fmt: skip
+    except SoftGymError as exc:
+        print(f"softgym study: {exc}", file=sys.stderr)
+        return 2
+    if args.plan:
+        for s in specs:
+            print(f"{s.scenario:24s} seed {s.seed:<4d} {s.generations:4d} generations  "
+                  f"{run_status(s.out, s.generations):8s} {s.out}")  # fmt: skip
+        return 0
+
+    def report(res):
+        if not args.quiet:
+            err = f"  {res['error']}" if res["status"] == "failed" else ""
+            print(f"{res['scenario']:24s} seed {res['seed']:<4d} {res['status']:8s} "
+                  f"generation {res['generation']:<4d} {res['wall']:8.1f} s{err}", flush=True)  # fmt: skip
+
+    if args.quiet:
+        logging.getLogger("evolvers").setLevel(logging.WARNING)
+    t0 = time.perf_counter()
+    try:
+        results = run_study(specs, workers=args.workers, scheduler=args.dask,
+                            study=study.name, on_result=report)  # fmt: skip
+    except SoftGymError as exc:
+        print(f"softgym study: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("softgym study: interrupted; run the same command again to resume", file=sys.stderr)
+        return 130
+    counts: dict[str, int] = {}
+    for r in results:
+        counts[r["status"]] = counts.get(r["status"], 0) + 1
+    summary = {
+        "study": study.name,
+        "out": str(args.out),
+        "runs": len(results),
+        "status": counts,
+        "wall_seconds": round(time.perf_counter() - t0, 2),
+        "report": f"softgym study report {args.out}",
+    }
+    print(json.dumps(summary, indent=2))
+    return 1 if counts.get("failed") else 0
+
+
+def _cmd_study_report(args: argparse.Namespace) -> int:
+    from evolvers.study_report import claims, load_runs, write_report
+
+    root = Path(args.runs)
+    if not root.is_dir() or not load_runs(root):
+        print(f"softgym study report: no run folders under {root}", file=sys.stderr)
+        return 2
+    readme = write_report(root, args.report_out)
+    for c in claims(load_runs(root)):
+        print(f"{c.id:22s} {c.verdict}")
+    print(readme)
+    return 0
+
+
+def _add_study_parser(sub) -> None:
+    """``softgym study [run] ...`` and ``softgym study report RUNS``."""
+    p = sub.add_parser(
+        "study",
+        help="run the seed report's scenarios over many seeds (resumable); 'study report RUNS'",
+        description="Run a study: every scenario x seed as a resumable run folder under --out "
+        "(complete runs are skipped, interrupted ones resume; run the same command again to "
+        "continue). 'softgym study report RUNS' writes the claim-by-claim report.",
+    )
+    p.add_argument("--study", default="seed-report", help="the named study (default seed-report)")
+    p.add_argument("--scenarios", nargs="+", metavar="NAME",
+                   help="scenarios to run (default: all of the study's; comma- or space-separated)")  # fmt: skip
+    p.add_argument("--seeds", type=int, help="seeds per scenario (default: the scenario's)")
+    p.add_argument("--first-seed", type=int, default=0, help="seeds are FIRST, FIRST+1, ...")
+    p.add_argument("--generations", type=int, help="generations per run (default: the scenario's)")
+    p.add_argument("--out", default="runs/study", help="the study's root folder")
+    p.add_argument("--workers", type=int, default=1,
+                   help="runs at a time on a Dask LocalCluster (1: one after the other, no Dask)")  # fmt: skip
+    p.add_argument("--dask", metavar="tcp://ADDRESS",
+                   help='run on an existing Dask scheduler\'s workers (pip install "softgym[distributed]")')  # fmt: skip
+    p.add_argument("--pop", type=int, help="population size (default 15; small values for tests)")
+    p.add_argument("--seconds", type=float, help="simulated seconds per evaluation (default 5)")
+    p.add_argument("--shape", type=int, nargs=3, metavar=("NX", "NY", "NZ"),
+                   help="robot grid (default 6 6 6)")  # fmt: skip
+    p.add_argument(
+        "--threads", type=int, help="OpenMP threads per run (default: 1 with --workers > 1)"
+    )
+    p.add_argument(
+        "--plan", action="store_true", help="list the runs and their status; run nothing"
+    )
+    p.add_argument("--quiet", action="store_true", help="no line per finished run")
+    ss = p.add_subparsers(dest="study_command", required=False)
+    r = ss.add_parser("run", help="run the study (the default)")
+    r.set_defaults(study_command="run")
+    r = ss.add_parser("report", help="write README.md and figures from a study's run folders")
+    r.add_argument("runs", help="the study's root folder (softgym study --out)")
+    r.add_argument("--out", dest="report_out", default="docs/study",
+                   help="where README.md and figures/ go (default docs/study)")  # fmt: skip
+    p.set_defaults(func=_cmd_study)
+
+
+class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """``--help`` shows every default (options without one say theirs in words)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        if action.default is None or isinstance(action, argparse._StoreTrueAction):
+            return action.help or ""
+        return super()._get_help_string(action)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``softgym`` command.
 
@@ -304,6 +435,7 @@ def main(argv: list[str] | None = None) -> int:
 
     p = sub.add_parser("experiments", help="list the named experiments")
     p.set_defaults(func=_cmd_experiments)
+    _add_study_parser(sub)
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     from softgym.exceptions import SoftGymError

@@ -1,0 +1,134 @@
+import json
+import math
+import re
+
+import numpy as np
+import pytest
+from evolver_helpers import tiny
+
+from evolvers.evaluation import EvalStats
+from evolvers.genome import Individual
+from evolvers.recorder import obstacle_footprint, study_columns
+from evolvers.study import SEED_REPORT, plan, run_status, run_study
+from evolvers.study_report import a12, load_runs, permutation_pvalue
+from softgym.cli import main
+from softgym.exceptions import InvalidParameterError
+
+TINY = ["--pop", "4", "--seconds", "1.5", "--shape", "4", "4", "4", "--quiet"]
+VERDICTS = {"holds", "partly", "does not hold", "not run"}
+
+
+def _statuses(out: str) -> list[str]:
+    return re.findall(r"seed \d+\s+(\w+)\s+generation", out)
+
+
+def test_study_runs_resumes_skips_and_reports(tmp_path, capsys):
+    # the CI version of the study: 2 scenarios x 2 seeds x 2 generations, then the report
+    root = tmp_path / "study"
+    study = ["study", "--scenarios", "controller-tournament,controller-pareto", "--seeds", "2",
+             "--out", str(root), *TINY]  # fmt: skip
+    assert main([*study, "--generations", "1"]) == 0
+    capsys.readouterr()
+    main([*study, "--generations", "1", "--plan"])
+    assert capsys.readouterr().out.count("complete") == 4
+    # a larger --generations resumes each run from its checkpoint; then everything is complete
+    logging_off = [a for a in study if a != "--quiet"]
+    assert main([*logging_off, "--generations", "2"]) == 0
+    assert _statuses(capsys.readouterr().out) == ["resumed"] * 4
+    assert main([*logging_off, "--generations", "2"]) == 0
+    assert _statuses(capsys.readouterr().out) == ["skipped"] * 4
+    for name in ("controller-tournament", "controller-pareto"):
+        for k in (0, 1):
+            run = root / name / f"seed-{k}"
+            assert run_status(run, 2) == "complete"
+            rows = [json.loads(x) for x in (run / "log.jsonl").read_text().splitlines()]
+            assert [r["generation"] for r in rows] == [0, 1, 2]
+            assert {"top_period", "top_n_muscle", "repeated_phenotypes"} <= set(rows[-1])
+        assert json.loads((root / name / "scenario.json").read_text())["seeds"] == [0, 1]
+
+    out = tmp_path / "report"
+    assert main(["study", "report", str(root), "--out", str(out)]) == 0
+    text = (out / "README.md").read_text()
+    claims = json.loads((out / "claims.json").read_text())
+    assert len(claims) >= 15 and {c["verdict"] for c in claims} <= VERDICTS
+    by_id = {c["id"]: c for c in claims}
+    for cid in ("tournament-vs-pareto", "pareto-muscles", "controller-genes"):
+        c = by_id[cid]
+        assert c["verdict"] != "not run"
+        assert re.search(r"\d+(\.\d+)? \[\d.*\], n=[24]\b", c["measured"]), c
+        assert f"| {cid} |" in text
+    assert by_id["T1-final"]["verdict"] == "not run"  # no materials runs here
+    assert "Provisional" in by_id["tournament-vs-pareto"]["why"]  # 2 of the report's 40 gens
+    for fig in ("fitness_controller-tournament.png", "fitness_controller-pareto.png",
+                "fig4_trio.png", "winners_controller.png"):  # fmt: skip
+        path = out / "figures" / fig
+        assert path.stat().st_size > 5000, fig
+        assert f"figures/{fig}" in text
+    finals = by_id["tournament-vs-pareto"]["data"]["tournament"]
+    assert len(finals) == 2 and all(math.isfinite(v) for v in finals)
+    assert main(["study", "report", str(tmp_path / "nothing"), "--out", str(out)]) == 2
+
+
+def test_plan_defaults_and_errors(tmp_path):
+    specs = plan(tmp_path)
+    counts = {}
+    for s in specs:
+        counts[s.scenario] = counts.get(s.scenario, 0) + 1
+    assert counts["controller-tournament"] >= 10 and counts["materials-t1"] >= 5
+    assert {s.generations for s in specs if s.scenario == "materials-t1"} == {300}
+    assert sum(counts.values()) == sum(sc.seeds for sc in SEED_REPORT.scenarios)
+    small = plan(tmp_path, scenarios=["basic"], seeds=3, generations=4, first_seed=7, pop_size=4)
+    assert [s.seed for s in small] == [7, 8, 9] and small[0].experiment.pop_size == 4
+    assert small[0].out == tmp_path / "basic" / "seed-7"
+    with pytest.raises(InvalidParameterError, match="no scenario"):
+        plan(tmp_path, scenarios=["nope"])
+    with pytest.raises(InvalidParameterError):
+        plan(tmp_path, seeds=0)
+
+
+def test_a_run_started_with_other_settings_fails_alone(tmp_path):
+    root = tmp_path / "s"
+    assert not run_study(plan(root, scenarios=["basic"], seeds=1, generations=1, pop_size=4,
+                              seconds=1.0, shape=(4, 4, 4)))[0]["status"] == "failed"  # fmt: skip
+    res = run_study(plan(root, scenarios=["basic"], seeds=1, generations=2, pop_size=5,
+                         seconds=1.0, shape=(4, 4, 4)))  # fmt: skip
+    assert res[0]["status"] == "failed" and "pop_size" in res[0]["error"]
+
+
+def test_statistics():
+    assert a12([3, 4, 5], [0, 1, 2]) == 1.0 and a12([1, 1], [1, 1]) == 0.5
+    assert permutation_pvalue([10, 11, 12, 13, 14], [0, 1, 2, 3, 4]) < 0.01
+    assert permutation_pvalue([0, 1, 2, 3, 4], [10, 11, 12, 13, 14]) > 0.99
+    assert math.isnan(permutation_pvalue([], [1.0]))
+
+
+def test_study_columns_count_wall_crossings():
+    exp = tiny("obstacles-attempt2")
+    x0, x1, y0, y1 = obstacle_footprint(exp)
+    assert (x0, x1) == (-4.0, 8.0)  # the fence around a 4x4 grid: 10-voxel interior, 1 thick
+    rng = np.random.default_rng(0)
+    inds = []
+    for i, final_x in enumerate((2.0, 8.5, 10.0)):  # inside, past, further past (voxel lengths)
+        ind = Individual.random(rng, i, exp.shape)
+        ind.objectives = {"max_xy_dist": final_x - 2.0, "norm_final_dist": 1.0, "n_voxels": 10.0, "n_muscle": 10.0 - i,
+                          "n_bone": float(i)}  # fmt: skip
+        ind.trace = np.array([[0.02, 0.02, 0.01, 1.0], [final_x * 0.01, 0.02, 0.01, 5.0]])
+        inds.append(ind)
+    row = study_columns(exp, inds, EvalStats(n_new=3, n_repeated=1))
+    assert row["crossed"] == 2 and row["top_crossed"] == 1 and row["top_id"] == 2
+    assert row["crosser_id"] == 2 and row["crosser_n_bone"] == 2.0
+    assert row["top_final_x"] == pytest.approx(10.0)
+    assert (row["new_individuals"], row["repeated_phenotypes"]) == (3, 1)
+    flat = study_columns(tiny("basic"), inds, EvalStats())
+    assert "crossed" not in flat and flat["top_period"] == 0.25
+
+
+@pytest.mark.filterwarnings("ignore::DeprecationWarning")
+def test_seeds_run_in_parallel_on_a_local_cluster(tmp_path):
+    pytest.importorskip("distributed")
+    specs = plan(tmp_path, scenarios=["controller-tournament"], seeds=2, generations=1,
+                 pop_size=4, seconds=1.0, shape=(4, 4, 4))  # fmt: skip
+    res = run_study(specs, workers=2)
+    assert sorted(r["status"] for r in res) == ["ran", "ran"]
+    runs = load_runs(tmp_path)["controller-tournament"]
+    assert [r.seed for r in runs] == [0, 1] and all(r.complete for r in runs)
