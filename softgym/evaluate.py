@@ -186,26 +186,8 @@ def evaluate(
 
 
 def _reorder(rollout: Any, perm: np.ndarray) -> Any:
-    """The rollout with its robots taken in ``perm`` order (per-voxel arrays regrouped).
-
-    (The engine's knowledge of :class:`~softgym.engine.Rollout`'s fields; it
-    belongs in a ``Rollout.take(indices)`` of the engine.)
-    """
-    from dataclasses import replace
-
-    off = rollout.voxel_offsets
-    pieces = [np.arange(off[i], off[i + 1]) for i in perm]
-    vox = np.concatenate(pieces) if pieces else np.zeros(0, dtype=np.int64)
-    counts = np.array([len(p) for p in pieces], dtype=np.int64)
-    per_robot = ("times", "cm", "cm_init", "init_reached", "cm_final", "dt", "steps", "time",
-                 "diverged", "diverged_time", "mass")  # fmt: skip
-    changes = {k: getattr(rollout, k)[perm] for k in per_robot}
-    changes.update(
-        positions=rollout.positions[vox], orientations=rollout.orientations[vox],
-        grid_index=rollout.grid_index[vox],
-        voxel_offsets=np.concatenate([[0], np.cumsum(counts)]).astype(np.int64),
-    )  # fmt: skip
-    return replace(rollout, **changes)
+    """The rollout with its robots taken in ``perm`` order."""
+    return rollout.take(perm)
 
 
 def evaluate_payload(payload: Mapping[str, Any]) -> dict[str, Any]:

@@ -101,6 +101,9 @@ cdef struct Batch:
     float64_t* col_ref       # (n_voxels, 4) position and size at the last candidate rebuild (state)
     float64_t* col_acc       # (n_robots,) the seed's displacement since that rebuild, in L (state)
     float64_t* col_vmax      # (n_robots,) fastest voxel speed after the last step (state)
+    intp_t* obs_start        # (n_robots + 1,) model 0: robot r's obstacle voxels [obs_start[r], obs_start[r+1])
+    float64_t* obs           # (n_obs, 4) fixed obstacle voxel centre (m) and its 2 E L (N/m)
+    intp_t* obs_rank         # (n_obs,) its index in the seed engine's voxel order
     float64_t* link_last     # (n_links, 9) last Pos2, Angle1, Angle2 in the bond frame (state)
 
 
@@ -121,6 +124,10 @@ cdef struct Contacts:
     float64_t margin         # horizon - largest contact envelope (m)
     float64_t built_scale    # largest voxel size when the list was built (m)
     int32 stale              # 1: rebuild before the next use
+    intp_t* opairs           # model 0: (ocapacity, 2) candidate (voxel, obstacle) pairs
+    intp_t n_opairs          # obstacle pairs in use
+    intp_t ocapacity         # obstacle pairs allocated
+    KeyIndex* ocells         # (n_obs_r,) obstacles sorted by spatial-hash cell
 
 
 cdef int advance_robot(Batch* b, intp_t r, step_t target, Contacts* c) noexcept nogil

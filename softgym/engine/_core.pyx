@@ -1333,6 +1333,8 @@ cdef int _seed_candidates(Batch* b, intp_t r, Contacts* c, int32 snapshot) noexc
         if R[4 * i + 3] > smax:
             smax = R[4 * i + 3]
     horizon = 2.0 * smax
+    if horizon < 2.0 * L and b.obs_start[r + 1] > b.obs_start[r]:
+        horizon = 2.0 * L  # an obstacle voxel keeps its size L
     if horizon > 3.0 * L:
         horizon = 3.0 * L
     if horizon <= 0.0:
@@ -1404,7 +1406,118 @@ cdef int _seed_candidates(Batch* b, intp_t r, Contacts* c, int32 snapshot) noexc
             c.pairs[2 * c.n_pairs] = i
             c.pairs[2 * c.n_pairs + 1] = c.row[k]
             c.n_pairs += 1
+    return _seed_obstacle_candidates(b, r, c, horizon)
+
+
+cdef enum:
+    OBS_OFF = 1 << 19  # cell offset of the obstacle hash: cells within +-2^19 horizons
+
+
+cdef inline int64_t _okey(int64_t ci, int64_t cj, int64_t ck) noexcept nogil:
+    return ((ci + OBS_OFF) << 40) | ((cj + OBS_OFF) << 20) | (ck + OBS_OFF)
+
+
+cdef int _seed_obstacle_candidates(Batch* b, intp_t r, Contacts* c, float64_t horizon) noexcept nogil:
+    # The seed's collision candidates between robot r's surface voxels (at
+    # col_ref) and its fixed obstacle voxels (the seed's walls), with the same
+    # rule as between voxels: closer than 3 L and than twice the size of the
+    # pair's first voxel in the seed's order (an obstacle keeps its size L).
+    cdef:
+        intp_t o0 = b.obs_start[r]
+        intp_t o1 = b.obs_start[r + 1]
+        intp_t n_o = o1 - o0
+        intp_t i, m, k, pos_, n_row, mm
+        int64_t ci, cj, ck, key
+        int di, dj, dk
+        float64_t L = b.L
+        float64_t inv_cell, dx, dy, dz, d2, act, s_first
+        float64_t* R = b.col_ref
+        intp_t* grown
+    c.n_opairs = 0
+    if n_o == 0 or horizon <= 0.0:
+        return STATUS_OK
+    if c.ocells == NULL:
+        c.ocells = <KeyIndex*> malloc(n_o * sizeof(KeyIndex))
+        if c.ocells == NULL:
+            return STATUS_MEMORY
+    inv_cell = 1.0 / horizon
+    for m in range(o0, o1):
+        c.ocells[m - o0].key = _okey(<int64_t> floor(b.obs[4 * m] * inv_cell),
+                                     <int64_t> floor(b.obs[4 * m + 1] * inv_cell),
+                                     <int64_t> floor(b.obs[4 * m + 2] * inv_cell))
+        c.ocells[m - o0].index = m
+    qsort(c.ocells, n_o, sizeof(KeyIndex), _cmp_key_index)
+    for i in range(b.vox_start[r], b.vox_start[r + 1]):
+        if not b.surface[i]:
+            continue
+        ci = <int64_t> floor(R[4 * i] * inv_cell)
+        cj = <int64_t> floor(R[4 * i + 1] * inv_cell)
+        ck = <int64_t> floor(R[4 * i + 2] * inv_cell)
+        n_row = 0
+        for di in range(-1, 2):
+            for dj in range(-1, 2):
+                for dk in range(-1, 2):
+                    key = _okey(ci + di, cj + dj, ck + dk)
+                    pos_ = _lower_bound(c.ocells, n_o, key)
+                    while pos_ < n_o and c.ocells[pos_].key == key:
+                        m = c.ocells[pos_].index
+                        pos_ += 1
+                        dx = b.obs[4 * m] - R[4 * i]
+                        dy = b.obs[4 * m + 1] - R[4 * i + 1]
+                        dz = b.obs[4 * m + 2] - R[4 * i + 2]
+                        d2 = dx * dx + dy * dy + dz * dz
+                        if d2 >= 9.0 * L * L:
+                            continue
+                        s_first = R[4 * i + 3] if b.seed_rank[i] < b.obs_rank[m] else L
+                        act = 2.0 * s_first
+                        if d2 >= act * act:
+                            continue
+                        if c.n_opairs + 1 > c.ocapacity:
+                            mm = 2 * (c.n_opairs + 1) + 64
+                            grown = <intp_t*> realloc(c.opairs, 2 * mm * sizeof(intp_t))
+                            if grown == NULL:
+                                return STATUS_MEMORY
+                            c.opairs = grown
+                            c.ocapacity = mm
+                        c.opairs[2 * c.n_opairs] = i
+                        c.opairs[2 * c.n_opairs + 1] = m
+                        c.n_opairs += 1
+                        n_row += 1
+        if n_row > 1:
+            # the row's obstacles in index order (results independent of the hash)
+            qsort(c.opairs + 2 * (c.n_opairs - n_row), n_row, 2 * sizeof(intp_t), _cmp_intp2)
     return STATUS_OK
+
+
+cdef int _cmp_intp2(const void* a, const void* b) noexcept nogil:
+    # (i, m) pairs of one row: by m
+    cdef intp_t x = (<const intp_t*> a)[1]
+    cdef intp_t y = (<const intp_t*> b)[1]
+    return -1 if x < y else (1 if x > y else 0)
+
+
+cdef inline void _collide_obstacles(Batch* b, Contacts* c) noexcept nogil:
+    # OUT (accumulated): force on the voxels touching an obstacle voxel (the
+    # seed's contact law; the obstacle is fixed and takes no force)
+    cdef:
+        intp_t k, i, m
+        float64_t dx, dy, dz, d2, env, dist, kk, fmag
+    for k in range(c.n_opairs):
+        i = c.opairs[2 * k]
+        m = c.opairs[2 * k + 1]
+        dx = b.pos[3 * i] - b.obs[4 * m]
+        dy = b.pos[3 * i + 1] - b.obs[4 * m + 1]
+        dz = b.pos[3 * i + 2] - b.obs[4 * m + 2]
+        d2 = dx * dx + dy * dy + dz * dz
+        env = 0.75 * (b.scale[i] + b.L)
+        if d2 >= env * env or d2 == 0.0:
+            continue
+        dist = sqrt(d2)
+        kk = b.k_floor[i] * b.obs[4 * m + 3] / (b.k_floor[i] + b.obs[4 * m + 3])
+        fmag = kk * (env - dist) / dist
+        b.force[3 * i] += fmag * dx
+        b.force[3 * i + 1] += fmag * dy
+        b.force[3 * i + 2] += fmag * dz
 
 
 cdef inline void _collide(Batch* b, Contacts* c) noexcept nogil:
@@ -1510,6 +1623,7 @@ cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
             status = _links_seed(b, r)
         if status == STATUS_OK and b.self_collision:
             _collide(b, c)
+            _collide_obstacles(b, c)
         if status == STATUS_OK:
             status = _integrate_seed(b, r, NULL, &dmax2)
         if status != STATUS_OK:
@@ -1712,6 +1826,9 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.col_ref = _f(a, "col_ref")
     b.col_acc = _f(a, "col_acc")
     b.col_vmax = _f(a, "col_vmax")
+    b.obs_start = <intp_t*> _p(a, "obs_start")
+    b.obs = _f(a, "obs") if a["obs"].shape[0] > 0 else NULL
+    b.obs_rank = <intp_t*> _p(a, "obs_rank") if a["obs_rank"].shape[0] > 0 else NULL
     b.surface = <flag_t*> _p(a, "surface")
     b.link_axis_count = <intp_t*> _p(a, "link_axis_count")
     b.excl_start = <intp_t*> _p(a, "excl_start")
@@ -1769,6 +1886,8 @@ cdef class ContactCache:
                 free(self.items[r].cells)
                 free(self.items[r].row)
                 free(self.items[r].ref)
+                free(self.items[r].opairs)
+                free(self.items[r].ocells)
             free(self.items)
 
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -59,6 +59,13 @@ class Rollout:
         Settling time (s) before the fitness reference (the seed's InitCmTime).
     trace_interval : float
         Seconds between centre-of-mass samples.
+    obstacle_mass : ndarray of shape (n_robots,), float64
+        Mass (kg) of each robot's terrain as the seed's fixed obstacle voxels
+        (its walls: 1 kg per lattice cell); 0 on flat ground.
+    obstacle_cm : ndarray of shape (n_robots, 3), float64
+        Their centre of mass (m). With ``obstacle_mass`` it gives the seed's
+        own centre of mass, which counts the walls
+        (:func:`softgym.metrics.dilute`).
     """
 
     times: np.ndarray
@@ -79,6 +86,35 @@ class Rollout:
     voxel_size: float
     init_time: float
     trace_interval: float
+    obstacle_mass: np.ndarray | None = None
+    obstacle_cm: np.ndarray | None = None
+
+    #: Fields with one entry (row) per robot.
+    PER_ROBOT = ("times", "cm", "cm_init", "init_reached", "cm_final", "dt", "steps", "time",
+                 "diverged", "diverged_time", "mass", "obstacle_mass", "obstacle_cm")  # fmt: skip
+    #: Fields with one row per voxel (sliced with ``voxel_offsets``).
+    PER_VOXEL = ("positions", "orientations", "grid_index")
+
+    def take(self, indices) -> Rollout:
+        """The rollout of the robots ``indices``, in that order (repeats allowed).
+
+        Parameters
+        ----------
+        indices : sequence of int
+
+        Returns
+        -------
+        Rollout
+        """
+        idx = np.asarray(indices, dtype=np.intp).reshape(-1)
+        off = self.voxel_offsets
+        pieces = [np.arange(off[i], off[i + 1]) for i in idx]
+        vox = np.concatenate(pieces) if pieces else np.zeros(0, dtype=np.intp)
+        counts = np.array([len(p) for p in pieces], dtype=np.int64)
+        changes = {k: getattr(self, k)[idx] for k in self.PER_ROBOT if getattr(self, k) is not None}
+        changes.update({k: getattr(self, k)[vox] for k in self.PER_VOXEL})
+        changes["voxel_offsets"] = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        return replace(self, **changes)
 
     @property
     def n_robots(self) -> int:

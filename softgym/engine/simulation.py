@@ -161,6 +161,65 @@ def _hop_neighbours(n: int, v1: np.ndarray, v2: np.ndarray, hops: int):
     return start, b
 
 
+#: The seed's obstacle voxels (its material 5, SEED_REFERENCE §2.2): E (Pa), density (kg/m^3).
+OBSTACLE_YOUNGS_MODULUS = 5e9
+OBSTACLE_DENSITY = 1e6
+#: Most lattice cells a terrain may turn into seed-model obstacle voxels.
+MAX_OBSTACLE_VOXELS = 200_000
+_RANK_W = 1 << 20  # lattice coordinates of the seed order key: (z, y, x) in base 2^20
+_RANK_OFF = 1 << 19
+
+
+def _seed_rank(g: np.ndarray) -> np.ndarray:
+    # index of world lattice cells in the seed engine's voxel order (x fastest, then y, then z)
+    g = np.asarray(g, dtype=np.int64) + _RANK_OFF
+    return ((g[:, 2] * _RANK_W + g[:, 1]) * _RANK_W + g[:, 0]).astype(np.intp)
+
+
+def obstacle_cells(terrain: Any) -> np.ndarray | None:
+    """The lattice cells (n, 3) of a terrain's boxes, or None if a box is off the lattice.
+
+    The seed engine has no boxes: its walls are fixed voxels of its obstacle
+    material in the lattice. The seed model turns a terrain whose boxes have
+    integer corners (in voxel lengths) into such voxels; other boxes keep the
+    penalty contact of the corotational model.
+    """
+    cells = []
+    total = 0.0
+    for b in terrain.boxes:
+        lo = np.asarray(b.lo, dtype=np.float64)
+        hi = np.asarray(b.hi, dtype=np.float64)
+        if not (np.all(np.abs(lo - np.rint(lo)) < 1e-9) and np.all(np.abs(hi - np.rint(hi)) < 1e-9)):
+            return None
+        total += float(np.prod(hi - lo))
+        if total > MAX_OBSTACLE_VOXELS:
+            return None
+        lo = np.rint(lo).astype(np.int64)
+        hi = np.rint(hi).astype(np.int64)
+        g = np.mgrid[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]].reshape(3, -1).T
+        cells.append(g)
+    if not cells:
+        return np.zeros((0, 3), dtype=np.int64)
+    return np.unique(np.concatenate(cells), axis=0)
+
+
+def obstacle_mass_and_center(terrain: Any, voxel_size: float) -> tuple[float, np.ndarray]:
+    """Mass (kg) and centre of mass (m) of a terrain's boxes as the seed's obstacle voxels.
+
+    The seed's centre of mass counts its 44 fixed wall voxels (SEED_REFERENCE
+    §1.8); this is what dilutes its obstacle metrics
+    (:func:`softgym.metrics.dilute`).
+    """
+    boxes = terrain.as_array(voxel_size)
+    if len(boxes) == 0:
+        return 0.0, np.zeros(3)
+    vol = np.prod(boxes[:, 3:] - boxes[:, :3], axis=1)
+    mass = OBSTACLE_DENSITY * vol
+    centres = 0.5 * (boxes[:, :3] + boxes[:, 3:])
+    return float(mass.sum()), (mass[:, None] * centres).sum(axis=0) / mass.sum()
+
+
+
 def _harmonic(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     s = a + b
     out = np.zeros_like(s)
@@ -361,10 +420,10 @@ class Simulation:
             grid_index.append(idx)
             degree = np.bincount(np.concatenate([v1, v2]), minlength=n)
             add(per_vox, "surface", (degree < 6).astype(np.int8))
-            # the seed engine's voxel order (x fastest, then y, then z): it
-            # decides which voxel of a pair sets the seed's candidate horizon
-            nx, ny = grid.shape[0], grid.shape[1]
-            add(per_vox, "seed_rank", (idx[:, 0] + nx * (idx[:, 1] + ny * idx[:, 2])).astype(np.intp))
+            # the seed engine's voxel order (x fastest, then y, then z) over
+            # the world lattice: it decides which voxel of a pair sets the
+            # seed's candidate horizon
+            add(per_vox, "seed_rank", _seed_rank(np.rint(body.origin / L).astype(np.int64) + idx))
             ex_start, ex_idx = _hop_neighbours(n, v1, v2, cfg.collision_exclusion)
             add(per_vox, "excl_count", np.diff(ex_start))
             excl.append(ex_idx + vox_start[-1])
@@ -379,7 +438,24 @@ class Simulation:
         a["surface"] = a["surface"].astype(np.int8)
         a["excl_start"] = np.concatenate([[0], np.cumsum(a.pop("excl_count"))]).astype(np.intp)
         a["excl_idx"] = np.ascontiguousarray(np.concatenate(excl), dtype=np.intp)
-        boxes = [t.as_array(L) for t in self.terrains]
+        # the seed model: lattice boxes become the seed's fixed obstacle voxels
+        # (contact through its self-collision law), other boxes keep the penalty contact
+        boxes, obs, obs_rank, obs_start = [], [], [], [0]
+        k_obs = 2.0 * OBSTACLE_YOUNGS_MODULUS * L
+        for t in self.terrains:
+            cells = obstacle_cells(t) if cfg.model == "seed" else None
+            if cells is None:
+                boxes.append(t.as_array(L))
+                cells = np.zeros((0, 3), dtype=np.int64)
+            else:
+                boxes.append(np.zeros((0, 6)))
+            centre = L * ((cells + 0.5) + np.array([1e-6, 1e-6, 0.0]))
+            obs.append(np.column_stack([centre, np.full(len(cells), k_obs)]))
+            obs_rank.append(_seed_rank(cells))
+            obs_start.append(obs_start[-1] + len(cells))
+        a["obs_start"] = np.asarray(obs_start, dtype=np.intp)
+        a["obs"] = np.ascontiguousarray(np.concatenate(obs), dtype=np.float64).reshape(-1, 4)
+        a["obs_rank"] = np.ascontiguousarray(np.concatenate(obs_rank), dtype=np.intp)
         a["box_start"] = np.concatenate([[0], np.cumsum([len(b) for b in boxes])]).astype(np.intp)
         a["boxes"] = np.ascontiguousarray(np.concatenate(boxes), dtype=np.float64).reshape(-1, 6)
         a["floor"] = np.array([int(t.floor and cfg.floor) for t in self.terrains], dtype=np.int8)
@@ -422,6 +498,9 @@ class Simulation:
         a["trace_n"] = np.zeros(n_robots, dtype=np.intp)
         a["trace_t"] = np.zeros((n_robots, 8))
         a["trace_cm"] = np.zeros((n_robots, 8, 3))
+        walls = [obstacle_mass_and_center(t, L) for t in self.terrains]
+        self._obstacle_mass = np.array([m for m, _ in walls], dtype=np.float64)
+        self._obstacle_cm = np.array([c for _, c in walls], dtype=np.float64).reshape(-1, 3)
         self._a = a
         self._grid_index = np.ascontiguousarray(np.concatenate(grid_index)).astype(np.int64)
         self._settings = {
@@ -788,6 +867,8 @@ class Simulation:
             voxel_size=float(cfg.voxel_size),
             init_time=float(cfg.init_time),
             trace_interval=float(cfg.trace_interval),
+            obstacle_mass=self._obstacle_mass.copy(),
+            obstacle_cm=self._obstacle_cm.copy(),
         )
 
     # ------------------------------------------------------------------ state

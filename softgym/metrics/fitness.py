@@ -12,7 +12,7 @@ worst value for a maximised objective.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -32,6 +32,7 @@ __all__ = [
     "Composition",
     "LCoefficient",
     "composition_counts",
+    "dilute",
     "l_coefficient",
     "l_coefficient_details",
     "l_coefficient_from_arrays",
@@ -316,6 +317,42 @@ def _worst(values: np.ndarray, rollout: Rollout) -> np.ndarray:
     out = np.asarray(values, dtype=np.float64).copy()
     out[np.asarray(rollout.diverged, dtype=bool)] = WORST_FITNESS
     return out
+
+
+def dilute(rollout: Rollout) -> Rollout:
+    """The rollout with the seed's own centre of mass, which counts the obstacle voxels.
+
+    The seed's engine averages over every voxel of its world, its 44 fixed wall
+    voxels included (SEED_REFERENCE §1.8), so each displacement in its obstacle
+    runs is the robot's times ``m_robot / (m_robot + m_walls)`` and its
+    MaxXYDist and L coefficient are computed on that diluted path. Use this to
+    compare a run with the report's numbers; softgym's own metrics stay
+    robot-only.
+
+    Parameters
+    ----------
+    rollout : Rollout
+
+    Returns
+    -------
+    Rollout
+        ``cm``, ``cm_init`` and ``cm_final`` replaced by the whole-world centre
+        of mass; unchanged when the rollout has no obstacle mass.
+    """
+    wm = rollout.obstacle_mass
+    if wm is None or not np.any(wm > 0):
+        return rollout
+    wc = np.asarray(rollout.obstacle_cm, dtype=np.float64)
+    m = np.asarray(rollout.mass, dtype=np.float64)
+    tot = (m + wm)[:, None]
+
+    def mix(cm: np.ndarray) -> np.ndarray:
+        if cm.ndim == 3:
+            return (m[:, None, None] * cm + wm[:, None, None] * wc[:, None, :]) / tot[:, :, None]
+        return (m[:, None] * cm + wm[:, None] * wc) / tot
+
+    return replace(rollout, cm=mix(rollout.cm), cm_init=mix(rollout.cm_init),
+                   cm_final=mix(rollout.cm_final))
 
 
 def norm_final_dist(rollout: Rollout) -> np.ndarray:

@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from softgym.exceptions import InvalidParameterError, InvalidTerrainError
-from softgym.metrics import WALK_METRICS, walk_metrics
+from softgym.metrics import WALK_METRICS, dilute, walk_metrics
 from softgym.terrain import Terrain
 
 if TYPE_CHECKING:  # annotations only: softgym.engine's __init__ loads compiled code
@@ -135,6 +135,11 @@ class Task:
         The metric whose per-step progress an environment rewards; default
         ``norm_final_dist`` on flat ground, ``max_xy_dist`` (the seed's
         obstacle fitness) with obstacles.
+    seed_centre_of_mass : bool
+        Score on the seed's own centre of mass, which counts the obstacles as
+        its 1-kg wall voxels (:func:`softgym.metrics.dilute`): the numbers of
+        the seed's obstacle runs, smaller than the robot's own by
+        ``m_robot / (m_robot + m_walls)``. Off by default (robot-only).
 
     Notes
     -----
@@ -150,6 +155,7 @@ class Task:
     sim: dict[str, Any] = field(default_factory=dict)
     n_threads: int | None = None
     reward: str | None = None
+    seed_centre_of_mass: bool = False
 
     def __post_init__(self) -> None:
         terrain = self.terrain
@@ -212,6 +218,8 @@ class Task:
             ``norm_final_dist``, ``max_xy_dist``, ``l_coefficient``,
             ``time_max_xy_dist``, ``diverged``.
         """
+        if self.seed_centre_of_mass:
+            rollout = dilute(rollout)
         return walk_metrics(rollout)
 
     # ------------------------------------------------------------------ data

@@ -26,12 +26,13 @@ def reference_robot(n=6, **kw):
     return two_material_body(g, **kw)
 
 
-def settled_block(mu_s=1.0, mu_k=0.5, terrain=None, z0=0.0):
+def settled_block(mu_s=1.0, mu_k=0.5, terrain=None, z0=0.0, model="seed"):
     """A 2x2x1 block settled for 0.5 s (global damping off: the closed forms have no drag)."""
     from softgym.engine import SimConfig, Simulation
 
     body = Body.uniform(np.ones((2, 2, 1)), mu_static=mu_s, mu_kinetic=mu_k, origin=(0.0, 0.0, z0))
-    sim = Simulation(body, SimConfig(init_time=0.0, global_damping=0.0), terrain=terrain)
+    cfg = SimConfig(init_time=0.0, global_damping=0.0, model=model)
+    sim = Simulation(body, cfg, terrain=terrain)
     sim.advance(0.5)
     return sim
 

@@ -125,3 +125,20 @@ def test_restore_robots_resets_one_robot_on_the_shared_clock():
     assert sim.time[1] == pytest.approx(1.3, abs=sim.dt[1])
     start["pos"][:] = 0.0  # set_state / restore_robots copied: the sim is unaffected
     assert np.abs(sim.positions(1)).max() > 0
+
+
+def test_rollout_take_reorders_every_per_robot_and_per_voxel_field():
+    import numpy as np
+
+    from softgym.engine import Body, Simulation
+    from softgym.terrain import Terrain
+
+    bodies = [Body.uniform(np.ones((2, 1, 1))), Body.uniform(np.ones((1, 3, 1)))]
+    r = Simulation(bodies, terrain=[Terrain.flat(), Terrain.fence(center=(0.5, 1.5))]).run(0.2)
+    t = r.take([1, 0, 1])
+    assert t.n_robots == 3
+    np.testing.assert_array_equal(t.cm[0], r.cm[1])
+    np.testing.assert_array_equal(t.obstacle_mass, r.obstacle_mass[[1, 0, 1]])
+    np.testing.assert_array_equal(t.robot_positions(0), r.robot_positions(1))
+    np.testing.assert_array_equal(t.robot_positions(1), r.robot_positions(0))
+    assert list(t.voxel_offsets) == [0, 3, 5, 8]

@@ -1,4 +1,9 @@
-"""Contact with terrain boxes and self-collision (tolerances stated per test)."""
+"""Contact with terrain boxes and self-collision (tolerances stated per test).
+
+Terrain boxes: the corotational model's penalty contact with friction (box
+tests below pin it); the seed model turns lattice boxes into the seed's fixed
+obstacle voxels (tests at the end).
+"""
 
 import numpy as np
 import pytest
@@ -8,6 +13,7 @@ from softgym.engine import Body, SimConfig, Simulation
 from softgym.terrain import Box, Terrain
 
 L = 0.01
+BOXES = SimConfig.corotational(init_time=0.0)  # the penalty box contact
 
 
 def test_block_dropped_onto_a_box_rests_on_its_top_within_2_percent():
@@ -15,7 +21,7 @@ def test_block_dropped_onto_a_box_rests_on_its_top_within_2_percent():
     # rest with its centres at top + L/2 (within 2 %).
     platform = Terrain.from_boxes([Box((-4, -4, 0), (6, 6, 2))])
     body = Body.uniform(np.ones((2, 2, 1)), origin=(0.0, 0.0, 4 * L))
-    sim = Simulation(body, SimConfig(init_time=0.0), terrain=platform)
+    sim = Simulation(body, BOXES, terrain=platform)
     sim.advance(1.5)
     z = sim.positions(0)[:, 2]
     assert np.abs(sim.velocities(0)).max() < 1e-4
@@ -30,7 +36,7 @@ def test_robot_driven_into_a_wall_never_enters_it():
     fence = Terrain.fence(inner=10, height=1, thickness=1, center=(1.0, 1.0))
     walls = fence.as_array(L)
     body = Body.uniform(np.ones((2, 2, 1)))
-    sim = Simulation(body, SimConfig(init_time=0.0), terrain=fence)
+    sim = Simulation(body, BOXES, terrain=fence)
     m = sim.masses(0)[0]
     sim.set_external_force(0, [0.8 * 9.81 * m, 0.0, 0.0])
     dt = sim.dt[0]
@@ -54,7 +60,7 @@ def test_robot_driven_into_a_wall_never_enters_it():
 
 def _block_on_platform(mu_s, mu_k):
     platform = Terrain.from_boxes([Box((-20, -20, 0), (40, 40, 2))])
-    return settled_block(mu_s, mu_k, terrain=platform, z0=2 * L)
+    return settled_block(mu_s, mu_k, terrain=platform, z0=2 * L, model="corotational")
 
 
 def test_static_friction_on_a_box_top_matches_the_floor():
@@ -162,7 +168,7 @@ def test_obstacles_are_not_robot_mass():
 def test_voxel_inside_a_box_is_pushed_out_through_the_nearest_face():
     # A voxel whose centre ended 0.3 L inside a box's -x face leaves through it.
     box = Terrain.from_boxes([Box((2, -1, 0), (6, 3, 3))])
-    sim = Simulation(Body.uniform(np.ones((1, 1, 1))), SimConfig(init_time=0.0), terrain=box)
+    sim = Simulation(Body.uniform(np.ones((1, 1, 1))), BOXES, terrain=box)
     state = sim.get_state()
     state["pos"][0] = [2.3 * L, 0.5 * L, 1.5 * L]
     sim.set_state(state)
@@ -170,3 +176,48 @@ def test_voxel_inside_a_box_is_pushed_out_through_the_nearest_face():
     p = sim.positions(0)[0]
     assert p[0] < 2 * L - 0.4 * L  # out through x0, not through the far faces
     assert abs(p[1] - 0.5 * L) < 1e-9
+
+
+def test_seed_model_walls_are_the_seeds_fixed_voxels():
+    # The seed model: a lattice box is the seed's fixed obstacle voxels (E 5e9),
+    # touched through the self-collision law (envelopes 0.75 (s1 + s2), no
+    # damping, no friction): a block dropped on a 2-voxel platform bounces on
+    # it, its centres on average one voxel above its top (the envelope is 1.5 L
+    # from the top layer's centres; within 2 %) and never lower than 0.8 L.
+    platform = Terrain.from_boxes([Box((-4, -4, 0), (6, 6, 2))])
+    body = Body.uniform(np.ones((2, 2, 1)), origin=(0.0, 0.0, 4 * L))
+    sim = Simulation(body, SimConfig(init_time=0.0, trace_interval=0.01), terrain=platform)
+    z = []
+    for _ in range(150):
+        sim.advance(0.01)
+        z.append(sim.positions(0)[:, 2].copy())
+    z = np.array(z)[50:]
+    assert z.min() > 2 * L + 0.8 * L
+    assert z.mean() == pytest.approx(2 * L + L, rel=0.02)
+    # without self-collision the seed's walls do not exist for the robot
+    sim = Simulation(body, SimConfig(init_time=0.0, self_collision=False), terrain=platform)
+    sim.advance(0.5)
+    assert sim.positions(0)[:, 2].max() < 0.6 * L  # fell through to the floor
+
+
+def test_seed_model_fence_stops_a_pushed_block():
+    # the seed's fence (1-voxel walls, obstacle voxels): a block pushed east with
+    # 0.8 of its weight stops against the wall, 1.5 L (the envelopes) short of
+    # the wall voxels' centres, and stays there
+    fence = Terrain.fence(inner=10, height=1, thickness=1, center=(1.0, 1.0))
+    sim = Simulation(Body.uniform(np.ones((2, 2, 1))), SimConfig(init_time=0.0), terrain=fence)
+    sim.set_external_force(0, [0.8 * 9.81 * sim.masses(0)[0], 0.0, 0.0])
+    sim.advance(1.8)
+    x_late = sim.positions(0)[:, 0].max()
+    sim.advance(0.2)
+    wall_centre = (1.0 + 5.0 + 0.5) * L
+    assert wall_centre - 1.7 * L < sim.positions(0)[:, 0].max() < wall_centre - 1.4 * L
+    assert abs(sim.positions(0)[:, 0].max() - x_late) < 1e-4
+
+
+def test_off_lattice_boxes_keep_the_penalty_contact_in_the_seed_model():
+    platform = Terrain.from_boxes([Box((-4.5, -4, 0), (6, 6, 2.5))])
+    body = Body.uniform(np.ones((2, 2, 1)), origin=(0.0, 0.0, 4 * L))
+    sim = Simulation(body, SimConfig(init_time=0.0), terrain=platform)
+    sim.advance(1.5)
+    np.testing.assert_allclose(sim.positions(0)[:, 2], 2.5 * L + 0.5 * L, rtol=0.02)

@@ -131,3 +131,24 @@ def test_composition_counts():
     assert composition_counts(RobotDesign(g), muscle_ids=(3,)).n_muscle == 1
     with pytest.raises(InvalidParameterError):
         composition_counts(np.full((2, 2, 2), -1))
+
+
+def test_dilute_gives_the_seeds_centre_of_mass_with_its_walls():
+    # the seed's CM counts its 44 one-kg wall voxels: every displacement shrinks
+    # by m / (m + 44) and the metrics follow
+    import numpy as np
+
+    from softgym.design import default_walker
+    from softgym.engine import Simulation
+    from softgym.metrics import dilute, norm_final_dist, walk_metrics
+    from softgym.terrain import Terrain
+
+    r = Simulation([default_walker()], terrain=Terrain.fence(center=(3, 3))).run(2.0)
+    assert r.obstacle_mass[0] == pytest.approx(44.0, rel=1e-12)
+    d = dilute(r)
+    m = r.mass[0]
+    np.testing.assert_allclose(norm_final_dist(d), norm_final_dist(r) * m / (m + r.obstacle_mass[0]), rtol=1e-9)
+    w = walk_metrics(d)
+    assert 0 < w["max_xy_dist"][0] < walk_metrics(r)["max_xy_dist"][0]
+    flat = Simulation([default_walker()]).run(0.2)
+    assert flat.obstacle_mass[0] == 0.0 and dilute(flat) is flat

