@@ -11,12 +11,22 @@ evolve
     on Dask, into a resumable run folder with log, checkpoints, best designs
     and figures.
 replay
-    Re-simulate the best robot of a run folder and render it (figures + GIF).
+    Re-simulate the best robot of a run folder and render it (figures, GIF, MP4).
 compare
     Best fitness per generation of several run folders in one figure (the
-    report's Fig. 4).
+    report's Fig. 4); runs of one configuration (seeds) as a median with an
+    interquartile band.
 experiments
     List the named experiments.
+view
+    Write a self-contained interactive 3D viewer (HTML) of a run's best robot
+    or of a design file.
+convert
+    Convert a design between JSON and ``.vxa`` (VoxCAD / evosoro).
+
+``softgym evolve --resume`` reads the experiment and settings from the run
+folder. Ctrl-C stops within a fraction of a second and prints the command that
+resumes. ``-v`` shows log lines (and Dask's); ``--help`` shows every default.
 study
     Run the seed report's scenarios over many seeds, each a resumable run
     folder (seeds in parallel on Dask); ``study report RUNS`` writes the
@@ -28,6 +38,8 @@ from __future__ import annotations
 import argparse
 import json
 import logging
+import shlex
+import signal
 import sys
 import time
 from pathlib import Path
@@ -69,73 +81,149 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     return 0
 
 
+#: evolve flags that define a run (what --resume reads from the run folder).
+_RUN_FLAGS = {
+    "experiment": "--experiment", "pop": "--pop", "seed": "--seed", "backend": "--backend",
+    "algorithm": "--algorithm", "task": "--task", "seconds": "--seconds", "shape": "--shape",
+    "selection": "--selection",
+}  # fmt: skip
+
+
+def _explicit_flags(parser: argparse.ArgumentParser, argv: list[str]) -> set[str]:
+    """Dests of the options typed on the command line (not left at their defaults)."""
+    found = set()
+    for action in parser._actions:  # argparse has no public API for this
+        for opt in action.option_strings:
+            if any(a == opt or a.startswith(opt + "=") for a in argv):
+                found.add(action.dest)
+    return found
+
+
+def _resumed_settings(args: argparse.Namespace, cfg: dict) -> dict:
+    """The run folder's settings; a differing explicit flag is a CheckpointError naming it."""
+    from evolvers.experiments import Experiment
+    from softgym.exceptions import CheckpointError
+
+    exp = Experiment.from_dict(cfg["experiment"])
+    recorded = {
+        "experiment": exp.name, "pop": exp.pop_size, "seed": cfg.get("seed"),
+        "backend": cfg.get("backend"), "algorithm": cfg.get("algorithm"),
+        "seconds": exp.seconds, "shape": list(exp.shape), "selection": exp.selection,
+    }  # fmt: skip
+    for dest in sorted(getattr(args, "explicit", set()) & set(_RUN_FLAGS)):
+        given = getattr(args, dest)
+        if dest == "task":
+            same = exp.replace(task=given).to_dict()["task"] == exp.to_dict()["task"]
+            shown = "its own task"
+        elif dest == "algorithm" and recorded["backend"] != "pymoo":
+            continue  # --algorithm only matters to pymoo
+        else:
+            want = list(given) if dest == "shape" else given
+            same = want == recorded[dest] or (dest == "seconds" and float(want) == recorded[dest])
+            rec = recorded[dest]
+            shown = " ".join(map(str, rec)) if dest == "shape" else rec
+        if not same:
+            flag = _RUN_FLAGS[dest]
+            given_s = " ".join(map(str, given)) if dest == "shape" else given
+            raise CheckpointError(
+                f"{args.out} was started with {flag} {shown}, not {given_s}; "
+                f"drop {flag} to resume it, or use another --out"
+            )
+    return {"experiment": exp, "seed": int(cfg["seed"]), "backend": cfg["backend"],
+            "algorithm": cfg.get("algorithm", args.algorithm),
+            "generations": args.generations if "generations" in getattr(args, "explicit", set())
+            else int(cfg.get("generations", args.generations))}  # fmt: skip
+
+
 def _make_run(args: argparse.Namespace, batch_fn):
     from evolvers.experiments import get_experiment
+    from evolvers.recorder import read_run_config
 
-    overrides = {"pop_size": args.pop}
-    if args.seconds is not None:
-        overrides["seconds"] = args.seconds
-    if args.shape is not None:
-        overrides["shape"] = tuple(args.shape)
-    if args.selection is not None:
-        overrides["selection"] = args.selection
-    if args.task is not None:
-        overrides["task"] = args.task
-    exp = get_experiment(args.experiment, **overrides)
+    if args.resume and (Path(args.out) / "config.json").is_file():
+        st = _resumed_settings(args, read_run_config(args.out))
+    else:
+        overrides = {"pop_size": args.pop}
+        if args.seconds is not None:
+            overrides["seconds"] = args.seconds
+        if args.shape is not None:
+            overrides["shape"] = tuple(args.shape)
+        if args.selection is not None:
+            overrides["selection"] = args.selection
+        if args.task is not None:
+            overrides["task"] = args.task
+        st = {"experiment": get_experiment(args.experiment, **overrides), "seed": args.seed,
+              "backend": args.backend, "algorithm": args.algorithm,
+              "generations": args.generations}  # fmt: skip
     extra = {}
-    if args.backend == "deap":
+    if st["backend"] == "deap":
         from evolvers.deap_runner import DeapRun as Run
-    elif args.backend == "pymoo":
+    elif st["backend"] == "pymoo":
         from evolvers.pymoo_runner import PymooRun as Run
 
-        extra["algorithm"] = args.algorithm
+        extra["algorithm"] = st["algorithm"]
     else:
         from evolvers.runner import EvolutionRun as Run
-    return Run(
-        exp, args.out, seed=args.seed, generations=args.generations, batch_fn=batch_fn,
-        n_threads=args.threads, figures=not args.no_figures, gif=not args.no_gif, **extra,
+    run = Run(
+        st["experiment"], args.out, seed=st["seed"], generations=st["generations"],
+        batch_fn=batch_fn, n_threads=args.threads, figures=not args.no_figures,
+        gif=not args.no_gif, progress=not args.quiet, **extra,
     )  # fmt: skip
+    run.resume_command = f"softgym evolve --out {shlex.quote(str(args.out))} --resume"
+    return run
+
+
+def _raise_keyboard_interrupt(signum, frame):  # SIGTERM: stop like Ctrl-C, checkpoint intact
+    raise KeyboardInterrupt
+
+
+def _quiet_dask(verbose: int) -> None:
+    """Dask's own INFO lines only with -v."""
+    level = logging.INFO if verbose else logging.WARNING
+    for name in ("distributed", "distributed.scheduler", "distributed.nanny",
+                 "distributed.worker", "distributed.core", "distributed.http.proxy"):  # fmt: skip
+        logging.getLogger(name).setLevel(level)
 
 
 def _cmd_evolve(args: argparse.Namespace) -> int:
     import contextlib
 
-    from tqdm import tqdm
+    from tqdm.contrib.logging import logging_redirect_tqdm
 
+    from evolvers.recorder import RunInterrupted
     from softgym.exceptions import SoftGymError
 
     t0 = time.perf_counter()
-    with contextlib.ExitStack() as stack:
-        batch_fn = None
-        try:
-            if args.dask:
-                from evolvers.distributed import DaskBatchFn, dask_client
+    previous = signal.signal(signal.SIGTERM, _raise_keyboard_interrupt)
+    try:
+        with contextlib.ExitStack() as stack:
+            stack.enter_context(logging_redirect_tqdm())
+            batch_fn = None
+            try:
+                if args.dask:
+                    from evolvers.distributed import DaskBatchFn, dask_client
 
-                client = stack.enter_context(dask_client(args.dask, n_workers=args.workers))
-                batch_fn = DaskBatchFn(client)
-            run = _make_run(args, batch_fn)
-        except SoftGymError as exc:
-            print(f"softgym evolve: {exc}", file=sys.stderr)
-            return 2
-        fit = run.experiment.fitness
-        bar = tqdm(total=run.generations + 1, desc=f"{run.experiment.name} [{run.backend}]",
-                   unit="gen", dynamic_ncols=True, disable=args.quiet)  # fmt: skip
-
-        def progress(r, row):
-            bar.n = row["generation"] + 1
-            best = row.get(f"{fit.name}_best", float("nan"))
-            bar.set_postfix(best=f"{best:.3f}", evals=row["evaluations_total"], refresh=False)
-            bar.refresh()
-
-        run.on_generation = progress
-        try:
-            run.run(resume=args.resume)
-        except SoftGymError as exc:
-            bar.close()
-            print(f"softgym evolve: {exc}", file=sys.stderr)
-            return 2
-        bar.close()
+                    _quiet_dask(args.verbose)
+                    client = stack.enter_context(dask_client(args.dask, n_workers=args.workers))
+                    _quiet_dask(args.verbose)
+                    batch_fn = DaskBatchFn(client)
+                run = _make_run(args, batch_fn)
+                run.run(resume=args.resume)
+            except SoftGymError as exc:
+                print(f"softgym evolve: {exc}", file=sys.stderr)
+                return 2
+    except RunInterrupted as exc:
+        where = (f"generation {exc.generation} is checkpointed in {exc.checkpoint}"
+                 if exc.checkpoint else "no generation had finished")  # fmt: skip
+        print(f"\nsoftgym evolve: interrupted; {where}\nresume with: {exc.resume}",
+              file=sys.stderr)  # fmt: skip
+        return 130
+    except KeyboardInterrupt:
+        print("\nsoftgym evolve: interrupted before the run started", file=sys.stderr)
+        return 130
+    finally:
+        signal.signal(signal.SIGTERM, previous)
     wall = time.perf_counter() - t0
+    fit = run.experiment.fitness
     best = run.hall_of_fame[0]["individual"] if run.hall_of_fame else None
     summary = {
         "experiment": run.experiment.name,
@@ -159,7 +247,12 @@ def _cmd_replay(args: argparse.Namespace) -> int:
     from softgym.design import RobotDesign
     from softgym.evaluate import evaluate
     from softgym.exceptions import SoftGymError
-    from softgym.render.figures import plot_robot, plot_trajectory, save_robot_gif
+    from softgym.render.figures import (
+        plot_robot,
+        plot_trajectory,
+        save_robot_gif,
+        trace_interval_for,
+    )
 
     run_dir = Path(args.run_dir)
     try:
@@ -176,7 +269,8 @@ def _cmd_replay(args: argparse.Namespace) -> int:
     m = evaluate([design], task=task, traces=True)
     out = Path(args.out) if args.out else run_dir / "replay"
     terrain = task.terrain_for(design.shape)
-    fine = evaluate([design], task=task.replace(trace_interval=0.05), traces=True)
+    fine = evaluate([design], task=task.replace(trace_interval=trace_interval_for(design)),
+                    traces=True)  # fmt: skip
     paths = [
         plot_robot(design, out / "best_robot.png", title=f"best robot ({exp['name']})"),
         plot_trajectory(
@@ -187,6 +281,11 @@ def _cmd_replay(args: argparse.Namespace) -> int:
         paths.append(
             save_robot_gif(design, out / "best_robot.gif", terrain, seconds, config=task.config())
         )
+    if args.video:
+        paths.append(
+            save_robot_gif(design, out / "best_robot.mp4", terrain, seconds, fps=20.0,
+                           config=task.config())  # fmt: skip
+        )
     metrics = {
         k: (v[0].item() if hasattr(v[0], "item") else v[0]) for k, v in m.items() if k != "traces"
     }
@@ -196,26 +295,111 @@ def _cmd_replay(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_compare(args: argparse.Namespace) -> int:
-    from softgym.exceptions import CheckpointError
-    from softgym.io import read_json
-    from softgym.render.figures import plot_best_fitness, read_log
+def _config_key(cfg: dict) -> str:
+    """What makes two runs the same configuration: everything but the seed."""
+    from evolvers.experiments import Experiment
 
-    curves = {}
-    metric = args.metric
+    exp = Experiment.from_dict(cfg["experiment"]).to_dict()
+    exp.pop("generations", None)
+    rest = {k: v for k, v in cfg.items() if k not in ("seed", "experiment", "generations")}
+    return json.dumps({"experiment": exp, **rest}, sort_keys=True, default=str)
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    import statistics
+
+    from evolvers.recorder import config_difference, read_run_config
+    from softgym.render.figures import plot_compare, read_log
+
+    groups: dict[str, list] = {}
+    configs: dict[str, dict] = {}
+    logs = {}
     for d in args.run_dirs:
-        cfg_path = Path(d) / "config.json"
-        cfg = read_json(cfg_path)  # CheckpointError naming the file if missing or corrupt
-        try:
-            label = f"{cfg['experiment']['name']} ({cfg['backend']}, seed {cfg['seed']})"
-            if metric is None:
-                first = cfg["experiment"]["objectives"][0]["name"]
-                metric = first if first != "age" else "norm_final_dist"
-        except (KeyError, TypeError, IndexError) as exc:
-            raise CheckpointError(f"{cfg_path}: not a softgym run config ({exc!r})") from None
-        curves[label] = read_log(d)
-    path = plot_best_fitness(curves, metric, args.out, ylabel=f"Best {metric}")
+        cfg = read_run_config(d)  # CheckpointError naming the folder if it is not a run
+        key = _config_key(cfg)
+        groups.setdefault(key, []).append(d)
+        configs.setdefault(key, cfg)
+        logs[d] = read_log(d)
+    metric = args.metric
+    if metric is None:
+        first = configs[next(iter(configs))]["experiment"]["objectives"][0]["name"]
+        metric = first if first != "age" else "norm_final_dist"
+    column = f"{metric}_{args.stat}"
+    for d, rows in logs.items():
+        if not rows or column not in rows[0]:
+            have = sorted({k.rsplit("_", 1)[0] for k in (rows[0] if rows else {})
+                           if k.endswith("_best")})  # fmt: skip
+            print(f"softgym compare: {d} did not record {metric!r} (it has: {', '.join(have) or 'no generation yet'}); "
+                  f"pick a metric every run has with --metric", file=sys.stderr)  # fmt: skip
+            return 2
+    labelled: dict[str, list] = {}
+    base = configs[next(iter(configs))]
+    for key, dirs in groups.items():
+        cfg = configs[key]
+        label = f"{cfg['experiment']['name']} ({cfg['backend']}"
+        label += f", {cfg['algorithm']})" if cfg.get("algorithm") else ")"
+        if label in labelled or any(k != key and configs[k]["experiment"]["name"] == cfg["experiment"]["name"]
+                                    and configs[k]["backend"] == cfg["backend"] for k in groups):  # fmt: skip
+            diff = config_difference(base, cfg)
+            if diff:
+                label += f" [{diff.split(':')[0]}={diff.split('!=')[-1].strip()}]"
+        labelled[label] = [logs[d] for d in dirs]
+    path = plot_compare(labelled, metric, args.out, stat=args.stat)
+    for label, runs in labelled.items():
+        finals = [rows[-1][column] for rows in runs]
+        print(f"{label}: {len(runs)} run(s), final {args.stat} {metric} median "
+              f"{statistics.median(finals):.4g}")  # fmt: skip
     print(path)
+    return 0
+
+
+def _cmd_view(args: argparse.Namespace) -> int:
+    from softgym.render.viewer import write_viewer
+
+    src = Path(args.source)
+    task, seconds, name = args.task or "flat", args.seconds, src.stem
+    if src.is_dir():
+        from evolvers.experiments import Experiment
+        from evolvers.recorder import read_run_config
+        from softgym.design import RobotDesign
+
+        exp = Experiment.from_dict(read_run_config(src)["experiment"])
+        design = RobotDesign.load(src / "best_design.json")
+        task = args.task or exp.make_task()
+        seconds = exp.seconds if seconds is None else seconds
+        name = f"{src.name}: best robot ({exp.name})"
+        out = Path(args.out) if args.out else src / "view.html"
+    else:
+        design = _load_design(src)
+        out = Path(args.out) if args.out else src.with_suffix(".html")
+    path = write_viewer(design, out, seconds=5.0 if seconds is None else seconds, fps=args.fps,
+                        task=task, name=name)  # fmt: skip
+    print(path)
+    return 0
+
+
+def _load_design(path: Path):
+    from softgym.design import RobotDesign, load_vxa
+
+    if path.suffix.lower() in (".vxa", ".vxd", ".xml"):
+        return load_vxa(path)
+    return RobotDesign.load(path)
+
+
+def _cmd_convert(args: argparse.Namespace) -> int:
+    from softgym.design import save_vxa
+
+    src, dst = Path(args.source), Path(args.dest)
+    design = _load_design(src)
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    if dst.suffix.lower() == ".vxa":
+        save_vxa(design, dst)
+    elif dst.suffix.lower() == ".json":
+        design.save(dst)
+    else:
+        print(f"softgym convert: {dst} must end in .json or .vxa", file=sys.stderr)
+        return 2
+    print(f"{src} -> {dst} ({design.n_voxels} voxels, {design.shape[0]}x{design.shape[1]}x{design.shape[2]})")
     return 0
 
 
@@ -362,16 +546,31 @@ def main(argv: list[str] | None = None) -> int:
     subcommand prints one line, ``softgym <command>: <message>``, to stderr and
     returns 2; ``softgym --debug <command> ...`` raises it instead (traceback).
     """
-    parser = argparse.ArgumentParser(prog="softgym", description=__doc__.split("\n")[0])
+    parser = argparse.ArgumentParser(
+        prog="softgym", description=__doc__.split("\n")[0], formatter_class=_HelpFormatter
+    )
+    parser.add_argument(
+        "-v", "--verbose", action="count", default=0,
+        help="log lines (-v: each generation and Dask's; -vv: debug)",
+    )  # fmt: skip
     parser.add_argument(
         "--debug", action="store_true", help="show the traceback of an error (before the command)"
     )
     sub = parser.add_subparsers(dest="command", required=True)
+    _add = sub.add_parser
+
+    def add_parser(name, **kw):  # every subcommand shows its defaults in --help
+        return _add(name, formatter_class=_HelpFormatter, allow_abbrev=False, **kw)
+
+    sub.add_parser = add_parser
     p = sub.add_parser("simulate", help="simulate one robot and plot its trajectory")
     p.add_argument("--design", help="a RobotDesign JSON file (default: the embedded walker)")
-    p.add_argument("--seconds", type=float, default=5.0)
-    p.add_argument("--actuation", choices=["seed", "symmetric"], default="seed")
-    p.add_argument("--out", default="runs/simulate")
+    p.add_argument("--seconds", type=float, default=5.0, help="simulated seconds")
+    p.add_argument(
+        "--actuation", choices=["seed", "symmetric"], default="seed",
+        help="muscle law: the seed's contraction-only, or symmetric",
+    )  # fmt: skip
+    p.add_argument("--out", default="runs/simulate", help="output folder")
     p.set_defaults(func=_cmd_simulate)
 
     p = sub.add_parser("evolve", help="evolve robots with one of the seed's experiments")
@@ -382,18 +581,25 @@ def main(argv: list[str] | None = None) -> int:
     )
     p.add_argument("--generations", type=int, default=10, help="generations after generation 0")
     p.add_argument("--pop", type=int, default=15, help="population size")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=0, help="seed of the run's random generator")
     p.add_argument("--out", default="runs/evolve", help="run folder")
     p.add_argument(
-        "--resume", action="store_true", help="continue the run folder's last checkpoint"
+        "--resume",
+        action="store_true",
+        help="continue the run folder's last checkpoint with its recorded settings "
+        "(experiment, seed, backend...; a differing flag is an error)",
     )
     p.add_argument(
         "--dask",
         metavar="local|tcp://ADDRESS",
-        help='evaluate on Dask: a LocalCluster or an existing scheduler (pip install "softgym[distributed]")',
+        help="evaluate on Dask: a LocalCluster or an existing scheduler "
+        '(pip install "softgym[distributed]"; default: local simulations, no Dask)',
     )
     p.add_argument("--workers", type=int, default=2, help="LocalCluster workers (--dask local)")
-    p.add_argument("--backend", choices=["native", "deap", "pymoo"], default="native")
+    p.add_argument(
+        "--backend", choices=["native", "deap", "pymoo"], default="native",
+        help="the search loop: softgym's own, a DEAP toolbox, or a pymoo algorithm",
+    )  # fmt: skip
     p.add_argument(
         "--algorithm",
         choices=["nsga2", "nsga3", "sms-emoa", "ga"],
@@ -405,39 +611,83 @@ def main(argv: list[str] | None = None) -> int:
         metavar="flat|wall|stairs|FILE.json",
         help="the world (default: the experiment's): a task name or a terrain JSON file",
     )
-    p.add_argument("--seconds", type=float, help="simulated seconds per evaluation (default 5)")
     p.add_argument(
-        "--shape", type=int, nargs=3, metavar=("NX", "NY", "NZ"), help="robot grid (default 6 6 6)"
+        "--seconds", type=float, help="simulated seconds per evaluation (default: the experiment's, 5)"
     )
+    p.add_argument(
+        "--shape", type=int, nargs=3, metavar=("NX", "NY", "NZ"),
+        help="robot grid (default: the experiment's, 6 6 6)",
+    )  # fmt: skip
     p.add_argument(
         "--selection",
         choices=["pareto", "tournament", "novelty", "novelty-archive", "nsga2"],
-        help="override the experiment's selection (native and DEAP backends)",
+        help="override the experiment's selection (native and DEAP backends; default: the experiment's)",
     )
-    p.add_argument("--threads", type=int, help="OpenMP threads of local simulations")
-    p.add_argument("--no-figures", action="store_true")
-    p.add_argument("--no-gif", action="store_true")
+    p.add_argument(
+        "--threads", type=int, help="OpenMP threads of local simulations (default: all usable CPUs)"
+    )
+    p.add_argument("--no-figures", action="store_true", help="write no figures at the end")
+    p.add_argument("--no-gif", action="store_true", help="no GIF of the best robot")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=_cmd_evolve)
+    evolve_parser = p
 
     p = sub.add_parser("replay", help="re-simulate and render the best robot of a run folder")
     p.add_argument("run_dir")
     p.add_argument("--seconds", type=float, help="simulated seconds (default: the run's)")
-    p.add_argument("--out", help="output folder (default RUN_DIR/replay)")
-    p.add_argument("--no-gif", action="store_true")
+    p.add_argument("--out", help="output folder (default: RUN_DIR/replay)")
+    p.add_argument("--no-gif", action="store_true", help="no GIF")
+    p.add_argument(
+        "--video", action="store_true", help='also an MP4 (pip install "softgym[video]")'
+    )
     p.set_defaults(func=_cmd_replay)
 
-    p = sub.add_parser("compare", help="best fitness per generation of several runs (Fig. 4)")
-    p.add_argument("run_dirs", nargs="+")
+    p = sub.add_parser(
+        "compare",
+        help="best fitness per generation of several runs; seeds of one configuration as "
+        "median + interquartile band (Fig. 4)",
+    )
+    p.add_argument("run_dirs", nargs="+", metavar="RUN", help="run folders (any mix)")
     p.add_argument("--metric", help="metric to compare (default: the first run's fitness)")
-    p.add_argument("--out", default="runs/compare.png")
+    p.add_argument(
+        "--stat", choices=["best", "median", "mean", "worst"], default="best",
+        help="per-generation statistic of each run",
+    )  # fmt: skip
+    p.add_argument("--out", default="runs/compare.png", help="figure file")
     p.set_defaults(func=_cmd_compare)
+
+    p = sub.add_parser(
+        "view", help="write an interactive 3D viewer (self-contained HTML) of a robot's rollout"
+    )
+    p.add_argument("source", metavar="RUN_OR_DESIGN",
+                   help="a run folder (its best robot, in its task) or a design .json / .vxa")  # fmt: skip
+    p.add_argument(
+        "--out", help="HTML file (default: RUN/view.html, or the design's name with .html)"
+    )
+    p.add_argument("--seconds", type=float, help="simulated seconds (default: the run's, or 5)")
+    p.add_argument("--fps", type=float, default=10.0, help="frames per simulated second")
+    p.add_argument(
+        "--task", metavar="flat|wall|stairs|FILE.json",
+        help="the world (default: the run's task, or flat)",
+    )  # fmt: skip
+    p.set_defaults(func=_cmd_view)
+
+    p = sub.add_parser("convert", help="convert a design between JSON and .vxa (both ways)")
+    p.add_argument("source", metavar="A", help="a design .json or .vxa file")
+    p.add_argument("dest", metavar="B", help="the output .json or .vxa file")
+    p.set_defaults(func=_cmd_convert)
 
     p = sub.add_parser("experiments", help="list the named experiments")
     p.set_defaults(func=_cmd_experiments)
     _add_study_parser(sub)
+    argv = sys.argv[1:] if argv is None else list(argv)
     args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    if args.command == "evolve":
+        args.explicit = _explicit_flags(evolve_parser, argv)
+    level = (logging.WARNING, logging.INFO, logging.DEBUG)[min(args.verbose, 2)]
+    logging.basicConfig(level=level, format="%(message)s")
+    for name in ("softgym", "evolvers"):
+        logging.getLogger(name).setLevel(level)
     from softgym.exceptions import SoftGymError
 
     try:

@@ -208,7 +208,7 @@ def plot_compare(
         med[have] = np.nanmedian(table[:, have], axis=0)
         q1[have], q3[have] = np.nanpercentile(table[:, have], [25, 75], axis=0)
         n = len(runs)
-        ax.plot(gens, med, color=color,
+        ax.plot(gens, med, color=color, marker="o" if n_gen < 30 else None, ms=3,
                 label=f"{label} (median of {n} runs)" if n > 1 else label)  # fmt: skip
         if n > 1:
             ax.fill_between(gens, q1, q3, color=color, alpha=0.25, lw=0)
