@@ -26,6 +26,8 @@ population 15, 15 children and 1 random newcomer per generation, 5 s simulated.
 
 from __future__ import annotations
 
+import logging
+import os
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
@@ -295,3 +297,27 @@ def get_experiment(name: str, **overrides: Any) -> Experiment:
             f"unknown experiment {name!r}; expected one of {list_experiments()}"
         ) from None
     return exp.replace(**overrides) if overrides else exp
+
+
+#: Environment variable: ``SOFTGYM_SMOKE=1`` cuts every run to smoke-test sizes
+#: (:func:`smoke_sizes`), so documentation examples run verbatim in seconds (the
+#: README's test sets it). Never set it for a real run: a warning says it is on.
+SMOKE_ENV = "SOFTGYM_SMOKE"
+
+
+def smoke_sizes(experiment: Experiment, generations: int) -> tuple[Experiment, int]:
+    """``(experiment, generations)``, cut to 1 generation of 4 robots of 4x4x4, 1.5 s each,
+    when ``SOFTGYM_SMOKE`` is set to a non-zero value (else unchanged).
+    """
+    if os.environ.get(SMOKE_ENV, "0").strip() in ("", "0"):
+        return experiment, generations
+    logging.getLogger("evolvers").warning(
+        "%s is set: %s cut to smoke-test sizes (1 generation, 4 robots of 4x4x4, 1.5 s)",
+        SMOKE_ENV, experiment.name,
+    )  # fmt: skip
+    small = experiment.replace(
+        pop_size=min(experiment.pop_size, 4),
+        seconds=min(experiment.seconds, 1.5),
+        shape=tuple(min(n, 4) for n in experiment.shape),
+    )
+    return small, min(int(generations), 1)

@@ -44,7 +44,7 @@ from pymoo.core.problem import Problem
 from pymoo.core.sampling import Sampling
 
 from evolvers.evaluation import BatchFn, EvalStats, Evaluator, PhenotypeCache, pack_traces
-from evolvers.experiments import Experiment
+from evolvers.experiments import Experiment, smoke_sizes
 from evolvers.genome import Individual
 from evolvers.operators import mut_controller, mut_cppn, mut_materials, set_counterphase
 from evolvers.recorder import RunRecorder, population_summary
@@ -387,10 +387,13 @@ class PymooRun:
         single_objective: bool | None = None,
         progress: bool = True,
     ) -> None:
+        experiment, gens = smoke_sizes(
+            experiment, experiment.generations if generations is None else int(generations)
+        )
         self.experiment = experiment
         self.out = Path(out)
         self.seed = int(seed)
-        self.generations = experiment.generations if generations is None else int(generations)
+        self.generations = gens
         if self.generations < 0:
             raise InvalidParameterError(f"generations must be >= 0, got {self.generations}")
         if isinstance(algorithm, str) and algorithm not in ALGORITHMS:

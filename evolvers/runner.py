@@ -29,7 +29,7 @@ from evolvers.evaluation import (
     pack_traces,
     unpack_traces,
 )
-from evolvers.experiments import Experiment
+from evolvers.experiments import Experiment, smoke_sizes
 from evolvers.genome import Individual
 from evolvers.operators import make_children
 from evolvers.recorder import RUN_SCHEMA, RunInterrupted, RunRecorder, population_summary
@@ -103,10 +103,13 @@ class EvolutionRun:
         gif: bool = True,
         progress: bool = True,
     ) -> None:
+        experiment, gens = smoke_sizes(
+            experiment, experiment.generations if generations is None else int(generations)
+        )
         self.experiment = experiment
         self.out = Path(out)
         self.seed = int(seed)
-        self.generations = experiment.generations if generations is None else int(generations)
+        self.generations = gens
         if self.generations < 0:
             raise InvalidParameterError(f"generations must be >= 0, got {self.generations}")
         self.batch_fn = batch_fn
