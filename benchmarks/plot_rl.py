@@ -58,10 +58,10 @@ def main(argv: list[str] | None = None) -> int:
         )
     ax.set_yscale("log")  # returns are distances (> 0) spanning three decades
     ax.set_xlabel("env steps (thousands)")
-    ax.set_ylabel("training return: NormFinalDist over 4 s (voxel lengths)")
+    ax.set_ylabel("training return:\nNormFinalDist in 4 s (voxel lengths)")
     ax.set_title("PPO on SoftWalker-Flat-v0 (dashed: random policy)")
     ax.legend(loc="lower right", fontsize=8)
-    fig.savefig(args.out, dpi=120)
+    fig.savefig(args.out, dpi=120, bbox_inches="tight")  # no clipped label
     print(f"wrote {args.out}", file=sys.stderr)
     return 0
 
