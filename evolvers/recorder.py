@@ -109,12 +109,10 @@ def read_run_config(out: str | Path) -> dict[str, Any]:
     Raises
     ------
     CheckpointError
-        If the folder holds no readable run config.
+        If the folder holds no readable run config (the message names the file).
     """
     path = Path(out) / "config.json"
-    if not path.is_file():
-        raise CheckpointError(f"{out}: not a run folder (no config.json)")
-    cfg = read_json(path)
+    cfg = read_json(path)  # CheckpointError naming the file if it is missing or corrupt
     if not isinstance(cfg, dict) or not isinstance(cfg.get("experiment"), dict):
         raise CheckpointError(f"{path}: not a softgym run config")
     return cfg
