@@ -33,7 +33,10 @@ from softgym.exceptions import InvalidParameterError
 from softgym.tasks import TaskLike
 from softgym.terrain import Terrain
 
-__all__ = ["SoftWalkerVectorEnv"]
+__all__ = ["MAX_NUM_ENVS", "SoftWalkerVectorEnv"]
+
+#: Most robots in one vector env (checked before anything is allocated per robot).
+MAX_NUM_ENVS = 65_536
 
 
 def _show(value: Any) -> str:
@@ -58,7 +61,7 @@ class SoftWalkerVectorEnv(VectorEnv):
     Parameters
     ----------
     num_envs : int
-        Number of robots.
+        Number of robots, 1..:data:`MAX_NUM_ENVS` (not a bool or float).
     designs : sequence of RobotDesign or paths, optional
         One design per robot (they may differ; each must fit ``grid_shape``).
     design : RobotDesign or path, optional
@@ -133,8 +136,10 @@ class SoftWalkerVectorEnv(VectorEnv):
             )
         self.autoreset_mode = mode
         ok = isinstance(num_envs, (int, np.integer)) and not isinstance(num_envs, (bool, np.bool_))
-        if not ok or num_envs < 1:
-            raise InvalidParameterError(f"num_envs must be an integer >= 1, got {_show(num_envs)}")
+        if not ok or not 1 <= num_envs <= MAX_NUM_ENVS:
+            raise InvalidParameterError(
+                f"num_envs must be an integer in 1..{MAX_NUM_ENVS}, got {_show(num_envs)}"
+            )
         num_envs = int(num_envs)
         if designs is not None and design is not None:
             raise InvalidParameterError("give design (one for all robots) or designs, not both")

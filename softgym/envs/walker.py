@@ -58,6 +58,8 @@ _NO_ENGINE_TRACE = 1.0e9
 #: Largest rendered frame side (pixels): a frame is width x height x 3 bytes.
 MAX_FRAME_SIDE = 4096
 RENDER_MODES: tuple[str, ...] = ("rgb_array",)
+# engine threads an env may ask for (the engine uses at most one per robot anyway)
+_MAX_THREADS = 1024
 
 
 def _show(value: Any) -> str:
@@ -139,6 +141,10 @@ def make_config(
     ``self_collision`` must be None or a bool (``"yes"`` or ``1`` is refused with
     :class:`~softgym.exceptions.InvalidParameterError`, not read as true).
     """
+    if actuation is not None and not isinstance(actuation, str):  # the engine checks the name
+        raise InvalidParameterError(
+            f'actuation must be None, "seed" or "symmetric", got {_show(actuation)}'
+        )
     if self_collision is not None and not isinstance(self_collision, (bool, np.bool_)):
         raise InvalidParameterError(
             f"self_collision must be None, True or False, got {_show(self_collision)}"
@@ -180,9 +186,9 @@ def make_batch(
     task's ``seconds`` minus the settling time (4 s for the seed's 5 s runs).
     A ``max_episode_steps`` that cuts episodes short warns.
     """
-    if n_threads is not None and (not _is_int(n_threads) or n_threads < 1):
+    if n_threads is not None and (not _is_int(n_threads) or not 1 <= n_threads <= _MAX_THREADS):
         raise InvalidParameterError(
-            f"n_threads must be None or an integer >= 1, got {_show(n_threads)}"
+            f"n_threads must be None or an integer in 1..{_MAX_THREADS}, got {_show(n_threads)}"
         )
     t = get_task(task)
     if terrain is not None:
@@ -326,7 +332,8 @@ class SoftWalkerEnv(gym.Env):
       (anything :func:`softgym.tasks.get_task` reads).
     * ``episode_seconds``: controlled time per episode; default the task's ``seconds`` minus
       the settling time (4 s: the seed's fitness window).
-    * ``control_dt``: seconds each action is held (0.05 s, about 78 engine steps of the default walker).
+    * ``control_dt``: seconds each action is held (0.05 s, about 78 engine steps of the default
+      walker), a finite number in (0, 10] s.
     * ``actuation``: ``"seed"`` (muscles only contract) or ``"symmetric"``; None keeps ``sim_config``'s (the seed's).
     * ``self_collision``: voxel-voxel contact within the robot, a bool; None keeps ``sim_config``'s (on).
     * ``grid_shape``: the lattice the spaces are built on, 3 ints (each 1..1000, at most 10^6
@@ -337,7 +344,7 @@ class SoftWalkerEnv(gym.Env):
     * ``render_mode``: None or ``"rgb_array"`` (an H x W x 3 uint8 frame, see
       :class:`softgym.render.VoxelRenderer`); ``width``, ``height``: frame size (320 x 240),
       ints in 1..4096 pixels.
-    * ``n_threads``: engine threads, None or an int >= 1 (1: a single robot cannot use more).
+    * ``n_threads``: engine threads, None or an int in 1..1024 (1: a single robot cannot use more).
     * ``max_episode_steps``: an extra cap on the steps per episode: None or an int in
       1..:data:`softgym.tasks.episode.MAX_STEPS_PER_EPISODE` (not a bool or a float), checked
       by the env. ``gym.make(id, max_episode_steps=...)`` is different: Gymnasium consumes it

@@ -30,6 +30,7 @@ from softgym.terrain import Terrain
 
 __all__ = [
     "DRIVES",
+    "MAX_CONTROL_DT",
     "MAX_STEPS_PER_EPISODE",
     "OBS_POSITION_BOUND",
     "OBS_VELOCITY_BOUND",
@@ -46,6 +47,9 @@ DRIVES: tuple[str, ...] = ("action", "controller")
 #: Most control steps an episode may have: its centre-of-mass samples are allocated up front
 #: (32 bytes a step per robot, so 32 MB per robot at the cap).
 MAX_STEPS_PER_EPISODE = 1_000_000
+#: Longest control step (s): one ``step`` call simulates this long, so it bounds a call's cost
+#: (the seed's whole evaluation is 5 s).
+MAX_CONTROL_DT = 10.0
 
 
 def observation_size(grid_shape: Sequence[int]) -> int:
@@ -116,7 +120,8 @@ class EpisodeBatch:
         (:func:`softgym.design.check_grid_shape`).
     control_dt, episode_seconds : float
         Seconds per action and per episode (after settling): finite numbers
-        > 0, not bools or strings; the episode has at most
+        > 0, not bools or strings; ``control_dt`` at most
+        :data:`MAX_CONTROL_DT`, and the episode has at most
         :data:`MAX_STEPS_PER_EPISODE` control steps.
     max_episode_steps : int or None
         Truncate after this many steps (the smaller of it and
@@ -168,6 +173,11 @@ class EpisodeBatch:
             ) from None
         self.n_cells = int(np.prod(self.grid_shape))
         self.control_dt = _positive("control_dt", control_dt)
+        if self.control_dt > MAX_CONTROL_DT:
+            raise InvalidParameterError(
+                f"control_dt must be at most MAX_CONTROL_DT = {MAX_CONTROL_DT} s "
+                f"(the time one step simulates), got {control_dt!r}"
+            )
         self.episode_seconds = _positive("episode_seconds", episode_seconds)
         cap = _check_max_episode_steps(max_episode_steps)
         ratio = self.episode_seconds / self.control_dt  # finite or inf, never NaN
