@@ -405,7 +405,8 @@ def run_study(
         worker processes, one run per worker.
     scheduler : str, optional
         A Dask scheduler address (``tcp://host:8786``): its workers run the
-        runs (``workers`` is then ignored).
+        runs (``workers`` is then ignored). They write the run folders at the
+        specs' paths, so the workers must see the same filesystem.
     study : str
         The study's name (recorded in study.json).
     on_result : callable, optional

@@ -697,21 +697,23 @@ def claim_controller_genes(runs: Mapping[str, list[RunData]]) -> Claim:
         return _untested(cid, sec, rep, m)
     ws = _winners(runs["controller-tournament"]) + _winners(runs["controller-pareto"])
     init = Controller()
-    parts, verdicts = [], []
+    parts, significant, direction = [], [], []
     for gene, ref, lower in (("period", init.period, True),
                              ("temp_amplitude", init.temp_amplitude, False),
                              ("muscle_cte", init.muscle_cte, False)):  # fmt: skip
         vals = [w.genes[gene] for w in ws]
         k = sum((v < ref) if lower else (v > ref) for v in vals)
         p = _sign_pvalue(k, len(vals))
-        verdicts.append(p < 0.05)
+        significant.append(p < 0.05)
+        direction.append(2 * k > len(vals))
         parts.append(f"{gene} {_summary(vals)} ({'<' if lower else '>'} initial {ref:g} in "
                      f"{k}/{len(vals)}, sign test p={p:.3g})")  # fmt: skip
-    verdict = HOLDS if all(verdicts) else PARTLY if any(verdicts) else FAILS
+    verdict = HOLDS if all(significant) else PARTLY if any(direction) else FAILS
     return Claim(
         cid, sec, rep, "; ".join(parts), verdict,
         "winners of both controller scenarios vs. the initial controller (14 °C, 0.25 s, 0.01); "
-        "holds when all three differ as claimed (sign test p < 0.05)",
+        "holds when all three moved as claimed (sign test p < 0.05), partly when some moved "
+        "that way in most seeds",
         {"genes": [w.genes for w in ws]},
     )  # fmt: skip
 

@@ -450,6 +450,8 @@ def _cmd_study(args: argparse.Namespace) -> int:
 
     if args.quiet:
         logging.getLogger("evolvers").setLevel(logging.WARNING)
+    if args.workers > 1 or args.dask:
+        _quiet_dask(args.verbose)
     t0 = time.perf_counter()
     try:
         results = run_study(specs, workers=args.workers, scheduler=args.dask,
