@@ -524,6 +524,7 @@ class RunRecorder:
         wall: float,
         state: Mapping[str, Any],
         arrays: Mapping[str, np.ndarray],
+        columns: Mapping[str, Any] | None = None,
     ) -> dict[str, Any]:
         """Book-keeping after a generation: totals, log row, checkpoint, log files, best designs.
 
@@ -538,6 +539,9 @@ class RunRecorder:
             Its wall time (s).
         state, arrays : dict
             The driver's part of the checkpoint (random states, counters, caches).
+        columns : dict, optional
+            More log columns of the driver (e.g. a quality-diversity archive's
+            QD-score and coverage), added to the row before it is checkpointed.
 
         Returns
         -------
@@ -550,6 +554,7 @@ class RunRecorder:
             self.experiment, generation, population, stats, wall,
             self.evaluations_total, self.wall_total,
         )  # fmt: skip
+        row.update(columns or {})
         self.rows.append(row)
         self.checkpoint(generation, population, state, arrays)
         self.write_log()
