@@ -31,6 +31,10 @@ study
     Run the seed report's scenarios over many seeds, each a resumable run
     folder (seeds in parallel on Dask); ``study report RUNS`` writes the
     claim-by-claim report and its figures.
+qd
+    Quality-diversity: a MAP-Elites archive (pyribs) of robots over body
+    descriptors, a resumable run folder with QD-score and coverage per
+    generation and a heatmap; ``qd export RUN`` writes the elites as designs.
 """
 
 from __future__ import annotations
@@ -532,6 +536,156 @@ def _add_study_parser(sub) -> None:
     p.set_defaults(func=_cmd_study)
 
 
+def _make_qd_run(args: argparse.Namespace, batch_fn):
+    """A QDRun from the flags; with --resume, the run folder's settings under the typed flags."""
+    from evolvers.experiments import Experiment, get_experiment
+    from evolvers.qd import QDConfig, QDRun
+    from evolvers.recorder import read_run_config
+
+    cfg = None
+    if args.resume and (Path(args.out) / "config.json").is_file():
+        cfg = read_run_config(args.out)  # a mismatch with a typed flag is named by QDRun.run
+    if cfg is not None and args.experiment is None:
+        exp = Experiment.from_dict(cfg["experiment"])
+    else:
+        exp = get_experiment(args.experiment or "basic", pop_size=16)
+    overrides = {"pop_size": args.batch, "seconds": args.seconds, "task": args.task,
+                 "shape": None if args.shape is None else tuple(args.shape)}  # fmt: skip
+    exp = exp.replace(**{k: v for k, v in overrides.items() if v is not None})
+    qd = QDConfig.from_dict(cfg["qd"]) if cfg is not None and "qd" in cfg else QDConfig()
+    typed = {"descriptors": args.descriptors, "cells": args.cells, "archive": args.archive,
+             "objective": args.objective}  # fmt: skip
+    typed = {k: tuple(v) if isinstance(v, list) else v for k, v in typed.items() if v is not None}
+    if typed:
+        base = qd.to_dict()
+        if "cells" not in typed and ("descriptors" in typed or "archive" in typed):
+            base["cells"] = base["cells"][:1]  # one value for every descriptor
+        qd = QDConfig.from_dict({**base, **typed})
+    seed = args.seed if args.seed is not None else int(cfg["seed"]) if cfg else 0
+    gens = args.generations
+    if gens is None:
+        gens = int(cfg.get("generations", 20)) if cfg else 20
+    run = QDRun(
+        exp, args.out, seed=seed, generations=gens, config=qd, batch_fn=batch_fn,
+        n_threads=args.threads, figures=not args.no_figures, gif=not args.no_gif,
+        progress=not args.quiet,
+    )  # fmt: skip
+    run.resume_command = f"softgym qd --out {shlex.quote(str(args.out))} --resume"
+    return run
+
+
+def _cmd_qd(args: argparse.Namespace) -> int:
+    if getattr(args, "qd_command", None) == "export":
+        return _cmd_qd_export(args)
+    import contextlib
+
+    from tqdm.contrib.logging import logging_redirect_tqdm
+
+    from evolvers.recorder import RunInterrupted
+
+    t0 = time.perf_counter()
+    previous = signal.signal(signal.SIGTERM, _raise_keyboard_interrupt)
+    try:
+        with contextlib.ExitStack() as stack:
+            stack.enter_context(logging_redirect_tqdm())
+            batch_fn = None
+            if args.dask:
+                from evolvers.distributed import DaskBatchFn, dask_client
+
+                _quiet_dask(args.verbose)
+                client = stack.enter_context(dask_client(args.dask, n_workers=args.workers))
+                _quiet_dask(args.verbose)
+                batch_fn = DaskBatchFn(client)
+            run = _make_qd_run(args, batch_fn)
+            run.run(resume=args.resume)
+    except RunInterrupted as exc:
+        where = (f"generation {exc.generation} is checkpointed in {exc.checkpoint}"
+                 if exc.checkpoint else "no generation had finished")  # fmt: skip
+        print(f"\nsoftgym qd: interrupted; {where}\nresume with: {exc.resume}", file=sys.stderr)
+        return 130
+    except KeyboardInterrupt:
+        print("\nsoftgym qd: interrupted before the run started", file=sys.stderr)
+        return 130
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    stats = run.stats()
+    summary = {
+        "experiment": run.experiment.name,
+        "archive": run.config.to_dict(),
+        "generations": run.generation,
+        "evaluations": run.evaluations_total,
+        **stats,
+        "objective": run.objective,
+        "wall_seconds": round(time.perf_counter() - t0, 2),
+        "out": str(run.out),
+        "figures": sorted(str(p) for p in (run.out / "figures").glob("*"))
+        if (run.out / "figures").exists()
+        else [],
+        "export": f"softgym qd export {shlex.quote(str(run.out))}",
+    }
+    print(json.dumps(summary, indent=2))
+    return 0
+
+
+def _cmd_qd_export(args: argparse.Namespace) -> int:
+    from evolvers.qd import export_elites
+
+    index = export_elites(args.run, args.export_out, top=args.top)
+    n = len(json.loads(index.read_text())["elites"])
+    print(f"wrote {n} elites (design .json and .vxa) and {index}")
+    return 0
+
+
+def _add_qd_parser(sub) -> None:
+    """``softgym qd [run] ...`` and ``softgym qd export RUN``."""
+    p = sub.add_parser(
+        "qd",
+        help="quality-diversity: a MAP-Elites archive of robots (pyribs); 'qd export RUN'",
+        description="Fill a MAP-Elites archive (pyribs) with robots: each cell keeps the best "
+        "robot of its body descriptors (default: stiff x filled fraction, 128 x 128 cells, "
+        "Mouret & Clune 2015). A resumable run folder with log (QD-score, coverage, best), "
+        "checkpoints, heatmap and best designs; 'softgym qd export RUN' writes the elites as "
+        'design files. Needs pip install "softgym[qd]".',
+    )
+    p.add_argument("--experiment", help="experiment whose task, rules and genes are used "
+                   "(default basic: CPPN bodies; softgym experiments lists them)")  # fmt: skip
+    p.add_argument("--generations", type=int, help="batches after the first (default 20)")
+    p.add_argument("--batch", type=int, help="robots per generation (default 16)")
+    p.add_argument("--seed", type=int, help="seed of the run (default 0)")
+    p.add_argument("--out", default="runs/qd", help="run folder")
+    p.add_argument("--resume", action="store_true",
+                   help="continue the run folder's last checkpoint with its recorded settings")  # fmt: skip
+    p.add_argument("--descriptors", nargs="+", metavar="NAME",
+                   help="body descriptors: stiff filled muscle height elongation "
+                   "(default stiff filled)")  # fmt: skip
+    p.add_argument("--cells", type=int, nargs="+",
+                   help="grid: cells per descriptor (one value for all; default 128); "
+                   "cvt: the number of centroids")  # fmt: skip
+    p.add_argument("--archive", choices=["grid", "cvt"], help="GridArchive (default) or CVTArchive")
+    p.add_argument("--objective", choices=["norm_final_dist", "max_xy_dist"],
+                   help="maximised metric (default: the experiment's fitness)")  # fmt: skip
+    p.add_argument("--task", metavar="flat|wall|stairs|FILE.json",
+                   help="the world (default: the experiment's)")  # fmt: skip
+    p.add_argument("--seconds", type=float, help="simulated seconds per evaluation (default 5)")
+    p.add_argument("--shape", type=int, nargs=3, metavar=("NX", "NY", "NZ"),
+                   help="robot grid (default 6 6 6)")  # fmt: skip
+    p.add_argument("--dask", metavar="local|tcp://ADDRESS",
+                   help='evaluate on Dask (pip install "softgym[distributed]")')  # fmt: skip
+    p.add_argument("--workers", type=int, default=2, help="LocalCluster workers (--dask local)")
+    p.add_argument("--threads", type=int, help="OpenMP threads of local simulations")
+    p.add_argument("--no-figures", action="store_true", help="write no figures at the end")
+    p.add_argument("--no-gif", action="store_true", help="no GIF of the best robot")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    ss = p.add_subparsers(dest="qd_command", required=False)
+    r = ss.add_parser("run", help="run (the default)")
+    r.set_defaults(qd_command="run")
+    r = ss.add_parser("export", help="write a QD run's elites as design files (.json, .vxa)")
+    r.add_argument("run", help="a softgym qd run folder")
+    r.add_argument("--out", dest="export_out", help="folder (default RUN/elites)")
+    r.add_argument("--top", type=int, help="only the best TOP elites")
+    p.set_defaults(func=_cmd_qd)
+
+
 class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
     """``--help`` shows every default (options without one say theirs in words)."""
 
@@ -682,6 +836,7 @@ def main(argv: list[str] | None = None) -> int:
     p = sub.add_parser("experiments", help="list the named experiments")
     p.set_defaults(func=_cmd_experiments)
     _add_study_parser(sub)
+    _add_qd_parser(sub)
     argv = sys.argv[1:] if argv is None else list(argv)
     args = parser.parse_args(argv)
     if args.command == "evolve":
