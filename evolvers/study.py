@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import json
 import logging
+import math
 import time
 import uuid
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -93,6 +94,9 @@ class Scenario:
         What the scenario tests.
     overrides : dict
         :class:`~evolvers.experiments.Experiment` field overrides.
+    cpu_per_generation : float, optional
+        Measured CPU seconds of one generation at the default sizes (one
+        thread): orders the runs longest first and gives ``--plan``'s estimate.
     """
 
     name: str
@@ -101,6 +105,7 @@ class Scenario:
     seeds: int
     description: str = ""
     overrides: Mapping[str, Any] = field(default_factory=dict)
+    cpu_per_generation: float | None = None
 
     def make_experiment(self, **overrides: Any) -> Experiment:
         """The experiment with the scenario's overrides, then ``overrides``."""
@@ -115,6 +120,7 @@ class Scenario:
             "seeds": int(self.seeds),
             "description": self.description,
             "overrides": dict(self.overrides),
+            "cpu_per_generation": self.cpu_per_generation,
         }
 
     @classmethod
@@ -127,6 +133,7 @@ class Scenario:
             seeds=int(data["seeds"]),
             description=str(data.get("description", "")),
             overrides=dict(data.get("overrides", {})),
+            cpu_per_generation=data.get("cpu_per_generation"),
         )
 
 
@@ -153,30 +160,32 @@ class Study:
 
 #: The seed report's claims (SEED_REFERENCE §3.9; issue 15): >= 10 seeds for the Fig. 4 trio,
 #: materials T2 and the obstacle final setup, >= 5 for the long runs and the obstacle attempts.
+#: ``cpu_per_generation``: CPU s of generations 1-4 of one seed (6x6x6, pop 15, 5 s, one thread,
+#: the corotational default physics), measured for issue 15; the whole study is ~40 CPU hours.
 SEED_REPORT = Study(
     "seed-report",
     (
         Scenario("materials-t1", "materials-t1", 300, 5,
-                 "materials evolution, treatment 1 (report Fig. 1, 300 generations)"),
+                 "materials evolution, treatment 1 (report Fig. 1, 300 generations)", cpu_per_generation=18.1),
         Scenario("materials-t2", "materials-t2", 50, 10,
-                 "materials evolution, treatment 2: also fewer voxels (50 generations)"),
+                 "materials evolution, treatment 2: also fewer voxels (50 generations)", cpu_per_generation=13.3),
         Scenario("novelty", "novelty", 200, 5,
-                 "novelty search within the generation (200 generations)"),
+                 "novelty search within the generation (200 generations)", cpu_per_generation=9.8),
         Scenario("novelty-archive", "novelty-archive", 200, 5,
-                 "novelty search with an archive of past behaviours (the 'patterns loop')"),
+                 "novelty search with an archive of past behaviours (the 'patterns loop')", cpu_per_generation=9.1),
         Scenario("basic-200", "basic", 200, 5,
-                 "fitness-based reference for novelty: the basic Pareto run over 200 generations"),
-        Scenario("basic", "basic", 40, 10, "basic evolution (report Fig. 4)"),
+                 "fitness-based reference for novelty: the basic Pareto run over 200 generations", cpu_per_generation=6.3),
+        Scenario("basic", "basic", 40, 10, "basic evolution (report Fig. 4)", cpu_per_generation=6.0),
         Scenario("controller-tournament", "controller-tournament", 40, 10,
-                 "controller evolution, fitness tournament (report Fig. 4)"),
+                 "controller evolution, fitness tournament (report Fig. 4)", cpu_per_generation=12.8),
         Scenario("controller-pareto", "controller-pareto", 40, 10,
-                 "controller evolution, Pareto on distance and muscles (report Fig. 4)"),
+                 "controller evolution, Pareto on distance and muscles (report Fig. 4)", cpu_per_generation=12.8),
         Scenario("obstacles-attempt1", "obstacles-attempt1", 80, 5,
-                 "wall, attempt 1: default controller, Pareto on MaxXYDist and muscles"),
+                 "wall, attempt 1: default controller, Pareto on MaxXYDist and muscles", cpu_per_generation=5.8),
         Scenario("obstacles-attempt2", "obstacles-attempt2", 80, 5,
-                 "wall, attempt 2: controller evolution, fitness tournament on MaxXYDist"),
+                 "wall, attempt 2: controller evolution, fitness tournament on MaxXYDist", cpu_per_generation=13.8),
         Scenario("obstacles", "obstacles", 120, 10,
-                 "wall, final setup: MaxXYDist, L coefficient, age, composition rules"),
+                 "wall, final setup: MaxXYDist, L coefficient, age, composition rules", cpu_per_generation=52.3),
     ),
 )  # fmt: skip
 
@@ -207,6 +216,7 @@ class RunSpec:
     generations: int
     out: Path
     n_threads: int | None = None
+    cpu_per_generation: float | None = None
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict."""
@@ -217,6 +227,7 @@ class RunSpec:
             "generations": int(self.generations),
             "out": str(self.out),
             "n_threads": self.n_threads,
+            "cpu_per_generation": self.cpu_per_generation,
         }
 
     @classmethod
@@ -229,14 +240,21 @@ class RunSpec:
             generations=int(data["generations"]),
             out=Path(data["out"]),
             n_threads=None if data.get("n_threads") is None else int(data["n_threads"]),
+            cpu_per_generation=data.get("cpu_per_generation"),
         )
 
     @property
     def cost(self) -> float:
-        """A rough relative cost (simulated robot-seconds) for scheduling longest first."""
+        """Estimated CPU seconds of the whole run (longest runs are scheduled first).
+
+        From the scenario's measured ``cpu_per_generation``, scaled by the
+        simulated robot-seconds of a generation relative to the default sizes
+        (pop 15 + 1, 5 s, 6x6x6); without a measurement, 10 s per default generation.
+        """
         e = self.experiment
-        n_vox = e.shape[0] * e.shape[1] * e.shape[2]
-        return (self.generations + 1) * (e.pop_size + e.n_random) * e.seconds * n_vox
+        scale = (e.pop_size + e.n_random) * e.seconds * math.prod(e.shape) / (16 * 5.0 * 216)
+        per_gen = 10.0 if self.cpu_per_generation is None else float(self.cpu_per_generation)
+        return (self.generations + 1) * per_gen * scale
 
 
 def plan(
@@ -286,7 +304,10 @@ def plan(
         n = sc.seeds if seeds is None else int(seeds)
         gens = sc.generations if generations is None else int(generations)
         for k in range(first_seed, first_seed + n):
-            specs.append(RunSpec(sc.name, exp, k, gens, root / sc.name / f"seed-{k}", n_threads))
+            specs.append(
+                RunSpec(sc.name, exp, k, gens, root / sc.name / f"seed-{k}", n_threads,
+                        sc.cpu_per_generation)
+            )  # fmt: skip
     return specs
 
 

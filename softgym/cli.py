@@ -441,9 +441,13 @@ def _cmd_study(args: argparse.Namespace) -> int:
         print(f"softgym study: {exc}", file=sys.stderr)
         return 2
     if args.plan:
+        todo = 0.0
         for s in specs:
+            status = run_status(s.out, s.generations)
+            todo += 0.0 if status == "complete" else s.cost
             print(f"{s.scenario:24s} seed {s.seed:<4d} {s.generations:4d} generations  "
-                  f"{run_status(s.out, s.generations):8s} {s.out}")  # fmt: skip
+                  f"{status:8s} ~{s.cost / 3600:5.2f} CPU h  {s.out}")  # fmt: skip
+        print(f"{len(specs)} runs; ~{todo / 3600:.1f} CPU hours to go (whole runs, estimated)")
         return 0
 
     def report(res):

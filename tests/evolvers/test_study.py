@@ -77,6 +77,7 @@ def test_plan_defaults_and_errors(tmp_path):
     assert counts["controller-tournament"] >= 10 and counts["materials-t1"] >= 5
     assert {s.generations for s in specs if s.scenario == "materials-t1"} == {300}
     assert sum(counts.values()) == sum(sc.seeds for sc in SEED_REPORT.scenarios)
+    assert 30 * 3600 < sum(s.cost for s in specs) < 50 * 3600  # the measured ~40 CPU hours
     small = plan(tmp_path, scenarios=["basic"], seeds=3, generations=4, first_seed=7, pop_size=4)
     assert [s.seed for s in small] == [7, 8, 9] and small[0].experiment.pop_size == 4
     assert small[0].out == tmp_path / "basic" / "seed-7"
