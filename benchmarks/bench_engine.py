@@ -8,7 +8,9 @@ Prints voxel-steps/s for batches of 1, 16 and 64 robots with 1 and 2 threads,
 robot sizes 4^3, 6^3 and 10^3, peak memory per robot, and ratios to the
 reference engines measured on this machine kind (quoted, not re-measured here:
 the seed's engine at -O3 ~2.3 M voxel-steps/s per core, the 2015 Voxelyze
-library 1.4-2.1 M). Appends a table to benchmarks/RESULTS.md.
+library 1.4-2.1 M), for the default "seed" preset (SimConfig.model, the seed
+engine's step) and rows of the "corotational" preset. Appends a table to
+benchmarks/RESULTS.md.
 
     python benchmarks/bench_engine.py            # full table (about 2 minutes)
     python benchmarks/bench_engine.py --quick --json   # < 60 s, last line is JSON
@@ -51,12 +53,12 @@ def reference_robot(n: int = 6) -> Body:
 
 
 def measure(n: int, batch: int, threads: int, seconds: float, repeats: int,
-            collisions: bool = False, world: str = "flat"):  # fmt: skip
+            collisions: bool = False, world: str = "flat", model: str = "seed"):  # fmt: skip
     """Best-of-`repeats` voxel-steps/s for `batch` reference robots of size n^3."""
     best = 0.0
     nbytes = 0
     diverged = 0
-    cfg = SimConfig(self_collision=collisions)
+    cfg = SimConfig(self_collision=collisions, model=model)
     # the seed's fence: a 2-voxel gap around the robot on every side
     terrain = Terrain.fence(inner=n + 4, center=(n / 2, n / 2)) if world == "fence" else None
     for _ in range(repeats):
@@ -74,6 +76,7 @@ def measure(n: int, batch: int, threads: int, seconds: float, repeats: int,
         "threads": threads,
         "collisions": collisions,
         "world": world,
+        "model": model,
         "seconds_simulated": seconds,
         "voxel_steps_per_s": best,
         "bytes_per_robot": nbytes / batch,
@@ -94,17 +97,19 @@ def main(argv: list[str] | None = None) -> int:
     print(f"softgym engine benchmark: OpenMP {'on' if openmp_enabled() else 'off'}, "
           f"{seconds} s simulated per robot", file=sys.stderr)
 
-    def run(n, batch, threads, collisions=False, world="flat"):
-        row = measure(n, batch, threads, seconds, repeats, collisions, world)
+    def run(n, batch, threads, collisions=False, world="flat", model="seed"):
+        row = measure(n, batch, threads, seconds, repeats, collisions, world, model)
         rows.append(row)
-        print(f"  {row['size']:>5} batch {batch:3d} threads {threads} "
+        print(f"  {model:12s} {row['size']:>5} batch {batch:3d} threads {threads} "
               f"{'self-collision' if collisions else 'no collision  '} {world:5s}: "
               f"{row['voxel_steps_per_s'] / 1e6:7.2f} M voxel-steps/s, "
               f"{row['bytes_per_robot'] / 1024:7.1f} KiB/robot", file=sys.stderr)
         return row
 
+    # both presets: "seed" (the default, the seed engine's step) and "corotational"
     if args.quick:
-        plan = [(6, 16, 1, False, "flat"), (6, 16, 2, False, "flat"), (6, 16, 1, True, "flat")]
+        plan = [(6, 16, 1, False, "flat"), (6, 16, 2, False, "flat"), (6, 16, 1, True, "flat"),
+                (6, 16, 1, False, "flat", "corotational")]
     else:
         plan = [(6, b, t, False, "flat") for b in (1, 16, 64) for t in (1, 2)]
         plan += [(n, 16, t, False, "flat") for n in (4, 10) for t in (1, 2)]
@@ -113,20 +118,24 @@ def main(argv: list[str] | None = None) -> int:
         plan += [(n, 16 if n < 16 else 4, 1, True, w) for n in (4, 6, 10, 16)
                  for w in ("flat", "fence")]  # fmt: skip
         plan += [(6, 16, 2, True, "fence")]
+        plan += [(6, 16, t, c, "flat", "corotational") for t in (1, 2) for c in (False, True)]
     for p in plan:
         run(*p)
 
-    def find(size, threads, collisions, world="flat"):
+    def find(size, threads, collisions, world="flat", model="seed"):
         return next(r for r in rows if r["size"] == size and r["batch"] == 16
                     and r["threads"] == threads and r["collisions"] == collisions
-                    and r["world"] == world)["voxel_steps_per_s"]  # fmt: skip
+                    and r["world"] == world and r["model"] == model)["voxel_steps_per_s"]  # fmt: skip
 
     v1, v2 = find("6^3", 1, False), find("6^3", 2, False)
     vc = find("6^3", 1, True)
+    vco = find("6^3", 1, False, model="corotational")
     summary = {
         "voxel_steps_per_s_1thread": v1,
         "voxel_steps_per_s_2threads": v2,
         "voxel_steps_per_s_1thread_collisions": vc,
+        "voxel_steps_per_s_1thread_corotational": vco,
+        "seed_vs_corotational": v1 / vco,
         "thread_scaling": v2 / v1,
         "vs_seed_engine_O3_per_core": v1 / SEED_ENGINE_O3,
         "vs_voxelyze_2015_per_core": [v1 / VOXELYZE_2015[1], v1 / VOXELYZE_2015[0]],
@@ -136,7 +145,8 @@ def main(argv: list[str] | None = None) -> int:
     }
     print(f"reference robot, batch 16: {v1 / 1e6:.2f} M voxel-steps/s on 1 thread, "
           f"{v2 / 1e6:.2f} M on 2 threads ({v2 / v1:.2f}x), {vc / 1e6:.2f} M on 1 thread "
-          f"with self-collision; "
+          f"with self-collision (seed preset); the corotational preset {vco / 1e6:.2f} M "
+          f"(seed preset = {v1 / vco:.2f}x it); "
           f"{v1 / SEED_ENGINE_O3:.1f}x the seed's engine at -O3 per core, "
           f"{v1 / VOXELYZE_2015[1]:.1f}-{v1 / VOXELYZE_2015[0]:.1f}x Voxelyze 2015 per core; "
           f"{summary['seconds_per_soft_robot_5s_1thread'] * 1000:.0f} ms per 6^3 soft robot "
@@ -147,16 +157,17 @@ def main(argv: list[str] | None = None) -> int:
         lines = [
             f"\n### bench_engine.py{' --quick' if args.quick else ''} — {stamp}, "
             f"{platform.machine()}, OpenMP {'on' if openmp_enabled() else 'off'}\n",
-            "| robot | batch | threads | self-collision | world | M voxel-steps/s | KiB per robot | diverged |",
-            "|---|---|---|---|---|---|---|---|",
+            "| preset | robot | batch | threads | self-collision | world | M voxel-steps/s | KiB per robot | diverged |",
+            "|---|---|---|---|---|---|---|---|---|",
         ]
         for r in rows:
-            lines.append(f"| {r['size']} | {r['batch']} | {r['threads']} | "
+            lines.append(f"| {r['model']} | {r['size']} | {r['batch']} | {r['threads']} | "
                          f"{'on' if r['collisions'] else 'off'} | {r['world']} | "
                          f"{r['voxel_steps_per_s'] / 1e6:.2f} | {r['bytes_per_robot'] / 1024:.1f} | "
                          f"{r['diverged']} |")
         lines.append(f"\n2 threads / 1 thread (6^3, batch 16): {v2 / v1:.2f}x; with self-collision "
                      f"{vc / 1e6:.2f} M voxel-steps/s on 1 thread; "
+                     f"seed preset / corotational preset: {v1 / vco:.2f}x; "
                      f"vs the seed's engine at -O3: {v1 / SEED_ENGINE_O3:.1f}x per core.\n")
         with RESULTS.open("a") as fh:
             fh.write("\n".join(lines))

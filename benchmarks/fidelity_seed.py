@@ -11,6 +11,9 @@ softgym and prints, per actuation regime:
   digit on sensitive bodies);
 * the median |log10 ratio| and the shares of cases within 2x and 3x;
 * the bodies one engine moves >= 1 voxel length and the other leaves under 0.01;
+* on the fence set, the same figures for MaxXYDist, the seed's obstacle fitness,
+  on the seed's own centre of mass (its 44 wall voxels included:
+  :func:`softgym.metrics.dilute`), which is what the oracle reports;
 * whether softgym reaches the issue's targets: rank correlation and the
   within-2x share at least 90 % of the oracle's self-agreement, and no body
   moved by one engine and left still by the other;
@@ -18,7 +21,7 @@ softgym and prints, per actuation regime:
 and the micro-case trace errors (``micro.json``: softgym's centre of mass at the
 oracle's sample steps, as a fraction of the oracle's displacement scale).
 
-    python benchmarks/fidelity_seed.py                      # everything (~15 min on 2 cores)
+    python benchmarks/fidelity_seed.py                      # everything (~30 min on 2 cores)
     python benchmarks/fidelity_seed.py --quick              # 12 cases per set
     python benchmarks/fidelity_seed.py --model corotational # the pre-fidelity step, for the "before" table
     python benchmarks/fidelity_seed.py --json               # last line: the figures as JSON
@@ -45,7 +48,8 @@ sys.path.insert(0, str(HERE))
 import fidelity_cases as fc  # noqa: E402
 
 from softgym.engine import SimConfig, Simulation  # noqa: E402
-from softgym.metrics import norm_final_dist  # noqa: E402
+from softgym.metrics import dilute, walk_metrics  # noqa: E402
+from softgym.terrain import Terrain  # noqa: E402
 
 DATA = HERE / "data" / "seed_engine"
 FLOOR = 0.01  # voxel lengths: smaller distances count as "stays put"
@@ -115,17 +119,30 @@ def agreement(x: np.ndarray, y: np.ndarray) -> dict[str, float]:
     }
 
 
+#: The metric compared per terrain: the seed's fitness on flat ground and on its fence.
+METRIC = {"flat": "NormFinalDist", "fence": "MaxXYDist"}
+#: softgym's name of each oracle metric.
+SOFTGYM_METRIC = {"NormFinalDist": "norm_final_dist", "MaxXYDist": "max_xy_dist"}
+
+
+def fence_terrain() -> Terrain:
+    """The seed's fence around a 6x6x6 robot at the origin (benchmarks/fidelity_cases.FENCE)."""
+    return Terrain.fence(inner=10, height=1, thickness=1, center=(3, 3))
+
+
 def load_oracle(sets: list[str]) -> tuple[list[Any], dict[tuple[str, str, int], float]]:
-    """The cases of the data files and their oracle NormFinalDist by (case, regime, draw)."""
+    """The cases of the data files and their oracle metric (:data:`METRIC`) by (case, regime, draw)."""
     cases, values = [], {}
     for s in sets:
         path = DATA / f"{s}.json"
         if not path.exists():
             continue
         data = json.loads(path.read_text())
-        cases += fc.cases_from_data(data)
+        found = fc.cases_from_data(data)
+        cases += found
+        terrain = {c.name: c.terrain for c in found}
         for rec in data["records"]:
-            v = rec.get("NormFinalDist")
+            v = rec.get(METRIC[terrain[rec["case"]]])
             values[(rec["case"], rec["regime"], int(rec["draw"]))] = (
                 float("nan") if rec.get("hung") or v is None else float(v))
     return cases, values
@@ -133,32 +150,36 @@ def load_oracle(sets: list[str]) -> tuple[list[Any], dict[tuple[str, str, int], 
 
 def run_softgym(cases: list[Any], draws: list[int], model: str, threads: int | None
                 ) -> dict[tuple[str, str, int], float]:
-    """softgym's NormFinalDist of every case, regime and draw, one batch per regime."""
+    """softgym's value of each case's metric (:data:`METRIC`) for every regime and draw,
+    one batch per regime and terrain (fence metrics on the seed's diluted centre of mass)."""
     out = {}
     cfg = SimConfig(model=model)
     for regime in fc.REGIMES:
-        jobs = [(c, d) for c in cases for d in draws if c.terrain == "flat"]
-        designs = [fc.case_design(c, regime, d) for c, d in jobs]
-        if not designs:
-            continue
-        sim = Simulation(designs, cfg, n_threads=threads)
-        r = sim.run(5.0)
-        nfd = norm_final_dist(r)
-        for (c, d), v, div in zip(jobs, nfd, r.diverged):
-            out[(c.name, regime, d)] = float("nan") if div else float(v)
+        for terrain in ("flat", "fence"):
+            jobs = [(c, d) for c in cases for d in draws if c.terrain == terrain]
+            if not jobs:
+                continue
+            designs = [fc.case_design(c, regime, d) for c, d in jobs]
+            world = fence_terrain() if terrain == "fence" else None
+            r = Simulation(designs, cfg, n_threads=threads, terrain=world).run(5.0)
+            if terrain == "fence":
+                r = dilute(r)
+            values = walk_metrics(r)[SOFTGYM_METRIC[METRIC[terrain]]]
+            for (c, d), v, div in zip(jobs, values, r.diverged):
+                out[(c.name, regime, d)] = float("nan") if div else float(v)
     return out
 
 
-def compare(cases, oracle, ours, draws) -> dict[str, Any]:
+def compare(cases, oracle, ours, draws, terrain: str = "flat", halves=ORACLE_HALVES) -> dict[str, Any]:
     """Per regime: softgym vs the oracle's first half, and the oracle's halves vs each other."""
     report = {}
     for regime in fc.REGIMES:
         rows = []
         for c in cases:
-            if c.terrain != "flat":
+            if c.terrain != terrain:
                 continue
-            half_a = [oracle.get((c.name, regime, d), np.nan) for d in ORACLE_HALVES[0]]
-            half_b = [oracle.get((c.name, regime, d), np.nan) for d in ORACLE_HALVES[1]]
+            half_a = [oracle.get((c.name, regime, d), np.nan) for d in halves[0]]
+            half_b = [oracle.get((c.name, regime, d), np.nan) for d in halves[1]]
             mine = [ours.get((c.name, regime, d), np.nan) for d in draws]
             if np.isnan(half_a).any() or np.isnan(half_b).any() or np.isnan(mine).any():
                 continue  # missing oracle data or a hung/diverged run
@@ -184,10 +205,12 @@ def compare(cases, oracle, ours, draws) -> dict[str, Any]:
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--model", default="seed", choices=["seed", "corotational"])
-    ap.add_argument("--sets", default="structured,random")
+    ap.add_argument("--sets", default="structured,random,fence")
     ap.add_argument("--draws", type=int, default=3, help="perturbed softgym draws per case (>= 3)")
     ap.add_argument("--quick", action="store_true", help="12 cases per set")
     ap.add_argument("--threads", type=int, default=None)
+    ap.add_argument("--halves", default="1,2,3/4,5,6",
+                    help="oracle draws of the two halves (a preview on partial data: 0/1)")
     ap.add_argument("--json", action="store_true")
     a = ap.parse_args()
     t0 = time.perf_counter()
@@ -199,23 +222,32 @@ def main() -> int:
             by_set.setdefault(c.set, []).append(c)
         cases = [c for cs in by_set.values() for c in cs[:12]]
     draws = list(range(1, a.draws + 1))
+    halves = tuple(tuple(int(x) for x in h.split(",")) for h in a.halves.split("/"))
     ours = run_softgym(cases, draws, a.model, a.threads)
     report = {"model": a.model, "sets": sets, "draws": draws, "n_cases": len(cases),
-              "regimes": compare(cases, oracle, ours, draws), "micro": micro_errors(a.model)}
+              "halves": halves,
+              "regimes": compare(cases, oracle, ours, draws, "flat", halves),
+              "fence_regimes": compare(cases, oracle, ours, draws, "fence", halves),
+              "micro": micro_errors(a.model)}
     report["wall_s"] = time.perf_counter() - t0
     print(f"softgym model {a.model!r} against the seed's engine: {len(cases)} cases "
-          f"({', '.join(sets)}), {len(draws)} softgym draws, oracle halves {ORACLE_HALVES}")
+          f"({', '.join(sets)}), {len(draws)} softgym draws, oracle halves {halves}")
     print(f"{'regime':8s} {'pair':18s} {'n':>4s} {'spearman':>9s} {'med|log10|':>10s} "
           f"{'<=2x':>6s} {'<=3x':>6s} {'moved/still':>11s}")
-    for regime, r in report["regimes"].items():
-        for label, key in (("softgym vs oracle", "softgym_vs_oracle"), ("oracle vs oracle", "oracle_vs_oracle")):
-            f = r[key]
-            print(f"{regime:8s} {label:18s} {f['n']:4d} {f['spearman']:9.3f} {f['median_abs_log10']:10.3f} "
-                  f"{f['within_2x']:6.0%} {f['within_3x']:6.0%} {f['moved_vs_still']:11d}")
-        t = r["targets"]
-        print(f"{'':8s} targets: spearman >= 0.9 x self {'met' if t['spearman'] else 'MISSED'}, "
-              f"within 2x >= 0.9 x self {'met' if t['within_2x'] else 'MISSED'}, "
-              f"no moved/still mismatch {'met' if t['moved_vs_still'] else 'MISSED'}")
+    for title, block in (("flat ground, NormFinalDist", "regimes"),
+                         ("the seed's fence, MaxXYDist (diluted)", "fence_regimes")):
+        if not report[block]:
+            continue
+        print(f"-- {title}")
+        for regime, r in report[block].items():
+            for label, key in (("softgym vs oracle", "softgym_vs_oracle"), ("oracle vs oracle", "oracle_vs_oracle")):
+                f = r[key]
+                print(f"{regime:8s} {label:18s} {f['n']:4d} {f['spearman']:9.3f} {f['median_abs_log10']:10.3f} "
+                      f"{f['within_2x']:6.0%} {f['within_3x']:6.0%} {f['moved_vs_still']:11d}")
+            t = r["targets"]
+            print(f"{'':8s} targets: spearman >= 0.9 x self {'met' if t['spearman'] else 'MISSED'}, "
+                  f"within 2x >= 0.9 x self {'met' if t['within_2x'] else 'MISSED'}, "
+                  f"no moved/still mismatch {'met' if t['moved_vs_still'] else 'MISSED'}")
     print("micro-cases (max |softgym - oracle| / the oracle's displacement scale):")
     for name, m in report["micro"].items():
         flag = "  (sensitive)" if m["sensitive"] else ""

@@ -46,34 +46,16 @@ _COUNTS = ("n_voxels", "n_muscle", "n_old_materials", "n_bone", "n_tissue")
 
 
 def estimated_cost(design: Any, voxel_size: float = 0.01) -> float:
-    """Relative simulation cost of a design: voxels x steps per simulated second.
+    """Relative simulation cost of a design: voxel-steps per simulated second.
 
-    The engine steps each robot at ``dt ~ 1 / sqrt(max k_axial / m)`` over its
-    links (a robot with a bone-bone link takes 10x more steps); the cost is
-    ``n_voxels * sqrt(max k / m)``. Used to order a batch longest-first, so
-    the engine's dynamic schedule over robots balances the threads.
+    The engine's own figure (:func:`softgym.engine.voxel_steps_per_second`):
+    a robot with a bone-bone link takes 10x more steps. Used to order a batch
+    longest-first, so the engine's dynamic schedule over robots balances the
+    threads.
     """
-    grid = np.asarray(design.grid)
-    table = design.material_table()
-    L = float(voxel_size)
-    E = table["youngs_modulus"][grid]
-    m = table["density"][grid] * L**3
-    filled = grid > 0
-    w2 = 0.0
-    for ax in range(3):
-        lo = [slice(None)] * 3
-        hi = [slice(None)] * 3
-        lo[ax] = slice(0, -1)
-        hi[ax] = slice(1, None)
-        ok = filled[tuple(lo)] & filled[tuple(hi)]
-        if not ok.any():
-            continue
-        a, b = E[tuple(lo)][ok], E[tuple(hi)][ok]
-        k = 2.0 * a * b / (a + b) * L
-        w2 = max(w2, float(np.max(np.maximum(k / m[tuple(lo)][ok], k / m[tuple(hi)][ok]))))
-    if w2 == 0.0 and filled.any():
-        w2 = float(np.max(E[filled] * L / m[filled]))
-    return float(filled.sum()) * float(np.sqrt(w2))
+    from softgym.engine import SimConfig, voxel_steps_per_second
+
+    return voxel_steps_per_second(design, SimConfig(voxel_size=float(voxel_size)))
 
 
 def _as_design(obj: Any):

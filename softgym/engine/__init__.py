@@ -8,7 +8,13 @@ from softgym.engine._openmp import omp_max_threads, openmp_enabled
 from softgym.engine.body import Body
 from softgym.engine.config import SimConfig
 from softgym.engine.rollout import Rollout
-from softgym.engine.simulation import Simulation, as_body, default_num_threads
+from softgym.engine.simulation import (
+    Simulation,
+    as_body,
+    default_num_threads,
+    time_step,
+    voxel_steps_per_second,
+)
 
 __all__ = [
     "Body",
@@ -19,4 +25,6 @@ __all__ = [
     "default_num_threads",
     "omp_max_threads",
     "openmp_enabled",
+    "time_step",
+    "voxel_steps_per_second",
 ]

@@ -1757,6 +1757,29 @@ cdef void robot_energy(Batch* b, intp_t r, float64_t* out) noexcept nogil:
 # Python-facing entry points. The wrapper (simulation.py) has validated dtypes,
 # shapes and contiguity; here arrays are only bound to the struct.
 
+#: What each STATUS_* code of a diverged robot means (``diverged_code``).
+STATUS_NAMES = {
+    STATUS_OK: "ok",
+    STATUS_STRAIN: "link strain above max_strain (or NaN)",
+    STATUS_NONFINITE: "non-finite or runaway voxel state",
+    STATUS_MEMORY: "out of memory for the self-collision candidates",
+}
+
+#: The arrays that cross into the kernel (bound by _bind; shapes, dtypes and
+#: units in _core.pxd's Batch): the Python side must provide every one.
+KERNEL_ARRAYS = (
+    "vox_start", "link_start", "link_axis_count", "dt", "steps", "temp_amp", "period",
+    "use_temp", "floor", "box_start", "boxes", "diverged", "diverged_time", "diverged_code",
+    "init_done", "cm_init", "mass_total", "trace_n", "trace_t", "trace_cm",
+    "pos", "vel", "quat", "angvel", "rot", "force", "moment", "ext_force", "mass", "inv_mass",
+    "inv_inertia", "scale", "cte", "cos_phase", "sin_phase", "temp", "k_floor", "c_floor",
+    "c_global", "rot_damp", "mu_s", "mu_k", "fixed", "surface", "excl_start", "excl_idx",
+    "seed_rank", "col_ref", "col_acc", "col_vmax", "obs_start", "obs", "obs_rank",
+    "link_out", "v1", "v2", "axis", "k_axial", "k_torsion", "k_bend", "c_axial", "c_torsion",
+    "c_bend", "c_seed", "homog", "link_sa", "link_last",
+)
+
+
 cdef inline float64_t* _f(object arrays, str name) except NULL:
     cdef cnp.ndarray a = arrays[name]
     return <float64_t*> cnp.PyArray_DATA(a)

@@ -123,9 +123,9 @@ class SimConfig:
         check("min_scale", 0 < finite("min_scale") <= 1, "in (0, 1]")
         check("max_strain", finite("max_strain") > 0, "> 0")
         check("trace_interval", finite("trace_interval") > 0, "> 0 s")
-        check("model", self.model in ("seed", "corotational"), '"seed" or "corotational"')
-        check("actuation", self.actuation in ("seed", "symmetric"), '"seed" or "symmetric"')
-        check("on_divergence", self.on_divergence in ("flag", "raise"), '"flag" or "raise"')
+        check("model", isinstance(self.model, str) and self.model in ("seed", "corotational"), '"seed" or "corotational"')
+        check("actuation", isinstance(self.actuation, str) and self.actuation in ("seed", "symmetric"), '"seed" or "symmetric"')
+        check("on_divergence", isinstance(self.on_divergence, str) and self.on_divergence in ("flag", "raise"), '"flag" or "raise"')
         check("floor", isinstance(self.floor, (bool, int)), "a bool")
         check("self_collision", isinstance(self.self_collision, (bool, int)), "a bool")
         check(

@@ -60,13 +60,8 @@ from softgym.exceptions import (
     SimulationDivergedError,
 )
 
-__all__ = ["Simulation", "as_body", "default_num_threads"]
+__all__ = ["Simulation", "as_body", "default_num_threads", "time_step", "voxel_steps_per_second"]
 
-_REASONS = {
-    1: "link strain above max_strain (or NaN)",
-    2: "non-finite or runaway voxel state",
-    3: "out of memory for the self-collision candidates",
-}
 
 # state arrays that change while the simulation runs (checkpointed by get_state):
 # per voxel, per robot, and the traces
@@ -218,6 +213,63 @@ def obstacle_mass_and_center(terrain: Any, voxel_size: float) -> tuple[float, np
     centres = 0.5 * (boxes[:, :3] + boxes[:, 3:])
     return float(mass.sum()), (mass[:, None] * centres).sum(axis=0) / mass.sum()
 
+
+
+def _time_step(k_axial, m, E, v1, v2, cfg: SimConfig) -> float:
+    # the seed's CalcMaxDt over a robot's links: dt_frac / (2 pi sqrt(max k_axial / m))
+    L = float(cfg.voxel_size)
+    if v1.size:
+        w2 = float(np.max(np.maximum(k_axial / m[v1], k_axial / m[v2])))
+    else:
+        # no link: the seed's CalcMaxDt falls back to max E / M (its units)
+        w2 = float(np.max(E / m)) if cfg.model == "seed" else float(np.max(E * L / m))
+    if cfg.model == "seed":
+        # the seed's CalcMaxDt writes pi as 3.1415926 and its DtFrac is single precision
+        return float(np.float32(cfg.dt_frac)) / (2.0 * 3.1415926 * math.sqrt(w2))
+    return cfg.dt_frac / (2.0 * math.pi * math.sqrt(w2))
+
+
+def time_step(body: Any, config: SimConfig | None = None) -> float:
+    """The time step (s) the engine takes for a robot (a Body or a design).
+
+    ``dt_frac / (2 pi sqrt(max k_axial / m))`` over its face links, k_axial the
+    harmonic mean of the two voxels' E times L (the seed's CalcMaxDt): a link
+    between stiff or light voxels shortens it, and so raises the cost of a
+    simulated second (:func:`voxel_steps_per_second`).
+    """
+    cfg = SimConfig() if config is None else config
+    body = as_body(body)
+    L = float(cfg.voxel_size)
+    grid = body.grid
+    idx = np.argwhere(grid > 0)
+    vmap = np.full(grid.shape, -1, dtype=np.int64)
+    vmap[tuple(idx.T)] = np.arange(idx.shape[0])
+    mat = grid[tuple(idx.T)]
+    E = body.youngs_modulus[mat]
+    m = body.density[mat] * L**3
+    v1s, v2s = [], []
+    for ax in range(3):
+        lo = [slice(None)] * 3
+        hi = [slice(None)] * 3
+        lo[ax] = slice(0, -1)
+        hi[ax] = slice(1, None)
+        a, b = vmap[tuple(lo)], vmap[tuple(hi)]
+        ok = (a >= 0) & (b >= 0)
+        v1s.append(a[ok])
+        v2s.append(b[ok])
+    v1, v2 = np.concatenate(v1s), np.concatenate(v2s)
+    if body.fixed is not None:
+        fixed = body.fixed[tuple(idx.T)] != 0
+        keep = ~(fixed[v1] & fixed[v2])
+        v1, v2 = v1[keep], v2[keep]
+    k_axial = _harmonic(E[v1], E[v2]) * L
+    return _time_step(k_axial, m, E, v1, v2, cfg)
+
+
+def voxel_steps_per_second(body: Any, config: SimConfig | None = None) -> float:
+    """Voxel-steps per simulated second of a robot: its cost (n_voxels / dt)."""
+    body = as_body(body)
+    return float(np.count_nonzero(body.grid)) / time_step(body, config)
 
 
 def _harmonic(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -382,17 +434,7 @@ class Simulation:
                          2.0 * np.sqrt(k_torsion * inertia[v]), 2.0 * np.sqrt(k_bend * inertia[v])]
             add(per_link, "c_seed", np.stack(ends, axis=1).reshape(-1, 8))
             add(per_link, "homog", (mat[v1] == mat[v2]).astype(np.int8))
-            # time step: the seed's CalcMaxDt over this robot's links
-            if v1.size:
-                w2 = np.max(np.maximum(k_axial / m[v1], k_axial / m[v2]))
-            else:
-                # no link: the seed's CalcMaxDt falls back to max E / M (its units)
-                w2 = np.max(E / m) if cfg.model == "seed" else np.max(E * L / m)
-            if cfg.model == "seed":
-                # the seed's CalcMaxDt writes pi as 3.1415926 and its DtFrac is single precision
-                dt = float(np.float32(cfg.dt_frac)) / (2.0 * 3.1415926 * math.sqrt(w2))
-            else:
-                dt = cfg.dt_frac / (2.0 * math.pi * math.sqrt(w2))
+            dt = _time_step(k_axial, m, E, v1, v2, cfg)
             dts.append(dt)
             masses.append(float(m.sum()))
             crit = 2.0 * np.sqrt(m * E * L)
@@ -501,6 +543,9 @@ class Simulation:
         walls = [obstacle_mass_and_center(t, L) for t in self.terrains]
         self._obstacle_mass = np.array([m for m, _ in walls], dtype=np.float64)
         self._obstacle_cm = np.array([c for _, c in walls], dtype=np.float64).reshape(-1, 3)
+        missing = [k for k in _core.KERNEL_ARRAYS if k not in a]
+        if missing:  # the kernel's declared contract (_core.KERNEL_ARRAYS)
+            raise RuntimeError(f"softgym engine: arrays {missing} missing for the kernel")
         self._a = a
         self._grid_index = np.ascontiguousarray(np.concatenate(grid_index)).astype(np.int64)
         self._settings = {
@@ -554,6 +599,17 @@ class Simulation:
     def diverged(self) -> np.ndarray:
         """Ndarray of shape (n_robots,), bool: robots frozen after divergence."""
         return self._a["diverged"].astype(bool)
+
+    @property
+    def cm_init(self) -> np.ndarray:
+        """Each robot's fitness reference, shape (n_robots, 3).
+
+        The centre of mass at the first step after ``init_time`` (the seed's
+        IniCM); the current one before that.
+        """
+        a = self._a
+        done = a["init_done"].astype(bool)
+        return np.where(done[:, None], a["cm_init"], self.center_of_mass())
 
     @property
     def nbytes(self) -> int:
@@ -758,6 +814,10 @@ class Simulation:
             raise InvalidParameterError(f"seconds must be finite and >= 0, got {seconds}")
         self.advance_to(self._t_target + seconds)
 
+    #: Most voxel-steps one :meth:`advance_to` may plan (checked before it runs:
+    #: nothing is lost): about 1.5 h on one core; a 6^3 soft robot's 5 s is 1.7e6.
+    max_voxel_steps: float = 5e10
+
     #: Work between two returns to Python in :meth:`advance_to`, in voxel-steps per
     #: thread (about 0.1 s of wall time): signals (Ctrl-C) act within a fraction of a
     #: second whatever the batch, and results do not depend on it.
@@ -786,10 +846,19 @@ class Simulation:
             raise InvalidParameterError(
                 f"time must be finite and >= the current target {self._t_target}, got {time}"
             )
-        self._ensure_trace_capacity(time + self._a["dt"].max())
         a = self._a
         dt = a["dt"]
         final = np.maximum(np.ceil(time / dt - 1e-9).astype(np.int64), a["steps"])
+        planned = float(np.sum((final - a["steps"]) * np.diff(a["vox_start"])))
+        if planned > self.max_voxel_steps:
+            raise InvalidParameterError(
+                f"advancing to t = {time:g} s needs {planned:.3g} voxel-steps (time steps down to "
+                f"{dt.min():.3g} s), over Simulation.max_voxel_steps = {self.max_voxel_steps:.3g} "
+                f"(about {self.max_voxel_steps / 1e7 / 3600:.0f} h on one core); stiffer or lighter "
+                "materials shrink the time step: check the materials or raise the limit"
+            )
+        self._ensure_trace_capacity(time + dt.max())
+        a = self._a
         before = a["diverged"].copy()
         # simulated seconds per chunk = work per chunk / voxel-steps per simulated second
         rate = float(np.sum(np.diff(a["vox_start"]) / dt))
@@ -802,7 +871,7 @@ class Simulation:
                 targets = final
             else:
                 targets = np.minimum(np.maximum(np.ceil(t / dt - 1e-9).astype(np.int64), a["steps"]), final)
-            _core.advance(a, self._settings, targets, self.n_threads, self._contacts)
+            _core.advance(a, self._settings, targets, threads, self._contacts)
             # back in Python: a pending SIGINT raises KeyboardInterrupt here
             self._t_target = t
             if progress is not None:
@@ -814,7 +883,7 @@ class Simulation:
             if new.size:
                 r = int(new[0])
                 raise SimulationDivergedError(
-                    r, float(a["diverged_time"][r]), _REASONS.get(int(a["diverged_code"][r]), "diverged")
+                    r, float(a["diverged_time"][r]), _core.STATUS_NAMES.get(int(a["diverged_code"][r]), "diverged")
                 )
 
     def run(self, seconds: float) -> Rollout:

@@ -180,3 +180,45 @@ def test_default_threads_come_from_the_environment_not_openmp_state(monkeypatch)
     monkeypatch.delenv("SOFTGYM_NUM_THREADS")
     monkeypatch.delenv("OMP_NUM_THREADS")
     assert default_num_threads() >= 1
+
+
+def test_time_step_is_the_engines_and_cost_follows_it():
+    import numpy as np
+
+    from softgym.design import RobotDesign, default_walker
+    from softgym.engine import SimConfig, Simulation, time_step, voxel_steps_per_second
+
+    bone = RobotDesign(np.array([[[2, 2], [2, 1]]]))
+    for d in (default_walker(), bone):
+        for cfg in (SimConfig(), SimConfig.corotational()):
+            assert time_step(d, cfg) == Simulation([d], cfg).dt[0]
+    assert voxel_steps_per_second(bone) > 5 * voxel_steps_per_second(RobotDesign(np.ones((1, 2, 2), int)))
+
+
+def test_an_unbounded_run_is_refused_before_it_starts():
+    # E 1e12 Pa at density 1e-3 kg/m^3 gives a time step of ~5e-11 s: one second
+    # would take days; the call is refused with a typed error and nothing changes
+    import numpy as np
+    import pytest
+
+    from softgym.engine import Body, Simulation
+    from softgym.exceptions import InvalidParameterError
+
+    body = Body.uniform(np.ones((2, 2, 2)), youngs_modulus=1e12, density=1e-3)
+    sim = Simulation([body])
+    state = sim.get_state()
+    with pytest.raises(InvalidParameterError, match="voxel-steps"):
+        sim.advance(1.0)
+    after = sim.get_state()
+    assert all(np.array_equal(state[k], after[k]) for k in state)
+
+
+def test_cm_init_is_public_and_equals_the_rollouts():
+    import numpy as np
+
+    from softgym.design import default_walker
+    from softgym.engine import SimConfig, Simulation
+
+    sim = Simulation([default_walker()], SimConfig(init_time=0.2))
+    sim.advance(0.5)
+    np.testing.assert_array_equal(sim.cm_init, sim.rollout().cm_init)
