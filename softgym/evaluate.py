@@ -70,6 +70,11 @@ def _as_design(obj: Any):
     )
 
 
+#: A batch estimated to take longer than this (s) shows a progress bar by default.
+PROGRESS_AFTER_S = 5.0
+_VOXEL_STEPS_PER_S = 5e6  # per thread, for that estimate (the seed preset's order of magnitude)
+
+
 def evaluate(
     designs: Any,
     task: TaskLike = "flat",
@@ -79,6 +84,7 @@ def evaluate(
     traces: bool = False,
     n_threads: int | None = None,
     config: Any = None,
+    progress: bool | None = None,
 ) -> dict[str, Any]:
     """Simulate designs together and return the task's metrics.
 
@@ -101,6 +107,9 @@ def evaluate(
         OpenMP threads (default: softgym's default).
     config : SimConfig, optional
         Full engine settings; replaces the task's (its ``trace_interval`` wins).
+    progress : bool, optional
+        Show a tqdm bar over the simulated time; default: only for a batch
+        estimated to take more than :data:`PROGRESS_AFTER_S` seconds.
 
     Returns
     -------
@@ -143,7 +152,7 @@ def evaluate(
         out["traces"] = [None] * n
     if n == 0:
         return out
-    from softgym.engine import Simulation
+    from softgym.engine import Simulation, voxel_steps_per_second
     from softgym.metrics import composition_counts
 
     cfg = task.config() if config is None else config.replace(trace_interval=task.trace_interval)
@@ -153,7 +162,18 @@ def evaluate(
     batch = [designs[i] for i in order]
     terrains = [task.terrain_for(d.shape) for d in batch]
     sim = Simulation(batch, config=cfg, n_threads=task.n_threads, terrain=terrains)
-    rollout = _reorder(sim.run(task.seconds), np.argsort(order))
+    if progress is None:
+        work = sum(voxel_steps_per_second(d, cfg) for d in batch) * task.seconds
+        progress = work / (_VOXEL_STEPS_PER_S * sim.n_threads) > PROGRESS_AFTER_S
+    if progress:
+        from tqdm.auto import tqdm
+
+        with tqdm(total=task.seconds, unit="s", desc=f"simulating {n} robots",
+                  bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} s [{elapsed}<{remaining}]") as bar:
+            sim.advance_to(task.seconds, progress=lambda t: bar.update(t - bar.n))
+    else:
+        sim.advance_to(task.seconds)
+    rollout = _reorder(sim.rollout(), np.argsort(order))
     out.update(task.metrics(rollout))
     for i, d in enumerate(designs):
         c = composition_counts(d)

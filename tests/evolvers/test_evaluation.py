@@ -60,3 +60,16 @@ def test_invalid_bodies_are_not_simulated():
     st = Evaluator(exp).evaluate([ind])
     assert st.n_invalid == 1 and st.n_simulated == 0
     assert ind.objectives["norm_final_dist"] == pytest.approx(-1e7)
+
+
+def test_evaluate_shows_a_progress_bar_on_request_and_results_do_not_change(capsys):
+    import numpy as np
+
+    import softgym
+    from softgym.design import default_walker
+
+    quiet = softgym.evaluate([default_walker()], seconds=0.3, progress=False)
+    shown = softgym.evaluate([default_walker()], seconds=0.3, progress=True)
+    assert "simulating 1 robots" in capsys.readouterr().err
+    for k in ("norm_final_dist", "max_xy_dist", "l_coefficient"):
+        np.testing.assert_array_equal(quiet[k], shown[k])
