@@ -36,7 +36,8 @@ def outcome(kind, fn, *args, **kwargs):
 
 
 def _set(tag, text, source=VXA):
-    return re.sub(rf"<{tag}>[^<>]*</{tag}>", f"<{tag}>{text}</{tag}>", source, count=1)
+    # a function replacement: the fuzzed text is data, not a pattern (no group references)
+    return re.sub(rf"<{tag}>[^<>]*</{tag}>", lambda _: f"<{tag}>{text}</{tag}>", source, count=1)
 
 
 # ------------------------------------------------------------------ reproducers of issue 12
