@@ -4,38 +4,16 @@ import hashlib
 import io
 import json
 import logging
-import os
 import zipfile
-from collections import Counter
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from fuzzing import FUZZ, outcome  # tests/fuzzing.py
+from hypothesis import given
 from hypothesis import strategies as st
 
 from softgym import io as sio
-from softgym.exceptions import CheckpointError, InvalidParameterError, SoftGymError
-
-OUTCOMES: Counter = Counter()
-FUZZ = settings(
-    max_examples=int(os.environ.get("SOFTGYM_FUZZ_EXAMPLES", "150")),
-    deadline=None,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
-    database=None,
-)
-
-
-def outcome(kind, fn, *args, **kwargs):
-    try:
-        fn(*args, **kwargs)
-    except SoftGymError as exc:
-        label = type(exc).__name__
-    except Exception as exc:  # noqa: BLE001 - the property under test
-        pytest.fail(f"{kind}: {type(exc).__name__} escaped: {exc!s:.300}")
-    else:
-        label = "valid"
-    OUTCOMES[(kind, label)] += 1
-    return label
+from softgym.exceptions import CheckpointError, InvalidParameterError
 
 
 def _save_three(directory):

@@ -2,37 +2,15 @@
 
 import json
 import math
-import os
-from collections import Counter
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from fuzzing import FUZZ, outcome  # tests/fuzzing.py
+from hypothesis import given
 from hypothesis import strategies as st
 
-from softgym.exceptions import InvalidTerrainError, SoftGymError
+from softgym.exceptions import InvalidTerrainError
 from softgym.terrain import MAX_BOXES, MAX_COORDINATE, Box, Terrain
-
-OUTCOMES: Counter = Counter()
-FUZZ = settings(
-    max_examples=int(os.environ.get("SOFTGYM_FUZZ_EXAMPLES", "150")),
-    deadline=None,
-    suppress_health_check=[HealthCheck.too_slow],
-    database=None,
-)
-
-
-def outcome(kind, fn, *args, **kwargs):
-    try:
-        fn(*args, **kwargs)
-    except SoftGymError as exc:
-        label = type(exc).__name__
-    except Exception as exc:  # noqa: BLE001 - the property under test
-        pytest.fail(f"{kind}: {type(exc).__name__} escaped: {exc!s:.300}")
-    else:
-        label = "valid"
-    OUTCOMES[(kind, label)] += 1
-    return label
 
 
 def doc(**changes):

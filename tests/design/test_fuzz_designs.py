@@ -9,39 +9,16 @@ import os
 import subprocess
 import sys
 import textwrap
-from collections import Counter
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from fuzzing import FUZZ, outcome  # tests/fuzzing.py
+from hypothesis import given
 from hypothesis import strategies as st
 
 from softgym.design import CPPN, CompositionRules, Controller, RobotDesign, default_walker
 from softgym.design.robot import MAX_GRID_DIM, MAX_GRID_VOXELS, check_grid_shape
 from softgym.exceptions import DesignFileError, InvalidDesignError, SoftGymError
-
-OUTCOMES: Counter = Counter()
-# SOFTGYM_FUZZ_EXAMPLES raises the count for a deeper run (the default keeps the suite fast)
-FUZZ = settings(
-    max_examples=int(os.environ.get("SOFTGYM_FUZZ_EXAMPLES", "150")),
-    deadline=None,
-    suppress_health_check=[HealthCheck.too_slow],
-    database=None,
-)
-
-
-def outcome(kind, fn, *args, **kwargs):
-    """Call ``fn``; count and return "valid" or the SoftGymError's class name; fail on anything else."""
-    try:
-        fn(*args, **kwargs)
-    except SoftGymError as exc:
-        label = type(exc).__name__
-    except Exception as exc:  # noqa: BLE001 - the property under test
-        pytest.fail(f"{kind}: {type(exc).__name__} escaped: {exc!s:.300}")
-    else:
-        label = "valid"
-    OUTCOMES[(kind, label)] += 1
-    return label
 
 
 def walker_dict(encoding="digits"):

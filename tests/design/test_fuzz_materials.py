@@ -1,12 +1,11 @@
 """Hostile inputs to Material, Palette, Controller and CompositionRules: valid or a SoftGymError."""
 
 import math
-import os
-from collections import Counter
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from fuzzing import FUZZ, outcome  # tests/fuzzing.py
+from hypothesis import given
 from hypothesis import strategies as st
 
 from softgym.design import (
@@ -17,29 +16,7 @@ from softgym.design import (
     Palette,
     default_walker,
 )
-from softgym.exceptions import InvalidDesignError, InvalidParameterError, SoftGymError
-
-OUTCOMES: Counter = Counter()
-FUZZ = settings(
-    max_examples=int(os.environ.get("SOFTGYM_FUZZ_EXAMPLES", "150")),
-    deadline=None,
-    suppress_health_check=[HealthCheck.too_slow],
-    database=None,
-)
-
-
-def outcome(kind, fn, *args, **kwargs):
-    try:
-        fn(*args, **kwargs)
-    except SoftGymError as exc:
-        label = type(exc).__name__
-    except Exception as exc:  # noqa: BLE001 - the property under test
-        pytest.fail(f"{kind}: {type(exc).__name__} escaped: {exc!s:.300}")
-    else:
-        label = "valid"
-    OUTCOMES[(kind, label)] += 1
-    return label
-
+from softgym.exceptions import InvalidDesignError, InvalidParameterError
 
 # ------------------------------------------------------------------ reproducers of issue 12
 

@@ -1,38 +1,17 @@
 """Hostile .vxa files: a design or an InvalidDesignError, never another exception or a huge allocation."""
 
-import os
 import re
-from collections import Counter
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from fuzzing import FUZZ, outcome  # tests/fuzzing.py
+from hypothesis import given
 from hypothesis import strategies as st
 
 from softgym.design import MAX_GRID_DIM, default_walker, from_vxa, load_vxa, to_vxa
-from softgym.exceptions import DesignFileError, InvalidDesignError, SoftGymError
+from softgym.exceptions import DesignFileError, InvalidDesignError
 
-OUTCOMES: Counter = Counter()
-FUZZ = settings(
-    max_examples=int(os.environ.get("SOFTGYM_FUZZ_EXAMPLES", "150")),
-    deadline=None,
-    suppress_health_check=[HealthCheck.too_slow],
-    database=None,
-)
 VXA = to_vxa(default_walker())
 LEAVES = sorted(set(re.findall(r"<(\w+)>[^<>]*</\1>", VXA)))
-
-
-def outcome(kind, fn, *args, **kwargs):
-    try:
-        fn(*args, **kwargs)
-    except SoftGymError as exc:
-        label = type(exc).__name__
-    except Exception as exc:  # noqa: BLE001 - the property under test
-        pytest.fail(f"{kind}: {type(exc).__name__} escaped: {exc!s:.300}")
-    else:
-        label = "valid"
-    OUTCOMES[(kind, label)] += 1
-    return label
 
 
 def _set(tag, text, source=VXA):

@@ -1,0 +1,41 @@
+"""Shared harness of the property-based (Hypothesis) tests of hostile inputs.
+
+Every public entry must give a valid object or a :class:`~softgym.exceptions.SoftGymError`,
+never another exception. ``outcome`` calls an entry and counts what it gave in ``OUTCOMES``
+(the tally of issue 12); ``SOFTGYM_FUZZ_EXAMPLES`` raises the example count for a deeper run.
+"""
+
+import os
+from collections import Counter
+
+import pytest
+from hypothesis import HealthCheck, settings
+
+from softgym.exceptions import SoftGymError
+
+#: Examples per property (the default keeps the suite fast).
+FUZZ_EXAMPLES = int(os.environ.get("SOFTGYM_FUZZ_EXAMPLES", "150"))
+
+FUZZ = settings(
+    max_examples=FUZZ_EXAMPLES,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow],
+    database=None,
+)
+
+#: (kind, "valid" or the error class name) -> count, over the whole run.
+OUTCOMES: Counter = Counter()
+
+
+def outcome(kind, fn, *args, **kwargs):
+    """Call ``fn``; count and return "valid" or the SoftGymError's class name; fail on anything else."""
+    try:
+        fn(*args, **kwargs)
+    except SoftGymError as exc:
+        label = type(exc).__name__
+    except Exception as exc:  # noqa: BLE001 - the property under test
+        pytest.fail(f"{kind}: {type(exc).__name__} escaped: {exc!s:.300}")
+    else:
+        label = "valid"
+    OUTCOMES[(kind, label)] += 1
+    return label
