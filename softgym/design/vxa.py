@@ -38,6 +38,7 @@ import math
 import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
+from typing import Any
 from xml.sax.saxutils import escape
 
 import numpy as np
@@ -372,6 +373,63 @@ def _thermal(amplitude: float) -> tuple[float, float]:
     return amplitude, 0.0
 
 
+#: Palette id of the seed's wall material (its material 5, "Obstacle").
+OBSTACLE_ID = 5
+
+
+def _with_obstacles(design: RobotDesign, terrain: Any) -> tuple[RobotDesign, list[tuple[float, ...]]]:
+    # the design inside a lattice that also holds the terrain's boxes as fixed
+    # Obstacle voxels; regions: (X, Y, Z, dX, dY, dZ) of each box as fractions
+    # of the lattice (the seed's <FRegion> geometry)
+    from softgym.exceptions import InvalidTerrainError
+
+    if OBSTACLE_ID not in design.palette or design.palette[OBSTACLE_ID].name != "Obstacle":
+        raise InvalidTerrainError(f"to_vxa(terrain=...) needs the Obstacle material at palette id {OBSTACLE_ID}")
+    boxes = []
+    for b in terrain.boxes:
+        lo = np.asarray(b.lo, dtype=np.float64)
+        hi = np.asarray(b.hi, dtype=np.float64)
+        if np.any(np.abs(lo - np.rint(lo)) > 1e-9) or np.any(np.abs(hi - np.rint(hi)) > 1e-9):
+            raise InvalidTerrainError(f"to_vxa: box {b.lo}-{b.hi} is off the lattice (corners must be integers)")
+        if lo[2] < 0:
+            raise InvalidTerrainError(f"to_vxa: box {b.lo}-{b.hi} reaches below the floor")
+        boxes.append((np.rint(lo).astype(int), np.rint(hi).astype(int)))
+    lo_all = np.minimum(np.min([lo for lo, _ in boxes], axis=0), 0)
+    lo_all[2] = 0
+    hi_all = np.maximum(np.max([hi for _, hi in boxes], axis=0), np.array(design.shape))
+    off = -lo_all
+    shape = tuple(int(v) for v in hi_all - lo_all)
+    check_grid_shape(shape, "to_vxa lattice with obstacles")
+    grid = np.zeros(shape, dtype=np.int8)
+    for lo, hi in boxes:
+        a, b = lo + off, hi + off
+        grid[a[0]:b[0], a[1]:b[1], a[2]:b[2]] = OBSTACLE_ID
+    nx, ny, nz = design.shape
+    robot = grid[off[0]:off[0] + nx, off[1]:off[1] + ny, :nz]
+    if np.any((robot == OBSTACLE_ID) & (design.grid > 0)):
+        raise InvalidTerrainError("to_vxa: a terrain box overlaps the robot")
+    robot[design.grid > 0] = design.grid[design.grid > 0]
+    ex, ey, ez = shape
+    regions = [((lo[0] + off[0]) / ex, (lo[1] + off[1]) / ey, (lo[2] + off[2]) / ez,
+                (hi[0] - lo[0]) / ex, (hi[1] - lo[1]) / ey, (hi[2] - lo[2]) / ez)
+               for lo, hi in boxes]  # fmt: skip
+    return design.replace(grid=grid), regions
+
+
+def _boundary_conditions(regions: list[tuple[float, ...]]) -> str:
+    if not regions:
+        return "  <Fixed_Regions><NumFixed>0</NumFixed></Fixed_Regions>"
+    parts = [f"  <Boundary_Conditions><NumBCs>{len(regions)}</NumBCs>"]
+    for x, y, z, dx, dy, dz in regions:
+        parts.append(
+            f"<FRegion><PrimType>0</PrimType><X>{x:.12g}</X><Y>{y:.12g}</Y><Z>{z:.12g}</Z>"
+            f"<dX>{dx:.12g}</dX><dY>{dy:.12g}</dY><dZ>{dz:.12g}</dZ>"
+            "<alfa>1</alfa><DofFixed>63</DofFixed></FRegion>"
+        )
+    parts.append("</Boundary_Conditions>")
+    return "".join(parts)
+
+
 def to_vxa(
     design: RobotDesign,
     *,
@@ -381,6 +439,7 @@ def to_vxa(
     dt_frac: float = 0.9,
     time_between_traces: float = 0.0,
     self_collisions: bool = True,
+    terrain: Any = None,
 ) -> str:
     """The ``.vxa`` text of a design, with the seed's simulation settings.
 
@@ -397,13 +456,28 @@ def to_vxa(
         ``<TimeBetweenTraces>`` (s); > 0 also sets ``<SaveTraces>`` 1.
     self_collisions : bool
         ``<SelfColEnabled>``.
+    terrain : Terrain, optional
+        Obstacles, written as the seed wrote its walls: voxels of the Obstacle
+        material (id 5) in the lattice, fixed by one ``<FRegion>`` per box
+        (``DofFixed`` 63), the lattice widened to hold them (the robot keeps
+        its place relative to them). Boxes must lie on the lattice (integer
+        corners in voxel lengths, nothing below the floor).
 
     Returns
     -------
     str
         ISO-8859-1-declared XML; non-ASCII characters of material names are
         written as character references.
+
+    Raises
+    ------
+    InvalidTerrainError
+        A box off the lattice, below the floor, or over the robot; or no
+        Obstacle material at id 5 in the design's palette.
     """
+    regions: list[tuple[float, ...]] = []
+    if terrain is not None and terrain.boxes:
+        design, regions = _with_obstacles(design, terrain)
     amp, base = _thermal(design.controller.temp_amplitude)
     lines = [
         '<?xml version="1.0" encoding="ISO-8859-1"?>',
@@ -430,7 +504,7 @@ def to_vxa(
         "  <MaxElasticMod>500000000</MaxElasticMod>",
         "</Simulator>",
         "<Environment>",
-        "  <Fixed_Regions><NumFixed>0</NumFixed></Fixed_Regions>",
+        _boundary_conditions(regions),
         "  <Forced_Regions><NumForced>0</NumForced></Forced_Regions>",
         "  <Gravity><GravEnabled>1</GravEnabled><GravAcc>-9.81</GravAcc><FloorEnabled>1</FloorEnabled>"
         "<FloorSlope>0</FloorSlope></Gravity>",

@@ -194,3 +194,31 @@ def test_missing_optional_parts_use_seed_defaults():
     d = from_vxa(text)
     assert d.controller.temp_amplitude == 14.0 and d.controller.period == 0.25
     assert d.palette[1].mu_static == 1.0
+
+
+def test_to_vxa_writes_a_terrain_as_the_seeds_fixed_obstacle_voxels():
+    # the seed's fence: 44 Obstacle voxels (id 5) around the robot, four fixed
+    # regions; the oracle gives this file the same numbers as the seed's own
+    # 50x50 obstacle workspace (checked when it was written)
+    import re
+
+    import numpy as np
+    import pytest
+
+    from softgym.design import default_walker
+    from softgym.design.vxa import parse_vxa, to_vxa
+    from softgym.exceptions import InvalidTerrainError
+    from softgym.terrain import Box, Terrain
+
+    walker = default_walker()
+    text = to_vxa(walker, terrain=Terrain.fence(center=(3, 3)))
+    grid = parse_vxa(text).design.grid
+    assert grid.shape == (12, 12, 6) and int((grid == 5).sum()) == 44
+    np.testing.assert_array_equal(grid[3:9, 3:9, :], walker.grid)
+    assert text.count("<DofFixed>63</DofFixed>") == 4
+    assert to_vxa(walker, terrain=Terrain.flat()) == to_vxa(walker)
+    with pytest.raises(InvalidTerrainError, match="off the lattice"):
+        to_vxa(walker, terrain=Terrain.from_boxes([Box((7.5, 0, 0), (9, 6, 1))]))
+    with pytest.raises(InvalidTerrainError, match="overlaps the robot"):
+        to_vxa(walker, terrain=Terrain.from_boxes([Box((5, 0, 0), (9, 6, 1))]))
+    assert re.search(r"<NumBCs>4</NumBCs>", text)
