@@ -618,6 +618,19 @@ class RunRecorder:
         atomic_write_json(self.out / "best_design.json", entries[0]["design"])
         self._write_design_files(entries)
 
+    def _vxa_text(self, design: Any, to_vxa: Any) -> str:
+        # the .vxa of a design in the run's world: obstacles on the lattice as the
+        # seed's fixed wall voxels; a world the seed could not hold gives the robot alone
+        from softgym.exceptions import InvalidTerrainError
+
+        seconds = float(self.experiment.seconds)
+        terrain = self.experiment.make_task().terrain_for(design.shape)
+        try:
+            return to_vxa(design, sim_time=seconds, terrain=terrain)
+        except InvalidTerrainError as exc:
+            log.warning("%s: .vxa without the terrain (%s)", self.out, exc)
+            return to_vxa(design, sim_time=seconds)
+
     def _write_design_files(self, entries: list[dict[str, Any]]) -> None:
         """best_design.vxa and best_designs/rank-K_id-N.{json,vxa} (stale ones removed)."""
         from softgym.design import RobotDesign
@@ -631,9 +644,8 @@ class RunRecorder:
             keep.update({f"{stem}.json", f"{stem}.vxa"})
             atomic_write_json(folder / f"{stem}.json", e["design"])
             try:
-                text = to_vxa(
-                    RobotDesign.from_dict(e["design"]), sim_time=float(self.experiment.seconds)
-                )
+                design = RobotDesign.from_dict(e["design"])
+                text = self._vxa_text(design, to_vxa)
             except Exception as exc:  # a design VoxCAD cannot hold must not stop the run
                 log.warning("%s: no .vxa for design %s (%s)", self.out, e["id"], exc)
                 continue
