@@ -180,6 +180,18 @@ def _raise_keyboard_interrupt(signum, frame):  # SIGTERM: stop like Ctrl-C, chec
     raise KeyboardInterrupt
 
 
+def _dask_batch_fn(args: argparse.Namespace, stack):
+    """The evaluation batch function of ``--dask`` (None without it); the client lives in ``stack``."""
+    if not args.dask:
+        return None
+    from evolvers.distributed import DaskBatchFn, dask_client
+
+    _quiet_dask(args.verbose)
+    client = stack.enter_context(dask_client(args.dask, n_workers=args.workers))
+    _quiet_dask(args.verbose)
+    return DaskBatchFn(client)
+
+
 def _quiet_dask(verbose: int) -> None:
     """Dask's own INFO lines only with -v."""
     level = logging.INFO if verbose else logging.WARNING
@@ -201,15 +213,8 @@ def _cmd_evolve(args: argparse.Namespace) -> int:
     try:
         with contextlib.ExitStack() as stack:
             stack.enter_context(logging_redirect_tqdm())
-            batch_fn = None
             try:
-                if args.dask:
-                    from evolvers.distributed import DaskBatchFn, dask_client
-
-                    _quiet_dask(args.verbose)
-                    client = stack.enter_context(dask_client(args.dask, n_workers=args.workers))
-                    _quiet_dask(args.verbose)
-                    batch_fn = DaskBatchFn(client)
+                batch_fn = _dask_batch_fn(args, stack)
                 run = _make_run(args, batch_fn)
                 run.run(resume=args.resume)
             except SoftGymError as exc:
@@ -592,14 +597,7 @@ def _cmd_qd(args: argparse.Namespace) -> int:
     try:
         with contextlib.ExitStack() as stack:
             stack.enter_context(logging_redirect_tqdm())
-            batch_fn = None
-            if args.dask:
-                from evolvers.distributed import DaskBatchFn, dask_client
-
-                _quiet_dask(args.verbose)
-                client = stack.enter_context(dask_client(args.dask, n_workers=args.workers))
-                _quiet_dask(args.verbose)
-                batch_fn = DaskBatchFn(client)
+            batch_fn = _dask_batch_fn(args, stack)
             run = _make_qd_run(args, batch_fn)
             run.run(resume=args.resume)
     except RunInterrupted as exc:
