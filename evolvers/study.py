@@ -66,6 +66,7 @@ __all__ = [
     "get_study",
     "plan",
     "run_one",
+    "run_order",
     "run_status",
     "run_study",
 ]
@@ -96,7 +97,8 @@ class Scenario:
         :class:`~evolvers.experiments.Experiment` field overrides.
     cpu_per_generation : float, optional
         Measured CPU seconds of one generation at the default sizes (one
-        thread): orders the runs longest first and gives ``--plan``'s estimate.
+        thread): orders the runs longest first within a round of seeds and gives
+        ``--plan``'s estimate.
     """
 
     name: str
@@ -407,6 +409,17 @@ def _write_manifest(root: Path, study: str, specs: Sequence[RunSpec]) -> None:
     )  # fmt: skip
 
 
+def run_order(specs: Sequence[RunSpec]) -> list[RunSpec]:
+    """The order runs start in: rounds of seeds, longest run first within a round.
+
+    Seed 0 of every scenario comes before seed 1 of any, so a study stopped
+    part-way (a session ends, a cluster allocation runs out) has results for
+    every scenario rather than all seeds of the longest one; within a round the
+    longest runs start first so the round finishes soonest.
+    """
+    return sorted(specs, key=lambda s: (s.seed, -s.cost))
+
+
 def run_study(
     specs: Sequence[RunSpec],
     workers: int = 1,
@@ -436,7 +449,7 @@ def run_study(
     Returns
     -------
     list of dict
-        The results of :func:`run_one`, longest runs first.
+        The results of :func:`run_one`, in the order of :func:`run_order`.
 
     Raises
     ------
@@ -448,7 +461,7 @@ def run_study(
     roots = {s.out.parent.parent for s in specs}
     for root in roots:
         _write_manifest(root, study, [s for s in specs if s.out.parent.parent == root])
-    ordered = sorted(specs, key=lambda s: -s.cost)
+    ordered = run_order(specs)
     results: list[dict[str, Any]] = []
 
     def done(res: dict[str, Any]) -> None:

@@ -424,7 +424,7 @@ def _cmd_experiments(args: argparse.Namespace) -> int:
 def _cmd_study(args: argparse.Namespace) -> int:
     if getattr(args, "study_command", None) == "report":
         return _cmd_study_report(args)
-    from evolvers.study import get_study, plan, run_status, run_study
+    from evolvers.study import get_study, plan, run_order, run_status, run_study
     from softgym.exceptions import SoftGymError
 
     overrides = {}
@@ -447,7 +447,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
         return 2
     if args.plan:
         todo = 0.0
-        for s in specs:
+        for s in run_order(specs):  # the order the runs start in
             status = run_status(s.out, s.generations)
             todo += 0.0 if status == "complete" else s.cost
             print(f"{s.scenario:24s} seed {s.seed:<4d} {s.generations:4d} generations  "

@@ -9,7 +9,7 @@ from evolver_helpers import tiny
 from evolvers.evaluation import EvalStats
 from evolvers.genome import Individual
 from evolvers.recorder import obstacle_footprint, study_columns
-from evolvers.study import SEED_REPORT, plan, run_status, run_study
+from evolvers.study import SEED_REPORT, plan, run_order, run_status, run_study
 from evolvers.study_report import a12, load_runs, permutation_pvalue
 from softgym.cli import main
 from softgym.exceptions import InvalidParameterError
@@ -81,6 +81,13 @@ def test_plan_defaults_and_errors(tmp_path):
     small = plan(tmp_path, scenarios=["basic"], seeds=3, generations=4, first_seed=7, pop_size=4)
     assert [s.seed for s in small] == [7, 8, 9] and small[0].experiment.pop_size == 4
     assert small[0].out == tmp_path / "basic" / "seed-7"
+    # rounds of seeds: every scenario's seed 0 before any seed 1, longest first within a round
+    order = run_order(specs)
+    first_round = order[: len(SEED_REPORT.scenarios)]
+    assert {s.seed for s in first_round} == {0}
+    assert {s.scenario for s in first_round} == {sc.name for sc in SEED_REPORT.scenarios}
+    assert [s.cost for s in first_round] == sorted((s.cost for s in first_round), reverse=True)
+    assert [s.seed for s in order] == sorted(s.seed for s in order)
     with pytest.raises(InvalidParameterError, match="no scenario"):
         plan(tmp_path, scenarios=["nope"])
     with pytest.raises(InvalidParameterError):
