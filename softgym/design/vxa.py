@@ -27,6 +27,13 @@ Export writes ``TempBase = 25`` and ``TempAmp = 25 + dT`` like the seed when
 that subtraction gives ``dT`` back exactly, and ``TempBase = 0``,
 ``TempAmp = dT`` otherwise, so export then import is exact.
 
+Obstacles: voxels inside a ``<FRegion>`` of ``<Boundary_Conditions>`` that fixes all
+six degrees of freedom (``<DofFixed>63``) are the seed's walls (its obstacle runs
+put 44 of them, material 5, in a 50x50x6 lattice). Import takes them out of the
+robot: :attr:`VxaDocument.terrain` holds them as boxes around the robot's grid,
+which is cropped to the robot's voxels in x and y; ``to_vxa(terrain=...)``
+writes them back the same way.
+
 Every problem with a file raises :class:`~softgym.exceptions.InvalidDesignError`
 naming the offending element.
 """
@@ -38,7 +45,7 @@ import math
 import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 from xml.sax.saxutils import escape
 
 import numpy as np
@@ -47,6 +54,9 @@ from softgym.design.controller import Controller
 from softgym.design.material import MAX_MATERIAL_ID, Material, Palette
 from softgym.design.robot import RobotDesign, _read_capped, check_grid_shape
 from softgym.exceptions import InvalidDesignError, InvalidParameterError
+
+if TYPE_CHECKING:
+    from softgym.terrain import Terrain
 
 __all__ = [
     "MAX_VXA_BYTES",
@@ -74,18 +84,25 @@ class VxaDocument:
     Attributes
     ----------
     design : RobotDesign
-        Structure, palette and controller.
+        Structure, palette and controller of the robot (the file's fixed
+        obstacle voxels taken out, the grid cropped to the robot in x and y).
     voxel_size : float
         ``<Lattice_Dim>`` (m); 0.01 if absent.
     settings : dict of str to str
         Text of every other leaf element of ``<Simulator>`` and
         ``<Environment>`` by tag (e.g. ``"StopConditionValue": "5"``), for
         callers that want the simulation settings.
+    terrain : Terrain or None
+        The file's fixed obstacle voxels (those inside a ``<FRegion>`` with
+        ``<DofFixed>63``) as boxes in voxel lengths around :attr:`design`'s
+        grid, one per region, or None when it has none: what
+        ``to_vxa(design, terrain=...)`` wrote, and the seed's fence.
     """
 
     design: RobotDesign
     voxel_size: float = 0.01
     settings: dict[str, str] = field(default_factory=dict)
+    terrain: Terrain | None = None
 
 
 # --------------------------------------------------------------------------------------------
@@ -212,6 +229,62 @@ def _parse_structure(structure: ET.Element) -> np.ndarray:
     return grid
 
 
+def _fixed_regions(root: ET.Element, shape: tuple[int, ...]) -> list[np.ndarray]:
+    # voxel masks of the <FRegion>s that fix all six degrees of freedom: a voxel
+    # belongs to a region when its centre lies in the region's box (fractions of
+    # the lattice, as VoxCAD places them)
+    masks = []
+    bcs = root.find("Environment/Boundary_Conditions")
+    if bcs is None:
+        return masks
+    centres = [(np.arange(n) + 0.5) / n for n in shape]
+    for k, reg in enumerate(bcs.findall("FRegion")):
+        where = f"<FRegion> {k} of <Boundary_Conditions>"
+        if reg.find("DofFixed") is None or _int(reg.find("DofFixed"), f"<DofFixed> of {where}") != 63:
+            continue
+        if reg.find("PrimType") is not None and _int(reg.find("PrimType"), f"<PrimType> of {where}") != 0:
+            continue  # only boxes (PrimType 0) hold the seed's walls
+        lo = [_number(reg.find(t), f"<{t}> of {where}") for t in ("X", "Y", "Z")]
+        size = [_number(reg.find(t), f"<{t}> of {where}") for t in ("dX", "dY", "dZ")]
+        inside = [(c >= a - 1e-9) & (c <= a + d + 1e-9) for c, a, d in zip(centres, lo, size)]
+        masks.append(inside[0][:, None, None] & inside[1][None, :, None] & inside[2][None, None, :])
+    return masks
+
+
+def _split_obstacles(grid: np.ndarray, masks: list[np.ndarray]) -> tuple[np.ndarray, Terrain | None]:
+    # the robot's grid (fixed voxels removed, cropped in x and y) and the fixed
+    # voxels as terrain boxes around it
+    from softgym.terrain import Box, Terrain
+
+    fixed = np.zeros(grid.shape, dtype=bool)
+    for m in masks:
+        fixed |= m & (grid > 0)
+    if not fixed.any():
+        return grid, None
+    robot = np.where(fixed, 0, grid).astype(np.int8)
+    filled = np.argwhere(robot > 0)
+    if filled.size == 0:
+        raise InvalidDesignError("every voxel of <Data> is a fixed obstacle voxel (<FRegion> with DofFixed 63): no robot")
+    lo = filled.min(axis=0)
+    hi = filled.max(axis=0) + 1
+    off = np.array([lo[0], lo[1], 0])
+    robot = robot[lo[0]:hi[0], lo[1]:hi[1], : hi[2]]
+    boxes = []
+    taken = np.zeros(grid.shape, dtype=bool)
+    for m in masks:
+        cells = m & fixed & ~taken
+        if not cells.any():
+            continue
+        taken |= cells
+        idx = np.argwhere(cells)
+        a, b = idx.min(axis=0), idx.max(axis=0) + 1
+        if cells[a[0]:b[0], a[1]:b[1], a[2]:b[2]].all():
+            boxes.append(Box(tuple(float(v) for v in a - off), tuple(float(v) for v in b - off)))
+        else:  # a region that is not a full box: one box per voxel
+            boxes += [Box(tuple(float(v) for v in c - off), tuple(float(v) for v in c - off + 1)) for c in idx]
+    return robot, Terrain.from_boxes(boxes, name="vxa obstacles")
+
+
 def parse_vxa(text: str | bytes) -> VxaDocument:
     """Parse the text of a ``.vxa`` file.
 
@@ -272,6 +345,7 @@ def parse_vxa(text: str | bytes) -> VxaDocument:
     if not materials:
         raise InvalidDesignError("<Palette> defines no <Material>")
     grid = _parse_structure(_find(vxc, "Structure", "<VXC>"))
+    grid, terrain = _split_obstacles(grid, _fixed_regions(root, grid.shape))
     used = sorted(int(v) for v in np.unique(grid) if v != 0)
     missing = [v for v in used if v not in materials]
     if missing:
@@ -327,11 +401,13 @@ def parse_vxa(text: str | bytes) -> VxaDocument:
         for el in section.iter():
             if len(el) == 0 and el is not section and el.text is not None and el.text.strip():
                 settings[el.tag] = el.text.strip()
-    return VxaDocument(design=design, voxel_size=voxel_size, settings=settings)
+    return VxaDocument(design=design, voxel_size=voxel_size, settings=settings, terrain=terrain)
 
 
 def from_vxa(text: str | bytes) -> RobotDesign:
-    """The :class:`RobotDesign` of a ``.vxa`` file's text; see :func:`parse_vxa`."""
+    """The :class:`RobotDesign` of a ``.vxa`` file's text (its robot: fixed obstacle
+    voxels are :attr:`VxaDocument.terrain` of :func:`parse_vxa`).
+    """
     return parse_vxa(text).design
 
 

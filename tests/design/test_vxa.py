@@ -211,14 +211,59 @@ def test_to_vxa_writes_a_terrain_as_the_seeds_fixed_obstacle_voxels():
     from softgym.terrain import Box, Terrain
 
     walker = default_walker()
-    text = to_vxa(walker, terrain=Terrain.fence(center=(3, 3)))
-    grid = parse_vxa(text).design.grid
-    assert grid.shape == (12, 12, 6) and int((grid == 5).sum()) == 44
-    np.testing.assert_array_equal(grid[3:9, 3:9, :], walker.grid)
+    fence = Terrain.fence(center=(3, 3))
+    text = to_vxa(walker, terrain=fence)
+    layers = re.findall(r"<Layer><!\[CDATA\[(.*?)\]\]></Layer>", text) or re.findall(r"<Layer>(.*?)</Layer>", text)
+    assert len(layers) == 6 and len(layers[0]) == 12 * 12  # the widened lattice
+    assert sum(layer.count("5") for layer in layers) == 44
     assert text.count("<DofFixed>63</DofFixed>") == 4
+    # import takes the fixed voxels back out of the robot, as the same boxes
+    doc = parse_vxa(text)
+    np.testing.assert_array_equal(doc.design.grid, walker.grid)
+    assert doc.terrain is not None
+    assert sorted((b.lo, b.hi) for b in doc.terrain.boxes) == sorted((b.lo, b.hi) for b in fence.boxes)
+    assert parse_vxa(to_vxa(walker)).terrain is None
     assert to_vxa(walker, terrain=Terrain.flat()) == to_vxa(walker)
     with pytest.raises(InvalidTerrainError, match="off the lattice"):
         to_vxa(walker, terrain=Terrain.from_boxes([Box((7.5, 0, 0), (9, 6, 1))]))
     with pytest.raises(InvalidTerrainError, match="overlaps the robot"):
         to_vxa(walker, terrain=Terrain.from_boxes([Box((5, 0, 0), (9, 6, 1))]))
     assert re.search(r"<NumBCs>4</NumBCs>", text)
+
+
+def test_the_seeds_own_obstacle_workspace_reads_as_robot_plus_fence():
+    # the seed's obstacle runs (SEED_REFERENCE 3.5): a 50x50x6 lattice, the robot at
+    # voxel (22, 22, 0), 44 wall voxels of material 5 fixed by four regions
+    import numpy as np
+
+    from softgym.design import default_walker
+    from softgym.design.vxa import parse_vxa, to_vxa
+    from softgym.terrain import Terrain
+
+    walker = default_walker()
+    small = to_vxa(walker, terrain=Terrain.fence(center=(3, 3)))
+    doc = parse_vxa(small)
+    big = np.zeros((50, 50, 6), dtype=np.int8)
+    big[22:28, 22:28, :] = walker.grid
+    wall = np.zeros((50, 50, 6), dtype=bool)
+    wall[19:31, 19:31, 0] = True
+    wall[20:30, 20:30, 0] = False
+    big[wall] = 5
+    layers = "".join(
+        "<Layer>" + "".join(str(int(v)) for v in big[:, :, z].T.ravel()) + "</Layer>" for z in range(6)
+    )
+    regions = [(19, 19, 12, 1), (19, 30, 12, 1), (19, 20, 1, 10), (30, 20, 1, 10)]
+    bcs = "".join(
+        f"<FRegion><PrimType>0</PrimType><X>{x / 50}</X><Y>{y / 50}</Y><Z>0</Z><dX>{dx / 50}</dX>"
+        f"<dY>{dy / 50}</dY><dZ>{1 / 6}</dZ><DofFixed>63</DofFixed></FRegion>"
+        for x, y, dx, dy in regions
+    )
+    text = re.sub(r"<X_Voxels>\d+</X_Voxels>", "<X_Voxels>50</X_Voxels>", small)
+    text = re.sub(r"<Y_Voxels>\d+</Y_Voxels>", "<Y_Voxels>50</Y_Voxels>", text)
+    text = re.sub(r"<Data>.*</Data>", f"<Data>{layers}</Data>", text, flags=re.S)
+    text = re.sub(r"<Boundary_Conditions>.*</Boundary_Conditions>",
+                  f"<Boundary_Conditions><NumBCs>4</NumBCs>{bcs}</Boundary_Conditions>", text, flags=re.S)
+    seed = parse_vxa(text)
+    np.testing.assert_array_equal(seed.design.grid, walker.grid)
+    assert sorted((b.lo, b.hi) for b in seed.terrain.boxes) == sorted((b.lo, b.hi) for b in doc.terrain.boxes)
+    assert sum(np.prod(b.size) for b in seed.terrain.boxes) == 44
