@@ -47,7 +47,7 @@ from evolvers.evaluation import BatchFn, EvalStats, Evaluator, PhenotypeCache, p
 from evolvers.experiments import Experiment, smoke_sizes
 from evolvers.genome import Individual
 from evolvers.operators import mut_controller, mut_cppn, mut_materials, set_counterphase
-from evolvers.recorder import RunRecorder, population_summary
+from evolvers.recorder import RecordedRun, RunRecorder, population_summary
 from evolvers.selection import Objective, minimised_matrix
 from softgym.design import CompositionRules, Controller
 from softgym.exceptions import CheckpointError, InvalidParameterError
@@ -346,7 +346,7 @@ def _algorithm_label(algorithm: Any) -> str:
     return getattr(algorithm, "__name__", type(algorithm).__name__)
 
 
-class PymooRun:
+class PymooRun(RecordedRun):
     """An experiment run with a pymoo algorithm through ask and tell (see the module docstring).
 
     Same run folder, log, figures and checkpoints as every driver
@@ -420,26 +420,6 @@ class PymooRun:
         self.algorithm: Algorithm | None = None
         self.generation = -1
         self.population: list[Individual] = []
-
-    # ------------------------------------------------------------------ the record
-    @property
-    def rows(self) -> list[dict[str, Any]]:
-        """The log rows so far (one per generation)."""
-        return self.recorder.rows
-
-    @property
-    def hall_of_fame(self) -> list[dict[str, Any]]:
-        """The best individuals so far (plain data, best first)."""
-        return self.recorder.hall_of_fame
-
-    @property
-    def evaluations_total(self) -> int:
-        """Simulations run so far."""
-        return self.recorder.evaluations_total
-
-    def best(self) -> Individual:
-        """The best individual found so far (by the first objective)."""
-        return self.recorder.best()
 
     # ------------------------------------------------------------------ the loop
     def _fresh(self) -> tuple[SoftbotProblem, Algorithm]:

@@ -65,7 +65,7 @@ from evolvers.experiments import Experiment, smoke_sizes
 from evolvers.genome import Individual
 from evolvers.operators import make_children
 from evolvers.pymoo_runner import IdCounter
-from evolvers.recorder import RunRecorder
+from evolvers.recorder import RecordedRun, RunRecorder
 from softgym.exceptions import CheckpointError, InvalidParameterError
 from softgym.io import (
     atomic_write_json,
@@ -340,7 +340,7 @@ class SoftbotEmitter(EmitterBase):
         self.improved_cells = len(np.unique(cells[status == 1]))
 
 
-class QDRun:
+class QDRun(RecordedRun):
     """A resumable MAP-Elites run of an experiment's robots (see the module docstring).
 
     ``generations`` counts the batches after generation 0 (the first, random
@@ -416,25 +416,6 @@ class QDRun:
         self.generation = -1
 
     # ------------------------------------------------------------------ the record
-    @property
-    def rows(self) -> list[dict[str, Any]]:
-        """The log rows so far (one per generation)."""
-        return self.recorder.rows
-
-    @property
-    def hall_of_fame(self) -> list[dict[str, Any]]:
-        """The best individuals so far (plain data, best first)."""
-        return self.recorder.hall_of_fame
-
-    @property
-    def evaluations_total(self) -> int:
-        """Simulations run so far."""
-        return self.recorder.evaluations_total
-
-    def best(self) -> Individual:
-        """The best individual found so far (by the experiment's fitness)."""
-        return self.recorder.best()
-
     def elites(self) -> list[Individual]:
         """The archive's elites in cell-index order."""
         return list(_elite_data(self.archive)["solution"])

@@ -32,7 +32,13 @@ from evolvers.evaluation import (
 from evolvers.experiments import Experiment, smoke_sizes
 from evolvers.genome import Individual
 from evolvers.operators import make_children
-from evolvers.recorder import RUN_SCHEMA, RunInterrupted, RunRecorder, population_summary
+from evolvers.recorder import (
+    RUN_SCHEMA,
+    RecordedRun,
+    RunInterrupted,
+    RunRecorder,
+    population_summary,
+)
 from evolvers.selection import (
     sel_fitness_tournament,
     sel_novelty,
@@ -51,7 +57,7 @@ from softgym.metrics import NoveltyArchive
 __all__ = ["RUN_SCHEMA", "EvolutionRun", "RunInterrupted", "population_summary"]
 
 
-class EvolutionRun:
+class EvolutionRun(RecordedRun):
     """A resumable evolutionary run of an :class:`~evolvers.experiments.Experiment` (native backend).
 
     Parameters
@@ -136,38 +142,9 @@ class EvolutionRun:
 
     # ------------------------------------------------------------------ the record
     @property
-    def rows(self) -> list[dict[str, Any]]:
-        """The log rows so far (one per generation)."""
-        return self.recorder.rows
-
-    @property
-    def hall_of_fame(self) -> list[dict[str, Any]]:
-        """The best individuals so far (plain data, best first)."""
-        return self.recorder.hall_of_fame
-
-    @property
-    def evaluations_total(self) -> int:
-        """Simulations run so far."""
-        return self.recorder.evaluations_total
-
-    @property
-    def wall_total(self) -> float:
-        """Wall time (s) of the generations so far."""
-        return self.recorder.wall_total
-
-    @property
     def config(self) -> dict[str, Any]:
         """What config.json records (and --resume checks)."""
         return dict(self.recorder.config)
-
-    @property
-    def checkpoint_dir(self) -> Path:
-        """Folder of the checkpoints."""
-        return self.recorder.checkpoint_dir
-
-    def best(self) -> Individual:
-        """The best individual found so far (by the first objective)."""
-        return self.recorder.best()
 
     # ------------------------------------------------------------------ backend hooks
     def _setup_backend(self) -> None:
