@@ -11,7 +11,16 @@ Contact between a voxel and a box uses the floor's laws: penalty normal force
 ``2 E L p`` on the voxel's penetration ``p`` of the box (treating the voxel as a
 sphere of its half actuated size), collision damping, and static/kinetic
 Coulomb friction with the voxel's coefficients, so a robot is stopped by a
-wall's side and can stand on its top.
+wall's side and can stand on its top. In the engine's ``"seed"`` model, boxes
+with integer corners become the seed's fixed wall voxels instead (its fence),
+unless the terrain says ``box_contact="surface"``.
+
+A terrain may also hold movable :class:`Block` objects: passive voxel bodies
+(a box to push, a cap to carry) simulated with each robot as a second
+component of its simulation entry. They touch the robot through the
+self-collision law, rest on the floor and boxes like voxels do, and are left
+out of the robot's centre of mass, actuation and metrics (except the task
+measures that read them).
 """
 
 from __future__ import annotations
@@ -27,7 +36,17 @@ import numpy as np
 
 from softgym.exceptions import InvalidTerrainError
 
-__all__ = ["MAX_BOXES", "MAX_COORDINATE", "MAX_TERRAIN_JSON_BYTES", "Box", "Terrain"]
+__all__ = [
+    "BOX_CONTACTS",
+    "MAX_BLOCK_DIM",
+    "MAX_BOXES",
+    "MAX_COORDINATE",
+    "MAX_OBJECTS",
+    "MAX_TERRAIN_JSON_BYTES",
+    "Block",
+    "Box",
+    "Terrain",
+]
 
 SCHEMA = "softgym.terrain"
 VERSION = 1
@@ -38,6 +57,14 @@ MAX_BOXES = 1000
 MAX_COORDINATE = 1e6
 #: Largest terrain JSON text (bytes) :meth:`Terrain.from_json` reads.
 MAX_TERRAIN_JSON_BYTES = 4 * 2**20
+#: Most movable blocks a terrain may hold.
+MAX_OBJECTS = 16
+#: Largest side of a block's grid (voxels).
+MAX_BLOCK_DIM = 32
+#: How boxes touch voxels: ``"auto"`` (the engine's ``"seed"`` model turns boxes with integer
+#: corners into the seed's fixed wall voxels, frictionless; otherwise penalty contact with
+#: friction) or ``"surface"`` (always the penalty contact with friction: ground to walk on).
+BOX_CONTACTS: tuple[str, ...] = ("auto", "surface")
 
 
 def _number(name: str, value: Any) -> float:
@@ -101,6 +128,146 @@ class Box:
         return all(self.lo[k] < hi[k] and lo[k] < self.hi[k] for k in range(3))
 
 
+def _positive(name: str, value: Any) -> float:
+    v = _number(name, value)
+    if not v > 0:
+        raise InvalidTerrainError(f"{name} must be > 0, got {v}")
+    return v
+
+
+@dataclass(frozen=True, eq=False)
+class Block:
+    """A passive, movable voxel body of one material (a box to push, a cap to carry).
+
+    Parameters
+    ----------
+    origin : sequence of 3 floats
+        Corner of the block's grid (voxel lengths): cell (i, j, k) has its
+        centre at ``origin + (i + 0.5, j + 0.5, k + 0.5)``. It may be off the
+        lattice (e.g. half a voxel from the robot, the self-contact envelope).
+    shape : sequence of 3 ints
+        Grid size (voxels), each in 1..:data:`MAX_BLOCK_DIM`.
+    cells : array_like of bool of shape ``shape``, optional
+        Filled cells (default all): any 6-connected shape.
+    youngs_modulus, density : float
+        Pa and kg/m^3 (> 0); the seed's tissue is 5e6 Pa and 1e6 kg/m^3. A
+        stiffer or lighter block than the robot shortens the time step.
+    poisson : float
+        Poisson's ratio in [0, 0.5).
+    mu_static, mu_kinetic : float
+        Friction coefficients against the floor and boxes (>= 0).
+    """
+
+    origin: tuple[float, float, float]
+    shape: tuple[int, int, int] = (1, 1, 1)
+    cells: Any = None
+    youngs_modulus: float = 5e6
+    density: float = 1e6
+    poisson: float = 0.35
+    mu_static: float = 1.0
+    mu_kinetic: float = 0.5
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "origin", _point("block origin", self.origin))
+        shape = self.shape
+        if (
+            isinstance(shape, (str, bytes))
+            or not isinstance(shape, (Sequence, np.ndarray))
+            or len(shape) != 3
+            or any(
+                isinstance(v, (bool, np.bool_))
+                or not isinstance(v, (int, np.integer))
+                or not 1 <= v <= MAX_BLOCK_DIM
+                for v in shape
+            )
+        ):
+            raise InvalidTerrainError(
+                f"block shape must be 3 integers, each in 1..{MAX_BLOCK_DIM}, got {shape!r:.80}"
+            )
+        shape = tuple(int(v) for v in shape)
+        object.__setattr__(self, "shape", shape)
+        if self.cells is None:
+            cells = np.ones(shape, dtype=bool)
+        else:
+            try:
+                cells = np.asarray(self.cells)
+            except (TypeError, ValueError):
+                raise InvalidTerrainError("block cells must be an array of bools") from None
+            if cells.shape != shape or cells.dtype.kind not in "biu":
+                raise InvalidTerrainError(
+                    f"block cells must be bools of shape {shape}, got {cells.dtype} {cells.shape}"
+                )
+            cells = cells.astype(bool)
+        if not cells.any():
+            raise InvalidTerrainError("a block needs at least one filled cell")
+        cells.setflags(write=False)
+        object.__setattr__(self, "cells", cells)
+        for name in ("youngs_modulus", "density"):
+            object.__setattr__(self, name, _positive(f"block {name}", getattr(self, name)))
+        nu = _number("block poisson", self.poisson)
+        if not 0.0 <= nu < 0.5:
+            raise InvalidTerrainError(f"block poisson must be in [0, 0.5), got {nu}")
+        object.__setattr__(self, "poisson", nu)
+        for name in ("mu_static", "mu_kinetic"):
+            v = _number(f"block {name}", getattr(self, name))
+            if v < 0:
+                raise InvalidTerrainError(f"block {name} must be >= 0, got {v}")
+            object.__setattr__(self, name, v)
+
+    @classmethod
+    def box(cls, lo: Sequence[float], size: Sequence[int], **material: Any) -> Block:
+        """A full box of ``size`` voxels with its corner at ``lo`` (voxel lengths)."""
+        return cls(tuple(lo), tuple(size), None, **material)
+
+    @property
+    def n_voxels(self) -> int:
+        """Filled cells."""
+        return int(np.count_nonzero(self.cells))
+
+    @property
+    def lo(self) -> tuple[float, float, float]:
+        """Minimum corner of its grid (voxel lengths)."""
+        return self.origin
+
+    @property
+    def hi(self) -> tuple[float, float, float]:
+        """Maximum corner of its grid (voxel lengths)."""
+        return tuple(o + s for o, s in zip(self.origin, self.shape))
+
+    @property
+    def center(self) -> np.ndarray:
+        """Centre of its filled cells (voxel lengths), shape (3,): its centre of mass at rest."""
+        return np.asarray(self.origin) + np.argwhere(self.cells).mean(axis=0) + 0.5
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain-JSON dict."""
+        out: dict[str, Any] = {"origin": list(self.origin), "shape": list(self.shape)}
+        if not self.cells.all():
+            out["cells"] = self.cells.astype(int).tolist()
+        for name in ("youngs_modulus", "density", "poisson", "mu_static", "mu_kinetic"):
+            out[name] = getattr(self, name)
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Any) -> Block:
+        """Inverse of :meth:`to_dict`."""
+        known = {"origin", "shape", "cells", "youngs_modulus", "density", "poisson",
+                 "mu_static", "mu_kinetic"}  # fmt: skip
+        if not isinstance(data, dict) or "origin" not in data or set(data) - known:
+            raise InvalidTerrainError(
+                f"a block is an object with 'origin' and optional {sorted(known - {'origin'})}, "
+                f"got {data!r:.80}"
+            )
+        return cls(**data)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Block):
+            return NotImplemented
+        return self.to_dict() == other.to_dict()
+
+    __hash__ = None  # type: ignore[assignment]
+
+
 @dataclass(frozen=True)
 class Terrain:
     """A floor at z = 0 (optional) and a list of static boxes.
@@ -110,15 +277,27 @@ class Terrain:
     boxes : sequence of Box
         Obstacles, in voxel lengths.
     floor : bool
-        Whether the floor plane z = 0 is present.
+        Whether the floor plane z = 0 is present (without it, boxes are the
+        only ground: platforms over a pit, a world under water).
     name : str
         A label for figures and logs.
+    meta : dict
+        What built it (builder name and arguments), for logs; not compared.
+    objects : sequence of Block
+        Movable passive bodies (at most :data:`MAX_OBJECTS`).
+    box_contact : {"auto", "surface"}
+        How boxes touch voxels (:data:`BOX_CONTACTS`): ``"surface"`` keeps
+        the penalty contact with friction in every engine model (ground to
+        walk on); ``"auto"`` lets the ``"seed"`` model make lattice boxes
+        the seed's frictionless wall voxels.
     """
 
     boxes: tuple[Box, ...] = ()
     floor: bool = True
     name: str = "flat"
     meta: dict[str, Any] = field(default_factory=dict, compare=False)
+    objects: tuple[Block, ...] = ()
+    box_contact: str = "auto"
 
     def __post_init__(self) -> None:
         if isinstance(self.boxes, (str, bytes)) or not isinstance(self.boxes, (Sequence, np.ndarray)):
@@ -143,6 +322,25 @@ class Terrain:
             raise InvalidTerrainError(f"terrain meta must be a dict, got {self.meta!r:.80}")
         object.__setattr__(self, "boxes", tuple(boxes))
         object.__setattr__(self, "floor", bool(self.floor))
+        if isinstance(self.objects, (str, bytes)) or not isinstance(self.objects, (Sequence, np.ndarray)):
+            raise InvalidTerrainError(f"terrain objects must be a sequence, got {self.objects!r:.80}")
+        if len(self.objects) > MAX_OBJECTS:
+            raise InvalidTerrainError(
+                f"a terrain holds at most {MAX_OBJECTS} objects, got {len(self.objects)}"
+            )
+        objects = []
+        for k, o in enumerate(self.objects):
+            if isinstance(o, Block):
+                objects.append(o)
+            elif isinstance(o, dict):
+                objects.append(Block.from_dict(o))
+            else:
+                raise InvalidTerrainError(f"object {k} must be a Block, got {o!r:.80}")
+        object.__setattr__(self, "objects", tuple(objects))
+        if not isinstance(self.box_contact, str) or self.box_contact not in BOX_CONTACTS:
+            raise InvalidTerrainError(
+                f"terrain box_contact must be one of {BOX_CONTACTS}, got {self.box_contact!r:.80}"
+            )
 
     # ------------------------------------------------------------- builders
     @classmethod
@@ -255,6 +453,15 @@ class Terrain:
                     f"box {k} {box.lo}-{box.hi} overlaps the robot's start region "
                     f"{tuple(robot_lo)}-{tuple(robot_hi)}"
                 )
+        for k, obj in enumerate(self.objects):
+            if all(obj.lo[a] < robot_hi[a] and robot_lo[a] < obj.hi[a] for a in range(3)):
+                cells = np.argwhere(obj.cells) + np.asarray(obj.origin)
+                inside = np.all((cells + 1 > np.asarray(robot_lo)) & (cells < np.asarray(robot_hi)), axis=1)
+                if inside.any():
+                    raise InvalidTerrainError(
+                        f"object {k} at {obj.origin} overlaps the robot's start region "
+                        f"{tuple(robot_lo)}-{tuple(robot_hi)}"
+                    )
 
     def as_array(self, voxel_size: float) -> np.ndarray:
         """Boxes in metres, ndarray of shape (n_boxes, 6): (x0, y0, z0, x1, y1, z1)."""
@@ -264,8 +471,8 @@ class Terrain:
 
     # ----------------------------------------------------------------- JSON
     def to_dict(self) -> dict[str, Any]:
-        """Plain-JSON dictionary with a schema version."""
-        return {
+        """Plain-JSON dictionary with a schema version (``objects`` and ``box_contact`` when set)."""
+        out = {
             "schema": SCHEMA,
             "version": VERSION,
             "name": self.name,
@@ -273,6 +480,11 @@ class Terrain:
             "boxes": [{"lo": list(b.lo), "hi": list(b.hi)} for b in self.boxes],
             "meta": self.meta,
         }
+        if self.objects:
+            out["objects"] = [o.to_dict() for o in self.objects]
+        if self.box_contact != "auto":
+            out["box_contact"] = self.box_contact
+        return out
 
     def to_json(self) -> str:
         """JSON text of :meth:`to_dict`."""
@@ -288,7 +500,8 @@ class Terrain:
             raise InvalidTerrainError(
                 f"terrain file version {version!r:.40} is not supported (this softgym reads 1..{VERSION})"
             )
-        unknown = set(data) - {"schema", "version", "name", "floor", "boxes", "meta"}
+        unknown = set(data) - {"schema", "version", "name", "floor", "boxes", "meta", "objects",
+                               "box_contact"}
         if unknown:
             raise InvalidTerrainError(f"unknown terrain field(s) {sorted(map(str, unknown))}")
         raw_boxes = data.get("boxes")
@@ -308,8 +521,12 @@ class Terrain:
                 boxes.append(Box(b["lo"], b["hi"]))
             except InvalidTerrainError as exc:
                 raise InvalidTerrainError(f"terrain box {k}: {exc}") from None
+        objects = data.get("objects", [])
+        if not isinstance(objects, list):
+            raise InvalidTerrainError(f"terrain 'objects' must be a list, got {objects!r:.80}")
         return cls(tuple(boxes), data.get("floor", True), data.get("name", "boxes"),
-                   data.get("meta", {}))  # fmt: skip
+                   data.get("meta", {}), tuple(Block.from_dict(o) for o in objects),
+                   data.get("box_contact", "auto"))  # fmt: skip
 
     @classmethod
     def from_json(cls, text: str | bytes) -> Terrain:

@@ -4,6 +4,7 @@ One :class:`Simulation` holds many robots (:class:`Body`) in flat arrays and
 advances them in parallel; :meth:`Simulation.run` returns a :class:`Rollout`.
 """
 
+from softgym.engine._core import AUX_NAMES
 from softgym.engine._openmp import omp_max_threads, openmp_enabled
 from softgym.engine.body import Body
 from softgym.engine.config import SimConfig
@@ -17,6 +18,7 @@ from softgym.engine.simulation import (
 )
 
 __all__ = [
+    "AUX_NAMES",
     "Body",
     "Rollout",
     "SimConfig",

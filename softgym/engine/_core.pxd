@@ -29,6 +29,8 @@ cdef struct Batch:
     int32 model              # 0: seed (the seed engine's step, see _core.pyx); 1: corotational
     float64_t bond_zeta      # the seed's BondDampingZ (model 0's finite-difference link damping)
     intp_t trace_capacity    # samples allocated per robot in trace_t / trace_cm
+    float64_t fluid_drag     # 1/2 rho C_d of a surrounding fluid (kg/m^3): quadratic drag on
+                             # each exposed face moving into it; 0: no fluid
 
     # ---- per robot ----------------------------------------------------------
     intp_t* vox_start        # (n_robots + 1,) robot r owns voxels [vox_start[r], vox_start[r+1])
@@ -51,6 +53,10 @@ cdef struct Batch:
     intp_t* trace_n          # (n_robots,) samples recorded
     float64_t* trace_t       # (n_robots, trace_capacity) sample times (s)
     float64_t* trace_cm      # (n_robots, trace_capacity, 3) sampled CM (m)
+    intp_t* body_end         # (n_robots,) robot r's own voxels are [vox_start[r], body_end[r]); the
+                             # rest of its range are passive objects (CTE 0, outside its CM)
+    float64_t* aux_init      # (n_robots, N_AUX) robot_aux when cm_init was recorded
+    float64_t* trace_aux     # (n_robots, trace_capacity, N_AUX) robot_aux at each CM sample
 
     # ---- per voxel ------------------------------------------------------------
     float64_t* pos           # (n_voxels, 3) centre position (m)
@@ -79,6 +85,8 @@ cdef struct Batch:
     flag_t* surface          # (n_voxels,) 1: misses a face bond (takes part in self-collision)
     intp_t* excl_start       # (n_voxels + 1,) CSR rows of voxels that never collide with voxel i
     intp_t* excl_idx         # (excl_start[-1],) their indices, sorted within each row
+    flag_t* faces            # (n_voxels,) exposed faces in the voxel's frame: bit 2a the -a face,
+                             # bit 2a + 1 the +a face (a = 0, 1, 2 for x, y, z); for fluid drag
 
     # ---- per link (beam between face neighbours v1 -> v2 along +axis) ------
     intp_t n_links           # links in the batch
@@ -130,6 +138,14 @@ cdef struct Contacts:
     KeyIndex* ocells         # (n_obs_r,) obstacles sorted by spatial-hash cell
 
 
+# What robot_aux reports (columns of aux_init / trace_aux).
+cdef enum:
+    N_AUX = 10               # objects' CM (3, m; 0 without objects), heading sum (2: the mass-
+                             # weighted x axes of the robot's voxels, x and y), bounding box of the
+                             # robot's voxel centres (5, m: x lo, x hi, y lo, y hi, z hi)
+
+
 cdef int advance_robot(Batch* b, intp_t r, step_t target, Contacts* c) noexcept nogil
 cdef void robot_cm(Batch* b, intp_t r, float64_t* out) noexcept nogil
+cdef void robot_aux(Batch* b, intp_t r, float64_t* out) noexcept nogil
 cdef void robot_energy(Batch* b, intp_t r, float64_t* out) noexcept nogil

@@ -862,6 +862,28 @@ cdef inline void _surface_contact(Batch* b, intp_t i, float64_t nx, float64_t ny
         f[2] -= fk * vtz
 
 
+cdef inline void _fluid_drag(Batch* b, intp_t i, float64_t* f) noexcept nogil:
+    # Quadratic fluid drag on voxel i's exposed faces (b.faces): a face of area
+    # s^2 moving into the fluid along its outward normal n at speed v.n > 0 takes
+    # -fluid_drag s^2 (v.n)^2 n (fluid_drag = rho C_d / 2); a face moving away
+    # takes none. Applied at the voxel's centre. IN/OUT: f.
+    cdef:
+        const float64_t* R = b.rot + 9 * i
+        const float64_t* v = b.vel + 3 * i
+        float64_t k = b.fluid_drag * b.scale[i] * b.scale[i]
+        float64_t vn, g
+        int32 a, bit
+        int32 exposed = b.faces[i]
+    for a in range(3):
+        vn = v[0] * R[a] + v[1] * R[3 + a] + v[2] * R[6 + a]
+        bit = 2 * a + 1 if vn > 0.0 else 2 * a
+        if exposed & (1 << bit):
+            g = k * vn * fabs(vn)
+            f[0] -= g * R[a]
+            f[1] -= g * R[3 + a]
+            f[2] -= g * R[6 + a]
+
+
 cdef inline float64_t _box_penetration(const float64_t* B, const float64_t* p, float64_t rad,
                                        float64_t* n) noexcept nogil:
     # Penetration (m, > 0 when touching) of a sphere of radius rad centred at p
@@ -941,6 +963,7 @@ cdef inline int _integrate(Batch* b, intp_t r, const float64_t* ref,
         float64_t* qq
         float64_t g = b.gravity
         int32 has_floor = b.floor[r]
+        int32 has_fluid = b.fluid_drag > 0.0
         intp_t k0 = b.box_start[r]
         intp_t k1 = b.box_start[r + 1]
         intp_t vs = b.vox_start[r]
@@ -964,6 +987,8 @@ cdef inline int _integrate(Batch* b, intp_t r, const float64_t* ref,
         my = b.moment[3 * i + 1]
         mz = b.moment[3 * i + 2]
         _clear(b, i)  # the scratch is zero again for the next step
+        if has_fluid:
+            _fluid_drag(b, i, f)
         if has_floor:
             pen = 0.5 * b.scale[i] - pos[3 * i + 2]
             if pen > 0.0:
@@ -1068,6 +1093,7 @@ cdef inline int _integrate_seed(Batch* b, intp_t r, const float64_t* ref,
         float64_t* av = b.angvel
         float64_t* qq
         int32 has_floor = b.floor[r]
+        int32 has_fluid = b.fluid_drag > 0.0
         intp_t k0 = b.box_start[r]
         intp_t k1 = b.box_start[r + 1]
         intp_t vs = b.vox_start[r]
@@ -1087,6 +1113,8 @@ cdef inline int _integrate_seed(Batch* b, intp_t r, const float64_t* ref,
         my = b.moment[3 * i + 1]
         mz = b.moment[3 * i + 2]
         _clear(b, i)
+        if has_fluid:
+            _fluid_drag(b, i, f)
         for k in range(k0, k1):
             pen = _box_penetration(b.boxes + 6 * k, pos + 3 * i, 0.5 * b.scale[i], n)
             if pen > 0.0:
@@ -1553,7 +1581,7 @@ cdef void robot_cm(Batch* b, intp_t r, float64_t* out) noexcept nogil:
     cdef:
         intp_t i
         float64_t sx = 0.0, sy = 0.0, sz = 0.0, m
-    for i in range(b.vox_start[r], b.vox_start[r + 1]):
+    for i in range(b.vox_start[r], b.body_end[r]):  # its objects excluded
         m = b.mass[i]
         sx += m * b.pos[3 * i]
         sy += m * b.pos[3 * i + 1]
@@ -1562,6 +1590,47 @@ cdef void robot_cm(Batch* b, intp_t r, float64_t* out) noexcept nogil:
     out[0] = sx * m
     out[1] = sy * m
     out[2] = sz * m
+
+
+cdef void robot_aux(Batch* b, intp_t r, float64_t* out) noexcept nogil:
+    # OUT: out[0:N_AUX] (see _core.pxd): the objects' centre of mass, the
+    # robot's heading sum and the bounding box of its voxel centres.
+    cdef:
+        intp_t i, k
+        intp_t be = b.body_end[r]
+        float64_t m, mo = 0.0
+    for k in range(N_AUX):
+        out[k] = 0.0
+    out[5] = b.pos[3 * b.vox_start[r]]
+    out[6] = out[5]
+    out[7] = b.pos[3 * b.vox_start[r] + 1]
+    out[8] = out[7]
+    out[9] = b.pos[3 * b.vox_start[r] + 2]
+    for i in range(b.vox_start[r], be):
+        m = b.mass[i]
+        out[3] += m * b.rot[9 * i]
+        out[4] += m * b.rot[9 * i + 3]
+        if b.pos[3 * i] < out[5]:
+            out[5] = b.pos[3 * i]
+        if b.pos[3 * i] > out[6]:
+            out[6] = b.pos[3 * i]
+        if b.pos[3 * i + 1] < out[7]:
+            out[7] = b.pos[3 * i + 1]
+        if b.pos[3 * i + 1] > out[8]:
+            out[8] = b.pos[3 * i + 1]
+        if b.pos[3 * i + 2] > out[9]:
+            out[9] = b.pos[3 * i + 2]
+    for i in range(be, b.vox_start[r + 1]):
+        m = b.mass[i]
+        mo += m
+        out[0] += m * b.pos[3 * i]
+        out[1] += m * b.pos[3 * i + 1]
+        out[2] += m * b.pos[3 * i + 2]
+    if mo > 0.0:
+        mo = 1.0 / mo
+        out[0] *= mo
+        out[1] *= mo
+        out[2] *= mo
 
 
 cdef inline void _record(Batch* b, intp_t r) noexcept nogil:
@@ -1577,6 +1646,7 @@ cdef inline void _record(Batch* b, intp_t r) noexcept nogil:
         b.cm_init[3 * r] = cm[0]
         b.cm_init[3 * r + 1] = cm[1]
         b.cm_init[3 * r + 2] = cm[2]
+        robot_aux(b, r, b.aux_init + N_AUX * r)
         b.init_done[r] = 1
     # sample k at the first step with t >= k * trace_interval (to within 1e-6 dt)
     while (b.trace_n[r] < b.trace_capacity
@@ -1589,6 +1659,7 @@ cdef inline void _record(Batch* b, intp_t r) noexcept nogil:
         b.trace_cm[3 * k] = cm[0]
         b.trace_cm[3 * k + 1] = cm[1]
         b.trace_cm[3 * k + 2] = cm[2]
+        robot_aux(b, r, b.trace_aux + N_AUX * k)
         b.trace_n[r] += 1
 
 
@@ -1777,6 +1848,7 @@ KERNEL_ARRAYS = (
     "seed_rank", "col_ref", "col_acc", "col_vmax", "obs_start", "obs", "obs_rank",
     "link_out", "v1", "v2", "axis", "k_axial", "k_torsion", "k_bend", "c_axial", "c_torsion",
     "c_bend", "c_seed", "homog", "link_sa", "link_last",
+    "body_end", "aux_init", "trace_aux", "faces",
 )
 
 
@@ -1803,6 +1875,11 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.model = s["model"]
     b.bond_zeta = s["bond_zeta"]
     b.trace_capacity = a["trace_t"].shape[1]
+    b.fluid_drag = s["fluid_drag"]
+    b.body_end = <intp_t*> _p(a, "body_end")
+    b.aux_init = _f(a, "aux_init")
+    b.trace_aux = _f(a, "trace_aux")
+    b.faces = <flag_t*> _p(a, "faces")
     b.vox_start = <intp_t*> _p(a, "vox_start")
     b.link_start = <intp_t*> _p(a, "link_start")
     b.dt = _f(a, "dt")
@@ -1952,6 +2029,22 @@ def compute_energy(dict arrays, dict settings, float64_t[:, ::1] out):
     _bind(&b, arrays, settings)
     for r in range(b.n_robots):
         robot_energy(&b, r, &out[r, 0])
+
+
+#: Columns of robot_aux (Rollout.aux, aux_init): what each one holds.
+AUX_NAMES = ("object_x", "object_y", "object_z", "heading_x", "heading_y",
+             "x_lo", "x_hi", "y_lo", "y_hi", "z_hi")
+
+
+def compute_aux(dict arrays, dict settings, float64_t[:, ::1] out):
+    """Fill ``out`` (n_robots, N_AUX) with each robot's current ``robot_aux`` (see ``AUX_NAMES``)."""
+    cdef Batch b
+    cdef intp_t r
+    _bind(&b, arrays, settings)
+    if out.shape[0] != b.n_robots or out.shape[1] != N_AUX:
+        raise ValueError("out must have shape (n_robots, N_AUX)")
+    for r in range(b.n_robots):
+        robot_aux(&b, r, &out[r, 0])
 
 
 def refresh_rotations(float64_t[:, ::1] quat, float64_t[:, ::1] rot):

@@ -78,6 +78,22 @@ class SimConfig:
         ``"flag"``: a diverged robot is frozen and flagged, the others go on;
         ``"raise"``: :class:`~softgym.exceptions.SimulationDivergedError` is
         raised after the call, naming the first diverged robot.
+    friction : float
+        Factor (>= 0) on every voxel's static and kinetic friction
+        coefficients against the floor and boxes: 0.1 is ice, 3 a grippy,
+        muddy ground (1).
+    incline : float
+        Tilt of the world (degrees, in [-60, 60]) about the y axis: gravity
+        gets ``g sin(incline)`` along -x, applied as each voxel's constant
+        external force (``Simulation.set_external_force`` replaces it), and
+        ``g cos(incline)`` along -z, so +x is uphill (0).
+    fluid_drag : float
+        ``rho C_d / 2`` (kg/m^3, >= 0) of a fluid around the voxels: each
+        exposed face (no bonded neighbour) of area ``s^2`` moving into the
+        fluid along its outward normal ``n`` at speed ``v.n > 0`` takes the
+        force ``-fluid_drag s^2 (v.n)^2 n`` at its voxel's centre (a face
+        moving away takes none). 0: no fluid (0). The seed's voxels weigh
+        1e6 kg/m^3, so a fluid of that density with ``C_d = 1`` is 5e5.
     """
 
     voxel_size: float = 0.01
@@ -96,6 +112,9 @@ class SimConfig:
     self_collision: bool = True
     collision_exclusion: int = 3
     on_divergence: Literal["flag", "raise"] = "flag"
+    friction: float = 1.0
+    incline: float = 0.0
+    fluid_drag: float = 0.0
 
     def __post_init__(self) -> None:
         def check(name: str, ok: bool, what: str) -> None:
@@ -126,6 +145,9 @@ class SimConfig:
         check("model", isinstance(self.model, str) and self.model in ("seed", "corotational"), '"seed" or "corotational"')
         check("actuation", isinstance(self.actuation, str) and self.actuation in ("seed", "symmetric"), '"seed" or "symmetric"')
         check("on_divergence", isinstance(self.on_divergence, str) and self.on_divergence in ("flag", "raise"), '"flag" or "raise"')
+        check("friction", finite("friction") >= 0, ">= 0 (a factor on the materials' friction)")
+        check("incline", -60 <= finite("incline") <= 60, "in [-60, 60] degrees")
+        check("fluid_drag", finite("fluid_drag") >= 0, ">= 0 kg/m^3")
         check("floor", isinstance(self.floor, (bool, int)), "a bool")
         check("self_collision", isinstance(self.self_collision, (bool, int)), "a bool")
         check(

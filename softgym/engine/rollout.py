@@ -66,6 +66,12 @@ class Rollout:
         Their centre of mass (m). With ``obstacle_mass`` it gives the seed's
         own centre of mass, which counts the walls
         (:func:`softgym.metrics.dilute`).
+    aux : ndarray of shape (n_robots, n_samples, n_aux), float64, optional
+        The kernel's task measures at ``times`` (columns
+        :data:`softgym.engine.AUX_NAMES`: the terrain objects' centre of mass,
+        the robot's heading sum, the bounding box of its voxel centres; m).
+    aux_init, aux_final : ndarray of shape (n_robots, n_aux), float64, optional
+        The same when ``cm_init`` was taken, and at the end of the run.
     """
 
     times: np.ndarray
@@ -88,10 +94,14 @@ class Rollout:
     trace_interval: float
     obstacle_mass: np.ndarray | None = None
     obstacle_cm: np.ndarray | None = None
+    aux: np.ndarray | None = None
+    aux_init: np.ndarray | None = None
+    aux_final: np.ndarray | None = None
 
     #: Fields with one entry (row) per robot.
     PER_ROBOT = ("times", "cm", "cm_init", "init_reached", "cm_final", "dt", "steps", "time",
-                 "diverged", "diverged_time", "mass", "obstacle_mass", "obstacle_cm")  # fmt: skip
+                 "diverged", "diverged_time", "mass", "obstacle_mass", "obstacle_cm", "aux",
+                 "aux_init", "aux_final")  # fmt: skip
     #: Fields with one row per voxel (sliced with ``voxel_offsets``).
     PER_VOXEL = ("positions", "orientations", "grid_index")
 

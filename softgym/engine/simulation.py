@@ -69,9 +69,10 @@ __all__ = ["Simulation", "as_body", "default_num_threads", "time_step", "voxel_s
 _VOXEL_STATE = ("pos", "vel", "quat", "angvel", "rot", "scale", "temp", "ext_force", "col_ref")
 # col_acc / col_vmax: the seed model's displacement since that rebuild and last fastest voxel speed
 _ROBOT_STATE = ("diverged", "diverged_time", "diverged_code", "init_done", "cm_init", "use_temp",
-                "col_acc", "col_vmax")
+                "col_acc", "col_vmax", "aux_init")
 _LINK_STATE = ("link_sa", "link_last")  # the seed model's per-link mode and memory
-_STATE = (*_VOXEL_STATE, *_ROBOT_STATE, *_LINK_STATE, "steps", "trace_n", "trace_t", "trace_cm")
+_STATE = (*_VOXEL_STATE, *_ROBOT_STATE, *_LINK_STATE, "steps", "trace_n", "trace_t", "trace_cm",
+          "trace_aux")
 
 
 def _env_threads(name: str) -> int | None:
@@ -272,6 +273,60 @@ def voxel_steps_per_second(body: Any, config: SimConfig | None = None) -> float:
     return float(np.count_nonzero(body.grid)) / time_step(body, config)
 
 
+def _component(body: Body | None, block: Any, L: float) -> dict[str, Any]:
+    """One component of a simulation entry (the robot's body, or a movable block).
+
+    Its voxels in C order of its grid: lattice index, material id and
+    properties, fixed flags, origin (m), exposed-face bits (``faces`` of
+    ``_core.pxd``), and its face links along each axis as local voxel pairs.
+    """
+    if body is not None:
+        grid = body.grid
+        idx = np.argwhere(grid > 0)
+        mat = grid[tuple(idx.T)]
+        out = {
+            "idx": idx, "mat": mat, "E": body.youngs_modulus[mat], "rho": body.density[mat],
+            "nu": body.poisson[mat], "mu_s": body.mu_static[mat], "mu_k": body.mu_kinetic[mat],
+            "origin": np.asarray(body.origin, dtype=np.float64),
+            "fixed": (np.zeros(idx.shape[0], dtype=np.int8) if body.fixed is None
+                      else body.fixed[tuple(idx.T)].astype(np.int8)),
+        }  # fmt: skip
+    else:
+        grid = block.cells.astype(np.int8)
+        idx = np.argwhere(grid > 0)
+        k = idx.shape[0]
+        out = {
+            "idx": idx, "mat": np.full(k, -1, dtype=np.int64),
+            "E": np.full(k, block.youngs_modulus), "rho": np.full(k, block.density),
+            "nu": np.full(k, block.poisson), "mu_s": np.full(k, block.mu_static),
+            "mu_k": np.full(k, block.mu_kinetic), "fixed": np.zeros(k, dtype=np.int8),
+            "origin": np.asarray(block.origin, dtype=np.float64) * L,
+        }  # fmt: skip
+    n = idx.shape[0]
+    vmap = np.full(grid.shape, -1, dtype=np.int64)
+    vmap[tuple(idx.T)] = np.arange(n)
+    v1s, v2s = [], []
+    faces = np.zeros(n, dtype=np.int64)
+    for ax in range(3):
+        lo = [slice(None)] * 3
+        hi = [slice(None)] * 3
+        lo[ax] = slice(0, -1)
+        hi[ax] = slice(1, None)
+        a = vmap[tuple(lo)]
+        b = vmap[tuple(hi)]
+        ok = (a >= 0) & (b >= 0)
+        v1s.append(a[ok])
+        v2s.append(b[ok])
+        # faces of voxels without a neighbour on that side are exposed
+        plus = np.ones(n, dtype=bool)
+        plus[a[ok]] = False
+        minus = np.ones(n, dtype=bool)
+        minus[b[ok]] = False
+        faces |= (minus.astype(np.int64) << (2 * ax)) | (plus.astype(np.int64) << (2 * ax + 1))
+    out.update(v1=v1s, v2=v2s, faces=faces.astype(np.int8))
+    return out
+
+
 def _harmonic(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     s = a + b
     out = np.zeros_like(s)
@@ -366,45 +421,41 @@ class Simulation:
         per_link: dict[str, list[np.ndarray]] = {}
         vox_start = [0]
         link_start = [0]
-        dts, masses, axis_counts, excl = [], [], [], []
+        dts, masses, axis_counts, excl, body_end = [], [], [], [], []
         grid_index = []
 
         def add(store, name, value):
             store.setdefault(name, []).append(np.asarray(value))
 
-        for body in self.bodies:
-            grid = body.grid
-            idx = np.argwhere(grid > 0)
+        for body, terrain in zip(self.bodies, self.terrains):
+            # the entry: the robot's voxels, then its terrain's movable blocks, each
+            # a component with its own links (none between components)
+            parts = [_component(body, None, L)]
+            parts += [_component(None, blk, L) for blk in terrain.objects]
+            idx = np.concatenate([p["idx"] for p in parts])
             n = idx.shape[0]
-            vmap = np.full(grid.shape, -1, dtype=np.int64)
-            vmap[tuple(idx.T)] = np.arange(n)
-            mat = grid[tuple(idx.T)]
-            E = body.youngs_modulus[mat]
-            rho = body.density[mat]
-            nu = body.poisson[mat]
+            n_own = parts[0]["idx"].shape[0]
+            E = np.concatenate([p["E"] for p in parts])
+            rho = np.concatenate([p["rho"] for p in parts])
+            nu = np.concatenate([p["nu"] for p in parts])
+            mat = np.concatenate([p["mat"] for p in parts])
             m = rho * L**3
             inertia = m * L**2 / 6.0
-            fixed = (
-                np.zeros(n, dtype=np.int8)
-                if body.fixed is None
-                else body.fixed[tuple(idx.T)].astype(np.int8)
-            )
-            # links along +x, +y, +z between filled face neighbours
+            fixed = np.concatenate([p["fixed"] for p in parts])
+            # links along +x, +y, +z between filled face neighbours of each component
             v1s, v2s, axes = [], [], []
-            for ax in range(3):
-                lo = [slice(None)] * 3
-                hi = [slice(None)] * 3
-                lo[ax] = slice(0, -1)
-                hi[ax] = slice(1, None)
-                a = vmap[tuple(lo)]
-                b = vmap[tuple(hi)]
-                ok = (a >= 0) & (b >= 0)
-                v1s.append(a[ok])
-                v2s.append(b[ok])
-                axes.append(np.full(int(ok.sum()), ax, dtype=np.int32))
+            off = 0
+            for p in parts:
+                v1s += [a + off for a in p["v1"]]
+                v2s += [b + off for b in p["v2"]]
+                axes += [np.full(a.size, ax, dtype=np.int32) for ax, a in enumerate(p["v1"])]
+                off += p["idx"].shape[0]
             v1 = np.concatenate(v1s)
             v2 = np.concatenate(v2s)
             axis = np.concatenate(axes)
+            if len(parts) > 1:  # links stay sorted by axis, each component's in order
+                order = np.argsort(axis, kind="stable")
+                v1, v2, axis = v1[order], v2[order], axis[order]
             keep = ~((fixed[v1] == 1) & (fixed[v2] == 1))
             v1, v2, axis = v1[keep], v2[keep], axis[keep]
             axis_counts.append(np.bincount(axis, minlength=3))  # links stay sorted by axis
@@ -436,28 +487,47 @@ class Simulation:
             add(per_link, "homog", (mat[v1] == mat[v2]).astype(np.int8))
             dt = _time_step(k_axial, m, E, v1, v2, cfg)
             dts.append(dt)
-            masses.append(float(m.sum()))
+            masses.append(float(m[:n_own].sum()))
+            body_end.append(vox_start[-1] + n_own)
             crit = 2.0 * np.sqrt(m * E * L)
+            origin = np.concatenate([np.broadcast_to(p["origin"], p["idx"].shape) for p in parts])
             if cfg.model == "seed":
                 # the seed's lattice positions carry its 1e-6 L offset in x and y
                 # (VX_Object::GetXYZ), which decides exact-zero tests downstream
-                pos = body.origin + L * ((idx + 0.5) + np.array([1e-6, 1e-6, 0.0]))
+                pos = origin + L * ((idx + 0.5) + np.array([1e-6, 1e-6, 0.0]))
             else:
-                pos = body.origin + (idx + 0.5) * L
+                pos = origin + (idx + 0.5) * L
             add(per_vox, "pos", pos)
+            faces = np.concatenate([p["faces"] for p in parts])
+            add(per_vox, "faces", faces)
             add(per_vox, "mass", m)
             add(per_vox, "inv_mass", 1.0 / m)
             add(per_vox, "inv_inertia", 1.0 / inertia)
-            add(per_vox, "cte", body.cte[mat])
-            add(per_vox, "cos_phase", np.cos(body.phase[mat]))
-            add(per_vox, "sin_phase", np.sin(body.phase[mat]))
+            cte = np.zeros(n)
+            cte[:n_own] = body.cte[mat[:n_own]]
+            phase = np.zeros(n)
+            phase[:n_own] = body.phase[mat[:n_own]]
+            add(per_vox, "cte", cte)
+            add(per_vox, "cos_phase", np.cos(phase))
+            add(per_vox, "sin_phase", np.sin(phase))
             add(per_vox, "k_floor", 2.0 * E * L)
             add(per_vox, "c_floor", cfg.collision_damping * crit)
             add(per_vox, "c_global", cfg.global_damping * crit)
             rot_damp = 1.0 - 10.0 * cfg.global_damping * 2.0 * np.sqrt(inertia * E * L**3) / inertia * dt
             add(per_vox, "rot_damp", np.clip(rot_damp, 0.0, 1.0))
-            add(per_vox, "mu_s", body.mu_static[mat])
-            add(per_vox, "mu_k", body.mu_kinetic[mat])
+            mu_s = np.concatenate([p["mu_s"] for p in parts])
+            mu_k = np.concatenate([p["mu_k"] for p in parts])
+            if cfg.friction != 1.0:
+                mu_s = mu_s * float(cfg.friction)
+                mu_k = mu_k * float(cfg.friction)
+            add(per_vox, "mu_s", mu_s)
+            add(per_vox, "mu_k", mu_k)
+            if cfg.incline != 0.0:  # the slope's pull along -x, per voxel
+                ext = np.zeros((n, 3))
+                ext[:, 0] = -m * float(cfg.gravity) * math.sin(math.radians(cfg.incline))
+            else:
+                ext = np.zeros((n, 3))
+            add(per_vox, "ext_force", ext)
             add(per_vox, "fixed", fixed)
             grid_index.append(idx)
             degree = np.bincount(np.concatenate([v1, v2]), minlength=n)
@@ -465,7 +535,10 @@ class Simulation:
             # the seed engine's voxel order (x fastest, then y, then z) over
             # the world lattice: it decides which voxel of a pair sets the
             # seed's candidate horizon
-            add(per_vox, "seed_rank", _seed_rank(np.rint(body.origin / L).astype(np.int64) + idx))
+            lattice = np.concatenate(
+                [np.broadcast_to(np.rint(p["origin"] / L).astype(np.int64), p["idx"].shape) for p in parts]
+            )
+            add(per_vox, "seed_rank", _seed_rank(lattice + idx))
             ex_start, ex_idx = _hop_neighbours(n, v1, v2, cfg.collision_exclusion)
             add(per_vox, "excl_count", np.diff(ex_start))
             excl.append(ex_idx + vox_start[-1])
@@ -485,7 +558,7 @@ class Simulation:
         boxes, obs, obs_rank, obs_start = [], [], [], [0]
         k_obs = 2.0 * OBSTACLE_YOUNGS_MODULUS * L
         for t in self.terrains:
-            cells = obstacle_cells(t) if cfg.model == "seed" else None
+            cells = obstacle_cells(t) if cfg.model == "seed" and t.box_contact == "auto" else None
             if cells is None:
                 boxes.append(t.as_array(L))
                 cells = np.zeros((0, 3), dtype=np.int64)
@@ -515,8 +588,13 @@ class Simulation:
         a["quat"][:, 0] = 1.0
         a["rot"] = np.zeros((n_vox, 9))
         a["rot"][:, [0, 4, 8]] = 1.0
-        for name in ("vel", "angvel", "force", "moment", "ext_force"):
+        for name in ("vel", "angvel", "force", "moment"):
             a[name] = np.zeros((n_vox, 3))
+        a["ext_force"] = np.ascontiguousarray(a["ext_force"], dtype=np.float64).reshape(-1, 3)
+        a["faces"] = a["faces"].astype(np.int8)
+        a["body_end"] = np.asarray(body_end, dtype=np.intp)
+        a["aux_init"] = np.zeros((n_robots, len(_core.AUX_NAMES)))
+        a["trace_aux"] = np.zeros((n_robots, 8, len(_core.AUX_NAMES)))
         a["scale"] = np.full(n_vox, L)
         a["seed_rank"] = a["seed_rank"].astype(np.intp)
         a["col_ref"] = np.zeros((n_vox, 4))
@@ -551,7 +629,7 @@ class Simulation:
         self._settings = {
             "n_robots": n_robots,
             "L": L,
-            "gravity": -float(cfg.gravity),
+            "gravity": -float(cfg.gravity) * (math.cos(math.radians(cfg.incline)) if cfg.incline else 1.0),
             "init_time": float(cfg.init_time),
             "min_scale": float(cfg.min_scale),
             "max_strain": float(cfg.max_strain),
@@ -560,7 +638,13 @@ class Simulation:
             "actuation_mode": 0 if cfg.actuation == "seed" else 1,
             "model": 0 if cfg.model == "seed" else 1,
             "bond_zeta": float(cfg.bond_damping),
+            "fluid_drag": float(cfg.fluid_drag),
         }
+        # robots' own voxels in the kernel arrays (None: no objects, all of them)
+        own = [np.arange(vox_start[r], body_end[r]) for r in range(n_robots)]
+        self._own = None if body_end == vox_start[1:] else np.concatenate(own).astype(np.intp)
+        counts = np.asarray(body_end) - np.asarray(vox_start[:-1])
+        self._own_offsets = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
 
     # --------------------------------------------------------------- properties
     @property
@@ -570,8 +654,8 @@ class Simulation:
 
     @property
     def n_voxels(self) -> int:
-        """Total number of voxels over the batch."""
-        return int(self._a["vox_start"][-1])
+        """Total number of the robots' voxels over the batch (their objects excluded)."""
+        return int(self._own_offsets[-1])
 
     @property
     def n_links(self) -> int:
@@ -580,8 +664,17 @@ class Simulation:
 
     @property
     def voxel_offsets(self) -> np.ndarray:
-        """Ndarray of shape (n_robots + 1,): robot i owns voxels ``[off[i], off[i+1])``."""
-        return self._a["vox_start"].astype(np.int64)
+        """Ndarray of shape (n_robots + 1,): robot i owns voxels ``[off[i], off[i+1])``.
+
+        Offsets into the robots' voxels (:attr:`all_positions`, the rollout's
+        positions), their terrain objects excluded.
+        """
+        return self._own_offsets.copy()
+
+    @property
+    def has_objects(self) -> bool:
+        """Whether some robot's terrain holds movable objects."""
+        return self._own is not None
 
     @property
     def dt(self) -> np.ndarray:
@@ -617,10 +710,46 @@ class Simulation:
         return int(sum(v.nbytes for v in self._a.values()))
 
     def _slice(self, robot: int) -> slice:
+        # the robot's own voxels in the kernel arrays (its objects follow them)
         if not 0 <= robot < self.n_robots:
             raise IndexError(f"robot index {robot} out of range for {self.n_robots} robots")
-        s = self._a["vox_start"]
-        return slice(int(s[robot]), int(s[robot + 1]))
+        return slice(int(self._a["vox_start"][robot]), int(self._a["body_end"][robot]))
+
+    def _object_slice(self, robot: int) -> slice:
+        if not 0 <= robot < self.n_robots:
+            raise IndexError(f"robot index {robot} out of range for {self.n_robots} robots")
+        return slice(int(self._a["body_end"][robot]), int(self._a["vox_start"][robot + 1]))
+
+    def object_positions(self, robot: int) -> np.ndarray:
+        """Voxel centres (m) of a robot's terrain objects, shape (n_object_voxels_r, 3) (a copy)."""
+        return self._a["pos"][self._object_slice(robot)].copy()
+
+    def object_orientations(self, robot: int) -> np.ndarray:
+        """Quaternions (w, x, y, z) of a robot's terrain object voxels, shape (n_object_voxels_r, 4)."""
+        return self._a["quat"][self._object_slice(robot)].copy()
+
+    def object_scales(self, robot: int) -> np.ndarray:
+        """Edge lengths (m) of a robot's terrain object voxels, shape (n_object_voxels_r,)."""
+        return self._a["scale"][self._object_slice(robot)].copy()
+
+    def object_center_of_mass(self) -> np.ndarray:
+        """Ndarray of shape (n_robots, 3): centre of mass (m) of each robot's objects (0 if none)."""
+        return self.aux()[:, 0:3]
+
+    def aux(self) -> np.ndarray:
+        """Each robot's task measures now, as the kernel samples them with the centre of mass.
+
+        Returns
+        -------
+        ndarray of shape (n_robots, len(AUX_NAMES)), float64
+            Columns :data:`softgym.engine.AUX_NAMES`: the objects' centre of
+            mass (m; 0 without objects), the heading sum (mass-weighted x axes
+            of the robot's voxels: its yaw is ``atan2(heading_y, heading_x)``)
+            and the bounding box of its voxel centres (m).
+        """
+        out = np.zeros((self.n_robots, len(_core.AUX_NAMES)))
+        _core.compute_aux(self._a, self._settings, out)
+        return out
 
     def positions(self, robot: int) -> np.ndarray:
         """Voxel centres (m) of one robot, shape (n_voxels_r, 3) (a copy)."""
@@ -651,16 +780,26 @@ class Simulation:
         return self._a["mass"][self._slice(robot)].copy()
 
     def center_of_mass(self) -> np.ndarray:
-        """Ndarray of shape (n_robots, 3): current centre of mass of each robot (m)."""
+        """Ndarray of shape (n_robots, 3): current centre of mass of each robot (m), objects excluded."""
         a = self._a
         w = a["mass"][:, None] * a["pos"]
-        sums = np.add.reduceat(w, a["vox_start"][:-1], axis=0)
+        if self._own is not None:
+            w = w[self._own]
+        sums = np.add.reduceat(w, self._own_offsets[:-1], axis=0)
         return sums / a["mass_total"][:, None]
 
-    def momentum(self) -> np.ndarray:
-        """Ndarray of shape (n_robots, 3): total linear momentum of each robot (kg m/s)."""
+    def momentum(self, objects: bool = False) -> np.ndarray:
+        """Ndarray of shape (n_robots, 3): total linear momentum of each robot (kg m/s).
+
+        ``objects=True`` adds its terrain objects' (the whole entry's momentum).
+        """
         a = self._a
-        return np.add.reduceat(a["mass"][:, None] * a["vel"], a["vox_start"][:-1], axis=0)
+        p = a["mass"][:, None] * a["vel"]
+        if objects:
+            return np.add.reduceat(p, a["vox_start"][:-1], axis=0)
+        if self._own is not None:
+            p = p[self._own]
+        return np.add.reduceat(p, self._own_offsets[:-1], axis=0)
 
     def energy(self) -> np.ndarray:
         """Mechanical energy per robot (J).
@@ -745,25 +884,32 @@ class Simulation:
         if not np.isfinite(arr).all():
             raise InvalidActionError("temperatures hold NaN or infinite values")
         a = self._a
+        temp = a["temp"] if self._own is None else np.zeros(int(a["vox_start"][-1]))
         if robots is None:
-            a["temp"][:] = arr
+            if self._own is None:
+                a["temp"][:] = arr
+            else:
+                a["temp"][self._own] = arr
             a["use_temp"][:] = 1
             return
         sel = np.zeros(self.n_robots, dtype=bool)
         sel[np.asarray(robots)] = True
-        voxels = np.repeat(sel, np.diff(a["vox_start"]))
-        a["temp"][voxels] = arr[voxels]
+        voxels = np.repeat(sel, np.diff(self._own_offsets))
+        if self._own is None:
+            temp[voxels] = arr[voxels]
+        else:
+            a["temp"][self._own[voxels]] = arr[voxels]
         a["use_temp"][sel] = 1
 
     @property
     def all_positions(self) -> np.ndarray:
-        """Voxel centres (m) of the whole batch, shape (n_voxels, 3) (a copy)."""
-        return self._a["pos"].copy()
+        """Voxel centres (m) of the whole batch, shape (n_voxels, 3) (a copy; robots' voxels only)."""
+        return self._a["pos"].copy() if self._own is None else self._a["pos"][self._own]
 
     @property
     def all_velocities(self) -> np.ndarray:
-        """Voxel velocities (m/s) of the whole batch, shape (n_voxels, 3) (a copy)."""
-        return self._a["vel"].copy()
+        """Voxel velocities (m/s) of the whole batch, shape (n_voxels, 3) (a copy; robots' voxels only)."""
+        return self._a["vel"].copy() if self._own is None else self._a["vel"][self._own]
 
     def set_external_force(self, robot: int, force: Any) -> None:
         """Apply a constant external force (N) to each voxel of one robot.
@@ -789,7 +935,7 @@ class Simulation:
         if need <= cap:
             return
         new = max(need, 2 * cap)
-        for name in ("trace_t", "trace_cm"):
+        for name in ("trace_t", "trace_cm", "trace_aux"):
             old = self._a[name]
             arr = np.zeros((old.shape[0], new, *old.shape[2:]))
             arr[:, :cap] = old
@@ -911,22 +1057,27 @@ class Simulation:
         rows = np.arange(self.n_robots)[:, None]
         times = a["trace_t"][rows, idx]
         cm = a["trace_cm"][rows, idx]
+        aux = a["trace_aux"][rows, idx]
+        aux_final = self.aux()
         if (n == 0).any():  # never stepped: the initial centre of mass
             cm0 = self.center_of_mass()
             cm[n == 0] = cm0[n == 0][:, None, :]
+            aux[n == 0] = aux_final[n == 0][:, None, :]
             times[n == 0] = 0.0
         init = a["init_done"].astype(bool)
         cm_init = np.where(init[:, None], a["cm_init"], cm[:, 0])
+        aux_init = np.where(init[:, None], a["aux_init"], aux[:, 0])
+        own = slice(None) if self._own is None else self._own
         return Rollout(
             times=times,
             cm=cm,
             cm_init=cm_init,
             init_reached=init,
             cm_final=self.center_of_mass(),
-            positions=a["pos"].copy(),
-            orientations=a["quat"].copy(),
+            positions=a["pos"][own].copy(),
+            orientations=a["quat"][own].copy(),
             voxel_offsets=self.voxel_offsets,
-            grid_index=self._grid_index.copy(),
+            grid_index=self._grid_index[own].copy(),
             dt=a["dt"].copy(),
             steps=a["steps"].copy(),
             time=self.time,
@@ -938,6 +1089,9 @@ class Simulation:
             trace_interval=float(cfg.trace_interval),
             obstacle_mass=self._obstacle_mass.copy(),
             obstacle_cm=self._obstacle_cm.copy(),
+            aux=aux,
+            aux_init=aux_init,
+            aux_final=aux_final,
         )
 
     # ------------------------------------------------------------------ state
@@ -961,7 +1115,7 @@ class Simulation:
                 raise InvalidParameterError(f"state is missing array {k!r}")
             v = np.asarray(state[k])
             cur = self._a[k]
-            if k in ("trace_t", "trace_cm"):
+            if k in ("trace_t", "trace_cm", "trace_aux"):
                 if v.shape[0] != cur.shape[0] or v.shape[2:] != cur.shape[2:]:
                     raise InvalidParameterError(f"state array {k!r} has shape {v.shape}")
             elif v.shape != cur.shape:
