@@ -24,6 +24,7 @@ from softgym.tasks import Task
 
 __all__ = [
     "FITNESS_METRICS",
+    "MAXIMIZED",
     "BatchFn",
     "EvalStats",
     "Evaluator",
@@ -35,6 +36,8 @@ __all__ = [
 
 #: Maximised metrics (the rest are counts, minimised when they are objectives).
 FITNESS_METRICS: tuple[str, ...] = ("norm_final_dist", "max_xy_dist", "l_coefficient")
+#: Every maximised metric: the fitness measures and a task's ``score`` (its own measure).
+MAXIMIZED: tuple[str, ...] = (*FITNESS_METRICS, "score")
 
 #: ``(designs as dicts, task) -> softgym.evaluate output with traces``.
 BatchFn = Callable[[list[dict[str, Any]], Task], dict[str, Any]]
@@ -135,7 +138,7 @@ class EvalStats:
 
 
 def _worst_objectives() -> dict[str, float]:
-    out = {m: (WORST_FITNESS if m in FITNESS_METRICS else WORST_MINIMIZED) for m in _STORED}
+    out = {m: (WORST_FITNESS if m in MAXIMIZED else WORST_MINIMIZED) for m in _STORED}
     out["diverged"] = 0.0
     return out
 
@@ -206,7 +209,8 @@ class Evaluator:
             designs = [todo[k][0].design(exp.shape).to_dict() for k in keys]
             res = self.batch_fn(designs, self.task)
             for i, key in enumerate(keys):
-                obj = {m: float(res[m][i]) for m in _STORED}
+                # (a batch function of an older softgym may not report "score")
+                obj = {m: float(res[m][i]) for m in _STORED if m in res}
                 tr = res["traces"][i]
                 tr = None if tr is None else np.asarray(tr, dtype=np.float64)
                 self.cache.put(key, obj, tr)

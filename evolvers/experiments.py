@@ -35,6 +35,7 @@ from typing import Any
 from evolvers.selection import Objective
 from softgym.design import MATERIAL_TREE_4, MATERIAL_TREE_8, CompositionRules
 from softgym.exceptions import InvalidParameterError
+from softgym.metrics import WALK_METRICS
 from softgym.tasks import Task, get_task
 from softgym.terrain import Terrain
 
@@ -115,7 +116,17 @@ class Experiment:
             raise InvalidParameterError("an experiment needs at least one objective")
         object.__setattr__(self, "shape", tuple(int(s) for s in self.shape))
         task = get_task(self.task)  # a name, alias, Terrain, or JSON file; raises if unknown
-        object.__setattr__(self, "task", task.terrain)
+        object.__setattr__(self, "task", task.spec)
+        if task.reward not in WALK_METRICS:
+            # a suite task that is not about walking: its score replaces the walking distances
+            objectives, seen = [], set()
+            for o in self.objectives:
+                if o.name in ("norm_final_dist", "max_xy_dist"):
+                    o = Objective("score", True)
+                if o.name not in seen:
+                    objectives.append(o)
+                    seen.add(o.name)
+            object.__setattr__(self, "objectives", tuple(objectives))
 
     @property
     def fitness(self) -> Objective:

@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from evolvers.evaluation import FITNESS_METRICS, EvalStats
+from evolvers.evaluation import FITNESS_METRICS, MAXIMIZED, EvalStats
 from evolvers.experiments import Experiment
 from evolvers.genome import Individual
 from softgym.exceptions import CheckpointError, InvalidParameterError
@@ -151,7 +151,7 @@ def _direction(exp: Experiment, metric: str) -> bool:
     for o in exp.objectives:
         if o.name == metric:
             return o.maximize
-    return metric in FITNESS_METRICS
+    return metric in MAXIMIZED
 
 
 def _stats_of(values: np.ndarray, maximize: bool) -> dict[str, float]:
@@ -244,7 +244,8 @@ def study_columns(
         if ind.objectives.get("n_voxels", 0) > 0
     ]
     row["muscle_fraction_median"] = float(np.median(fractions)) if fractions else float("nan")
-    metrics = (*FITNESS_METRICS, *_TOP_COUNTS)
+    scored = ("score",) if any(o.name == "score" for o in exp.objectives) else ()
+    metrics = (*FITNESS_METRICS, *scored, *_TOP_COUNTS)
     values = np.array([ind.value(name) for ind in pop], dtype=np.float64)
     top = pop[int(np.argmax(values if maximize else -values))] if pop else None
     row.update(_individual_columns("top", top, metrics))

@@ -35,6 +35,7 @@ METRIC_KEYS: tuple[str, ...] = (
     "max_xy_dist",
     "l_coefficient",
     "time_max_xy_dist",
+    "score",
     "diverged",
     "n_voxels",
     "n_muscle",
@@ -173,8 +174,9 @@ def evaluate(
             sim.advance_to(task.seconds, progress=lambda t: bar.update(t - bar.n))
     else:
         sim.advance_to(task.seconds)
-    rollout = _reorder(sim.rollout(), np.argsort(order))
-    out.update(task.metrics(rollout))
+    back = np.argsort(order)
+    rollout = _reorder(sim.rollout(), back)
+    out.update(task.metrics(rollout, [terrains[i] for i in back]))
     for i, d in enumerate(designs):
         c = composition_counts(d)
         for k in _COUNTS:

@@ -439,11 +439,7 @@ class SoftWalkerEnv(gym.Env):
     def _info(self, with_mask: bool = False) -> dict[str, Any]:
         raw = self._batch.infos()
         info: dict[str, Any] = {
-            "norm_final_dist": float(raw["norm_final_dist"][0]),
-            "max_xy_dist": float(raw["max_xy_dist"][0]),
-            "l_coefficient": float(raw["l_coefficient"][0]),
-            "diverged": bool(raw["diverged"][0]),
-            "time": float(raw["time"][0]),
+            key: (bool(v[0]) if key == "diverged" else float(v[0])) for key, v in raw.items()
         }
         if with_mask:
             info["muscle_mask"] = self.muscle_mask

@@ -35,9 +35,11 @@ from softgym.metrics.novelty import (
     traces_from_rollout,
     trajectory_vectors,
 )
+from softgym.metrics.task_measures import TASK_MEASURES, task_measure, task_measure_from_arrays
 
 __all__ = [
     "L_TOLERANCE",
+    "TASK_MEASURES",
     "NO_TRAJECTORY_NOVELTY",
     "WALK_METRICS",
     "WORST_FITNESS",
@@ -61,6 +63,8 @@ __all__ = [
     "similarity_matrix",
     "traces_from_rollout",
     "trajectory_vectors",
+    "task_measure",
+    "task_measure_from_arrays",
     "walk_metrics",
     "walk_metrics_from_arrays",
 ]

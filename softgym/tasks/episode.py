@@ -21,11 +21,13 @@ from softgym.design import MAX_GRID_DIM, RobotDesign, check_grid_shape
 from softgym.engine import SimConfig, Simulation
 from softgym.exceptions import InvalidActionError, InvalidDesignError, InvalidParameterError
 from softgym.metrics import (
+    WALK_METRICS,
     max_xy_dist_from_arrays,
     norm_final_dist_from_arrays,
+    task_measure_from_arrays,
     walk_metrics_from_arrays,
 )
-from softgym.tasks.task import Task
+from softgym.tasks.task import Task, measure_params
 from softgym.terrain import Terrain
 
 __all__ = [
@@ -235,6 +237,12 @@ class EpisodeBatch:
         self.steps = np.zeros(n, dtype=np.int64)
         self.metric_value = np.zeros((n, 2))  # norm_final_dist, max_xy_dist
         self.done_diverged = np.zeros(n, dtype=bool)
+        # a suite task's measure: its per-robot parameters, the kernel's auxiliary samples
+        self._measure = self.metric not in ("norm_final_dist", "max_xy_dist")
+        self._params = measure_params(self.terrains)
+        self.aux0 = np.zeros((n, 0))
+        self._trace_aux = np.zeros((n, self.max_steps + 1, 0))
+        self.score_value = np.zeros(n)
         # centre of mass (m) and time since placement (s) at the episode start and each step
         self._trace_cm = np.zeros((n, self.max_steps + 1, 3))
         self._trace_t = np.zeros((n, self.max_steps + 1))
@@ -263,13 +271,28 @@ class EpisodeBatch:
         self._settled_time = sim.time
         # the engine's own reference centre of mass (its first step after init_time), the one
         # softgym.evaluate's metrics start from
-        self.cm0 = sim.rollout().cm_init
+        ro = sim.rollout()
+        self.cm0 = ro.cm_init
+        self.aux0 = ro.aux_init
+        if self._measure:
+            self._trace_aux = np.zeros((self.n_robots, self.max_steps + 1, self.aux0.shape[1]))
 
     def _start_trace(self, ids: np.ndarray | slice) -> None:
         self._trace_cm[ids] = 0.0
         self._trace_t[ids] = 0.0
         self._trace_cm[ids, 0] = self.cm0[ids]
         self._trace_t[ids, 0] = self._settled_time[ids]
+        if self._measure:
+            self._trace_aux[ids] = 0.0
+            self._trace_aux[ids, 0] = self.aux0[ids]
+
+    def _task_measure(self, k: np.ndarray) -> np.ndarray:
+        # the suite task's measure of every robot over its samples 0..k
+        kmax = int(k.max()) + 1
+        return task_measure_from_arrays(
+            self.metric, self.cm0, self.aux0, self._trace_cm[:, :kmax], self._trace_aux[:, :kmax],
+            np.arange(kmax)[None, :] <= k[:, None], self.L, self._params,
+        )  # fmt: skip
 
     def reset_all(self) -> None:
         """Every robot back to its settled start state (the first call settles them)."""
@@ -279,6 +302,7 @@ class EpisodeBatch:
             self.sim.set_state(self._settled)
         self.steps[:] = 0
         self.metric_value[:] = 0.0
+        self.score_value[:] = 0.0
         # a robot that diverged while settling cannot run: its episodes end at the first step
         self.done_diverged[:] = self._settled["diverged"] != 0
         self._time_offset[:] = 0.0
@@ -297,6 +321,7 @@ class EpisodeBatch:
         self.sim.restore_robots(init, ids)
         self.steps[ids] = 0
         self.metric_value[ids] = 0.0
+        self.score_value[ids] = 0.0
         self.done_diverged[ids] = init["diverged"][ids] != 0
         self._time_offset[ids] = self.sim.time[ids] - self._settled_time[ids]
         self._start_trace(ids)
@@ -390,9 +415,10 @@ class EpisodeBatch:
         live = stepped & ~self.done_diverged
         newly_div = live & diverged
         ok = live & ~diverged
-        reward[ok] = new[ok, col] - self.metric_value[ok, col]
-        # a diverged episode forfeits its progress: its return sums to 0
-        reward[newly_div] = 0.0 - self.metric_value[newly_div, col]
+        if not self._measure:
+            reward[ok] = new[ok, col] - self.metric_value[ok, col]
+            # a diverged episode forfeits its progress: its return sums to 0
+            reward[newly_div] = 0.0 - self.metric_value[newly_div, col]
         self.metric_value[ok] = new[ok]
         self.done_diverged |= newly_div
         self.steps[stepped] += 1
@@ -400,6 +426,12 @@ class EpisodeBatch:
         rows = np.flatnonzero(ok)
         self._trace_cm[rows, k[rows]] = cm[rows]
         self._trace_t[rows, k[rows]] = self.sim.time[rows] - self._time_offset[rows]
+        if self._measure:
+            self._trace_aux[rows, k[rows]] = self.sim.aux()[rows]
+            score = self._task_measure(k)
+            reward[ok] = score[ok] - self.score_value[ok]
+            reward[newly_div] = 0.0 - self.score_value[newly_div]
+            self.score_value[ok] = score[ok]
         terminated[stepped] = self.done_diverged[stepped]
         truncated[stepped] = (self.steps[stepped] >= self.max_steps) & ~terminated[stepped]
         return reward, terminated, truncated, self.done_diverged.copy()
@@ -447,13 +479,14 @@ class EpisodeBatch:
         -------
         dict of str to ndarray of shape (n_robots,)
             ``norm_final_dist``, ``max_xy_dist``, ``l_coefficient``,
-            ``time_max_xy_dist``, ``diverged``.
+            ``time_max_xy_dist``, ``diverged``, a suite task's measure and
+            ``score`` (the task's reward metric).
         """
         k = np.minimum(self.steps, self.max_steps)
         kmax = int(k.max()) + 1
         rows = np.arange(self.n_robots)
         end = self._trace_t[rows, k]
-        return walk_metrics_from_arrays(
+        out = walk_metrics_from_arrays(
             self.cm0,
             self._trace_cm[rows, k],
             self._trace_cm[:, :kmax],
@@ -463,17 +496,22 @@ class EpisodeBatch:
             diverged=self.done_diverged,
             valid=np.arange(kmax)[None, :] <= k[:, None],
         )
+        if self._measure:
+            value = self._task_measure(k)
+            value[self.done_diverged] = out["norm_final_dist"][self.done_diverged]  # the worst
+            out[self.metric] = value
+        out["score"] = out[self.metric].copy()
+        return out
 
     def infos(self) -> dict[str, np.ndarray]:
-        """Per-robot metrics and clock: arrays of shape (n_robots,)."""
+        """Per-robot metrics, score and clock: arrays of shape (n_robots,)."""
         m = self.metrics()
-        return {
-            "norm_final_dist": m["norm_final_dist"],
-            "max_xy_dist": m["max_xy_dist"],
-            "l_coefficient": m["l_coefficient"],
-            "diverged": m["diverged"],
-            "time": self.clock(),
-        }
+        out = {key: m[key] for key in (*WALK_METRICS, "diverged")}
+        if self._measure:
+            out[self.metric] = m[self.metric]
+        out["score"] = m["score"]
+        out["time"] = self.clock()
+        return out
 
     # ------------------------------------------------------------- rendering
     def colors(self, r: int) -> np.ndarray:

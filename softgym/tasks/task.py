@@ -16,6 +16,12 @@ stairs     three concentric rings, each 2 voxels wide and   ``max_xy_dist``
            1 voxel higher than the one inside it
 =========  ===============================================  ==============================
 
+The rest of the suite (``stairs_down``, ``rough``, ``gap``, ``tunnel``,
+``incline``, ``ice``, ``mud``, ``jump``, ``turn``, ``push``, ``carry``,
+``swim``, ``grow``) is defined in :mod:`softgym.tasks.suite`: each has its
+layout, engine settings, measure and difficulty arguments
+(``Task("gap", options={"width": 3})`` or ``get_task("gap:width=3")``).
+
 A custom world is a :class:`~softgym.terrain.Terrain` (or its JSON file),
 accepted wherever a task name is: ``softgym.evaluate(d, task=Terrain.stairs())``,
 ``gym.make("SoftWalker-Flat-v0", task="my_boxes.json")``,
@@ -34,7 +40,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from softgym.exceptions import InvalidParameterError, InvalidTerrainError
-from softgym.metrics import WALK_METRICS, dilute, walk_metrics
+from softgym.metrics import TASK_MEASURES, WALK_METRICS, dilute, task_measure, walk_metrics
+from softgym.tasks.suite import KINDS
 from softgym.terrain import Terrain
 
 if TYPE_CHECKING:  # annotations only: softgym.engine's __init__ loads compiled code
@@ -49,6 +56,7 @@ __all__ = [
     "TaskLike",
     "flat_layout",
     "get_task",
+    "measure_params",
     "register_task",
     "stairs_layout",
     "task_names",
@@ -58,8 +66,9 @@ __all__ = [
 #: Schema tag of :meth:`Task.to_dict`.
 SCHEMA = "softgym.task"
 
-#: Metrics whose per-step progress can be a reward: the walking measures of the final position.
-REWARDS: tuple[str, ...] = ("norm_final_dist", "max_xy_dist")
+#: Metrics whose per-step progress can be a reward (a task's score): the walking measures of
+#: the final position and the suite's measures (:data:`softgym.metrics.TASK_MEASURES`).
+REWARDS: tuple[str, ...] = ("norm_final_dist", "max_xy_dist", *TASK_MEASURES)
 
 
 def _around(shape: Sequence[int]) -> tuple[float, tuple[float, float]]:
@@ -89,11 +98,13 @@ def stairs_layout(shape: Sequence[int]) -> Terrain:
     return Terrain.stairs(inner=inner, center=center)
 
 
-#: Terrains placed around each robot's grid (its corner at the origin): name -> builder(shape).
-LAYOUTS: dict[str, Callable[[Sequence[int]], Terrain]] = {
+#: Terrains placed around each robot's grid (its corner at the origin): name -> builder(shape,
+#: **options) (the suite's kinds take their arguments, :mod:`softgym.tasks.suite`).
+LAYOUTS: dict[str, Callable[..., Terrain]] = {
     "flat": flat_layout,
     "wall": wall_layout,
     "stairs": stairs_layout,
+    **{name: kind.layout for name, kind in KINDS.items()},
 }
 
 #: Other names users know a task by (the seed's reports call the wall a fence).
@@ -140,13 +151,19 @@ class Task:
         its 1-kg wall voxels (:func:`softgym.metrics.dilute`): the numbers of
         the seed's obstacle runs, smaller than the robot's own by
         ``m_robot / (m_robot + m_walls)``. Off by default (robot-only).
+    options : dict
+        Arguments of a suite task (:mod:`softgym.tasks.suite`: gap width,
+        step height, roughness...), checked against their ranges; the ones
+        not given take their defaults (all are stored).
 
     Notes
     -----
-    Every task reports the same measures, :func:`softgym.metrics.walk_metrics`
+    Every task reports the walking measures, :func:`softgym.metrics.walk_metrics`
     of its rollout (:meth:`metrics`): ``norm_final_dist``, ``max_xy_dist``,
     ``l_coefficient`` (:data:`~softgym.metrics.WALK_METRICS`), with
-    ``time_max_xy_dist`` and ``diverged``.
+    ``time_max_xy_dist`` and ``diverged``; a suite task adds its measure
+    (``reward``), and every task reports ``score``, the value of its reward
+    metric.
     """
 
     terrain: str | Terrain = "flat"
@@ -156,6 +173,7 @@ class Task:
     n_threads: int | None = None
     reward: str | None = None
     seed_centre_of_mass: bool = False
+    options: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         terrain = self.terrain
@@ -173,10 +191,26 @@ class Task:
         object.__setattr__(self, "terrain", terrain)
         object.__setattr__(self, "seconds", _positive("seconds", self.seconds))
         object.__setattr__(self, "trace_interval", _positive("trace_interval", self.trace_interval))
-        object.__setattr__(self, "sim", dict(self.sim))
+        if not isinstance(self.options, Mapping):
+            raise InvalidParameterError(f"options must be a dict, got {type(self.options).__name__}")
+        kind = KINDS.get(terrain) if isinstance(terrain, str) else None
+        if kind is None:
+            if self.options:
+                raise InvalidParameterError(
+                    f"task {self.name!r} takes no options, got {sorted(self.options)}"
+                )
+            object.__setattr__(self, "options", {})
+            object.__setattr__(self, "sim", dict(self.sim))
+        else:
+            options = kind.resolve(self.options)
+            object.__setattr__(self, "options", options)
+            # the kind's engine settings, under the caller's
+            object.__setattr__(self, "sim", {**kind.sim(options), **dict(self.sim)})
         if self.n_threads is not None:
             object.__setattr__(self, "n_threads", int(self.n_threads))
         reward = self.reward
+        if reward is None and kind is not None:
+            reward = kind.reward
         if reward is None:
             reward = "norm_final_dist" if terrain == "flat" else "max_xy_dist"
         if reward not in REWARDS:
@@ -190,16 +224,30 @@ class Task:
         return self.terrain if isinstance(self.terrain, str) else self.terrain.name
 
     @property
+    def spec(self) -> str | Terrain:
+        """The task as :func:`get_task` reads it: ``"name"`` or ``"name:arg=value,..."``, or its Terrain."""
+        if isinstance(self.terrain, Terrain):
+            return self.terrain
+        kind = KINDS.get(self.terrain)
+        if kind is None:
+            return self.terrain
+        changed = {k: v for k, v in self.options.items() if v != kind.options[k].default}
+        if not changed:
+            return self.terrain
+        return self.terrain + ":" + ",".join(f"{k}={v!r}" for k, v in sorted(changed.items()))
+
+    @property
     def metric_names(self) -> tuple[str, ...]:
-        """The fitness measures the task reports (:data:`softgym.metrics.WALK_METRICS`)."""
-        return WALK_METRICS
+        """The fitness measures the task reports: :data:`softgym.metrics.WALK_METRICS` and its score."""
+        extra = (self.reward,) if self.reward not in WALK_METRICS else ()
+        return (*WALK_METRICS, *extra, "score")
 
     # ----------------------------------------------------------------- world
     def terrain_for(self, shape: Sequence[int]) -> Terrain:
         """The terrain of a robot whose grid of ``shape`` has its corner at the origin."""
         if isinstance(self.terrain, Terrain):
             return self.terrain
-        return LAYOUTS[self.terrain](shape)
+        return LAYOUTS[self.terrain](shape, **self.options)
 
     def config(self, base: SimConfig | None = None) -> SimConfig:
         """The engine settings: ``base`` (default the seed's) with ``sim`` and ``trace_interval``."""
@@ -209,18 +257,37 @@ class Task:
         return cfg.replace(trace_interval=float(self.trace_interval))
 
     # --------------------------------------------------------------- scoring
-    def metrics(self, rollout: Rollout) -> dict[str, np.ndarray]:
-        """What the task reports of a rollout: :func:`softgym.metrics.walk_metrics`.
+    def metrics(self, rollout: Rollout, terrains: Sequence[Terrain] | None = None) -> dict[str, np.ndarray]:
+        """What the task reports of a rollout: :func:`softgym.metrics.walk_metrics`, its measure, ``score``.
+
+        Parameters
+        ----------
+        rollout : Rollout
+        terrains : sequence of Terrain, optional
+            Each robot's world (its ``meta`` holds the measure's parameters:
+            the gap's edge, the push target); default the task's for each
+            robot's grid (read from ``rollout.grid_index``).
 
         Returns
         -------
         dict of str to ndarray of shape (n_robots,)
             ``norm_final_dist``, ``max_xy_dist``, ``l_coefficient``,
-            ``time_max_xy_dist``, ``diverged``.
+            ``time_max_xy_dist``, ``diverged``, the task's measure (a suite
+            task's ``reward``) and ``score`` (the reward metric's value).
         """
         if self.seed_centre_of_mass:
             rollout = dilute(rollout)
-        return walk_metrics(rollout)
+        out = walk_metrics(rollout)
+        if self.reward not in out:
+            if terrains is None:
+                off = rollout.voxel_offsets
+                terrains = [
+                    self.terrain_for(rollout.grid_index[off[i]:off[i + 1]].max(axis=0) + 1)
+                    for i in range(rollout.n_robots)
+                ]
+            out[self.reward] = task_measure(self.reward, rollout, measure_params(terrains))
+        out["score"] = out[self.reward].copy()
+        return out
 
     # ------------------------------------------------------------------ data
     def replace(self, **changes: Any) -> Task:
@@ -245,6 +312,21 @@ class Task:
         if isinstance(kw.get("terrain"), Mapping):
             kw["terrain"] = Terrain.from_dict(dict(kw["terrain"]))
         return cls(**kw)
+
+
+def measure_params(terrains: Sequence[Terrain]) -> dict[str, np.ndarray]:
+    """The task measures' per-robot parameters from their terrains' ``meta`` (voxel lengths)."""
+    n = len(terrains)
+    out = {"center": np.zeros((n, 2)), "edge": np.zeros(n), "target": np.zeros((n, 2))}
+    for i, t in enumerate(terrains):
+        meta = t.meta or {}
+        if "center" in meta:
+            out["center"][i] = np.asarray(meta["center"], dtype=np.float64)[:2]
+        if "edge" in meta:
+            out["edge"][i] = float(meta["edge"])
+        if "target" in meta:
+            out["target"][i] = np.asarray(meta["target"], dtype=np.float64)[:2]
+    return out
 
 
 #: The named tasks: one name each (``"fence"`` is read as ``"wall"``, see :data:`ALIASES`).
@@ -301,13 +383,31 @@ def _read_file(path: Path) -> Task:
     return get_task(data)
 
 
+def _parse_options(spec: str, text: str) -> dict[str, float]:
+    out: dict[str, float] = {}
+    for item in filter(None, (p.strip() for p in text.split(","))):
+        key, eq, value = item.partition("=")
+        try:
+            if not eq:
+                raise ValueError
+            v = float(value)
+            out[key.strip()] = int(v) if v.is_integer() and "." not in value else v
+        except ValueError:
+            raise InvalidParameterError(
+                f"task {spec!r}: arguments are name=number pairs separated by commas "
+                f"(e.g. 'gap:width=3,depth=5'), got {item!r}"
+            ) from None
+    return out
+
+
 def get_task(spec: TaskLike, **overrides: Any) -> Task:
     """The :class:`Task` of a name, a JSON file, a Terrain, a Task or a dict.
 
     Parameters
     ----------
     spec : str, path, Terrain, Task or dict
-        A registered name (:func:`task_names`) or alias; the path of a
+        A registered name (:func:`task_names`) or alias, optionally with
+        arguments (``"gap:width=3,depth=5"``); the path of a
         terrain JSON file (``Terrain.to_json``) or of a task JSON file
         (``Task.to_dict``); a :class:`~softgym.terrain.Terrain`; a Task; a
         dict of either.
@@ -334,6 +434,9 @@ def get_task(spec: TaskLike, **overrides: Any) -> Task:
             task = Task(terrain=Terrain.from_dict(dict(spec)))
         else:
             task = Task.from_dict(spec)
+    elif isinstance(spec, str) and ":" in spec and spec.split(":", 1)[0] in TASKS:
+        name, args = spec.split(":", 1)
+        task = TASKS[name].replace(options={**TASKS[name].options, **_parse_options(spec, args)})
     elif isinstance(spec, (str, os.PathLike)):
         key = ALIASES.get(str(spec), str(spec))
         if isinstance(spec, str) and key in TASKS:

@@ -23,10 +23,11 @@ def small_design() -> RobotDesign:
 
 
 def test_one_name_per_task_and_fence_is_an_alias_of_wall():
-    assert task_names() == ["flat", "wall", "stairs"]
+    assert task_names()[:3] == ["flat", "wall", "stairs"]
+    assert len(task_names()) >= 14 and "fence" not in task_names()
     assert ALIASES == {"fence": "wall"}
     assert get_task("fence") is TASKS["wall"] and Task("fence") == Task("wall")
-    assert [TASKS[n].reward for n in task_names()] == [
+    assert [TASKS[n].reward for n in task_names()[:3]] == [
         "norm_final_dist",
         "max_xy_dist",
         "max_xy_dist",
