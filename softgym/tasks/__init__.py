@@ -1,9 +1,10 @@
 """Tasks: what a run of the engine means, shared by ``softgym.evaluate``, the envs and evolution.
 
 A :class:`Task` is a terrain + a duration + a sampling interval + the metrics
-it reports (:func:`softgym.metrics.walk_metrics`) + the reward an env derives
-from them. :data:`TASKS` holds the named ones (``flat``, ``wall``, ``stairs``;
-``fence`` is an alias of ``wall``); :func:`get_task` also reads a
+it reports (:func:`softgym.metrics.walk_metrics`, a suite task's measure) + the
+reward an env derives from them. :data:`TASKS` holds the named ones (``flat``,
+``wall``, ``stairs``, ``fence`` an alias of ``wall``, and the suite of
+:mod:`softgym.tasks.suite`: ``gap``, ``push``, ``swim``...); :func:`get_task` also reads a
 :class:`~softgym.terrain.Terrain`, a terrain JSON file or a Task's dict, so a
 custom world goes wherever a task name does. :class:`EpisodeBatch` runs a task
 as control episodes of N robots (what the Gymnasium envs adapt).
@@ -20,6 +21,7 @@ from softgym.tasks.episode import (
     EpisodeBatch,
     observation_size,
 )
+from softgym.tasks.suite import KINDS, Option, TaskKind
 from softgym.tasks.task import (
     ALIASES,
     LAYOUTS,
@@ -29,6 +31,7 @@ from softgym.tasks.task import (
     TaskLike,
     flat_layout,
     get_task,
+    measure_params,
     register_task,
     stairs_layout,
     task_names,
@@ -44,10 +47,14 @@ __all__ = [
     "REWARDS",
     "TASKS",
     "EpisodeBatch",
+    "KINDS",
+    "Option",
+    "TaskKind",
     "Task",
     "TaskLike",
     "flat_layout",
     "get_task",
+    "measure_params",
     "observation_size",
     "register_task",
     "stairs_layout",

@@ -177,13 +177,13 @@ def rough_layout(shape: Sequence[int], roughness: float = 1.0, tile: float = 3.0
 
 
 def gap_layout(shape: Sequence[int], width: float = 2.0, depth: float = 4.0) -> Terrain:
-    """A start platform (the grid and 1 voxel around it) in a pit ring ``width`` wide, then ground.
+    """A start platform (the grid and half a voxel around it) in a pit ring ``width`` wide, then ground.
 
     No floor: the platforms are boxes with their tops at z = 0 and the pit's
     bottom is ``depth`` below them, so a robot that steps off falls in.
     """
     c = _centre(shape)
-    inner = _around(shape, margin=1.0)
+    inner = _around(shape, margin=0.5)
     outer = 20.0
     bottom = -depth
     boxes = [_square(c, inner / 2.0, bottom, 0.0)]
@@ -206,17 +206,20 @@ def tunnel_layout(shape: Sequence[int], clearance: float = 1.0, length: float = 
 
 def push_layout(shape: Sequence[int], size: int = 3, distance: float = 10.0,
                 density: float = 5e5) -> Terrain:  # fmt: skip
-    """A cube of ``size`` voxels half a voxel ahead of the robot (+x), a target ``distance`` further."""
-    nx, ny = float(shape[0]), float(shape[1])
-    origin = (nx + 0.5, ny / 2.0 - size / 2.0, 0.0)
+    """A cube of ``size`` voxels half a voxel from the robot's -x side, a target ``distance`` further.
+
+    (-x: where the default walker and the seed's sinusoid head.)
+    """
+    ny = float(shape[1])
+    origin = (-0.5 - size, ny / 2.0 - size / 2.0, 0.0)
     # E in proportion to the density keeps the robot's time step (the seed's tissue: 5e6 Pa, 1e6 kg/m^3)
     block = Block.box(origin, (size, size, size), density=density, youngs_modulus=5.0 * density)
-    target = [float(block.center[0] + distance), float(block.center[1])]
+    target = [float(block.center[0] - distance), float(block.center[1])]
     meta = {"builder": "push", "size": size, "distance": distance, "target": target}
     return Terrain((), True, "push", meta, objects=(block,))
 
 
-def carry_layout(shape: Sequence[int], rim: int = 1, density: float = 1e5) -> Terrain:
+def carry_layout(shape: Sequence[int], rim: int = 2, density: float = 1e5) -> Terrain:
     """A cap on the robot: a plate over its grid with a ``rim`` hanging round its top layers.
 
     The cap sits at the self-contact distance (1.5 voxels between centres), so
@@ -303,21 +306,22 @@ KINDS: dict[str, TaskKind] = {
         TaskKind("jump", "raise the centre of mass as high as possible", _flat("jump"), "peak_height"),
         TaskKind("turn", "turn in place about the vertical axis", _flat("turn"), "yaw"),
         TaskKind(
-            "push", "push a box towards a target ahead (+x)", push_layout, "push_progress",
+            "push", "push a box to a target (-x of the robot)", push_layout, "push_progress",
             {"size": Option(3, 1, 6, "side of the box, voxels", integer=True),
              "distance": Option(10.0, 1.0, 50.0, "target distance from the box, voxel lengths"),
              "density": Option(5e5, 1e4, 1e7, "the box's density, kg/m^3 (the robot's: 1e6)")},
         ),
         TaskKind(
             "carry", "walk with a cap on top without dropping it", carry_layout, "carried_dist",
-            {"rim": Option(1, 0, 4, "depth of the cap's rim round the robot's top, voxels", integer=True),
+            {"rim": Option(2, 0, 4, "depth of the cap's rim round the robot's top, voxels", integer=True),
              "density": Option(1e5, 1e4, 1e7, "the cap's density, kg/m^3 (the robot's: 1e6)")},
         ),
         TaskKind(
-            "swim", "swim in a fluid (no floor, no weight, drag on exposed faces)", _swim,
+            "swim", "swim in a fluid (no floor, no weight, drag on exposed faces; muscles expand and contract)", _swim,
             "swim_dist",
-            {"drag": Option(5e5, 1e3, 1e8, "rho C_d / 2 of the fluid, kg/m^3")},
-            sim=lambda o: {"fluid_drag": float(o["drag"]), "gravity": 0.0, "floor": False},
+            {"drag": Option(5e6, 1e3, 1e8, "rho C_d / 2 of the fluid, kg/m^3")},
+            sim=lambda o: {"fluid_drag": float(o["drag"]), "gravity": 0.0, "floor": False,
+                           "actuation": "symmetric"},
         ),
         TaskKind(
             "grow", "spread the largest footprint (muscles expand and contract)", _flat("grow"),

@@ -139,7 +139,8 @@ class Task:
         Seconds between centre-of-mass samples (the L coefficient's
         resolution): 0.5 for the seed's novelty runs, 0.1 otherwise.
     sim : dict
-        Overrides of :class:`~softgym.engine.SimConfig` (e.g. ``{"actuation": "symmetric"}``).
+        Overrides of :class:`~softgym.engine.SimConfig` (e.g. ``{"actuation": "symmetric"}``),
+        over the settings a suite task sets itself (:attr:`engine_settings`).
     n_threads : int, optional
         OpenMP threads of the simulation (default: softgym's default).
     reward : {"norm_final_dist", "max_xy_dist"}, optional
@@ -202,10 +203,8 @@ class Task:
             object.__setattr__(self, "options", {})
             object.__setattr__(self, "sim", dict(self.sim))
         else:
-            options = kind.resolve(self.options)
-            object.__setattr__(self, "options", options)
-            # the kind's engine settings, under the caller's
-            object.__setattr__(self, "sim", {**kind.sim(options), **dict(self.sim)})
+            object.__setattr__(self, "options", kind.resolve(self.options))
+            object.__setattr__(self, "sim", dict(self.sim))
         if self.n_threads is not None:
             object.__setattr__(self, "n_threads", int(self.n_threads))
         reward = self.reward
@@ -253,8 +252,16 @@ class Task:
         """The engine settings: ``base`` (default the seed's) with ``sim`` and ``trace_interval``."""
         from softgym.engine import SimConfig
 
-        cfg = SimConfig(**dict(self.sim)) if base is None else base.replace(**dict(self.sim))
+        sim = self.engine_settings
+        cfg = SimConfig(**sim) if base is None else base.replace(**sim)
         return cfg.replace(trace_interval=float(self.trace_interval))
+
+    @property
+    def engine_settings(self) -> dict[str, Any]:
+        """The :class:`~softgym.engine.SimConfig` fields the task sets: its kind's, then ``sim``."""
+        kind = KINDS.get(self.terrain) if isinstance(self.terrain, str) else None
+        base = kind.sim(self.options) if kind is not None else {}
+        return {**base, **dict(self.sim)}
 
     # --------------------------------------------------------------- scoring
     def metrics(self, rollout: Rollout, terrains: Sequence[Terrain] | None = None) -> dict[str, np.ndarray]:

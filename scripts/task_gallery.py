@@ -1,0 +1,88 @@
+"""Render one frame per task of the suite into a grid image (docs/figures/task_gallery.png).
+
+Each task's world around the default walker, after ``--seconds`` (1 s of
+settling, then the walker's own controller, the seed's sinusoid) in that task's
+engine settings; movable objects are drawn in grey, worlds below z = 0 lifted
+over the renderer's floor.
+
+    python scripts/task_gallery.py                     # docs/figures/task_gallery.png
+    python scripts/task_gallery.py --out gallery.png --seconds 2
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+
+from softgym.design import default_walker
+from softgym.engine import Simulation
+from softgym.render import VoxelRenderer
+from softgym.tasks import get_task, task_names
+from softgym.terrain import Box, Terrain
+
+OBJECT_COLOR = (0.55, 0.55, 0.6)
+
+
+def frame(name: str, seconds: float, renderer: VoxelRenderer) -> np.ndarray:
+    """The default walker in task ``name`` after ``seconds``, as an RGB frame."""
+    design = default_walker()
+    task = get_task(name)
+    terrain = task.terrain_for(design.shape)
+    sim = Simulation([design], config=task.config(), terrain=terrain, n_threads=1)
+    sim.advance(seconds)
+    table = np.zeros((design.palette.max_id + 1, 3))
+    for k, mat in design.palette.items():
+        table[k] = mat.color[:3]
+    gi = sim.grid_index(0)
+    colors = table[design.grid[tuple(gi.T)]]
+    pos, quat, scale = sim.positions(0), sim.orientations(0), sim.scales(0)
+    if terrain.objects:
+        obj = sim.object_positions(0)
+        pos = np.concatenate([pos, obj])
+        quat = np.concatenate([quat, sim.object_orientations(0)])
+        scale = np.concatenate([scale, sim.object_scales(0)])
+        colors = np.concatenate([colors, np.tile(OBJECT_COLOR, (len(obj), 1))])
+    target = sim.center_of_mass()[0]
+    low = min((b.lo[2] for b in terrain.boxes), default=0.0)
+    if low < 0:  # the renderer draws a floor at z = 0: lift a world that goes below it
+        lift = np.array([0.0, 0.0, -low])
+        terrain = Terrain(
+            tuple(Box(np.add(b.lo, lift), np.add(b.hi, lift)) for b in terrain.boxes), True, name
+        )
+        pos = pos + lift * sim.config.voxel_size
+        target = target + lift * sim.config.voxel_size
+    return renderer.render(pos, quat, scale, colors, terrain=terrain, target=target)
+
+
+def main() -> None:
+    """Render the gallery (command line)."""
+    p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    p.add_argument("--out", default=str(Path(__file__).resolve().parents[1] / "docs" / "figures"
+                                        / "task_gallery.png"))  # fmt: skip
+    p.add_argument("--seconds", type=float, default=1.5)
+    p.add_argument("--columns", type=int, default=4)
+    args = p.parse_args()
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    names = task_names()
+    renderer = VoxelRenderer(320, 240, pixels_per_voxel=9.0)
+    cols = args.columns
+    rows = -(-len(names) // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(3.2 * cols, 2.6 * rows))
+    for ax in np.ravel(axes):
+        ax.axis("off")
+    for ax, name in zip(np.ravel(axes), names):
+        ax.imshow(frame(name, args.seconds, renderer))
+        ax.set_title(f"{name} ({get_task(name).reward})", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(args.out, dpi=100)
+    print(args.out)
+
+
+if __name__ == "__main__":
+    main()
