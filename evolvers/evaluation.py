@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -45,9 +46,13 @@ BatchFn = Callable[[list[dict[str, Any]], Task], dict[str, Any]]
 _STORED = tuple(k for k in METRIC_KEYS if k != "time_max_xy_dist")
 
 
-def local_batch_fn(designs: list[dict[str, Any]], task: Task) -> dict[str, Any]:
-    """Evaluate every design in one local Simulation (:func:`softgym.evaluate`)."""
-    return evaluate(designs, task=task, traces=True)
+def local_batch_fn(
+    designs: list[dict[str, Any]], task: Task, progress: bool | None = None
+) -> dict[str, Any]:
+    """Evaluate every design in one local Simulation (:func:`softgym.evaluate`;
+    ``progress`` as there: None shows a bar for a batch that takes long).
+    """
+    return evaluate(designs, task=task, traces=True, progress=progress)
 
 
 def pack_traces(traces: Sequence[np.ndarray | None]) -> tuple[np.ndarray, np.ndarray]:
@@ -158,6 +163,9 @@ class Evaluator:
         OpenMP threads of local simulations.
     cache : PhenotypeCache, optional
         Shared results (a fresh cache by default).
+    progress : bool
+        False keeps the default batch function's progress bar off (a run
+        that shows none of its own, e.g. inside a study).
     """
 
     def __init__(
@@ -166,10 +174,12 @@ class Evaluator:
         batch_fn: BatchFn | None = None,
         n_threads: int | None = None,
         cache: PhenotypeCache | None = None,
+        progress: bool = True,
     ) -> None:
         self.experiment = experiment
         self.task = experiment.make_task(n_threads)
-        self.batch_fn = batch_fn or local_batch_fn
+        # the default batch function shows a bar on long batches unless asked not to
+        self.batch_fn = batch_fn or (local_batch_fn if progress else partial(local_batch_fn, progress=False))
         self.cache = PhenotypeCache() if cache is None else cache
         self.n_evaluations = 0
 

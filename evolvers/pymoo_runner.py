@@ -406,7 +406,7 @@ class PymooRun(RecordedRun):
             (algorithm == "ga") if single_objective is None else single_objective
         )
         self.on_generation = on_generation
-        self.evaluator = Evaluator(experiment, batch_fn=batch_fn, n_threads=n_threads)
+        self.evaluator = Evaluator(experiment, batch_fn=batch_fn, n_threads=n_threads, progress=progress)
         self.recorder = RunRecorder(
             out, experiment, self.seed, self.backend, figures, gif,
             extra_config={"algorithm": _algorithm_label(algorithm)}, progress=progress,

@@ -393,7 +393,7 @@ class QDRun(RecordedRun):
         self.objective = self.config.objective_for(experiment)
         self.on_generation = on_generation
         self.figures = figures
-        self.evaluator = Evaluator(experiment, batch_fn=batch_fn, n_threads=n_threads)
+        self.evaluator = Evaluator(experiment, batch_fn=batch_fn, n_threads=n_threads, progress=progress)
         self.recorder = RunRecorder(
             out, experiment, self.seed, self.backend, figures, gif,
             extra_config={"qd": self.config.to_dict()}, progress=progress,

@@ -123,7 +123,7 @@ class EvolutionRun(RecordedRun):
         self.on_generation = on_generation
         self.figures = figures
         self.gif = gif
-        self.evaluator = Evaluator(experiment, batch_fn=batch_fn, n_threads=n_threads)
+        self.evaluator = Evaluator(experiment, batch_fn=batch_fn, n_threads=n_threads, progress=progress)
         self.recorder = RunRecorder(
             out, experiment, self.seed, self.backend, figures, gif, progress=progress
         )

@@ -48,6 +48,19 @@ def test_progress_bar_and_log_lines(tmp_path, caplog, capsys):
     assert "[native]" not in capsys.readouterr().err
 
 
+def test_a_quiet_run_keeps_long_batches_quiet_too(tmp_path, capsys, monkeypatch):
+    # inside a study the runs show no bar: not even the evaluation's own bar,
+    # which a long batch shows by default
+    import importlib
+
+    ev = importlib.import_module("softgym.evaluate")  # the module (the package exports the function)
+    monkeypatch.setattr(ev, "PROGRESS_AFTER_S", 0.0)  # every batch counts as long
+    EvolutionRun(tiny(), tmp_path / "loud", seed=0, generations=0, figures=False).run()
+    assert "simulating" in capsys.readouterr().err
+    EvolutionRun(tiny(), tmp_path / "q", seed=0, generations=0, figures=False, progress=False).run()
+    assert capsys.readouterr().err == ""
+
+
 def test_resume_mismatch_names_the_one_setting(tmp_path):
     EvolutionRun(tiny(), tmp_path / "r", seed=0, generations=0, figures=False,
                  progress=False).run()  # fmt: skip
