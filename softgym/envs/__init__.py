@@ -6,6 +6,10 @@ id                         world                                       reward (p
 ``SoftWalker-Flat-v0``     flat floor                                  NormFinalDist progress
 ``SoftWalker-Wall-v0``     the seed's fence (1 voxel high, 2 away)     MaxXYDist progress
 ``SoftWalker-Stairs-v0``   three rings, each one voxel higher          MaxXYDist progress
+``SoftWalker-<Name>-v0``   the suite's other tasks (softgym.tasks.     the task's score
+                           suite: StairsDown, Rough, Gap, Tunnel,      progress
+                           Incline, Ice, Mud, Jump, Turn, Push,
+                           Carry, Swim, Grow)
 =========================  ==========================================  =====================
 
 Every task of :data:`softgym.tasks.TASKS` gets an id (a task added with

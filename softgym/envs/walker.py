@@ -229,6 +229,34 @@ class SoftWalkerEnv(gym.Env):
     * ``SoftWalker-Stairs-v0``: three concentric rings, each one voxel higher
       than the one inside it; reward on ``MaxXYDist``.
 
+    and the rest of the task suite (:mod:`softgym.tasks.suite`), each rewarded
+    on the progress of its own measure (:mod:`softgym.metrics.task_measures`):
+
+    ==============================  ==============================================  ===================
+    id                              world and goal                                  measure
+    ==============================  ==============================================  ===================
+    ``SoftWalker-StairsDown-v0``    walk down a stepped pyramid from its top        ``max_xy_dist``
+    ``SoftWalker-Rough-v0``         a seeded random height field of boxes           ``max_xy_dist``
+    ``SoftWalker-Gap-v0``           no floor: cross the pit around the start        ``gap_crossed``
+    ``SoftWalker-Tunnel-v0``        crawl out under a low ring-shaped roof          ``max_xy_dist``
+    ``SoftWalker-Incline-v0``       walk uphill (+x): gravity tilted                ``x_progress``
+    ``SoftWalker-Ice-v0``           ground friction x 0.1                           ``norm_final_dist``
+    ``SoftWalker-Mud-v0``           ground friction x 4                             ``norm_final_dist``
+    ``SoftWalker-Jump-v0``          raise the centre of mass                        ``peak_height``
+    ``SoftWalker-Turn-v0``          turn in place about z                           ``yaw`` (rad)
+    ``SoftWalker-Push-v0``          push a box to a target                          ``push_progress``
+    ``SoftWalker-Carry-v0``         walk with a cap on top, not dropping it         ``carried_dist``
+    ``SoftWalker-Swim-v0``          no floor, no weight, drag on exposed faces      ``swim_dist``
+    ``SoftWalker-Grow-v0``          spread the largest footprint                    ``footprint_gain``
+    ==============================  ==============================================  ===================
+
+    A task's difficulty arguments go through ``task=``:
+    ``gym.make("SoftWalker-Gap-v0", task="gap:width=4")`` or
+    ``task=softgym.tasks.Task("gap", options={"width": 4})``; out-of-range
+    values raise :class:`~softgym.exceptions.InvalidParameterError`. Movable
+    objects (push, carry) are not part of the observation (the robot feels
+    them through contact).
+
     The spaces depend on ``grid_shape`` only, never on the body, so any two
     bodies of one grid share them (and one vector env can hold both).
 
@@ -282,8 +310,9 @@ class SoftWalkerEnv(gym.Env):
     The per-step progress of the task metric, in voxel lengths: on Flat the
     increase of ``NormFinalDist = |CM_xy(t) - CM_xy(t0)| / L``; on Wall and
     Stairs the increase of ``MaxXYDist = max(|dx|, |dy|) / L`` (the seed's
-    obstacle fitness); ``t0`` is the episode start (after settling). The
-    return of an episode is therefore the metric at its end: with the default
+    obstacle fitness); on the suite's other tasks the increase of their
+    measure; ``t0`` is the episode start (after settling). The
+    return of an episode is therefore the metric at its end (``info["score"]``): with the default
     4 s episode, the seed's fitness over its window t in (1, 5] s. A diverged
     episode forfeits its progress: the diverging step's reward makes its
     return 0.
@@ -315,7 +344,8 @@ class SoftWalkerEnv(gym.Env):
     start), ``l_coefficient`` (the seed's ``MaxXYDist^2 / t_max``, from one
     centre-of-mass sample per control step, ``t_max`` the engine time of the
     first sample within 0.1 voxel of ``MaxXYDist``), ``diverged`` (bool) and
-    ``time`` (s since the robot was placed). Diverged episodes report
+    ``time`` (s since the robot was placed), ``score`` (the task's reward
+    metric) and, on a suite task, its measure by name. Diverged episodes report
     :data:`softgym.metrics.WORST_FITNESS` for the metrics, as the seed does.
     :meth:`reset`'s info also holds ``muscle_mask`` (bool, one per cell).
 
@@ -359,7 +389,8 @@ class SoftWalkerEnv(gym.Env):
 
     ## Version History
 
-    * v0: initial version. Since the task layer (issue 11): ``task`` also takes a Task,
+    * v0: initial version. Since the task suite (issue 14): ``info["score"]``, 13 more ids,
+      task arguments in ``task=``. Since the task layer (issue 11): ``task`` also takes a Task,
       Terrain or JSON file, ``episode_seconds`` defaults to the task's, the wall is centred on
       the design's grid (as in ``softgym.evaluate``; the default walker fills its grid, so
       its world is unchanged), ``l_coefficient`` uses the engine's sample times, and
