@@ -26,6 +26,7 @@ is given with it.
 from __future__ import annotations
 
 import json
+import logging
 import math
 import os
 from collections.abc import Callable, Mapping, Sequence
@@ -38,6 +39,10 @@ import numpy as np
 from evolvers.genome import Individual
 from softgym.design import CONTROLLER_BOUNDS, Controller
 from softgym.design.material import EVOLVABLE_BOUNDS, MUSCLE_IDS, TISSUE_IDS
+from softgym.exceptions import CheckpointError
+from softgym.render.figures import read_log
+
+log = logging.getLogger(__name__)
 
 __all__ = [
     "REPORT_CURVES",
@@ -165,19 +170,6 @@ class RunData:
         return Individual.from_dict(self.best["genome"])
 
 
-def _read_jsonl(path: Path) -> list[dict[str, Any]]:
-    if not path.exists():
-        return []
-    rows = []
-    for line in path.read_text().splitlines():
-        if line.strip():
-            try:
-                rows.append(json.loads(line))
-            except ValueError:
-                break  # a torn last line: keep what was written whole
-    return rows
-
-
 def load_runs(root: str | os.PathLike[str]) -> dict[str, list[RunData]]:
     """Every run folder under ``root``, by scenario, each list sorted by seed.
 
@@ -201,7 +193,11 @@ def load_runs(root: str | os.PathLike[str]) -> dict[str, list[RunData]]:
                 scenario = json.loads(sc_path.read_text())["name"]
             except (OSError, ValueError, KeyError):
                 pass
-        rows = _read_jsonl(run_dir / "log.jsonl")
+        try:
+            rows = read_log(run_dir)
+        except CheckpointError as exc:  # one damaged run must not stop the report
+            log.warning("skipping a run: %s", exc)
+            continue
         best = None
         try:
             best = json.loads((run_dir / "best_designs.json").read_text())["best"][0]

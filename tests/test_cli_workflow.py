@@ -80,6 +80,17 @@ def test_compare_groups_seeds_and_explains_a_missing_metric(runs, tmp_path, caps
     # a mix of experiments compares on a metric both record
     assert main(["compare", str(runs / "a0"), str(runs / "o"), "--metric", "n_muscle",
                  "--out", str(out)]) == 0  # fmt: skip
+    # a damaged log is one line naming the file and line, exit 2
+    import shutil
+
+    bad = tmp_path / "bad"
+    shutil.copytree(runs / "a1", bad)
+    lines = (bad / "log.jsonl").read_text().splitlines()
+    (bad / "log.jsonl").write_text("\n".join([lines[0], lines[1][:20], *lines[2:]]) + "\n")
+    capsys.readouterr()
+    assert main(["compare", str(runs / "a0"), str(bad), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "log.jsonl: line 2 is not JSON" in err
 
 
 def test_convert_both_ways_and_view(runs, tmp_path, capsys):

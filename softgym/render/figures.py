@@ -95,9 +95,35 @@ def _save(fig: Any, path: str | os.PathLike[str]) -> Path:
 
 
 def read_log(run_dir: str | os.PathLike[str]) -> list[dict[str, Any]]:
-    """The per-generation rows of a run folder's ``log.jsonl``."""
+    """The per-generation rows of a run folder's ``log.jsonl`` ([] when it has none yet).
+
+    Raises
+    ------
+    CheckpointError
+        Naming the file and line, if a line is not a JSON object (the log is
+        written atomically, so this is damage, not a run still writing).
+    """
+    from softgym.exceptions import CheckpointError
+
     path = Path(run_dir) / "log.jsonl"
-    return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+    if not path.exists():
+        return []
+    try:
+        text = path.read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise CheckpointError(f"{path}: cannot be read ({exc})") from None
+    rows = []
+    for n, line in enumerate(text.splitlines(), 1):
+        if not line.strip():
+            continue
+        try:
+            row = json.loads(line)
+        except ValueError as exc:
+            raise CheckpointError(f"{path}: line {n} is not JSON ({exc})") from None
+        if not isinstance(row, dict):
+            raise CheckpointError(f"{path}: line {n} is not a JSON object")
+        rows.append(row)
+    return rows
 
 
 def plot_fitness_trend(

@@ -90,6 +90,11 @@ def test_grid_shape_check_is_strict():
     for bad in [(6.5, 6, 6), (6.0, 6, 6), (True, 6, 6), ("6", 6, 6), "666", (6, 6), (0, 6, 6), 6]:
         with pytest.raises(InvalidDesignError, match="grid_shape"):
             check_grid_shape(bad, "grid_shape")
+    # an int too long for Python to print still gets the typed, short message
+    for bad in [(10**5000, 6, 6), (10**5000, 6.5, 6)]:
+        with pytest.raises(InvalidDesignError, match="16610-bit integer") as info:
+            check_grid_shape(bad, "grid_shape")
+        assert len(str(info.value)) < 120
 
 
 def test_ragged_or_overflowing_grids_raise_typed_errors():
