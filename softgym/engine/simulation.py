@@ -350,6 +350,11 @@ class Simulation:
         terrain for every robot, or one per robot. Robots never touch each
         other: each lives in its own copy of its world. The floor is
         ``config.floor`` (a terrain built with ``floor=False`` turns it off).
+        A terrain's movable objects (``Terrain.objects``) join their robot's
+        entry after its voxels: they touch it through the self-collision law
+        and stay out of its centre of mass, actuation and per-robot views
+        (``positions``, ``all_positions``, ``voxel_offsets``, the rollout's
+        voxels); ``object_positions`` and ``aux`` show them.
     n_threads : int, optional
         OpenMP threads used by :meth:`run` (default :func:`default_num_threads`).
         Results are bit-identical for any thread count.
@@ -383,6 +388,11 @@ class Simulation:
         if self.n_threads < 1:
             raise InvalidParameterError(f"n_threads must be >= 1, got {n_threads}")
         self.terrains = self._terrains(terrain)
+        if not self.config.self_collision and any(t.objects for t in self.terrains):
+            raise InvalidParameterError(
+                "a terrain's movable objects touch the robot through self-collision: "
+                "SimConfig.self_collision must be True"
+            )
         self._build()
         self._initial = {k: self._a[k].copy() for k in _STATE}
         self._contacts = _core.ContactCache(self.n_robots)
@@ -884,19 +894,17 @@ class Simulation:
         if not np.isfinite(arr).all():
             raise InvalidActionError("temperatures hold NaN or infinite values")
         a = self._a
-        temp = a["temp"] if self._own is None else np.zeros(int(a["vox_start"][-1]))
+        # the robots' voxels in the kernel arrays (their objects, after them, keep T = 0)
+        own = slice(None) if self._own is None else self._own
         if robots is None:
-            if self._own is None:
-                a["temp"][:] = arr
-            else:
-                a["temp"][self._own] = arr
+            a["temp"][own] = arr
             a["use_temp"][:] = 1
             return
         sel = np.zeros(self.n_robots, dtype=bool)
         sel[np.asarray(robots)] = True
         voxels = np.repeat(sel, np.diff(self._own_offsets))
         if self._own is None:
-            temp[voxels] = arr[voxels]
+            a["temp"][voxels] = arr[voxels]
         else:
             a["temp"][self._own[voxels]] = arr[voxels]
         a["use_temp"][sel] = 1

@@ -46,6 +46,8 @@ OBS_POSITION_BOUND = 50.0
 OBS_VELOCITY_BOUND = 500.0
 #: What drives the muscles: the actions, or the design's own controller (actions ignored).
 DRIVES: tuple[str, ...] = ("action", "controller")
+#: RGB colour of movable objects (push, carry) in rendered frames.
+OBJECT_COLOR = (0.55, 0.55, 0.6)
 #: Most control steps an episode may have: its centre-of-mass samples are allocated up front
 #: (32 bytes a step per robot, so 32 MB per robot at the cap).
 MAX_STEPS_PER_EPISODE = 1_000_000
@@ -530,11 +532,22 @@ class EpisodeBatch:
     def render_frame(self, renderer: Any, r: int) -> np.ndarray:
         """Robot ``r`` and its terrain drawn by ``renderer`` (a :class:`~softgym.render.VoxelRenderer`)."""
         sim = self.sim
+        if not self.terrains[r].objects:
+            return renderer.render(
+                sim.positions(r),
+                sim.orientations(r),
+                sim.scales(r),
+                self.colors(r),
+                grid_index=sim.grid_index(r),
+                terrain=self.terrains[r],
+            )
+        # with its movable objects, in grey
+        obj = sim.object_positions(r)
         return renderer.render(
-            sim.positions(r),
-            sim.orientations(r),
-            sim.scales(r),
-            self.colors(r),
-            grid_index=sim.grid_index(r),
+            np.concatenate([sim.positions(r), obj]),
+            np.concatenate([sim.orientations(r), sim.object_orientations(r)]),
+            np.concatenate([sim.scales(r), sim.object_scales(r)]),
+            np.concatenate([self.colors(r), np.tile(OBJECT_COLOR, (len(obj), 1))]),
             terrain=self.terrains[r],
+            target=sim.center_of_mass()[r],
         )

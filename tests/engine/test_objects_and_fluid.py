@@ -157,6 +157,8 @@ def test_typed_errors_for_the_new_settings_and_objects():
         Block((0, 0, 0), (0, 1, 1))
     with pytest.raises(InvalidTerrainError, match="overlaps the robot"):
         Simulation(_cube(), terrain=Terrain(objects=(Block.box((1.0, 1.0, 1.0), (1, 1, 1)),)))
+    with pytest.raises(InvalidParameterError, match="self_collision"):
+        Simulation(_cube(), config=SimConfig(self_collision=False), terrain=_box_world())
     with pytest.raises(InvalidTerrainError, match="box_contact"):
         Terrain(box_contact="sticky")
 
