@@ -7,9 +7,9 @@ simulate
     centre-of-mass trajectory figure and a summary JSON.
 evolve
     Run one of the seed study's experiments (native loop, DEAP or pymoo),
-    on its task or another (``--task stairs|wall|flat|FILE.json``), locally or
-    on Dask, into a resumable run folder with log, checkpoints, best designs
-    and figures.
+    on its task or another (``--task NAME``: any task of softgym.tasks, with
+    arguments as ``gap:width=3``, or FILE.json), locally or on Dask, into a
+    resumable run folder with log, checkpoints, best designs and figures.
 replay
     Re-simulate the best robot of a run folder and render it (figures, GIF, MP4).
 compare
@@ -666,7 +666,7 @@ def _add_qd_parser(sub) -> None:
     p.add_argument("--archive", choices=["grid", "cvt"], help="GridArchive (default) or CVTArchive")
     p.add_argument("--objective", choices=["norm_final_dist", "max_xy_dist"],
                    help="maximised metric (default: the experiment's fitness)")  # fmt: skip
-    p.add_argument("--task", metavar="flat|wall|stairs|FILE.json",
+    p.add_argument("--task", metavar="TASK[:ARG=V,...]|FILE.json",
                    help="the world (default: the experiment's)")  # fmt: skip
     p.add_argument("--seconds", type=float, help="simulated seconds per evaluation (default 5)")
     p.add_argument("--shape", type=int, nargs=3, metavar=("NX", "NY", "NZ"),
@@ -766,7 +766,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     p.add_argument(
         "--task",
-        metavar="flat|wall|stairs|FILE.json",
+        metavar="TASK[:ARG=V,...]|FILE.json",
         help="the world (default: the experiment's): a task name or a terrain JSON file",
     )
     p.add_argument(
@@ -825,7 +825,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--seconds", type=float, help="simulated seconds (default: the run's, or 5)")
     p.add_argument("--fps", type=float, default=10.0, help="frames per simulated second")
     p.add_argument(
-        "--task", metavar="flat|wall|stairs|FILE.json",
+        "--task", metavar="TASK[:ARG=V,...]|FILE.json",
         help="the world (default: the run's task, or flat)",
     )  # fmt: skip
     p.set_defaults(func=_cmd_view)
