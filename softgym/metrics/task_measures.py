@@ -14,9 +14,9 @@ get :data:`~softgym.metrics.WORST_FITNESS`.
 measure             value (voxel lengths unless said)
 ==================  ==========================================================================
 ``x_progress``      ``(x_end - x_0) / L``: signed progress along +x (uphill on an incline)
-``gap_crossed``     how far the centre of mass got past the start platform's edge
-                    (``max(|x - c_x|, |y - c_y|) / L - edge``, >= 0), 0 if it ended below
-                    the platform's top (in the pit)
+``gap_crossed``     how far the robot reaches past the start platform's edge: its farthest
+                    voxel centre beyond the square ``|x - c_x|, |y - c_y| <= edge`` (>= 0),
+                    0 if its centre of mass ended below the platform's top (in the pit)
 ``peak_height``     the highest centre of mass over the episode above its start
 ``yaw``             ``|heading_end - heading_0|`` unwrapped over the samples (rad): turning
 ``push_progress``   how much nearer the object got to its target (xy)
@@ -133,8 +133,12 @@ def task_measure_from_arrays(
         elif name == "gap_crossed":
             c = np.asarray(params["center"], dtype=np.float64).reshape(-1, 2)
             edge = np.asarray(params["edge"], dtype=np.float64).reshape(-1)
-            d = np.max(np.abs(end[:, :2] / L - c), axis=1)
-            out = np.where(end[:, 2] >= 0.0, np.maximum(d - edge, 0.0), 0.0)
+            box = aend[:, _XLO:_YHI + 1] / L  # x lo, x hi, y lo, y hi of the voxel centres
+            reach = np.max(
+                np.column_stack([box[:, 1] - c[:, 0], c[:, 0] - box[:, 0],
+                                 box[:, 3] - c[:, 1], c[:, 1] - box[:, 2]]), axis=1
+            ) - edge  # fmt: skip
+            out = np.where(end[:, 2] >= 0.0, np.maximum(reach, 0.0), 0.0)
         elif name == "peak_height":
             z = np.where(ok, cm[:, :, 2], -np.inf)
             out = np.maximum(z.max(axis=1) - cm0[:, 2], 0.0) / L

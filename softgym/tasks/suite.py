@@ -156,18 +156,22 @@ def stairs_down_layout(shape: Sequence[int], step_height: float = 1.0, n_steps: 
 
 def rough_layout(shape: Sequence[int], roughness: float = 1.0, tile: float = 3.0,
                  extent: float = 12.0, seed: int = 0) -> Terrain:  # fmt: skip
-    """A seeded random height field: square tiles of heights uniform in [0, roughness]."""
-    cx, cy = _centre(shape)
+    """A seeded random height field: square tiles of heights uniform in [0, roughness].
+
+    The tiles start 1 voxel from the grid (that margin and the grid stay flat)
+    and cover ``extent`` voxel lengths beyond it on every side.
+    """
     nx, ny = float(shape[0]), float(shape[1])
     rng = np.random.default_rng(int(seed))
     n = int(math.ceil(extent / tile))
+    mx = int(math.ceil((nx + 2.0) / tile))  # tiles over the flat start square, from x = -1
+    my = int(math.ceil((ny + 2.0) / tile))
     boxes = []
-    for i in range(-n, n):
-        for j in range(-n, n):
-            x0, y0 = cx + i * tile, cy + j * tile
+    for i in range(-n, mx + n):
+        for j in range(-n, my + n):
+            x0, y0 = -1.0 + i * tile, -1.0 + j * tile
             h = float(rng.uniform(0.0, roughness))
-            # the start region (the grid and a 1-voxel margin) stays flat
-            if x0 < nx + 1 and x0 + tile > -1 and y0 < ny + 1 and y0 + tile > -1:
+            if 0 <= i < mx and 0 <= j < my:  # the start square stays flat
                 continue
             if h >= 0.05:
                 boxes.append(Box((x0, y0, 0.0), (x0 + tile, y0 + tile, round(h, 3))))
@@ -177,13 +181,13 @@ def rough_layout(shape: Sequence[int], roughness: float = 1.0, tile: float = 3.0
 
 
 def gap_layout(shape: Sequence[int], width: float = 2.0, depth: float = 4.0) -> Terrain:
-    """A start platform (the grid and half a voxel around it) in a pit ring ``width`` wide, then ground.
+    """A start platform (the grid's footprint) in a pit ring ``width`` wide, then ground.
 
     No floor: the platforms are boxes with their tops at z = 0 and the pit's
     bottom is ``depth`` below them, so a robot that steps off falls in.
     """
     c = _centre(shape)
-    inner = _around(shape, margin=0.5)
+    inner = _around(shape, margin=0.0)
     outer = 20.0
     bottom = -depth
     boxes = [_square(c, inner / 2.0, bottom, 0.0)]
@@ -194,7 +198,7 @@ def gap_layout(shape: Sequence[int], width: float = 2.0, depth: float = 4.0) -> 
     return Terrain(tuple(boxes), False, "gap", meta, box_contact="surface")
 
 
-def tunnel_layout(shape: Sequence[int], clearance: float = 1.0, length: float = 6.0) -> Terrain:
+def tunnel_layout(shape: Sequence[int], clearance: float = 0.75, length: float = 6.0) -> Terrain:
     """A ring-shaped low roof around the start: its underside ``clearance`` below the grid's top."""
     c = _centre(shape)
     inner = _around(shape)
@@ -278,19 +282,19 @@ KINDS: dict[str, TaskKind] = {
              "seed": _SEED},
         ),
         TaskKind(
-            "gap", "cross a pit from the start platform to the ground around it", gap_layout,
+            "gap", "reach across a pit from the start platform to the ground around it", gap_layout,
             "gap_crossed",
             {"width": Option(2.0, 0.5, 10.0, "width of the pit, voxel lengths"),
              "depth": Option(4.0, 1.0, 20.0, "depth of the pit, voxel lengths")},
         ),
         TaskKind(
             "tunnel", "crawl out under a low roof", tunnel_layout, "max_xy_dist",
-            {"clearance": Option(1.0, 0.0, 4.0, "how far the roof is below the grid's top, voxel lengths"),
+            {"clearance": Option(0.75, 0.0, 4.0, "how far the roof is below the grid's top, voxel lengths"),
              "length": Option(6.0, 1.0, 20.0, "length of the roofed ring, voxel lengths")},
         ),
         TaskKind(
             "incline", "walk uphill (+x) on a slope made by tilting gravity", _flat("incline"),
-            "x_progress", {"angle": Option(10.0, 0.0, 30.0, "slope, degrees")},
+            "x_progress", {"angle": Option(5.0, 0.0, 30.0, "slope, degrees")},
             sim=lambda o: {"incline": float(o["angle"])},
         ),
         TaskKind(

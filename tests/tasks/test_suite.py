@@ -65,7 +65,7 @@ def test_difficulty_arguments_change_the_world():
     hi = get_task("stairs_down:step_height=2").terrain_for(shape)
     assert min(b.hi[2] for b in hi.boxes) == -6.0
     gap = get_task("gap:width=4").terrain_for(shape)
-    assert not gap.floor and gap.meta["edge"] == 3.5 and gap.box_contact == "surface"
+    assert not gap.floor and gap.meta["edge"] == 3.0 and gap.box_contact == "surface"
     assert get_task("incline:angle=20").config().incline == 20.0
     swim = get_task("swim").config()
     assert swim.gravity == 0.0 and swim.floor is False and swim.fluid_drag > 0
@@ -86,16 +86,19 @@ def test_push_measure_of_a_box_pushed_a_known_distance():
 
 
 def test_gap_measure_is_zero_on_the_platform_or_in_the_pit():
-    params = {"center": np.array([[3.0, 3.0]]), "edge": np.array([3.5])}
+    params = {"center": np.array([[3.0, 3.0]]), "edge": np.array([3.0])}
     start = [3 * L, 3 * L, 2.7 * L]
-    beyond = [3 * L + 6 * L, 3 * L, 2.7 * L]  # 6 from the centre: 2.5 past the edge
-    fell = [3 * L + 6 * L, 3 * L, -1.5 * L]
-    a = _aux()
-    assert task_measure_from_arrays("gap_crossed", *_arrays([start, start], [a, a]), L, params)[0] == 0
-    assert task_measure_from_arrays(
-        "gap_crossed", *_arrays([start, beyond], [a, a]), L, params
-    )[0] == pytest.approx(2.5)
-    assert task_measure_from_arrays("gap_crossed", *_arrays([start, fell], [a, a]), L, params)[0] == 0
+    on = _aux(box=(0.5 * L, 5.5 * L, 0.5 * L, 5.5 * L, 5.5 * L))  # the voxel centres at rest
+    reach = _aux(box=(-2.5 * L, 3.5 * L, 0.5 * L, 5.5 * L, 5.5 * L))  # 2.5 past the -x edge
+    moved = [0.0, 3 * L, 2.7 * L]
+    fell = [0.0, 3 * L, -1.5 * L]
+
+    def gap(cm, aux):
+        return task_measure_from_arrays("gap_crossed", *_arrays(cm, aux), L, params)[0]
+
+    assert gap([start, start], [on, on]) == 0.0
+    assert gap([start, moved], [on, reach]) == pytest.approx(2.5)
+    assert gap([start, fell], [on, reach]) == 0.0
 
 
 def test_a_robot_that_never_leaves_the_platform_scores_zero_on_gap():
