@@ -307,7 +307,10 @@ KINDS: dict[str, TaskKind] = {
             {"friction": Option(4.0, 1.0, 20.0, "factor on the materials' friction")},
             sim=lambda o: {"friction": float(o["friction"])},
         ),
-        TaskKind("jump", "raise the centre of mass as high as possible", _flat("jump"), "peak_height"),
+        TaskKind(
+            "jump", "raise the centre of mass as high as possible (muscles expand and contract)",
+            _flat("jump"), "peak_height", sim=lambda o: {"actuation": "symmetric"},
+        ),
         TaskKind("turn", "turn in place about the vertical axis", _flat("turn"), "yaw"),
         TaskKind(
             "push", "push a box to a target (-x of the robot)", push_layout, "push_progress",
