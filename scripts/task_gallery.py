@@ -1,7 +1,7 @@
 """Render one frame per task of the suite into a grid image (docs/figures/task_gallery.png).
 
-Each task's world around the default walker, after ``--seconds`` (1 s of
-settling, then the walker's own controller, the seed's sinusoid) in that task's
+Each task's world around the default walker after ``--seconds`` (1 s: the end of
+settling; later, the walker's own controller, the seed's sinusoid) in that task's
 engine settings; movable objects are drawn in grey, worlds below z = 0 lifted
 over the renderer's floor.
 
@@ -61,7 +61,7 @@ def main() -> None:
     p = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     p.add_argument("--out", default=str(Path(__file__).resolve().parents[1] / "docs" / "figures"
                                         / "task_gallery.png"))  # fmt: skip
-    p.add_argument("--seconds", type=float, default=1.5)
+    p.add_argument("--seconds", type=float, default=1.0)
     p.add_argument("--columns", type=int, default=4)
     args = p.parse_args()
     import matplotlib
