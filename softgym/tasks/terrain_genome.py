@@ -89,9 +89,13 @@ _KEY_SHAPE = (4, 4, 4)
 MUTATION_SIGMA = 0.15
 
 
+def _fmt(v: float) -> str:
+    return str(int(v)) if v == int(v) else f"{v:g}"
+
+
 def _gene(name: str, value: Any) -> float:
     lo, hi, unit = TERRAIN_BOUNDS[name]
-    shown = f"[{lo:g}, {hi:g}]" + (f" {unit}" if unit else "")
+    shown = f"[{_fmt(lo)}, {_fmt(hi)}]" + (f" {unit}" if unit else "")
     if isinstance(value, (bool, np.bool_, str, bytes)) or not isinstance(value, Real):
         raise InvalidTerrainError(
             f"terrain genome {name} must be a number in {shown}, got {value!r:.80}"
