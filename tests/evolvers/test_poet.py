@@ -198,3 +198,21 @@ def test_simulated_run_writes_pairs_and_figures(tmp_path):
         assert (tmp_path / "r" / "figures" / name).is_file()
     data = json.loads((tmp_path / "r" / "pairs.json").read_text())
     assert data["pairs"][0]["describe"] == "flat" and data["pairs"][0]["design"]["schema"]
+
+
+def test_pairs_on_dask_equal_local(tmp_path):
+    pytest.importorskip("distributed")
+    from evolvers.distributed import dask_client
+    from evolvers.poet import DaskJobsFn
+
+    exp = tiny("obstacles-attempt2", seconds=1.0, pop_size=3)
+    cfg = PoetConfig(reproduce_every=1, transfer_every=1, mc_low=0.0, mc_high=50.0,
+                     repro_threshold=0.0, solved_threshold=5.0)  # fmt: skip
+    common = {"seed": 2, "iterations": 2, "config": cfg, "figures": False, "progress": False}
+    local = PoetRun(exp, tmp_path / "local", **common)
+    local.run()
+    with dask_client("local", n_workers=2, processes=False) as client:
+        remote = PoetRun(exp, tmp_path / "dask", jobs_fn=DaskJobsFn(client), **common)
+        remote.run()
+    assert len(local.pairs) > 1  # a terrain was admitted: several terrains were evaluated at once
+    assert _rows(remote.rows) == _rows(local.rows)
