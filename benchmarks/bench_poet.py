@@ -47,7 +47,8 @@ class BudgetReached(Exception):
 
 
 def _config(args, **changes) -> PoetConfig:
-    kw = {"reproduce_every": args.k, "transfer_every": args.t, "max_active": args.max_active}
+    kw = {"reproduce_every": args.k, "transfer_every": args.t, "max_active": args.max_active,
+          "score_cap": args.score_cap}  # fmt: skip
     kw.update(changes)
     return PoetConfig(**kw)
 
@@ -117,6 +118,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--k", type=int, help="reproduce every K iterations (default 5; quick 3)")
     ap.add_argument("--t", type=int, help="transfer every T iterations (default 5; quick 3)")
     ap.add_argument("--max-active", type=int, help="active pairs (default 6; quick 4)")
+    ap.add_argument("--score-cap", type=float,
+                    help="scores saturate here (PoetConfig.score_cap; default: none)")  # fmt: skip
     ap.add_argument("--out", help="keep the run folders here (default: a temporary folder)")
     ap.add_argument("--figures", help="write the README figures into this folder")
     ap.add_argument("--no-append", action="store_true", help="do not append to RESULTS.md")
@@ -148,7 +151,8 @@ def main(argv: list[str] | None = None) -> int:
             f"controller GA, 3 s simulated, {args.pop} robots a pair, K = {args.k}, T = {args.t}, "
             f"at most {args.max_active} active pairs; band [{cfg.mc_low:.2f}, {cfg.mc_high:.2f}], "
             f"reproduction {cfg.repro_threshold:.2f}, solved {cfg.solved_threshold:.2f} voxel lengths "
-            f"of max_xy_dist; {wall / 60:.0f} min wall")  # fmt: skip
+            f"of max_xy_dist{'' if args.score_cap is None else f', scores capped at {args.score_cap:g}'}; "
+            f"{wall / 60:.0f} min wall")  # fmt: skip
     lines = [head, "", "| seed | ANNECS POET | ANNECS control | pairs POET / control | "
              "simulations POET / control | hardest solved terrain | POET robot | direct evolution, "
              "same budget |", "|---|---|---|---|---|---|---|---|"]  # fmt: skip

@@ -199,6 +199,11 @@ class PoetConfig:
         Gaussian step of a terrain gene, as a fraction of its range.
     start_terrain : dict, optional
         The first pair's terrain (a :class:`TerrainGenome` dict; default flat).
+    score_cap : float, optional
+        Scores saturate here, as a BipedalWalker reward does once the course is
+        finished (about 300: ``poet_thresholds``' map gives 12.13); default
+        none: ``max_xy_dist`` grows with speed, so a mastered terrain's mutants
+        stay above ``mc_high`` (trivial) until they are much harder.
     """
 
     reproduce_every: int = 5
@@ -214,6 +219,7 @@ class PoetConfig:
     generator: str = "mutate"
     mutation_sigma: float = 0.15
     start_terrain: dict[str, Any] | None = None
+    score_cap: float | None = None
 
     def __post_init__(self) -> None:
         for name in ("reproduce_every", "transfer_every"):
@@ -229,6 +235,11 @@ class PoetConfig:
             raise InvalidParameterError(
                 f"the minimal-criterion band needs 0 <= mc_low < mc_high, got [{self.mc_low}, {self.mc_high}]"
             )
+        if self.score_cap is not None:
+            cap = self.score_cap
+            if isinstance(cap, bool) or not isinstance(cap, (int, float)) or not cap > self.mc_low:
+                raise InvalidParameterError(f"score_cap must be a number > mc_low, got {cap!r}")
+            object.__setattr__(self, "score_cap", float(cap))
         if self.mutation_sigma <= 0:
             raise InvalidParameterError(f"mutation_sigma must be > 0, got {self.mutation_sigma}")
         if self.generator not in GENERATORS:
@@ -418,6 +429,7 @@ class Pair:
     novel: bool = False
     counted: bool = False
     metric: str = field(default="max_xy_dist", repr=False)
+    cap: float | None = field(default=None, repr=False)
 
     @property
     def active(self) -> bool:
@@ -426,7 +438,7 @@ class Pair:
 
     def score_of(self, ind: Individual) -> float:
         """A robot's score here (its metric clipped at 0; 0 before evaluation)."""
-        return _score(ind.objectives, self.metric)
+        return _score(ind.objectives, self.metric, self.cap)
 
     @property
     def best(self) -> Individual:
@@ -453,7 +465,9 @@ class Pair:
         }
 
     @classmethod
-    def from_dict(cls, data: Mapping[str, Any], metric: str = "max_xy_dist") -> Pair:
+    def from_dict(
+        cls, data: Mapping[str, Any], metric: str = "max_xy_dist", cap: float | None = None
+    ) -> Pair:
         """Inverse of :meth:`to_dict`."""
         return cls(
             id=int(data["id"]),
@@ -466,12 +480,14 @@ class Pair:
             novel=bool(data["novel"]),
             counted=bool(data["counted"]),
             metric=metric,
+            cap=cap,
         )
 
 
-def _score(objectives: Mapping[str, float], metric: str) -> float:
+def _score(objectives: Mapping[str, float], metric: str, cap: float | None = None) -> float:
     v = float(objectives.get(metric, 0.0))
-    return v if math.isfinite(v) and v > 0 else 0.0
+    v = v if math.isfinite(v) and v > 0 else 0.0
+    return v if cap is None else min(v, cap)
 
 
 def _worst() -> dict[str, float]:
@@ -663,7 +679,7 @@ class PoetRun:
             for i, (ind, (key, obj)) in enumerate(zip(inds, row)):
                 if obj is None:
                     obj = self.cache.get(key)[0]
-                s[i] = _score(obj, self.metric)
+                s[i] = _score(obj, self.metric, self.config.score_cap)
                 if assign:
                     ind.objectives = dict(obj)
                     ind.trace = None
@@ -713,7 +729,8 @@ class PoetRun:
     def _first(self, events: dict[str, Any], total: EvalStats) -> None:
         exp = self.experiment
         pop = [self._random_individual() for _ in range(exp.pop_size)]
-        root = Pair(self.pair_ids(), self.config.start, pop, None, 0, metric=self.metric)
+        root = Pair(self.pair_ids(), self.config.start, pop, None, 0, metric=self.metric,
+                    cap=self.config.score_cap)  # fmt: skip
         self.pairs.append(root)
         _, st = self.evaluate([(root.terrain, pop)], assign=True)
         self._stats_sum(total, st)
@@ -830,7 +847,13 @@ class PoetRun:
             source = kept[i_best]
             pop = [ind.child(self.ids()) for ind in source.population]
             pair = Pair(
-                self.pair_ids(), child, pop, parent.id, self.iteration + 1, metric=self.metric
+                self.pair_ids(),
+                child,
+                pop,
+                parent.id,
+                self.iteration + 1,
+                metric=self.metric,
+                cap=cfg.score_cap,
             )
             _, st = self.evaluate([(child, pop)], assign=True)
             self._stats_sum(total, st)
@@ -970,7 +993,9 @@ class PoetRun:
             self.annecs = int(state["annecs"])
             self.annecs_archive = int(state["annecs_archive"])
             self.n_simulated = int(state["n_simulated"])
-            self.pairs = [Pair.from_dict(d, self.metric) for d in state["pairs"]]
+            self.pairs = [
+                Pair.from_dict(d, self.metric, self.config.score_cap) for d in state["pairs"]
+            ]
             self.iteration = int(state["generation"])
             self.cache = PhenotypeCache.from_arrays(arrays)
         except (KeyError, TypeError, ValueError) as exc:

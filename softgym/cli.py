@@ -695,7 +695,8 @@ def _add_qd_parser(sub) -> None:
 
 #: poet flags that map onto PoetConfig fields (None: not typed; the config's default applies).
 _POET_FLAGS = ("reproduce_every", "transfer_every", "max_children", "max_admitted", "max_active",
-               "mc_low", "mc_high", "repro_threshold", "solved_threshold", "generator")  # fmt: skip
+               "mc_low", "mc_high", "repro_threshold", "solved_threshold", "generator",
+               "score_cap")  # fmt: skip
 
 
 def _make_poet_run(args: argparse.Namespace, jobs_fn):
@@ -834,6 +835,8 @@ def _add_poet_parser(sub) -> None:
     p.add_argument("--mc-high", type=float, help="minimal criterion, high end (default 13.35)")
     p.add_argument("--repro-threshold", type=float, help="score to reproduce (default 9.09)")
     p.add_argument("--solved-threshold", type=float, help="score that solves (default 10)")
+    p.add_argument("--score-cap", type=float,
+                   help="scores saturate here, like a finished BipedalWalker course (default: none)")  # fmt: skip
     p.add_argument("--start-terrain", metavar="GENOME.json",
                    help="the first pair's terrain genome (default: flat)")  # fmt: skip
     p.add_argument("--seconds", type=float, help="simulated seconds per evaluation (default 3)")

@@ -216,3 +216,13 @@ def test_pairs_on_dask_equal_local(tmp_path):
         remote.run()
     assert len(local.pairs) > 1  # a terrain was admitted: several terrains were evaluated at once
     assert _rows(remote.rows) == _rows(local.rows)
+
+
+def test_score_cap_saturates_scores_so_nothing_is_trivial(tmp_path):
+    with pytest.raises(InvalidParameterError, match="score_cap"):
+        PoetConfig(score_cap=1.0)
+    run = _run(tmp_path / "r", iterations=8, config=PoetConfig(**CFG, score_cap=12.0))
+    run.run()
+    assert all(t["score"] <= 12.0 for r in run.rows for t in r["terrains"])
+    reasons = [x["reason"] for r in run.rows for x in r["rejected"]]
+    assert not any(x.startswith("trivial") for x in reasons)
