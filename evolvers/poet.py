@@ -54,6 +54,11 @@ where ``trapped`` (3) is about what a robot that never leaves the fenced start
 area scores (the fence's inner face is 2 voxels from the footprint) and
 ``solved`` (10) is a distance that clears the fence and the ring of bumps of
 the default 4x4x4 course: band [3.76, 13.35], reproduction 9.09, solved 10.
+A BipedalWalker reward also saturates once the course is finished (about 300);
+``max_xy_dist`` does not, so a fast robot keeps its terrain's mutants above
+the band. ``PoetConfig(score_cap=12.13)`` (reward 300 through the same map)
+makes scores saturate too; it is off by default (``benchmarks/RESULTS.md``
+compares both).
 
 The run folder is the one every driver writes (:class:`~evolvers.recorder.RunRecorder`):
 config.json, log.jsonl / log.csv with one row per iteration (the standard
