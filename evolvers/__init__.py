@@ -11,6 +11,8 @@
   (the same loop on a DEAP toolbox), :class:`~evolvers.pymoo_runner.PymooRun`
   (any pymoo algorithm through ask and tell: NSGA-II, NSGA-III, SMS-EMOA, GA...);
   Dask evaluation in :mod:`evolvers.distributed` (``pip install "softgym[distributed]"``).
+* Open-ended search: :mod:`evolvers.qd` (MAP-Elites on pyribs) and :mod:`evolvers.poet`
+  (co-evolution of robots and terrains after Enhanced POET).
 
 The DEAP, pymoo and Dask modules are imported on demand (``from evolvers.deap_runner import DeapRun``).
 """

@@ -35,6 +35,11 @@ qd
     Quality-diversity: a MAP-Elites archive (pyribs) of robots over body
     descriptors, a resumable run folder with QD-score and coverage per
     generation and a heatmap; ``qd export RUN`` writes the elites as designs.
+poet
+    Co-evolution of robots and terrains (Enhanced POET): a resumable run folder
+    with terrains, score matrices, admissions, transfers and ANNECS per
+    iteration, and figures; ``poet compare RUN...`` plots ANNECS of runs
+    (POET against the random-terrain control).
 """
 
 from __future__ import annotations
@@ -688,6 +693,170 @@ def _add_qd_parser(sub) -> None:
     p.set_defaults(func=_cmd_qd)
 
 
+#: poet flags that map onto PoetConfig fields (None: not typed; the config's default applies).
+_POET_FLAGS = ("reproduce_every", "transfer_every", "max_children", "max_admitted", "max_active",
+               "mc_low", "mc_high", "repro_threshold", "solved_threshold", "generator",
+               "score_cap")  # fmt: skip
+
+
+def _make_poet_run(args: argparse.Namespace, jobs_fn):
+    """A PoetRun from the flags; with --resume, the run folder's settings under the typed flags."""
+    from evolvers.experiments import Experiment
+    from evolvers.poet import PoetConfig, PoetRun, poet_experiment
+    from evolvers.recorder import read_run_config
+    from softgym.io import read_json
+
+    cfg = None
+    if args.resume and (Path(args.out) / "config.json").is_file():
+        cfg = read_run_config(args.out)  # a mismatch with a typed flag is named by PoetRun.run
+    exp = Experiment.from_dict(cfg["experiment"]) if cfg is not None else poet_experiment()
+    sizes = {"pop_size": args.pop, "seconds": args.seconds,
+             "shape": None if args.shape is None else tuple(args.shape)}  # fmt: skip
+    exp = exp.replace(**{k: v for k, v in sizes.items() if v is not None})
+    base = dict(cfg["poet"]) if cfg is not None and "poet" in cfg else PoetConfig().to_dict()
+    typed = {k: getattr(args, k) for k in _POET_FLAGS if getattr(args, k) is not None}
+    if args.start_terrain is not None:
+        typed["start_terrain"] = read_json(args.start_terrain)
+    poet = PoetConfig.from_dict({**base, **typed})
+    seed = args.seed if args.seed is not None else int(cfg["seed"]) if cfg else 0
+    iters = args.iterations
+    if iters is None:
+        iters = int(cfg.get("generations", 40)) if cfg else 40
+    run = PoetRun(
+        exp, args.out, seed=seed, iterations=iters, config=poet, jobs_fn=jobs_fn,
+        n_threads=args.threads, figures=not args.no_figures, progress=not args.quiet,
+    )  # fmt: skip
+    run.resume_command = f"softgym poet --out {shlex.quote(str(args.out))} --resume"
+    return run
+
+
+def _cmd_poet(args: argparse.Namespace) -> int:
+    if getattr(args, "poet_command", None) == "compare":
+        return _cmd_poet_compare(args)
+    import contextlib
+
+    from tqdm.contrib.logging import logging_redirect_tqdm
+
+    from evolvers.recorder import RunInterrupted
+
+    t0 = time.perf_counter()
+    previous = signal.signal(signal.SIGTERM, _raise_keyboard_interrupt)
+    try:
+        with contextlib.ExitStack() as stack:
+            stack.enter_context(logging_redirect_tqdm())
+            jobs_fn = None
+            if args.dask:
+                from evolvers.distributed import dask_client
+                from evolvers.poet import DaskJobsFn
+
+                _quiet_dask(args.verbose)
+                client = stack.enter_context(dask_client(args.dask, n_workers=args.workers))
+                _quiet_dask(args.verbose)
+                jobs_fn = DaskJobsFn(client)
+            run = _make_poet_run(args, jobs_fn)
+            pairs = run.run(resume=args.resume)
+    except RunInterrupted as exc:
+        where = (f"iteration {exc.generation} is checkpointed in {exc.checkpoint}"
+                 if exc.checkpoint else "no iteration had finished")  # fmt: skip
+        print(f"\nsoftgym poet: interrupted; {where}\nresume with: {exc.resume}", file=sys.stderr)
+        return 130
+    except KeyboardInterrupt:
+        print("\nsoftgym poet: interrupted before the run started", file=sys.stderr)
+        return 130
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    summary = {
+        "iterations": run.iteration,
+        "generator": run.config.generator,
+        "evaluations": run.evaluations_total,
+        "annecs": run.annecs,
+        "annecs_archive": run.annecs_archive,
+        "pairs": len(pairs),
+        "active": len(run.active()),
+        "solved": sum(p.solved is not None for p in pairs),
+        "wall_seconds": round(time.perf_counter() - t0, 2),
+        "out": str(run.out),
+        "figures": sorted(str(p) for p in (run.out / "figures").glob("*"))
+        if (run.out / "figures").exists()
+        else [],
+    }
+    print(json.dumps(summary, indent=2))
+    return 0
+
+
+def _cmd_poet_compare(args: argparse.Namespace) -> int:
+    from evolvers.poet import plot_annecs
+    from evolvers.recorder import read_run_config
+    from softgym.exceptions import CheckpointError
+    from softgym.render.figures import read_log
+
+    groups: dict[str, list] = {}
+    for d in args.runs:
+        cfg = read_run_config(d)
+        if "poet" not in cfg:
+            raise CheckpointError(f"{d}: not a POET run folder (softgym poet)")
+        label = "POET" if cfg["poet"]["generator"] == "mutate" else "random terrains (control)"
+        groups.setdefault(label, []).append(read_log(d))
+    path = plot_annecs(groups, args.compare_out)
+    for label, runs in groups.items():
+        finals = sorted(rows[-1]["annecs"] if rows else 0 for rows in runs)
+        print(f"{label}: {len(runs)} run(s), final ANNECS {finals}")
+    print(path)
+    return 0
+
+
+def _add_poet_parser(sub) -> None:
+    """``softgym poet [run] ...`` and ``softgym poet compare RUN...``."""
+    p = sub.add_parser(
+        "poet",
+        help="co-evolve robots and terrains (Enhanced POET); 'poet compare RUN...'",
+        description="Co-evolve terrains (a 7-gene obstacle course: fence, bumps, stairs, gap) "
+        "and the robots that walk them, after Enhanced POET: active (terrain, robots) pairs, "
+        "minimal criterion, PATA-EC novelty, transfers, ANNECS. A resumable run folder with "
+        "one log row per iteration and figures (ANNECS, transfer heatmap, hardest solved "
+        "terrains); thresholds are voxel lengths of max_xy_dist (POET's 25-340 band, 200 "
+        "reproduction and 230 solved map to 3.76-13.35, 9.09 and 10).",
+    )
+    p.add_argument("--iterations", type=int, help="iterations after the first (default 40)")
+    p.add_argument("--pop", type=int, help="robots per pair (default 8)")
+    p.add_argument("--seed", type=int, help="seed of the run (default 0)")
+    p.add_argument("--out", default="runs/poet", help="run folder")
+    p.add_argument("--resume", action="store_true",
+                   help="continue the run folder's last checkpoint with its recorded settings")  # fmt: skip
+    p.add_argument("--generator", choices=["mutate", "random"],
+                   help="candidate terrains: mutants of eligible parents (default) or uniform "
+                   "draws (the random-terrain control)")  # fmt: skip
+    p.add_argument("--reproduce-every", type=int, help="K: iterations between reproductions (default 5)")
+    p.add_argument("--transfer-every", type=int, help="T: iterations between transfers (default 5)")
+    p.add_argument("--max-children", type=int, help="candidate terrains per round (default 8)")
+    p.add_argument("--max-admitted", type=int, help="terrains admitted per round (default 1)")
+    p.add_argument("--max-active", type=int, help="active pairs before the oldest retire (default 8)")
+    p.add_argument("--mc-low", type=float, help="minimal criterion, low end (default 3.76)")
+    p.add_argument("--mc-high", type=float, help="minimal criterion, high end (default 13.35)")
+    p.add_argument("--repro-threshold", type=float, help="score to reproduce (default 9.09)")
+    p.add_argument("--solved-threshold", type=float, help="score that solves (default 10)")
+    p.add_argument("--score-cap", type=float,
+                   help="scores saturate here, like a finished BipedalWalker course (default: none)")  # fmt: skip
+    p.add_argument("--start-terrain", metavar="GENOME.json",
+                   help="the first pair's terrain genome (default: flat)")  # fmt: skip
+    p.add_argument("--seconds", type=float, help="simulated seconds per evaluation (default 3)")
+    p.add_argument("--shape", type=int, nargs=3, metavar=("NX", "NY", "NZ"),
+                   help="robot grid (default 4 4 4)")  # fmt: skip
+    p.add_argument("--dask", metavar="local|tcp://ADDRESS",
+                   help='evaluate the pairs in parallel on Dask (pip install "softgym[distributed]")')  # fmt: skip
+    p.add_argument("--workers", type=int, default=2, help="LocalCluster workers (--dask local)")
+    p.add_argument("--threads", type=int, help="OpenMP threads of local simulations")
+    p.add_argument("--no-figures", action="store_true", help="write no figures at the end")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    ss = p.add_subparsers(dest="poet_command", required=False)
+    r = ss.add_parser("run", help="run (the default)")
+    r.set_defaults(poet_command="run")
+    r = ss.add_parser("compare", help="ANNECS over iterations of POET runs and controls, one figure")
+    r.add_argument("runs", nargs="+", metavar="RUN", help="softgym poet run folders")
+    r.add_argument("--out", dest="compare_out", default="runs/poet_annecs.png", help="figure file")
+    p.set_defaults(func=_cmd_poet)
+
+
 class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
     """``--help`` shows every default (options without one say theirs in words)."""
 
@@ -839,6 +1008,7 @@ def main(argv: list[str] | None = None) -> int:
     p.set_defaults(func=_cmd_experiments)
     _add_study_parser(sub)
     _add_qd_parser(sub)
+    _add_poet_parser(sub)
     argv = sys.argv[1:] if argv is None else list(argv)
     args = parser.parse_args(argv)
     if args.command == "evolve":
