@@ -89,6 +89,7 @@ from evolvers.evaluation import BatchFn, EvalStats, PhenotypeCache, local_batch_
 from evolvers.experiments import Experiment, get_experiment, smoke_sizes
 from evolvers.genome import Individual
 from evolvers.operators import make_children
+from evolvers.pymoo_runner import IdCounter
 from evolvers.recorder import RunRecorder
 from evolvers.selection import sel_fitness_tournament
 from softgym.design import CONTROLLER_BOUNDS, Controller
@@ -388,16 +389,6 @@ class DaskJobsFn:
         return list(self.client.gather(futures))
 
 
-class _Counter:
-    def __init__(self, start: int = 0) -> None:
-        self.value = int(start)
-
-    def __call__(self) -> int:
-        v = self.value
-        self.value += 1
-        return v
-
-
 # ---------------------------------------------------------------------- pairs
 @dataclass
 class Pair:
@@ -577,8 +568,8 @@ class PoetRun:
 
     def _fresh(self) -> None:
         self.rng = np.random.default_rng(self.seed)
-        self.ids = _Counter()
-        self.pair_ids = _Counter()
+        self.ids = IdCounter()
+        self.pair_ids = IdCounter()
         self.pairs: list[Pair] = []
         self.cache = PhenotypeCache()
         self.iteration = -1
@@ -673,7 +664,7 @@ class PoetRun:
             outs = self.jobs_fn(payload)
             for b, res in zip(batches, outs):
                 for i, key in enumerate(b["keys"]):
-                    obj = {m: float(res[m][i]) for m in _STORED}
+                    obj = {m: float(res[m][i]) for m in _STORED if m in res}  # (a fake or older batch may lack "score")
                     self.cache.put(key, obj, None)
                     stats.n_diverged += int(obj["diverged"])
                     stats.n_simulated += 1
