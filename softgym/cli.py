@@ -51,7 +51,9 @@ import shlex
 import signal
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 __all__ = ["main"]
 
@@ -205,37 +207,54 @@ def _quiet_dask(verbose: int) -> None:
         logging.getLogger(name).setLevel(level)
 
 
-def _cmd_evolve(args: argparse.Namespace) -> int:
+def _interruptible(command: str, unit: str, start: Callable[[Any], Any]) -> tuple[int | None, Any]:
+    """Run ``start(stack)`` the way every long command runs: SIGTERM acts as Ctrl-C, log
+    lines go around tqdm bars, and ``stack`` (an ExitStack) holds what the run opens
+    (a Dask client). Returns ``(None, start's result)``, or ``(130, None)`` after
+    printing where an interrupted run is checkpointed (``unit``: "generation",
+    "iteration") and the command that resumes it.
+    """
     import contextlib
 
     from tqdm.contrib.logging import logging_redirect_tqdm
 
     from evolvers.recorder import RunInterrupted
-    from softgym.exceptions import SoftGymError
 
-    t0 = time.perf_counter()
     previous = signal.signal(signal.SIGTERM, _raise_keyboard_interrupt)
     try:
         with contextlib.ExitStack() as stack:
             stack.enter_context(logging_redirect_tqdm())
-            try:
-                batch_fn = _dask_batch_fn(args, stack)
-                run = _make_run(args, batch_fn)
-                run.run(resume=args.resume)
-            except SoftGymError as exc:
-                print(f"softgym evolve: {exc}", file=sys.stderr)
-                return 2
+            return None, start(stack)
     except RunInterrupted as exc:
-        where = (f"generation {exc.generation} is checkpointed in {exc.checkpoint}"
-                 if exc.checkpoint else "no generation had finished")  # fmt: skip
-        print(f"\nsoftgym evolve: interrupted; {where}\nresume with: {exc.resume}",
-              file=sys.stderr)  # fmt: skip
-        return 130
+        where = (f"{unit} {exc.generation} is checkpointed in {exc.checkpoint}"
+                 if exc.checkpoint else f"no {unit} had finished")  # fmt: skip
+        print(f"\nsoftgym {command}: interrupted; {where}\nresume with: {exc.resume}", file=sys.stderr)
+        return 130, None
     except KeyboardInterrupt:
-        print("\nsoftgym evolve: interrupted before the run started", file=sys.stderr)
-        return 130
+        print(f"\nsoftgym {command}: interrupted before the run started", file=sys.stderr)
+        return 130, None
     finally:
         signal.signal(signal.SIGTERM, previous)
+
+
+def _cmd_evolve(args: argparse.Namespace) -> int:
+    from softgym.exceptions import SoftGymError
+
+    def start(stack):
+        try:
+            run = _make_run(args, _dask_batch_fn(args, stack))
+            run.run(resume=args.resume)
+            return run
+        except SoftGymError as exc:
+            print(f"softgym evolve: {exc}", file=sys.stderr)
+            return None
+
+    t0 = time.perf_counter()
+    status, run = _interruptible("evolve", "generation", start)
+    if status is not None:
+        return status
+    if run is None:
+        return 2
     wall = time.perf_counter() - t0
     fit = run.experiment.fitness
     best = run.hall_of_fame[0]["individual"] if run.hall_of_fame else None
@@ -591,30 +610,16 @@ def _make_qd_run(args: argparse.Namespace, batch_fn):
 def _cmd_qd(args: argparse.Namespace) -> int:
     if getattr(args, "qd_command", None) == "export":
         return _cmd_qd_export(args)
-    import contextlib
 
-    from tqdm.contrib.logging import logging_redirect_tqdm
-
-    from evolvers.recorder import RunInterrupted
+    def start(stack):
+        run = _make_qd_run(args, _dask_batch_fn(args, stack))
+        run.run(resume=args.resume)
+        return run
 
     t0 = time.perf_counter()
-    previous = signal.signal(signal.SIGTERM, _raise_keyboard_interrupt)
-    try:
-        with contextlib.ExitStack() as stack:
-            stack.enter_context(logging_redirect_tqdm())
-            batch_fn = _dask_batch_fn(args, stack)
-            run = _make_qd_run(args, batch_fn)
-            run.run(resume=args.resume)
-    except RunInterrupted as exc:
-        where = (f"generation {exc.generation} is checkpointed in {exc.checkpoint}"
-                 if exc.checkpoint else "no generation had finished")  # fmt: skip
-        print(f"\nsoftgym qd: interrupted; {where}\nresume with: {exc.resume}", file=sys.stderr)
-        return 130
-    except KeyboardInterrupt:
-        print("\nsoftgym qd: interrupted before the run started", file=sys.stderr)
-        return 130
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+    status, run = _interruptible("qd", "generation", start)
+    if status is not None:
+        return status
     stats = run.stats()
     summary = {
         "experiment": run.experiment.name,
@@ -733,38 +738,25 @@ def _make_poet_run(args: argparse.Namespace, jobs_fn):
 def _cmd_poet(args: argparse.Namespace) -> int:
     if getattr(args, "poet_command", None) == "compare":
         return _cmd_poet_compare(args)
-    import contextlib
 
-    from tqdm.contrib.logging import logging_redirect_tqdm
+    def start(stack):
+        jobs_fn = None
+        if args.dask:
+            from evolvers.distributed import dask_client
+            from evolvers.poet import DaskJobsFn
 
-    from evolvers.recorder import RunInterrupted
+            _quiet_dask(args.verbose)
+            client = stack.enter_context(dask_client(args.dask, n_workers=args.workers))
+            _quiet_dask(args.verbose)
+            jobs_fn = DaskJobsFn(client)
+        run = _make_poet_run(args, jobs_fn)
+        return run, run.run(resume=args.resume)
 
     t0 = time.perf_counter()
-    previous = signal.signal(signal.SIGTERM, _raise_keyboard_interrupt)
-    try:
-        with contextlib.ExitStack() as stack:
-            stack.enter_context(logging_redirect_tqdm())
-            jobs_fn = None
-            if args.dask:
-                from evolvers.distributed import dask_client
-                from evolvers.poet import DaskJobsFn
-
-                _quiet_dask(args.verbose)
-                client = stack.enter_context(dask_client(args.dask, n_workers=args.workers))
-                _quiet_dask(args.verbose)
-                jobs_fn = DaskJobsFn(client)
-            run = _make_poet_run(args, jobs_fn)
-            pairs = run.run(resume=args.resume)
-    except RunInterrupted as exc:
-        where = (f"iteration {exc.generation} is checkpointed in {exc.checkpoint}"
-                 if exc.checkpoint else "no iteration had finished")  # fmt: skip
-        print(f"\nsoftgym poet: interrupted; {where}\nresume with: {exc.resume}", file=sys.stderr)
-        return 130
-    except KeyboardInterrupt:
-        print("\nsoftgym poet: interrupted before the run started", file=sys.stderr)
-        return 130
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+    status, result = _interruptible("poet", "iteration", start)
+    if status is not None:
+        return status
+    run, pairs = result
     summary = {
         "iterations": run.iteration,
         "generator": run.config.generator,
