@@ -20,6 +20,7 @@ import numpy as np
 from evolvers.experiments import Experiment
 from evolvers.genome import Individual
 from softgym.evaluate import METRIC_KEYS, evaluate
+from softgym.exceptions import CheckpointError
 from softgym.metrics import WORST_FITNESS, WORST_MINIMIZED
 from softgym.tasks import Task
 
@@ -30,9 +31,11 @@ __all__ = [
     "EvalStats",
     "Evaluator",
     "PhenotypeCache",
+    "STORED_METRICS",
     "local_batch_fn",
     "pack_traces",
     "unpack_traces",
+    "worst_objectives",
 ]
 
 #: Maximised metrics (the rest are counts, minimised when they are objectives).
@@ -43,7 +46,15 @@ MAXIMIZED: tuple[str, ...] = (*FITNESS_METRICS, "score")
 #: ``(designs as dicts, task) -> softgym.evaluate output with traces``.
 BatchFn = Callable[[list[dict[str, Any]], Task], dict[str, Any]]
 
-_STORED = tuple(k for k in METRIC_KEYS if k != "time_max_xy_dist")
+#: The metrics kept per evaluated phenotype (on individuals and in the cache).
+STORED_METRICS: tuple[str, ...] = tuple(k for k in METRIC_KEYS if k != "time_max_xy_dist")
+
+#: The cache's columns in checkpoints written before they carried their names
+#: (``cache_metrics``): :data:`STORED_METRICS` before the task suite added ``score``.
+_UNNAMED_CACHE_COLUMNS: tuple[str, ...] = (
+    "norm_final_dist", "max_xy_dist", "l_coefficient", "diverged",
+    "n_voxels", "n_muscle", "n_old_materials", "n_bone", "n_tissue",
+)  # fmt: skip
 
 
 def local_batch_fn(
@@ -103,11 +114,13 @@ class PhenotypeCache:
         """Checkpoint arrays (plain dtypes, no pickle)."""
         keys = list(self._data)
         values = np.array(
-            [[self._data[k][0].get(m, np.nan) for m in _STORED] for k in keys], dtype=np.float64
-        ).reshape(len(keys), len(_STORED))
+            [[self._data[k][0].get(m, np.nan) for m in STORED_METRICS] for k in keys],
+            dtype=np.float64,
+        ).reshape(len(keys), len(STORED_METRICS))
         data, lengths = pack_traces([self._data[k][1] for k in keys])
         return {
             "cache_keys": np.array(keys, dtype="<U64"),
+            "cache_metrics": np.array(STORED_METRICS, dtype="<U32"),
             "cache_values": values,
             "cache_traces": data,
             "cache_trace_len": lengths,
@@ -115,13 +128,36 @@ class PhenotypeCache:
 
     @classmethod
     def from_arrays(cls, arrays: dict[str, np.ndarray]) -> PhenotypeCache:
-        """Inverse of :meth:`to_arrays` (an empty cache if the arrays are absent)."""
+        """Inverse of :meth:`to_arrays` (an empty cache if the arrays are absent).
+
+        Columns are matched by the names stored with them (``cache_metrics``),
+        so a checkpoint reads back right after the stored metrics change;
+        older checkpoints without names have :data:`_UNNAMED_CACHE_COLUMNS`.
+        A value stored as NaN (a metric the entry did not have) stays absent.
+
+        Raises
+        ------
+        CheckpointError
+            If the number of columns does not match their names.
+        """
         cache = cls()
         if "cache_keys" not in arrays:
             return cache
+        if "cache_metrics" in arrays:
+            names = tuple(str(m) for m in arrays["cache_metrics"].tolist())
+        else:
+            names = _UNNAMED_CACHE_COLUMNS
+        values = np.asarray(arrays["cache_values"], dtype=np.float64)
+        if values.ndim != 2 or values.shape[1] != len(names):
+            raise CheckpointError(
+                f"cache_values: {values.shape[-1] if values.ndim else 0} columns for "
+                f"{len(names)} metric names {names}; the checkpoint is damaged (one resumed "
+                "across the addition of 'score' is repaired by scripts/repair_cache_columns.py)"
+            )
         traces = unpack_traces(arrays["cache_traces"], arrays["cache_trace_len"])
-        for key, row, tr in zip(arrays["cache_keys"].tolist(), arrays["cache_values"], traces):
-            cache._data[str(key)] = ({m: float(v) for m, v in zip(_STORED, row)}, tr)
+        for key, row, tr in zip(arrays["cache_keys"].tolist(), values, traces):
+            obj = {m: float(v) for m, v in zip(names, row) if not np.isnan(v)}
+            cache._data[str(key)] = (obj, tr)
         return cache
 
 
@@ -142,8 +178,12 @@ class EvalStats:
     n_repeated: int = 0
 
 
-def _worst_objectives() -> dict[str, float]:
-    out = {m: (WORST_FITNESS if m in MAXIMIZED else WORST_MINIMIZED) for m in _STORED}
+def worst_objectives() -> dict[str, float]:
+    """The objectives of an invalid or diverged robot: the worst value of every
+    stored metric (maximised ones :data:`~softgym.metrics.WORST_FITNESS`, counts
+    :data:`~softgym.metrics.WORST_MINIMIZED`), ``diverged`` 0.
+    """
+    out = {m: (WORST_FITNESS if m in MAXIMIZED else WORST_MINIMIZED) for m in STORED_METRICS}
     out["diverged"] = 0.0
     return out
 
@@ -179,7 +219,9 @@ class Evaluator:
         self.experiment = experiment
         self.task = experiment.make_task(n_threads)
         # the default batch function shows a bar on long batches unless asked not to
-        self.batch_fn = batch_fn or (local_batch_fn if progress else partial(local_batch_fn, progress=False))
+        self.batch_fn = batch_fn or (
+            local_batch_fn if progress else partial(local_batch_fn, progress=False)
+        )
         self.cache = PhenotypeCache() if cache is None else cache
         self.n_evaluations = 0
 
@@ -199,7 +241,7 @@ class Evaluator:
             stats.n_new += int(new)
             grid = ind.grid(exp.shape)
             if exp.rules.violations(grid):
-                ind.objectives = _worst_objectives()
+                ind.objectives = worst_objectives()
                 ind.trace = None
                 stats.n_invalid += 1
                 continue
@@ -220,7 +262,7 @@ class Evaluator:
             res = self.batch_fn(designs, self.task)
             for i, key in enumerate(keys):
                 # (a batch function of an older softgym may not report "score")
-                obj = {m: float(res[m][i]) for m in _STORED if m in res}
+                obj = {m: float(res[m][i]) for m in STORED_METRICS if m in res}
                 tr = res["traces"][i]
                 tr = None if tr is None else np.asarray(tr, dtype=np.float64)
                 self.cache.put(key, obj, tr)

@@ -85,7 +85,14 @@ from typing import Any
 
 import numpy as np
 
-from evolvers.evaluation import BatchFn, EvalStats, PhenotypeCache, local_batch_fn
+from evolvers.evaluation import (
+    STORED_METRICS,
+    BatchFn,
+    EvalStats,
+    PhenotypeCache,
+    local_batch_fn,
+    worst_objectives,
+)
 from evolvers.experiments import Experiment, get_experiment, smoke_sizes
 from evolvers.genome import Individual
 from evolvers.operators import make_children
@@ -93,10 +100,9 @@ from evolvers.pymoo_runner import IdCounter
 from evolvers.recorder import RunRecorder
 from evolvers.selection import sel_fitness_tournament
 from softgym.design import CONTROLLER_BOUNDS, Controller
-from softgym.evaluate import METRIC_KEYS, evaluate_payload
+from softgym.evaluate import evaluate_payload
 from softgym.exceptions import CheckpointError, InvalidParameterError
 from softgym.io import rng_from_state, rng_state
-from softgym.metrics import WORST_FITNESS
 from softgym.tasks import Task
 from softgym.tasks.terrain_genome import TerrainGenome
 
@@ -131,8 +137,6 @@ GENERATORS: tuple[str, ...] = ("mutate", "random")
 
 #: Draws of a candidate terrain before it counts as a duplicate of a known one.
 _MUTATION_TRIES = 10
-
-_STORED = tuple(k for k in METRIC_KEYS if k != "time_max_xy_dist")
 
 #: ``[(design dicts, task), ...] -> [softgym.evaluate output, ...]``: one batch per terrain.
 JobsFn = Callable[[list[tuple[list[dict[str, Any]], Task]]], list[dict[str, Any]]]
@@ -486,11 +490,6 @@ def _score(objectives: Mapping[str, float], metric: str, cap: float | None = Non
     return v if cap is None else min(v, cap)
 
 
-def _worst() -> dict[str, float]:
-    return {m: (WORST_FITNESS if m in ("norm_final_dist", "max_xy_dist", "l_coefficient") else 0.0)
-            for m in _STORED}  # fmt: skip
-
-
 # ---------------------------------------------------------------------- the run
 class PoetRun:
     """A resumable POET run (see the module docstring).
@@ -640,7 +639,7 @@ class PoetRun:
                 stats.n_individuals += 1
                 if exp.rules.violations(ind.grid(exp.shape)):
                     stats.n_invalid += 1
-                    row.append(("", _worst()))
+                    row.append(("", worst_objectives()))
                     continue
                 key = self._key(terrain, ind)
                 if key in self.cache:
@@ -664,7 +663,9 @@ class PoetRun:
             outs = self.jobs_fn(payload)
             for b, res in zip(batches, outs):
                 for i, key in enumerate(b["keys"]):
-                    obj = {m: float(res[m][i]) for m in _STORED if m in res}  # (a fake or older batch may lack "score")
+                    obj = {
+                        m: float(res[m][i]) for m in STORED_METRICS if m in res
+                    }  # (a fake or older batch may lack "score")
                     self.cache.put(key, obj, None)
                     stats.n_diverged += int(obj["diverged"])
                     stats.n_simulated += 1

@@ -3,10 +3,11 @@ import pytest
 from evolver_helpers import tiny
 
 import softgym
-from evolvers.evaluation import Evaluator, PhenotypeCache
+from evolvers.evaluation import STORED_METRICS, Evaluator, PhenotypeCache
 from evolvers.genome import Individual
 from softgym.design import default_walker
 from softgym.evaluate import Task
+from softgym.exceptions import CheckpointError
 
 
 def test_softgym_evaluate_returns_metrics_for_a_batch():
@@ -73,3 +74,47 @@ def test_evaluate_shows_a_progress_bar_on_request_and_results_do_not_change(caps
     assert "simulating 1 robots" in capsys.readouterr().err
     for k in ("norm_final_dist", "max_xy_dist", "l_coefficient"):
         np.testing.assert_array_equal(quiet[k], shown[k])
+
+
+def _cache_with_one_entry() -> tuple[PhenotypeCache, dict[str, float]]:
+    obj = {
+        "norm_final_dist": 3.5, "max_xy_dist": 4.0, "l_coefficient": 7.0, "score": 3.5,
+        "diverged": 0.0, "n_voxels": 120.0, "n_muscle": 60.0, "n_old_materials": 2.0,
+        "n_bone": 5.0, "n_tissue": 55.0,
+    }  # fmt: skip
+    assert set(obj) == set(STORED_METRICS)
+    cache = PhenotypeCache()
+    cache.put("k", obj, np.arange(8.0).reshape(2, 4))
+    return cache, obj
+
+
+def test_cache_columns_are_read_back_by_name_not_position():
+    cache, obj = _cache_with_one_entry()
+    arrays = cache.to_arrays()
+    assert PhenotypeCache.from_arrays(arrays).get("k")[0] == obj
+    # a checkpoint whose columns come in another order (e.g. written by a version
+    # with a different metric list) still maps every value to its own metric
+    order = np.arange(len(STORED_METRICS))[::-1]
+    shuffled = dict(arrays)
+    shuffled["cache_metrics"] = arrays["cache_metrics"][order]
+    shuffled["cache_values"] = arrays["cache_values"][:, order]
+    assert PhenotypeCache.from_arrays(shuffled).get("k")[0] == obj
+
+
+def test_cache_from_a_checkpoint_without_column_names_uses_the_old_layout():
+    # checkpoints written before the names were stored had no "score" column:
+    # nine columns, diverged right after the three fitness measures
+    cache, obj = _cache_with_one_entry()
+    arrays = cache.to_arrays()
+    del arrays["cache_metrics"]
+    arrays["cache_values"] = np.array([[3.5, 4.0, 7.0, 0.0, 120.0, 60.0, 2.0, 5.0, 55.0]])
+    back = PhenotypeCache.from_arrays(arrays).get("k")[0]
+    assert back == {k: v for k, v in obj.items() if k != "score"}
+
+
+def test_cache_with_columns_that_do_not_match_their_names_is_a_checkpoint_error():
+    cache, _ = _cache_with_one_entry()
+    arrays = cache.to_arrays()
+    arrays["cache_values"] = arrays["cache_values"][:, :-1]
+    with pytest.raises(CheckpointError, match="cache_values"):
+        PhenotypeCache.from_arrays(arrays)
