@@ -15,6 +15,8 @@ loop and hands the recorder each finished generation::
     best_designs/          each of them as rank-K_id-N.json and .vxa
     final_population.json  the last population
     figures/               fitness trend, best robot, its trajectory, its GIF
+    notes.jsonl            remarks on the run's history that its numbers cannot tell
+                           (e.g. a repair, :func:`add_run_note`); study reports quote them
 
 A checkpoint holds the recorder's state (log rows, hall of fame, totals) and
 whatever the driver adds (its random states, counters, the phenotype cache).
@@ -28,10 +30,12 @@ checkpoint and the command that resumes.
 from __future__ import annotations
 
 import csv
+import datetime as _dt
 import io
 import json
 import logging
 import math
+import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -56,13 +60,50 @@ __all__ = [
     "RUN_SCHEMA",
     "RecordedRun",
     "RunRecorder",
+    "add_run_note",
     "log_row",
     "obstacle_footprint",
     "population_summary",
+    "read_run_notes",
     "study_columns",
 ]
 
 log = logging.getLogger("evolvers")
+
+#: A run folder's notes, one JSON object per line (:func:`add_run_note`).
+NOTES_FILE = "notes.jsonl"
+
+
+def add_run_note(run_dir: str | os.PathLike[str], text: str, **fields: Any) -> None:
+    """Append a note to a run folder's ``notes.jsonl`` (atomic rewrite).
+
+    For what the logs cannot show: a repair, a resume across a change that
+    affected results. ``fields`` (plain JSON values) are stored with the text
+    and the time.
+    """
+    path = Path(run_dir) / NOTES_FILE
+    notes = read_run_notes(run_dir)
+    when = _dt.datetime.now().astimezone().isoformat(timespec="seconds")
+    notes.append({"time": when, "text": str(text), **fields})
+    atomic_write_text(path, "".join(json.dumps(n) + "\n" for n in notes))
+
+
+def read_run_notes(run_dir: str | os.PathLike[str]) -> list[dict[str, Any]]:
+    """The notes of a run folder (an empty list if it has none).
+
+    Raises
+    ------
+    CheckpointError
+        If ``notes.jsonl`` is not JSON lines.
+    """
+    path = Path(run_dir) / NOTES_FILE
+    if not path.exists():
+        return []
+    try:
+        return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+    except ValueError as exc:
+        raise CheckpointError(f"{path}: not JSON lines ({exc})") from None
+
 
 #: ``"schema"`` of a run's config.json.
 RUN_SCHEMA = "softgym.run"

@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from evolvers.genome import Individual
+from evolvers.recorder import read_run_notes
 from softgym.design import CONTROLLER_BOUNDS, Controller
 from softgym.design.material import EVOLVABLE_BOUNDS, MUSCLE_IDS, TISSUE_IDS
 from softgym.exceptions import CheckpointError
@@ -112,6 +113,8 @@ class RunData:
     rows: list[dict[str, Any]]
     best: dict[str, Any] | None
     complete: bool
+    #: The run folder's notes (:func:`evolvers.recorder.read_run_notes`).
+    notes: list[dict[str, Any]] = field(default_factory=list)
 
     @property
     def seed(self) -> int:
@@ -209,7 +212,14 @@ def load_runs(root: str | os.PathLike[str]) -> dict[str, list[RunData]]:
             and bool(rows)
             and int(rows[-1]["generation"]) >= gens
         )
-        runs.setdefault(scenario, []).append(RunData(scenario, run_dir, cfg, rows, best, complete))
+        try:
+            notes = read_run_notes(run_dir)
+        except CheckpointError as exc:
+            log.warning("%s", exc)
+            notes = [{"text": f"unreadable notes: {exc}"}]
+        runs.setdefault(scenario, []).append(
+            RunData(scenario, run_dir, cfg, rows, best, complete, notes)
+        )
     for v in runs.values():
         v.sort(key=lambda r: r.seed)
     return runs
@@ -1113,6 +1123,13 @@ def write_report(
     if unfinished:
         lines += ["", "Not finished: " + ", ".join(
             f"{n} seed {r.seed} (generation {r.generation} of {r.target})" for n, r in unfinished) + "."]  # fmt: skip
+    noted = [(n, r) for n, rs in runs.items() for r in rs if r.notes]
+    if noted:
+        lines += ["", "Notes the run folders carry (`notes.jsonl`):", ""]
+        for n, r in noted:
+            for note in r.notes:
+                when = f" ({note['time'][:10]})" if "time" in note else ""
+                lines.append(f"* {n} seed {r.seed}{when}: {note['text']}")
     lines += [
         "",
         "## Claims",

@@ -51,7 +51,7 @@ import numpy as np
 
 from evolvers.evaluation import STORED_METRICS
 from evolvers.experiments import Experiment
-from evolvers.recorder import RunRecorder
+from evolvers.recorder import RunRecorder, add_run_note
 from softgym.io import list_checkpoints, load_checkpoint, read_json, save_checkpoint
 
 #: The stored metrics when the damage happened (``score`` fourth); the current list.
@@ -169,13 +169,36 @@ def repair_checkpoint(
     return counts
 
 
+def note_text(counts: dict[str, int], resumed_at: int | None, objectives: list[str],
+              until: int | None = None) -> str:  # fmt: skip
+    """The note a repaired run folder gets (``notes.jsonl``)."""
+    used = [o for o in objectives if o in COUNTS]
+    since = f"from generation {resumed_at} " if resumed_at is not None else ""
+    if since and until is not None:
+        since = f"in generations {resumed_at}-{until} "
+    text = (
+        f"resumed across the addition of 'score' to the stored metrics: cached results were read "
+        f"one column off {since}(composition counts and 'diverged' only; the fitness measures were "
+        f"right). Repaired by scripts/repair_cache_columns.py: {counts['cache_rows']} cached "
+        f"results, {counts['individuals']} individuals, {counts['row_tops']} log rows' "
+        "best-robot counts restored"
+        + (f"; the population count columns of {counts['rows_blanked']} generations are NaN"
+           if counts["rows_blanked"] else "")
+        + (f". Selection in those generations used the shifted {', '.join(used)} of cached "
+           "robots (an objective here): it cannot be undone" if used else
+           ". No count is an objective here: selection was not affected")
+        + "."
+    )  # fmt: skip
+    return text
+
+
 def repair_run(run: Path, resumed_at: int | None, dry_run: bool) -> None:
     """Repair every checkpoint of a run folder, then its logs and best-design files."""
     ckpt_dir = run / "checkpoints"
     paths = list_checkpoints(ckpt_dir)
     if not paths:
         raise SystemExit(f"{run}: no checkpoints")
-    last_state = None
+    last_state, last_counts = None, {}
     for path in paths:
         doc = read_json(path)
         state, arrays = load_checkpoint(path)
@@ -184,10 +207,15 @@ def repair_run(run: Path, resumed_at: int | None, dry_run: bool) -> None:
         print(f"{path}: {json.dumps(counts)}")
         if not dry_run:
             save_checkpoint(ckpt_dir, int(doc["step"]), state, arrays, keep=len(paths) + 1)
-        last_state = state
+        last_state, last_counts = state, counts
     if dry_run or last_state is None:
         return
     config = read_json(run / "config.json")
+    if any(last_counts.values()):
+        objectives = [o["name"] for o in config["experiment"]["objectives"]]
+        text = note_text(last_counts, resumed_at, objectives, until=last_state.get("generation"))
+        add_run_note(run, text, script="scripts/repair_cache_columns.py", resumed_at=resumed_at,
+                     repaired=last_counts)  # fmt: skip
     rec = RunRecorder(run, Experiment.from_dict(config["experiment"]), seed=int(config["seed"]),
                       backend=str(config["backend"]), figures=False, gif=False, progress=False)  # fmt: skip
     rec.rows = list(last_state["rows"])

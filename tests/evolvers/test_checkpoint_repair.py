@@ -9,6 +9,7 @@ nothing had happened.
 """
 
 import importlib.util
+import json
 import math
 import shutil
 from pathlib import Path
@@ -17,6 +18,7 @@ import numpy as np
 import pytest
 from evolver_helpers import tiny
 
+from evolvers.recorder import read_run_notes
 from evolvers.runner import EvolutionRun, population_summary
 from softgym.design import CompositionRules
 from softgym.exceptions import CheckpointError
@@ -82,3 +84,15 @@ def test_a_damaged_checkpoint_is_refused_and_the_repair_restores_it_exactly(tmp_
     ref = EvolutionRun(exp, tmp_path / "ref", seed=3, generations=2, figures=False)
     fixed = EvolutionRun(exp, tmp_path / "bad", seed=3, generations=2, figures=False)
     assert population_summary(fixed.run(resume=True)) == population_summary(ref.run(resume=True))
+
+
+def test_the_repair_leaves_a_note_that_says_what_it_cannot_undo(tmp_path):
+    exp = tiny("materials-t1", rules=CompositionRules.seed())
+    EvolutionRun(exp, tmp_path / "run", seed=3, generations=1, figures=False).run()
+    _damage(tmp_path / "run")
+    assert repair.main([str(tmp_path / "run"), "--resumed-at", "1"]) == 0
+    [note] = read_run_notes(tmp_path / "run")
+    assert note["resumed_at"] == 1 and note["repaired"]["individuals"] > 0
+    assert "n_old_materials" in note["text"] and "cannot be undone" in note["text"]
+    rows = [json.loads(x) for x in (tmp_path / "run" / "log.jsonl").read_text().splitlines()]
+    assert math.isnan(rows[1]["n_voxels_median"]) and not math.isnan(rows[0]["n_voxels_median"])

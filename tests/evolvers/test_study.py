@@ -8,7 +8,7 @@ from evolver_helpers import tiny
 
 from evolvers.evaluation import EvalStats
 from evolvers.genome import Individual
-from evolvers.recorder import obstacle_footprint, study_columns
+from evolvers.recorder import add_run_note, obstacle_footprint, read_run_notes, study_columns
 from evolvers.study import SEED_REPORT, plan, run_order, run_status, run_study
 from evolvers.study_report import a12, load_runs, permutation_pvalue
 from softgym.cli import main
@@ -46,9 +46,13 @@ def test_study_runs_resumes_skips_and_reports(tmp_path, capsys):
             assert {"top_period", "top_n_muscle", "repeated_phenotypes"} <= set(rows[-1])
         assert json.loads((root / name / "scenario.json").read_text())["seeds"] == [0, 1]
 
+    # a note in a run folder (e.g. left by a repair) is quoted by the report
+    add_run_note(root / "controller-pareto" / "seed-1", "repaired after a bad resume", generation=1)
+    assert read_run_notes(root / "controller-pareto" / "seed-1")[0]["generation"] == 1
     out = tmp_path / "report"
     assert main(["study", "report", str(root), "--out", str(out)]) == 0
     text = (out / "README.md").read_text()
+    assert "controller-pareto seed 1 (" in text and "repaired after a bad resume" in text
     claims = json.loads((out / "claims.json").read_text())
     assert len(claims) >= 15 and {c["verdict"] for c in claims} <= VERDICTS
     by_id = {c["id"]: c for c in claims}
