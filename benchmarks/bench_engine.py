@@ -19,21 +19,18 @@ benchmarks/RESULTS.md.
 from __future__ import annotations
 
 import argparse
-import datetime as _dt
 import json
-import platform
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
+import results_log
 
 from softgym.engine import Body, SimConfig, Simulation, openmp_enabled
 from softgym.terrain import Terrain
 
 SEED_ENGINE_O3 = 2.3e6  # voxel-steps/s per core, the seed's engine compiled with -O3 (issue 3)
 VOXELYZE_2015 = (1.4e6, 2.1e6)  # the 2015 Voxelyze library on this machine kind (issue 3)
-RESULTS = Path(__file__).with_name("RESULTS.md")
 
 
 def reference_robot(n: int = 6) -> Body:
@@ -153,10 +150,8 @@ def main(argv: list[str] | None = None) -> int:
           f"(5 s simulated) on one core", file=sys.stderr)
 
     if not args.no_append:
-        stamp = _dt.datetime.now().strftime("%Y-%m-%d %H:%M")
         lines = [
-            f"\n### bench_engine.py{' --quick' if args.quick else ''} — {stamp}, "
-            f"{platform.machine()}, OpenMP {'on' if openmp_enabled() else 'off'}\n",
+            results_log.heading("bench_engine.py", args.quick),
             "| preset | robot | batch | threads | self-collision | world | M voxel-steps/s | KiB per robot | diverged |",
             "|---|---|---|---|---|---|---|---|---|",
         ]
@@ -169,8 +164,7 @@ def main(argv: list[str] | None = None) -> int:
                      f"{vc / 1e6:.2f} M voxel-steps/s on 1 thread; "
                      f"seed preset / corotational preset: {v1 / vco:.2f}x; "
                      f"vs the seed's engine at -O3: {v1 / SEED_ENGINE_O3:.1f}x per core.\n")
-        with RESULTS.open("a") as fh:
-            fh.write("\n".join(lines))
+        results_log.append("\n".join(lines))
     if args.json:
         print(json.dumps(summary))
     return 0

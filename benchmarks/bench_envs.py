@@ -21,22 +21,19 @@ benchmarks/RESULTS.md.
 from __future__ import annotations
 
 import argparse
-import datetime as _dt
 import json
 import os
-import platform
 import sys
 import time
-from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
+import results_log
 
 import softgym  # noqa: F401  (registers the ids)
 from softgym.design import default_walker
 from softgym.engine import Simulation, default_num_threads, openmp_enabled
 
-RESULTS = Path(__file__).with_name("RESULTS.md")
 EVOGYM_WALKER = 400.0  # env steps/s, EvoGym Walker-v0 on this machine kind (issue 6)
 ENV_ID = "SoftWalker-Flat-v0"
 
@@ -168,10 +165,10 @@ def main(argv: list[str] | None = None) -> int:
         "quick": args.quick,
     }
     if not args.no_append:
-        stamp = _dt.datetime.now().strftime("%Y-%m-%d %H:%M")
         lines = [
-            f"\n### bench_envs.py{' --quick' if args.quick else ''} — {stamp}, {platform.machine()}, "
-            f"{cores} CPUs, {threads} engine threads, OpenMP {'on' if openmp_enabled() else 'off'}\n",
+            results_log.heading(
+                "bench_envs.py", args.quick, [f"{cores} CPUs", f"{threads} engine threads"]
+            ),
             f"{ENV_ID}, default walker (216 voxels), control_dt 0.05 s, random actions.\n",
             "| measure | value | note |",
             "|---|---|---|",
@@ -180,8 +177,7 @@ def main(argv: list[str] | None = None) -> int:
         lines.append(
             f"\nBatched vector env / SyncVectorEnv at N = {n}: {ratio:.2f}x per env step.\n"
         )
-        with RESULTS.open("a") as fh:
-            fh.write("\n".join(lines))
+        results_log.append("\n".join(lines))
     if args.json:
         print(json.dumps(summary))
     return 0

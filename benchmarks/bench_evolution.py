@@ -24,14 +24,12 @@ robot and 7 s per bone robot. Target: under 5 s per generation on 2 cores.
 from __future__ import annotations
 
 import argparse
-import datetime as _dt
 import json
-import platform
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
+import results_log
 
 from evolvers.evaluation import Evaluator, PhenotypeCache
 from evolvers.experiments import get_experiment
@@ -40,7 +38,6 @@ from evolvers.operators import make_children
 from evolvers.selection import sel_fitness_tournament
 from softgym.engine import default_num_threads, openmp_enabled
 
-RESULTS = Path(__file__).with_name("RESULTS.md")
 SEED_SOFT_S = 0.75  # s per soft 6x6x6 robot, 5 s simulated, the seed's engine at -O3, one core
 SEED_BONE_S = (3.5, 12.0)  # s per robot with bone
 
@@ -120,11 +117,8 @@ def main(argv: list[str] | None = None) -> int:
         f"seed's engine ~{seed_mid:.0f} s for the same robots ({seed_mid / mean:.0f}x); target < 5 s"
     )
     if not args.no_append:
-        stamp = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M")
         lines = [
-            "",
-            f"### bench_evolution.py — {stamp}, {platform.machine()}, OpenMP {'on' if openmp_enabled() else 'off'}, "
-            f"{default_num_threads()} threads",
+            results_log.heading("bench_evolution.py", details=[f"{default_num_threads()} threads"]),
             "",
             f"Seed setup: {args.experiment}, 31 evaluations of 6x6x6 CPPN robots per generation, "
             f"{args.seconds:g} s simulated, {'parents cached' if args.cached else 'all 31 simulated'}.",
@@ -140,8 +134,7 @@ def main(argv: list[str] | None = None) -> int:
         lines.append(f"Mean {mean:.2f} s per generation (CPU {cpu_mean:.2f} s; on a shared machine "
                      f"CPU / 2 is the uncontended 2-core time) at bone fraction {bone:.2f} "
                      f"(target < 5 s; the seed's engine ~{seed_mid:.0f} s).")  # fmt: skip
-        with RESULTS.open("a") as fh:
-            fh.write("\n".join(lines) + "\n")
+        results_log.append("\n".join(lines))
     if args.json:
         print(json.dumps({"seconds_per_generation": mean, "cpu_seconds_per_generation": cpu_mean,
                           "bone_fraction": bone, "rows": rows}))  # fmt: skip

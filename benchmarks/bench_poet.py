@@ -26,20 +26,16 @@ seeds) and seed 0's gallery and transfer heatmap.
 from __future__ import annotations
 
 import argparse
-import datetime as _dt
 import json
-import platform
 import shutil
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+import results_log
 
 from evolvers.poet import PoetConfig, PoetRun, plot_annecs, poet_experiment
-from softgym.engine import openmp_enabled
-
-RESULTS = Path(__file__).with_name("RESULTS.md")
 
 
 class BudgetReached(Exception):
@@ -111,7 +107,11 @@ def run_seed(seed: int, args, root: Path) -> dict:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--quick", action="store_true", help="20 iterations, 6 robots a pair, K = T = 3, 4 active pairs")
+    ap.add_argument(
+        "--quick",
+        action="store_true",
+        help="20 iterations, 6 robots a pair, K = T = 3, 4 active pairs",
+    )
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--iterations", type=int, help="iterations per run (default 40; quick 20)")
     ap.add_argument("--pop", type=int, help="robots per pair (default 8; quick 6)")
@@ -177,11 +177,7 @@ def main(argv: list[str] | None = None) -> int:
     print()
     print(text)
     if not args.no_append:
-        stamp = _dt.datetime.now().strftime("%Y-%m-%d %H:%M")
-        mode = " --quick" if q else ""
-        with RESULTS.open("a") as fh:
-            fh.write(f"\n### bench_poet.py{mode} — {stamp}, {platform.machine()}, "
-                     f"OpenMP {'on' if openmp_enabled() else 'off'}\n\n{text}\n")  # fmt: skip
+        results_log.append(results_log.heading("bench_poet.py", q) + "\n" + text + "\n")
     if args.out:
         summary = [{k: v for k, v in r.items() if k != "rows"} for r in results]
         (Path(args.out) / "bench_poet.json").write_text(json.dumps(summary, indent=1))

@@ -26,14 +26,13 @@ seeds MAP-Elites beat each baseline on (same seed).
 from __future__ import annotations
 
 import argparse
-import datetime as _dt
 import json
-import platform
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+import results_log
 
 from evolvers.descriptors import MOURET_CLUNE_2015, descriptor_values
 from evolvers.evaluation import local_batch_fn
@@ -42,9 +41,7 @@ from evolvers.pymoo_runner import PymooRun
 from evolvers.qd import QDConfig, QDRun, archive_stats, make_archive
 from evolvers.runner import EvolutionRun
 from softgym.design import RobotDesign
-from softgym.engine import openmp_enabled
 
-RESULTS = Path(__file__).with_name("RESULTS.md")
 METHODS = ("map-elites", "nsga2", "novelty")
 METRICS = ("qd_score", "coverage", "best")
 
@@ -171,11 +168,7 @@ def main(argv: list[str] | None = None) -> int:
     print()
     print(text)
     if not args.no_append:
-        stamp = _dt.datetime.now().strftime("%Y-%m-%d %H:%M")
-        mode = " --quick" if q else ""
-        with RESULTS.open("a") as fh:
-            fh.write(f"\n### bench_qd.py{mode} — {stamp}, {platform.machine()}, "
-                     f"OpenMP {'on' if openmp_enabled() else 'off'}\n\n{text}\n")  # fmt: skip
+        results_log.append(results_log.heading("bench_qd.py", q) + "\n" + text + "\n")
     if args.json:
         print(json.dumps({"results": results, "wall": walls, "args": vars(args)}))
     return 0
