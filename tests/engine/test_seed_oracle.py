@@ -19,7 +19,11 @@ BENCH = Path(__file__).resolve().parents[2] / "benchmarks"
 sys.path.insert(0, str(BENCH))
 
 import fidelity_cases as fc  # noqa: E402
+import fidelity_evolved as fe  # noqa: E402
 import fidelity_seed as fs  # noqa: E402
+
+from softgym.design.robot import RobotDesign  # noqa: E402
+from softgym.metrics import dilute, walk_metrics  # noqa: E402
 
 MICRO = json.loads((BENCH / "data" / "seed_engine" / "micro.json").read_text())["cases"]
 STRUCTURED = json.loads((BENCH / "data" / "seed_engine" / "structured.json").read_text())
@@ -42,14 +46,25 @@ def test_the_corotational_model_does_not_follow_a_folding_column():
 
 
 def _oracle_draws(case: str, regime: str) -> np.ndarray:
-    return np.array([r["NormFinalDist"] for r in STRUCTURED["records"]
-                     if r["case"] == case and r["regime"] == regime and not r["hung"]])
+    return np.array(
+        [
+            r["NormFinalDist"]
+            for r in STRUCTURED["records"]
+            if r["case"] == case and r["regime"] == regime and not r["hung"]
+        ]
+    )
 
 
 # whole bodies: the seed's gentle default, a bone body at medium and strong
 # actuation, a walker at medium (its oracle draws agree with each other)
-BODIES = [("half_x_plus_soft", "gentle"), ("quadruped_soft", "gentle"), ("biped_walls", "gentle"),
-          ("half_x_plus_bone", "medium"), ("half_x_plus_bone", "strong"), ("l_shape_bone", "medium")]
+BODIES = [
+    ("half_x_plus_soft", "gentle"),
+    ("quadruped_soft", "gentle"),
+    ("biped_walls", "gentle"),
+    ("half_x_plus_bone", "medium"),
+    ("half_x_plus_bone", "strong"),
+    ("l_shape_bone", "medium"),
+]
 
 
 def test_whole_bodies_fall_inside_the_oracles_perturbed_range():
@@ -62,3 +77,24 @@ def test_whole_bodies_fall_inside_the_oracles_perturbed_range():
         lo, hi = draws.min(), draws.max()
         slack = 0.01 * hi + 1e-4  # 1 % for the oracle's 6 printed digits and our rounding
         assert lo - slack <= v <= hi + slack, f"{n} {regime}: {v:.5f} outside [{lo:.5f}, {hi:.5f}]"
+
+
+EVOLVED = BENCH / "data" / "seed_engine" / "evolved.json"
+
+
+@pytest.mark.parametrize("name", ["obstacles-s0-id1880", "obstacles-s0-id1834"])
+def test_evolved_fence_robots_match_the_seed_engine(name):
+    # robots evolved by softgym on the seed's obstacle task (bone, evolved controller),
+    # inside the seed's fence: its diluted MaxXYDist agrees with the seed's engine
+    # (evolved.json, made by make_evolved_data.py) to 1 %, unperturbed and perturbed
+    cases, oracle = fe.load(EVOLVED)
+    drawn = sorted(d for n, d in oracle if n == name and np.isfinite(oracle[(n, d)]))
+    designs = [
+        fc.perturb(RobotDesign.from_dict(cases[name]["design"]), d, name=name) for d in drawn
+    ]
+    r = dilute(Simulation(designs, SimConfig(), terrain=fs.fence_terrain()).run(5.0))
+    for d, v in zip(drawn, walk_metrics(r)["max_xy_dist"]):
+        ref = oracle[(name, d)]
+        assert abs(v - ref) <= 0.01 * ref + 1e-4, (
+            f"{name} draw {d}: {v:.5f} vs the oracle's {ref:.5f}"
+        )
