@@ -78,8 +78,10 @@ def state_of(sim: Simulation, robot: int, rollout) -> dict[str, np.ndarray]:
     out = {}
     for k in ("pos", "vel", "quat", "angvel", "rot", "scale", "col_ref"):
         out[k] = np.array(a[k][vlo:vhi])
-    for k in ("link_sa", "link_last"):
-        out[k] = np.array(a[k][llo:lhi])
+    out["link_sa"] = np.array(a["link_sa"][llo:lhi])
+    last = a["link_last"]
+    # (n_links, 9) before the speed work, (9, n_links) after: compared as (n_links, 9)
+    out["link_last"] = np.array(last[llo:lhi] if last.shape == (sim.n_links, 9) else last[:, llo:lhi].T)
     for k in ("steps", "diverged", "diverged_code", "diverged_time", "cm_init", "col_acc",
               "col_vmax", "aux_init", "trace_n"):  # fmt: skip
         out[k] = np.array(a[k][robot])
