@@ -243,6 +243,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", action="store_true", help="print one JSON object as the last line")
     ap.add_argument("--verbose", action="store_true", help="SB3's training log every update")
     args = ap.parse_args(argv)
+    command = "python benchmarks/rl_ppo.py " + " ".join(sys.argv[1:] if argv is None else argv)
+    t_start = time.perf_counter()
     try:
         import torch
         from stable_baselines3 import PPO
@@ -266,6 +268,7 @@ def main(argv: list[str] | None = None) -> int:
     probe = gym.make(ENV_ID, **kw)
     sinusoid = Sinusoid.from_env(probe)
     grid_shape = probe.unwrapped.grid_shape
+    preset = probe.unwrapped.sim.config.model
     probe.close()
     policy_kwargs: dict = {"log_std_init": args.log_std_init}
     if args.policy == "mlp":
@@ -343,8 +346,8 @@ def main(argv: list[str] | None = None) -> int:
         ),
     }
     print(
-        f"PPO on {ENV_ID}: {args.timesteps} env steps ({args.n_envs} envs {args.vec}, control_dt "
-        f"{args.control_dt} s) in {train_s:.0f} s ({args.timesteps / train_s:.0f} steps/s incl. "
+        f"PPO on {ENV_ID} ({preset} preset): {args.timesteps} env steps ({args.n_envs} envs "
+        f"{args.vec}, control_dt {args.control_dt} s) in {train_s:.0f} s ({args.timesteps / train_s:.0f} steps/s incl. "
         f"updates)",
         file=sys.stderr,
     )
@@ -362,12 +365,20 @@ def main(argv: list[str] | None = None) -> int:
         print(
             json.dumps(
                 {
+                    "command": command,
+                    "env": ENV_ID,
+                    "preset": preset,
                     "timesteps": args.timesteps,
                     "train_seconds": train_s,
+                    "wall_seconds": time.perf_counter() - t_start,
                     "actuation": args.actuation or "seed",
                     "control_dt": args.control_dt,
+                    "n_envs": args.n_envs,
+                    "episodes": args.episodes,
+                    "seed": args.seed,
                     "curve": curve,
                     **{k: v[0] for k, v in results.items()},
+                    "std": {k: v[1] for k, v in results.items()},
                 }
             )
         )
