@@ -1,0 +1,45 @@
+"""The stored PPO runs (benchmarks/data/rl/) and the figure script that draws them (issue 13)."""
+
+import importlib.util
+from pathlib import Path
+
+import pytest
+
+BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
+KEYS = {"command", "preset", "timesteps", "train_seconds", "wall_seconds", "actuation",
+        "control_dt", "curve", "ppo", "ppo_sampled", "random", "sinusoid"}  # fmt: skip
+
+
+def _plot_rl():
+    spec = importlib.util.spec_from_file_location("plot_rl", BENCH / "plot_rl.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_stored_rl_runs_are_complete():
+    plot_rl = _plot_rl()
+    paths = plot_rl.stored_runs()
+    assert len(paths) >= 2
+    for path in paths:
+        run = plot_rl.load(path)
+        assert KEYS <= run.keys(), f"{path.name} lacks {KEYS - run.keys()}"
+        assert run["preset"] == "seed"
+        assert run["curve"][-1][0] >= run["timesteps"]
+        assert str(run["timesteps"]) in run["command"]
+
+
+def test_plot_rl_draws_the_stored_runs(tmp_path):
+    pytest.importorskip("matplotlib")
+    out = tmp_path / "ppo.png"
+    assert _plot_rl().main(["--out", str(out)]) == 0
+    assert out.stat().st_size > 10_000
+
+
+def test_plot_rl_reads_a_log_ending_with_the_json_line(tmp_path):
+    log = tmp_path / "run.log"
+    log.write_text('training...\n{"curve": [[2048, 0.1]], "ppo": 0.2}\n')
+    assert _plot_rl().load(log)["ppo"] == 0.2
+    log.write_text("no json here\n")
+    with pytest.raises(SystemExit):
+        _plot_rl().load(log)
