@@ -39,23 +39,20 @@ reward metric: voxel lengths, radians for ``turn``, voxel lengths^2 for
 from __future__ import annotations
 
 import argparse
-import datetime as _dt
 import json
 import logging
-import platform
 import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import results_log  # benchmarks/results_log.py
 
 from softgym.design import CONTROLLER_BOUNDS, default_walker
 from softgym.engine import Body, Simulation
 from softgym.envs import SoftWalkerVectorEnv
 from softgym.tasks import get_task, task_names
-
-RESULTS = Path(__file__).with_name("RESULTS.md")
 
 
 def _run_episode(env: SoftWalkerVectorEnv, policy) -> np.ndarray:
@@ -375,12 +372,18 @@ def main() -> None:
                 f"{r['evolved_max']:.2f}] | {r['steps_per_s']:.0f} |"
             )
         evals = rows[0]["evaluations"] // args.seeds
-        mode = "--quick" if args.quick else "full"
         text += (
-            f"\n## Task suite ({mode}: (mu + lambda) = ({args.mu} + {args.pop}), {args.generations} "
-            f"generations ({evals} controllers a seed), {args.seeds} seed(s), {args.episode:g} s "
-            f"episodes), {_dt.date.today().isoformat()}, {platform.machine()}, {args.threads} "
-            f"threads, {total / 60:.0f} min\n\n"
+            results_log.heading(
+                "bench_tasks.py",
+                args.quick,
+                (
+                    f"(mu + lambda) = ({args.mu} + {args.pop}), {args.generations} generations "
+                    f"({evals} controllers a seed), {args.seeds} seed(s), {args.episode:g} s episodes",
+                    f"{args.threads} threads",
+                    f"{total / 60:.0f} min",
+                ),
+            )
+            + "\n"
             "`benchmarks/bench_tasks.py`: the default walker; random actions in the task's Gym "
             "env (mean of 3); the seed's sinusoid (the design's controller); the best of that "
             "sinusoid at the walker's four headings (0, 90, 180, 270 degrees about the vertical); "
@@ -401,10 +404,17 @@ def main() -> None:
                 f"{r['codesign_max']:.2f}] | {int(np.median(r['evaluations']))} |"
             )
         text += (
-            f"\n## Task suite, body + controller co-design ({args.cd_pop} robots, {args.cd_generations} "
-            f"generations, {args.seeds} seed(s), {args.episode:g} s episodes), "
-            f"{_dt.date.today().isoformat()}, {platform.machine()}, {args.threads} threads, "
-            f"{total / 60:.0f} min\n\n"
+            results_log.heading(
+                "bench_tasks.py --codesign",
+                args.quick,
+                (
+                    f"body + controller co-design, {args.cd_pop} robots, {args.cd_generations} "
+                    f"generations, {args.seeds} seed(s), {args.episode:g} s episodes",
+                    f"{args.threads} threads",
+                    f"{total / 60:.0f} min",
+                ),
+            )
+            + "\n"
             "`benchmarks/bench_tasks.py --codesign`: `softgym evolve`'s controller-tournament "
             "experiment (6x6x6 CPPN bodies from random and the seed's controller GA) selecting "
             "on the task's `score`; the best score reached (median [min, max] over seeds).\n\n"
@@ -414,8 +424,7 @@ def main() -> None:
     print(text)
     print(f"total {total:.0f} s")
     if text and not args.no_append:
-        with RESULTS.open("a") as f:
-            f.write(text)
+        results_log.append(text)
     if args.json:
         print(json.dumps(rows + cd_rows))
 
