@@ -21,12 +21,15 @@ seeds MAP-Elites beat each baseline on (same seed).
 
     python benchmarks/bench_qd.py --quick              # 4x4x4 robots, 1.5 s, 5 seeds
     python benchmarks/bench_qd.py --seeds 5 --budget 2000   # 6x6x6, 5 s: hours on 2 cores
+    python benchmarks/bench_qd.py --seeds 5 --budget 1000 --data benchmarks/data/qd/qd_6x6x6_1000.json \
+        --figure docs/figures/qd_6x6x6_1000.png            # resumable; redraws from the stored runs
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import tempfile
 import time
 from pathlib import Path
@@ -44,6 +47,7 @@ from softgym.design import RobotDesign
 
 METHODS = ("map-elites", "nsga2", "novelty")
 METRICS = ("qd_score", "coverage", "best")
+CURVE_POINTS = 10
 
 
 class BudgetReached(Exception):
@@ -91,13 +95,20 @@ def run_method(method: str, seed: int, args, out: Path) -> tuple[dict[str, float
     if len(rec.distances) < n:
         raise RuntimeError(f"{method} seed {seed}: only {len(rec.distances)} simulations")
     archive = make_archive(_config(args), seed)
-    archive.add(
-        np.array([None] * n, dtype=object),
-        np.asarray(rec.distances[:n]),
-        descriptor_values(rec.grids[:n], MOURET_CLUNE_2015),
-    )
-    st = archive_stats(archive)
-    return {"qd_score": st["qd_score"], "coverage": st["coverage"], "best": st["qd_best"]}, wall
+    distances = np.asarray(rec.distances[:n])
+    descriptors = descriptor_values(rec.grids[:n], MOURET_CLUNE_2015)
+    # the archive after every tenth of the budget, in the order the search simulated them
+    # (adding in chunks keeps the best robot of each cell, as one add of all of them would)
+    curve = []
+    marks = np.unique(np.linspace(0, n, CURVE_POINTS + 1).astype(int))
+    for lo, hi in zip(marks[:-1], marks[1:]):
+        archive.add(
+            np.array([None] * (hi - lo), dtype=object), distances[lo:hi], descriptors[lo:hi]
+        )
+        st = archive_stats(archive)
+        curve.append([int(hi), st["qd_score"], st["coverage"], st["qd_best"]])
+    return {"qd_score": st["qd_score"], "coverage": st["coverage"], "best": st["qd_best"],
+            "curve": curve}, wall  # fmt: skip
 
 
 def _config(args) -> QDConfig:
@@ -121,6 +132,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--cells", type=int, help="cells per descriptor (default 128; quick 32)")
     ap.add_argument("--methods", nargs="+", choices=METHODS, default=list(METHODS))
     ap.add_argument("--out", help="keep the run folders here (default: a temporary folder)")
+    ap.add_argument("--data", help="JSON file of finished runs: each (method, seed) is stored as "
+                    "it ends and skipped when the same command is run again (resume)")  # fmt: skip
+    ap.add_argument("--figure", help="draw QD-score, coverage and best against simulations here")
     ap.add_argument("--json", action="store_true", help="print a JSON line at the end")
     ap.add_argument("--no-append", action="store_true", help="do not append to RESULTS.md")
     args = ap.parse_args(argv)
@@ -130,13 +144,23 @@ def main(argv: list[str] | None = None) -> int:
     args.seconds = args.seconds or (1.5 if q else 5.0)
     args.cells = args.cells or (32 if q else 128)
 
+    config = {k: getattr(args, k) for k in ("budget", "batch", "shape", "seconds", "cells")}
+    store = _load_store(args.data, config)
     results: dict[str, list[dict[str, float]]] = {m: [] for m in args.methods}
     walls: dict[str, float] = dict.fromkeys(args.methods, 0.0)
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(args.out or tmp)
         for seed in range(args.seeds):
             for m in args.methods:
-                res, wall = run_method(m, seed, args, root / f"seed-{seed}")
+                key = f"{m}/{seed}"
+                if key in store["runs"]:
+                    res, wall = store["runs"][key], store["runs"][key]["wall"]
+                    print(f"seed {seed} {m:10s} (stored in {args.data})", flush=True)
+                else:
+                    res, wall = run_method(m, seed, args, root / f"seed-{seed}")
+                    if args.data:
+                        store["runs"][key] = {**res, "wall": wall}
+                        _save_store(args.data, store)
                 results[m].append(res)
                 walls[m] += wall
                 print(f"seed {seed} {m:10s} QD-score {res['qd_score']:8.3f}  coverage "
@@ -169,9 +193,60 @@ def main(argv: list[str] | None = None) -> int:
     print(text)
     if not args.no_append:
         results_log.append(results_log.heading("bench_qd.py", q) + "\n" + text + "\n")
+    if args.figure:
+        _figure(results, args)
+        print(f"wrote {args.figure}")
     if args.json:
         print(json.dumps({"results": results, "wall": walls, "args": vars(args)}))
     return 0
+
+
+def _load_store(path: str | None, config: dict) -> dict:
+    """The ``--data`` file's runs (empty if none); refuses a file made with other sizes."""
+    if not path or not Path(path).exists():
+        return {"config": config, "runs": {}}
+    store = json.loads(Path(path).read_text())
+    if store.get("config") != config:
+        raise SystemExit(f"bench_qd: {path} holds runs of {store.get('config')}, not {config}; "
+                         "use another --data file")  # fmt: skip
+    return store
+
+
+def _save_store(path: str, store: dict) -> None:
+    """Write ``store`` atomically (a killed run never leaves half a file)."""
+    tmp = Path(f"{path}.tmp")
+    tmp.write_text(json.dumps(store, indent=1) + "\n")
+    os.replace(tmp, path)
+
+
+def _figure(results: dict[str, list[dict]], args) -> None:
+    """QD-score, coverage and best distance against simulations: median and IQR over seeds."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    labels = {"qd_score": "QD-score (sum of elites' distances,\nvoxel lengths)",
+              "coverage": "coverage (filled cells / cells)",
+              "best": "best distance (voxel lengths)"}  # fmt: skip
+    fig, axes = plt.subplots(1, 3, figsize=(12, 3.8), layout="constrained")
+    for m, runs in results.items():
+        curves = np.array([r["curve"] for r in runs])  # seeds x points x (n, qd, coverage, best)
+        x = curves[0, :, 0]
+        for ax, col in zip(axes, (1, 2, 3)):
+            q1, med, q3 = np.percentile(curves[:, :, col], [25, 50, 75], axis=0)
+            (line,) = ax.plot(x, med, label=f"{m} ({len(runs)} seeds)")
+            ax.fill_between(x, q1, q3, color=line.get_color(), alpha=0.2, lw=0)
+    for ax, key in zip(axes, METRICS):
+        ax.set_xlabel("simulations")
+        ax.set_ylabel(labels[key])
+        ax.grid(alpha=0.3)
+    axes[0].legend(loc="upper left", fontsize=8)
+    shape = "x".join(map(str, args.shape))
+    fig.suptitle(f"MAP-Elites vs NSGA-II vs novelty search: {shape} CPPN robots, {args.seconds:g} s, "
+                 f"archive stiff x filled, {args.cells} x {args.cells} cells (median, IQR)")  # fmt: skip
+    fig.savefig(args.figure, dpi=110)
+    plt.close(fig)
 
 
 if __name__ == "__main__":
