@@ -29,7 +29,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import tempfile
 import time
 from pathlib import Path
@@ -44,6 +43,7 @@ from evolvers.pymoo_runner import PymooRun
 from evolvers.qd import QDConfig, QDRun, archive_stats, make_archive
 from evolvers.runner import EvolutionRun
 from softgym.design import RobotDesign
+from softgym.io import atomic_write_text
 
 METHODS = ("map-elites", "nsga2", "novelty")
 METRICS = ("qd_score", "coverage", "best")
@@ -160,7 +160,7 @@ def main(argv: list[str] | None = None) -> int:
                     res, wall = run_method(m, seed, args, root / f"seed-{seed}")
                     if args.data:
                         store["runs"][key] = {**res, "wall": wall}
-                        _save_store(args.data, store)
+                        atomic_write_text(args.data, json.dumps(store, indent=1) + "\n")
                 results[m].append(res)
                 walls[m] += wall
                 print(f"seed {seed} {m:10s} QD-score {res['qd_score']:8.3f}  coverage "
@@ -210,13 +210,6 @@ def _load_store(path: str | None, config: dict) -> dict:
         raise SystemExit(f"bench_qd: {path} holds runs of {store.get('config')}, not {config}; "
                          "use another --data file")  # fmt: skip
     return store
-
-
-def _save_store(path: str, store: dict) -> None:
-    """Write ``store`` atomically (a killed run never leaves half a file)."""
-    tmp = Path(f"{path}.tmp")
-    tmp.write_text(json.dumps(store, indent=1) + "\n")
-    os.replace(tmp, path)
 
 
 def _figure(results: dict[str, list[dict]], args) -> None:

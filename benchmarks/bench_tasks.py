@@ -44,7 +44,6 @@ import logging
 import tempfile
 import time
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import results_log  # benchmarks/results_log.py
@@ -165,11 +164,13 @@ class PhaseRunner:
         self.config = self.task.config()
         self.n, self.threads = n, args.threads
         self.cells = self.base.grid.size
+        self.terrains = [self.task.terrain_for(d.shape) for d in self.designs]  # one per heading
         self.settled = []
-        for d in self.designs:
+        for d, terrain in zip(self.designs, self.terrains):
             zero = phase_body(d, np.zeros(self.cells), np.ones(self.cells))
-            sim = Simulation([zero] * n, config=self.config, terrain=[self.task.terrain_for(d.shape)] * n,
-                             n_threads=self.threads)  # fmt: skip
+            sim = Simulation(
+                [zero] * n, config=self.config, terrain=[terrain] * n, n_threads=self.threads
+            )
             sim.advance_to(self.config.init_time)
             self.settled.append(sim.get_state())
         self.evaluations = 0
@@ -184,7 +185,7 @@ class PhaseRunner:
         m = len(genomes)
         pad = genomes + [genomes[0]] * (self.n - m)  # the settled states are of n robots
         bodies = [phase_body(self.designs[g.heading], g.phase, g.amp, g.period) for g in pad]
-        terrains = [self.task.terrain_for(self.designs[g.heading].shape) for g in pad]
+        terrains = [self.terrains[g.heading] for g in pad]
         sim = Simulation(bodies, config=self.config, terrain=terrains, n_threads=self.threads)
         heads = np.array([g.heading for g in pad])
         sim.set_state(self.settled[int(heads[0])])
@@ -279,16 +280,13 @@ def codesign(task: str, seed: int, args: argparse.Namespace) -> dict[str, float]
     from evolvers.runner import EvolutionRun
     from evolvers.selection import Objective
 
-    # (a .vxa cannot hold a world off the lattice, e.g. the tunnel's roof: the run folder warns per file)
-    logging.getLogger("evolvers").addFilter(lambda r: "without the terrain" not in r.getMessage())
     exp = get_experiment("controller-tournament", task=task, seconds=1.0 + args.episode,
                          pop_size=args.cd_pop, objectives=(Objective("score", True),))  # fmt: skip
     with tempfile.TemporaryDirectory() as out:
         run = EvolutionRun(exp, out, seed=seed, generations=args.cd_generations,
                            n_threads=args.threads, figures=False, gif=False, progress=False)  # fmt: skip
         run.run()
-        log = [json.loads(line) for line in (Path(out) / "log.jsonl").read_text().splitlines()]
-    return {"best": max(g["score_best"] for g in log), "evaluations": log[-1]["evaluations_total"]}
+    return {"best": max(g["score_best"] for g in run.rows), "evaluations": run.evaluations_total}
 
 
 def main() -> None:
@@ -321,6 +319,11 @@ def main() -> None:
     args.episode = 3.0
     names = [] if args.codesign_only else (args.tasks.split(",") if args.tasks else task_names())
     cd_names = args.codesign.split(",") if args.codesign else []
+    if cd_names:
+        # (a .vxa cannot hold a world off the lattice, e.g. the tunnel's roof: run folders warn per file)
+        logging.getLogger("evolvers").addFilter(
+            lambda r: "without the terrain" not in r.getMessage()
+        )
     rows = []
     t_all = time.perf_counter()
     for name in names:
