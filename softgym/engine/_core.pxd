@@ -90,7 +90,7 @@ cdef struct Batch:
 
     # ---- per link (beam between face neighbours v1 -> v2 along +axis) ------
     intp_t n_links           # links in the batch
-    float64_t* link_out      # (10, n_links) scratch: |extension|, force on v2, moments on v1, v2
+    float64_t* link_out      # (N_LINK_OUT, n_links) scratch (each link kernel names its rows)
     intp_t* v1               # (n_links,) voxel on the negative side
     intp_t* v2               # (n_links,) voxel on the positive side
     int32* axis              # (n_links,) 0, 1, 2 for x, y, z

@@ -38,6 +38,7 @@ from libc.stdlib cimport calloc, malloc, realloc, free, qsort
 from libc.string cimport memcpy, memset
 
 cimport numpy as cnp
+import numpy as np
 
 from softgym.engine._typedefs cimport float64_t, intp_t, step_t, int32, flag_t
 
@@ -136,7 +137,7 @@ cdef extern from *:
 
 
 cdef enum:
-    N_LINK_OUT = 10  # rows of the per-link output scratch (see _link_kernel)
+    N_LINK_OUT = 23  # rows of the per-link scratch (see _link_kernel, _seed_links_along)
 
 
 cdef void _link_kernel(intp_t lo, intp_t hi, intp_t ax, intp_t p, intp_t q,
@@ -532,28 +533,280 @@ cdef void _seed_geom(intp_t lo, intp_t hi, intp_t ax, cintp_rp v1, cintp_rp v2,
         o_st[li] = (fabs(p2) + fabs(p1)) / p0
 
 
-cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
-                                  float64_t inv_dt) noexcept nogil:
-    # _links_seed for its links [lo, hi), all along axis ax (a compile-time
-    # constant once inlined). The bond frame is voxel 1's frame turned by the
-    # proper rotation P that takes the link axis onto +x (the seed's
-    # ToXDirBond): (x, y, z) -> (x, y, z), (y, -x, z), (z, y, -x) for ax 0, 1, 2.
+cdef intp_t _seed_modes(Batch* b, intp_t lo, intp_t hi, float64_t* o, intp_t n) noexcept nogil:
+    # First pass of _seed_links_along over its links [lo, hi): each link's
+    # mode, small or large angle, with the seed's hysteresis (updates
+    # link_sa), then the strain check. Row 9 (the transverse ratio) becomes
+    # the mode as 1.0 / 0.0 and row 22 1.0 on a mode-change step. Returns hi,
+    # or the first link whose extension is beyond max_strain.
     cdef:
-        intp_t li, i, j
-        float64_t L = b.L
-        float64_t bz = 0.5 * b.bond_zeta
-        float64_t bzh = 0.5 * bz
-        float64_t max_ext = b.max_strain * L
-        # module constants as locals (the compiler cannot assume that stores
-        # through the force pointers leave globals alone)
+        intp_t li
+        float64_t max_ext = b.max_strain * b.L
         float64_t sa_w = SMALL_ANGLE_W
         float64_t sah_w = SMALLISH_ANGLE_W
-        float64_t sa_rad = SMALL_ANGLE_RAD
         float64_t st_in = SA_BOND_BEND_RAD
         float64_t ex_in = SA_BOND_EXT_PERC
         float64_t st_out = HYSTERESIS * SA_BOND_BEND_RAD
         float64_t ex_out = HYSTERESIS * SA_BOND_EXT_PERC
+        flag_t* link_sa = b.link_sa
+        float64_t qw, p0, nom, st, ex, P0
+        int32 sa, changed
+    for li in range(lo, hi):
+        p0 = o[li]
+        qw = o[3 * n + li]
+        nom = o[7 * n + li]
+        st = o[9 * n + li]
+        ex = p0 / nom
+        sa = link_sa[li]
+        changed = 0
+        if not sa and qw > sa_w and st < st_in and ex < ex_in:
+            sa = 1
+            changed = 1
+        elif sa and (not (qw > sah_w) or st > st_out or ex > ex_out):
+            sa = 0
+            changed = 1
+        link_sa[li] = sa
+        o[9 * n + li] = 1.0 if sa else 0.0
+        o[22 * n + li] = 1.0 if changed else 0.0
+        P0 = p0 - nom if sa else o[8 * n + li] - nom
+        if not (fabs(P0) <= max_ext):
+            return li  # also catches NaN
+    return hi
+
+
+cdef extern from *:
+    # The second pass of _seed_links_along, in C for one pragma: the bond-frame
+    # quantities of links lo..hi in the mode the first pass gave them, without
+    # branches so the loop vectorises (the outputs are distinct rows of the
+    # scratch: no two iterations touch the same element). Every candidate
+    # value is computed and one is selected, the same IEEE result as the
+    # branchy scalar code (_seed_frame_one; -ffp-contract=off: no fused
+    # multiply-adds). Outputs: the displacement P, voxel 1's rotation vector
+    # (y, z; its x is 0), voxel 2's, the large-angle frame rq = (rw, 0, ry,
+    # rz). A link whose rotation vector needs the seed's acos branch (angles
+    # beyond ~5.6 degrees), or whose chord points backwards, gets fix = 1 and
+    # is redone by _seed_frame_one.
+    """
+    #if defined(__clang__)
+    #define SOFTGYM_IVDEP _Pragma("clang loop vectorize(assume_safety)")
+    #elif defined(__GNUC__)
+    #define SOFTGYM_IVDEP _Pragma("GCC ivdep")
+    #else
+    #define SOFTGYM_IVDEP
+    #endif
+    #if defined(_MSC_VER)
+    #define SOFTGYM_ALWAYS_INLINE static __forceinline
+    #else
+    #define SOFTGYM_ALWAYS_INLINE static inline __attribute__((always_inline))
+    #endif
+    SOFTGYM_ALWAYS_INLINE void softgym_seed_frames_impl(
+        const int all_small, Py_ssize_t lo, Py_ssize_t hi, double sa_rad, double thr,
+        const double *p0_, const double *p1_, const double *p2_, const double *qw_,
+        const double *n1_, const double *n2_, const double *n3_, const double *nom_,
+        const double *len_, const double *sa_,
+        double *o_P0, double *o_P1, double *o_P2, double *o_a1y, double *o_a1z,
+        double *o_a2x, double *o_a2y, double *o_a2z, double *o_rw, double *o_ry,
+        double *o_rz, double *o_fix)
+    {
+        Py_ssize_t li;
+        SOFTGYM_IVDEP
+        for (li = lo; li < hi; li++) {
+            double p0 = p0_[li], p1 = p1_[li], p2 = p2_[li], qw = qw_[li];
+            double n1 = n1_[li], n2 = n2_[li], n3 = n3_[li], nom = nom_[li], cl = len_[li];
+            long long is_sa = all_small ? 1 : sa_[li] != 0.0;
+            /* small angle: k of qw (_rotvec_k without its acos branch) */
+            double sl = 1.0 - qw * qw;
+            double ks = 2.0 * sqrt((2.0 - 2.0 * qw) / sl);
+            double k = sl <= 0.0 ? 0.0 : ks;
+            long long fix = is_sa & (sl > 0.0) & (sl >= thr);
+            /* large angle: rq onto the chord (exactly along it when the
+               transverse ratios are small) */
+            long long zero = (p0 == 0.0) & (p1 == 0.0) & (p2 == 0.0);
+            double yx = p1 / p0, zx = p2 / p0;
+            long long small = (yx < sa_rad) & (yx > -sa_rad) & (zx < sa_rad) & (zx > -sa_rad);
+            double ry_s = 0.5 * zx, rz_s = -0.5 * yx;
+            double rw_s = 1.0 + 0.5 * (-ry_s * ry_s - rz_s * rz_s);
+            double ln = sqrt(p0 * p0 + p1 * p1 + p2 * p2);
+            double nx = p0 / ln, ny = p1 / ln, nz = p2 / ln;
+            double rho = 1.0 / sqrt(nz * nz + ny * ny);
+            double ch = sqrt(0.5 * (1.0 + nx)), sh = sqrt(0.5 * (1.0 - nx));
+            double ry_l = nz * rho * sh, rz_l = -ny * rho * sh;
+            fix |= (1 - is_sa) & (1 - zero) & (1 - small) & (nx < -0.5);
+            double rw = zero ? 1.0 : (small ? rw_s : ch);
+            double ry = zero ? 0.0 : (small ? ry_s : ry_l);
+            double rz = zero ? 0.0 : (small ? rz_s : rz_l);
+            sl = 1.0 - rw * rw;
+            ks = 2.0 * sqrt((2.0 - 2.0 * rw) / sl);
+            double k1 = sl <= 0.0 ? 0.0 : ks;
+            fix |= (1 - is_sa) & (1 - zero) & (sl > 0.0) & (sl >= thr);
+            double a1y = ry * k1, a1z = rz * k1;
+            /* tq = rq nq (rq's x part is zero) */
+            double tw = rw * qw - ry * n2 - rz * n3;
+            double tx = rw * n1 + ry * n3 - rz * n2;
+            double ty = rw * n2 + ry * qw + rz * n1;
+            double tz = rw * n3 - ry * n1 + rz * qw;
+            sl = 1.0 - tw * tw;
+            ks = 2.0 * sqrt((2.0 - 2.0 * tw) / sl);
+            double k2 = sl <= 0.0 ? 0.0 : ks;
+            fix |= (1 - is_sa) & (sl > 0.0) & (sl >= thr);
+            double P0_s = p0 - nom, P0_l = cl - nom;
+            double a2x_s = n1 * k, a2y_s = n2 * k, a2z_s = n3 * k;
+            double a2x_l = tx * k2, a2y_l = ty * k2, a2z_l = tz * k2;
+            o_P0[li] = is_sa ? P0_s : P0_l;
+            o_P1[li] = is_sa ? p1 : 0.0;
+            o_P2[li] = is_sa ? p2 : 0.0;
+            o_a1y[li] = (is_sa | zero) ? 0.0 : a1y;
+            o_a1z[li] = (is_sa | zero) ? 0.0 : a1z;
+            o_a2x[li] = is_sa ? a2x_s : a2x_l;
+            o_a2y[li] = is_sa ? a2y_s : a2y_l;
+            o_a2z[li] = is_sa ? a2z_s : a2z_l;
+            o_rw[li] = is_sa ? 1.0 : rw;  /* unused in small-angle mode */
+            o_ry[li] = is_sa ? 0.0 : ry;
+            o_rz[li] = is_sa ? 0.0 : rz;
+            o_fix[li] = fix ? 1.0 : 0.0;
+        }
+    }
+    static void softgym_seed_frames(
+        Py_ssize_t lo, Py_ssize_t hi, double sa_rad, double thr,
+        const double *p0_, const double *p1_, const double *p2_, const double *qw_,
+        const double *n1_, const double *n2_, const double *n3_, const double *nom_,
+        const double *len_, const double *sa_,
+        double *o_P0, double *o_P1, double *o_P2, double *o_a1y, double *o_a1z,
+        double *o_a2x, double *o_a2y, double *o_a2z, double *o_rw, double *o_ry,
+        double *o_rz, double *o_fix)
+    {
+        /* blocks of links all in small-angle mode (a settled or gently
+           actuated body: most of them) skip the large-angle candidates */
+        Py_ssize_t blo, bhi, li;
+        for (blo = lo; blo < hi; blo = bhi) {
+            int all_small = 1;
+            bhi = blo + 64 < hi ? blo + 64 : hi;
+            for (li = blo; li < bhi; li++)
+                all_small &= sa_[li] != 0.0;
+            if (all_small)
+                softgym_seed_frames_impl(1, blo, bhi, sa_rad, thr, p0_, p1_, p2_, qw_, n1_, n2_,
+                                         n3_, nom_, len_, sa_, o_P0, o_P1, o_P2, o_a1y, o_a1z,
+                                         o_a2x, o_a2y, o_a2z, o_rw, o_ry, o_rz, o_fix);
+            else
+                softgym_seed_frames_impl(0, blo, bhi, sa_rad, thr, p0_, p1_, p2_, qw_, n1_, n2_,
+                                         n3_, nom_, len_, sa_, o_P0, o_P1, o_P2, o_a1y, o_a1z,
+                                         o_a2x, o_a2y, o_a2z, o_rw, o_ry, o_rz, o_fix);
+        }
+    }
+    """
+    void softgym_seed_frames(intp_t lo, intp_t hi, float64_t sa_rad, float64_t thr,
+                             const float64_t* p0_, const float64_t* p1_, const float64_t* p2_,
+                             const float64_t* qw_, const float64_t* n1_, const float64_t* n2_,
+                             const float64_t* n3_, const float64_t* nom_, const float64_t* len_,
+                             const float64_t* sa_, float64_t* o_P0, float64_t* o_P1,
+                             float64_t* o_P2, float64_t* o_a1y, float64_t* o_a1z,
+                             float64_t* o_a2x, float64_t* o_a2y, float64_t* o_a2z,
+                             float64_t* o_rw, float64_t* o_ry, float64_t* o_rz,
+                             float64_t* o_fix) noexcept nogil
+
+
+cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n) noexcept nogil:
+    # softgym_seed_frames for one link, with the seed's branches (its acos
+    # approximation and the backward-chord rule)
+    cdef:
+        float64_t sa_rad = SMALL_ANGLE_RAD
         float64_t th_discard = SEED_PI - DISCARD_ANGLE_RAD
+        float64_t p0 = o[li], p1 = o[n + li], p2 = o[2 * n + li], qw = o[3 * n + li]
+        float64_t n1 = o[4 * n + li], n2 = o[5 * n + li], n3 = o[6 * n + li]
+        float64_t nom = o[7 * n + li]
+        float64_t k, rw = 1.0, ry = 0.0, rz = 0.0, tw, tx, ty, tz
+        float64_t a1y = 0.0, a1z = 0.0, a2x, a2y, a2z, P0, P1, P2
+        float64_t len_, nx, ny, nz, rho, ch, sh, yx, zx
+    if o[9 * n + li] != 0.0:
+        # small angle: voxel 1's frame, offsets along its axes
+        k = _rotvec_k(qw)
+        a2x = n1 * k
+        a2y = n2 * k
+        a2z = n3 * k
+        P0 = p0 - nom
+        P1 = p1
+        P2 = p2
+    else:
+        # large angle: the frame turned by rq = (rw, 0, ry, rz) onto the
+        # chord (the seed's ToXDirBond of the relative position)
+        if not (p0 == 0.0 and p1 == 0.0 and p2 == 0.0):
+            yx = p1 / p0
+            zx = p2 / p0
+            if yx < sa_rad and yx > -sa_rad and zx < sa_rad and zx > -sa_rad:
+                ry = 0.5 * zx
+                rz = -0.5 * yx
+                rw = 1.0 + 0.5 * (-ry * ry - rz * rz)
+            else:
+                len_ = sqrt(p0 * p0 + p1 * p1 + p2 * p2)
+                nx = p0 / len_
+                ny = p1 / len_
+                nz = p2 / len_
+                # acos(nx) > pi - 1e-7 (acos(x) <= acos(-0.5) < 2.1 for x >= -0.5)
+                if nx < -0.5 and acos(nx) > th_discard:
+                    rw = 0.0
+                    ry = 1.0
+                else:
+                    rho = 1.0 / sqrt(nz * nz + ny * ny)
+                    ch = sqrt(0.5 * (1.0 + nx))  # cos(th / 2)
+                    sh = sqrt(0.5 * (1.0 - nx))  # sin(th / 2)
+                    rw = ch
+                    ry = nz * rho * sh
+                    rz = -ny * rho * sh
+            k = _rotvec_k(rw)  # the seed's, with its acos approximation
+            a1y = ry * k
+            a1z = rz * k
+        # tq = rq nq (rq's x part is zero)
+        tw = rw * qw - ry * n2 - rz * n3
+        tx = rw * n1 + ry * n3 - rz * n2
+        ty = rw * n2 + ry * qw + rz * n1
+        tz = rw * n3 - ry * n1 + rz * qw
+        k = _rotvec_k(tw)
+        a2x = tx * k
+        a2y = ty * k
+        a2z = tz * k
+        P0 = o[8 * n + li] - nom
+        P1 = 0.0
+        P2 = 0.0
+    o[10 * n + li] = P0
+    o[11 * n + li] = P1
+    o[12 * n + li] = P2
+    o[13 * n + li] = a1y
+    o[14 * n + li] = a1z
+    o[15 * n + li] = a2x
+    o[16 * n + li] = a2y
+    o[17 * n + li] = a2z
+    o[18 * n + li] = rw
+    o[19 * n + li] = ry
+    o[20 * n + li] = rz
+
+
+cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
+                                  float64_t inv_dt) noexcept nogil:
+    # _links_seed for its links [lo, hi), all along axis ax (a compile-time
+    # constant once inlined), in passes over the link scratch b.link_out
+    # (profiled: the square roots and divisions of the large-angle frames
+    # dominated the step; one branch-free vector loop does them for many links
+    # at once, the same IEEE operations as the seed's scalar code):
+    #   _seed_geom           rows 0-9: relative position p, orientation (qw, n),
+    #                        nominal length, chord length, transverse ratio
+    #   _seed_modes          the mode (link_sa; row 9 becomes 1.0 small / 0.0
+    #                        large angle), row 22 1.0 on a mode-change step,
+    #                        the strain check (stops at the first strained link)
+    #   softgym_seed_frames  rows 10-20: displacement P, rotation vectors a1
+    #                        (y, z) and a2, the large-angle frame rq; row 21
+    #                        marks links whose rotation needs the acos branch
+    #   _seed_frame_one      redoes those links with the seed's branches
+    #   the loop below       forces and moments (stiffness, then the seed's
+    #                        damping from the link's memory), back to the
+    #                        world and scattered in link order
+    # The bond frame is voxel 1's frame turned by the proper rotation P that
+    # takes the link axis onto +x (the seed's ToXDirBond): (x, y, z) ->
+    # (x, y, z), (y, -x, z), (z, y, -x) for ax 0, 1, 2.
+    cdef:
+        intp_t li, i, j, end
+        float64_t L = b.L
+        float64_t bz = 0.5 * b.bond_zeta
+        float64_t bzh = 0.5 * bz
         const float64_t* rot = b.rot
         const intp_t* v1 = b.v1
         const intp_t* v2 = b.v2
@@ -568,14 +821,12 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
         const float64_t* k_bend = b.k_bend
         const float64_t* c_seed = b.c_seed
         float64_t* link_last = b.link_last
-        float64_t qw, p0, p1, p2, n1, n2, n3
-        float64_t rw = 1.0, ry = 0.0, rz = 0.0, tw, tx, ty, tz, k
+        float64_t rw, ry, rz
         float64_t a1x, a1y, a1z, a2x, a2y, a2z, P0, P1, P2
         float64_t f1x, f1y, f1z, m1x, m1y, m1z, f2x, f2y, f2z, m2x, m2y, m2z
         float64_t vx, vy, vz, ra1x, ra1y, ra1z, ra2x, ra2y, ra2z
         float64_t r0, r1, r2, r4, r5, r8, n2q, gx, gy, gz
-        float64_t nom, st, ex, ka, kt, kb, b2, ca, cb2, ca2, cb3
-        float64_t len_, nx, ny, nz, rho, ch, sh, yx, zx
+        float64_t ka, kt, kb, b2, ca, cb2, ca2, cb3
         float64_t w[3]
         float64_t* last
         float64_t* fo
@@ -587,87 +838,33 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
         return STATUS_OK
     _seed_geom(lo, hi, ax, v1, v2, b.pos, rot, b.quat, b.scale, o, o + n, o + 2 * n,
                o + 3 * n, o + 4 * n, o + 5 * n, o + 6 * n, o + 7 * n, o + 8 * n, o + 9 * n)
-    for li in range(lo, hi):
+    end = _seed_modes(b, lo, hi, o, n)
+    softgym_seed_frames(lo, end, SMALL_ANGLE_RAD, SLTHRESH_ACOS2SQRT, o, o + n, o + 2 * n,
+                        o + 3 * n, o + 4 * n, o + 5 * n, o + 6 * n, o + 7 * n, o + 8 * n,
+                        o + 9 * n, o + 10 * n, o + 11 * n, o + 12 * n, o + 13 * n, o + 14 * n,
+                        o + 15 * n, o + 16 * n, o + 17 * n, o + 18 * n, o + 19 * n, o + 20 * n,
+                        o + 21 * n)
+    for li in range(lo, end):
+        if o[21 * n + li] != 0.0:
+            _seed_frame_one(li, o, n)
+    for li in range(lo, end):
         i = v1[li]
         j = v2[li]
         R1 = rot + 9 * i
-        p0 = o[li]
-        p1 = o[n + li]
-        p2 = o[2 * n + li]
-        qw = o[3 * n + li]
-        n1 = o[4 * n + li]
-        n2 = o[5 * n + li]
-        n3 = o[6 * n + li]
-        nom = o[7 * n + li]
-        st = o[9 * n + li]
-        ex = p0 / nom
         sa = link_sa[li]
-        changed = 0
-        if not sa and qw > sa_w and st < st_in and ex < ex_in:
-            sa = 1
-            changed = 1
-        elif sa and (not (qw > sah_w) or st > st_out or ex > ex_out):
-            sa = 0
-            changed = 1
-        link_sa[li] = sa
+        changed = o[22 * n + li] != 0.0
+        P0 = o[10 * n + li]
+        P1 = o[11 * n + li]
+        P2 = o[12 * n + li]
         a1x = 0.0
-        a1y = 0.0
-        a1z = 0.0
-        if sa:
-            # small angle: voxel 1's frame, offsets along its axes
-            k = _rotvec_k(qw)
-            a2x = n1 * k
-            a2y = n2 * k
-            a2z = n3 * k
-            P0 = p0 - nom
-            P1 = p1
-            P2 = p2
-        else:
-            # large angle: the frame turned by rq = (rw, 0, ry, rz) onto the
-            # chord (the seed's ToXDirBond of the relative position)
-            rw = 1.0
-            ry = 0.0
-            rz = 0.0
-            if not (p0 == 0.0 and p1 == 0.0 and p2 == 0.0):
-                yx = p1 / p0
-                zx = p2 / p0
-                if yx < sa_rad and yx > -sa_rad and zx < sa_rad and zx > -sa_rad:
-                    ry = 0.5 * zx
-                    rz = -0.5 * yx
-                    rw = 1.0 + 0.5 * (-ry * ry - rz * rz)
-                else:
-                    len_ = sqrt(p0 * p0 + p1 * p1 + p2 * p2)
-                    nx = p0 / len_
-                    ny = p1 / len_
-                    nz = p2 / len_
-                    # acos(nx) > pi - 1e-7 (acos(x) <= acos(-0.5) < 2.1 for x >= -0.5)
-                    if nx < -0.5 and acos(nx) > th_discard:
-                        rw = 0.0
-                        ry = 1.0
-                    else:
-                        rho = 1.0 / sqrt(nz * nz + ny * ny)
-                        ch = sqrt(0.5 * (1.0 + nx))  # cos(th / 2)
-                        sh = sqrt(0.5 * (1.0 - nx))  # sin(th / 2)
-                        rw = ch
-                        ry = nz * rho * sh
-                        rz = -ny * rho * sh
-                k = _rotvec_k(rw)  # the seed's, with its acos approximation
-                a1y = ry * k
-                a1z = rz * k
-            # tq = rq nq (rq's x part is zero)
-            tw = rw * qw - ry * n2 - rz * n3
-            tx = rw * n1 + ry * n3 - rz * n2
-            ty = rw * n2 + ry * qw + rz * n1
-            tz = rw * n3 - ry * n1 + rz * qw
-            k = _rotvec_k(tw)
-            a2x = tx * k
-            a2y = ty * k
-            a2z = tz * k
-            P0 = o[8 * n + li] - nom
-            P1 = 0.0
-            P2 = 0.0
-        if not (fabs(P0) <= max_ext):
-            return STATUS_STRAIN  # also catches NaN
+        a1y = o[13 * n + li]
+        a1z = o[14 * n + li]
+        a2x = o[15 * n + li]
+        a2y = o[16 * n + li]
+        a2z = o[17 * n + li]
+        rw = o[18 * n + li]
+        ry = o[19 * n + li]
+        rz = o[20 * n + li]
         ka = k_axial[li]
         kt = k_torsion[li]
         kb = k_bend[li]
@@ -790,7 +987,7 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
         mo[0] -= w[0]
         mo[1] -= w[1]
         mo[2] -= w[2]
-    return STATUS_OK
+    return STATUS_OK if end == hi else STATUS_STRAIN
 
 
 cdef int _links_seed(Batch* b, intp_t r) noexcept nogil:
@@ -1838,6 +2035,8 @@ STATUS_NAMES = {
 
 #: The arrays that cross into the kernel (bound by _bind; shapes, dtypes and
 #: units in _core.pxd's Batch): the Python side must provide every one.
+LINK_SCRATCH_ROWS = N_LINK_OUT  # rows of arrays["link_out"] (n_links columns)
+
 KERNEL_ARRAYS = (
     "vox_start", "link_start", "link_axis_count", "dt", "steps", "temp_amp", "period",
     "use_temp", "floor", "box_start", "boxes", "diverged", "diverged_time", "diverged_code",
@@ -1936,6 +2135,8 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     # links: a robot without links leaves these arrays empty (never dereferenced)
     b.n_links = a["v1"].shape[0]
     if a["v1"].shape[0] > 0:
+        if a["link_out"].shape[0] < N_LINK_OUT:
+            raise ValueError(f"link_out needs {N_LINK_OUT} rows (LINK_SCRATCH_ROWS)")
         b.link_out = _f(a, "link_out")
         b.v1 = <intp_t*> _p(a, "v1")
         b.v2 = <intp_t*> _p(a, "v2")
@@ -2053,3 +2254,44 @@ def refresh_rotations(float64_t[:, ::1] quat, float64_t[:, ::1] rot):
     with nogil:
         for i in range(quat.shape[0]):
             _rotation_matrix(&quat[i, 0], &rot[i, 0])
+
+
+def seed_frames(float64_t[:, ::1] geom, bint scalar=False):
+    """The seed model's bond-frame pass on given link geometry (for tests).
+
+    ``geom`` is (10, n): rows 0-9 of the link scratch as ``_seed_geom`` and
+    ``_seed_modes`` leave them (relative position p0, p1, p2; relative
+    orientation qw, n1, n2, n3; nominal length; chord length; the mode, 1.0
+    small / 0.0 large angle). Returns (11, n): the displacement P, voxel 1's
+    rotation vector (y, z), voxel 2's, the large-angle frame (rw, ry, rz),
+    from the vectorised kernel with its scalar fix-ups, or (``scalar``) from
+    the seed's branchy scalar code for every link. The two must be equal bit
+    for bit.
+    """
+    cdef:
+        intp_t n = geom.shape[1], li, k
+        cnp.ndarray[float64_t, ndim=2] o = np.zeros((N_LINK_OUT, max(n, 1)))
+        float64_t* op = <float64_t*> cnp.PyArray_DATA(o)
+        intp_t stride = o.shape[1]
+    if geom.shape[0] != 10:
+        raise ValueError("geom must have 10 rows")
+    for k in range(10):
+        for li in range(n):
+            op[k * stride + li] = geom[k, li]
+    with nogil:
+        if scalar:
+            for li in range(n):
+                _seed_frame_one(li, op, stride)
+        else:
+            softgym_seed_frames(0, n, SMALL_ANGLE_RAD, SLTHRESH_ACOS2SQRT, op, op + stride,
+                                op + 2 * stride, op + 3 * stride, op + 4 * stride,
+                                op + 5 * stride, op + 6 * stride, op + 7 * stride,
+                                op + 8 * stride, op + 9 * stride, op + 10 * stride,
+                                op + 11 * stride, op + 12 * stride, op + 13 * stride,
+                                op + 14 * stride, op + 15 * stride, op + 16 * stride,
+                                op + 17 * stride, op + 18 * stride, op + 19 * stride,
+                                op + 20 * stride, op + 21 * stride)
+            for li in range(n):
+                if op[21 * stride + li] != 0.0:
+                    _seed_frame_one(li, op, stride)
+    return o[10:21, :n].copy()
