@@ -594,6 +594,19 @@ cdef extern from *:
     #else
     #define SOFTGYM_IVDEP
     #endif
+    #include <string.h>
+    /* c ? a : b on the bits: compilers keep it a blend (a select before a
+       store may otherwise become a masked store, slow on some cores) */
+    static inline double softgym_pick(long long c, double a, double b)
+    {
+        unsigned long long ua, ub, m = (unsigned long long)0 - (unsigned long long)(c != 0);
+        double r;
+        memcpy(&ua, &a, sizeof ua);
+        memcpy(&ub, &b, sizeof ub);
+        ua = (ua & m) | (ub & ~m);
+        memcpy(&r, &ua, sizeof r);
+        return r;
+    }
     #if defined(_MSC_VER)
     #define SOFTGYM_ALWAYS_INLINE static __forceinline
     #else
@@ -652,18 +665,18 @@ cdef extern from *:
             double P0_s = p0 - nom, P0_l = cl - nom;
             double a2x_s = n1 * k, a2y_s = n2 * k, a2z_s = n3 * k;
             double a2x_l = tx * k2, a2y_l = ty * k2, a2z_l = tz * k2;
-            o_P0[li] = is_sa ? P0_s : P0_l;
-            o_P1[li] = is_sa ? p1 : 0.0;
-            o_P2[li] = is_sa ? p2 : 0.0;
-            o_a1y[li] = (is_sa | zero) ? 0.0 : a1y;
-            o_a1z[li] = (is_sa | zero) ? 0.0 : a1z;
-            o_a2x[li] = is_sa ? a2x_s : a2x_l;
-            o_a2y[li] = is_sa ? a2y_s : a2y_l;
-            o_a2z[li] = is_sa ? a2z_s : a2z_l;
-            o_rw[li] = is_sa ? 1.0 : rw;  /* unused in small-angle mode */
-            o_ry[li] = is_sa ? 0.0 : ry;
-            o_rz[li] = is_sa ? 0.0 : rz;
-            o_fix[li] = fix ? 1.0 : 0.0;
+            o_P0[li] = softgym_pick(is_sa, P0_s, P0_l);
+            o_P1[li] = softgym_pick(is_sa, p1, 0.0);
+            o_P2[li] = softgym_pick(is_sa, p2, 0.0);
+            o_a1y[li] = softgym_pick(is_sa | zero, 0.0, a1y);
+            o_a1z[li] = softgym_pick(is_sa | zero, 0.0, a1z);
+            o_a2x[li] = softgym_pick(is_sa, a2x_s, a2x_l);
+            o_a2y[li] = softgym_pick(is_sa, a2y_s, a2y_l);
+            o_a2z[li] = softgym_pick(is_sa, a2z_s, a2z_l);
+            o_rw[li] = softgym_pick(is_sa, 1.0, rw);  /* unused in small-angle mode */
+            o_ry[li] = softgym_pick(is_sa, 0.0, ry);
+            o_rz[li] = softgym_pick(is_sa, 0.0, rz);
+            o_fix[li] = softgym_pick(fix, 1.0, 0.0);
         }
     }
     static void softgym_seed_frames(
@@ -1272,23 +1285,82 @@ cdef inline void _seed_floor(Batch* b, intp_t i, float64_t dt, float64_t* f) noe
         f[1] = 0.0
 
 
+cdef extern from *:
+    # The orientation step of _integrate_seed for voxels lo..hi, in C for the
+    # vectorising pragma: q + (w dt / 2) x q (w the new angular velocity),
+    # renormalised exactly (the seed's square root and division), snapped to
+    # the identity at w >= 1, into the scratch rows q_out (4, n_voxels). The
+    # same IEEE operations as the scalar seed code; the square root and the
+    # division of one voxel no longer wait on the previous voxel's.
+    """
+    static void softgym_seed_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,
+                                   const double *av, const double *quat, double *q_out)
+    {
+        Py_ssize_t i;
+        SOFTGYM_IVDEP
+        for (i = lo; i < hi; i++) {
+            double wx = av[3 * i] * 0.5 * dt;
+            double wy = av[3 * i + 1] * 0.5 * dt;
+            double wz = av[3 * i + 2] * 0.5 * dt;
+            double q0 = quat[4 * i], q1 = quat[4 * i + 1], q2 = quat[4 * i + 2], q3 = quat[4 * i + 3];
+            double qw = q0 - wx * q1 - wy * q2 - wz * q3;
+            double qx = q1 + wx * q0 + wy * q3 - wz * q2;
+            double qy = q2 + wy * q0 + wz * q1 - wx * q3;
+            double qz = q3 + wz * q0 + wx * q2 - wy * q1;
+            double nq = sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
+            double inv = 1.0 / nq;
+            double nw = nq != 0.0 ? qw * inv : qw;
+            double nx = nq != 0.0 ? qx * inv : qx;
+            double ny = nq != 0.0 ? qy * inv : qy;
+            double nz = nq != 0.0 ? qz * inv : qz;
+            long long one = nw >= 1.0;
+            q_out[i] = one ? 1.0 : nw;
+            q_out[n + i] = one ? 0.0 : nx;
+            q_out[2 * n + i] = one ? 0.0 : ny;
+            q_out[3 * n + i] = one ? 0.0 : nz;
+        }
+    }
+    """
+    void softgym_seed_quats(intp_t lo, intp_t hi, intp_t n, float64_t dt, const float64_t* av,
+                            const float64_t* quat, float64_t* q_out) noexcept nogil
+
+
+cdef inline void _seed_orient(Batch* b, intp_t lo, intp_t hi, float64_t dt) noexcept nogil:
+    # the orientation step of _integrate_seed for voxels lo..hi (fixed voxels
+    # keep theirs): new quaternions, then their rotation matrices
+    cdef:
+        intp_t i
+        intp_t n = b.vox_start[b.n_robots]  # voxels in the batch: the row stride
+        float64_t* qo = b.vox_out
+        float64_t* qq
+    softgym_seed_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
+    for i in range(lo, hi):
+        if b.fixed[i]:
+            continue
+        qq = b.quat + 4 * i
+        qq[0] = qo[i]
+        qq[1] = qo[n + i]
+        qq[2] = qo[2 * n + i]
+        qq[3] = qo[3 * n + i]
+        _rotation_matrix(qq, b.rot + 9 * i)
+
+
 cdef inline int _integrate_seed(Batch* b, intp_t r, const float64_t* ref,
                                 float64_t* dmax2) noexcept nogil:
     # Model 0's voxel update (the seed's EulerStep): as _integrate, with the
     # seed's floor and exact quaternion renormalisation snapped to the identity
-    # at w >= 1. Terrain boxes use the common surface contact.
+    # at w >= 1 (_seed_orient, after the loop: no voxel's update reads
+    # another's orientation). Terrain boxes use the common surface contact.
     cdef:
         intp_t i, k
         float64_t dt = b.dt[r]
         float64_t h, pen, cg, rd, d2, mx, my, mz
         float64_t c0 = 0.0, c1 = 0.0, c2 = 0.0
-        float64_t wx, wy, wz, qw, qx, qy, qz, nq
         float64_t f[3]
         float64_t n[3]
         float64_t* pos = b.pos
         float64_t* vel = b.vel
         float64_t* av = b.angvel
-        float64_t* qq
         int32 has_floor = b.floor[r]
         int32 has_fluid = b.fluid_drag > 0.0
         intp_t k0 = b.box_start[r]
@@ -1326,6 +1398,7 @@ cdef inline int _integrate_seed(Batch* b, intp_t r, const float64_t* ref,
         pos[3 * i + 1] += vel[3 * i + 1] * dt
         pos[3 * i + 2] += vel[3 * i + 2] * dt
         if not (fabs(pos[3 * i]) + fabs(pos[3 * i + 1]) + fabs(pos[3 * i + 2]) < RUNAWAY):
+            _seed_orient(b, vs, i, dt)  # the voxels before it were stepped
             _clear_robot(b, r)
             return STATUS_NONFINITE
         if ref != NULL:
@@ -1343,31 +1416,7 @@ cdef inline int _integrate_seed(Batch* b, intp_t r, const float64_t* ref,
         av[3 * i] = (av[3 * i] + mx * h) * rd
         av[3 * i + 1] = (av[3 * i + 1] + my * h) * rd
         av[3 * i + 2] = (av[3 * i + 2] + mz * h) * rd
-        wx = av[3 * i] * 0.5 * dt
-        wy = av[3 * i + 1] * 0.5 * dt
-        wz = av[3 * i + 2] * 0.5 * dt
-        qq = b.quat + 4 * i
-        qw = qq[0] - wx * qq[1] - wy * qq[2] - wz * qq[3]
-        qx = qq[1] + wx * qq[0] + wy * qq[3] - wz * qq[2]
-        qy = qq[2] + wy * qq[0] + wz * qq[1] - wx * qq[3]
-        qz = qq[3] + wz * qq[0] + wx * qq[2] - wy * qq[1]
-        nq = sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
-        if nq != 0.0:
-            nq = 1.0 / nq
-            qw = qw * nq
-            qx = qx * nq
-            qy = qy * nq
-            qz = qz * nq
-        if qw >= 1.0:
-            qw = 1.0
-            qx = 0.0
-            qy = 0.0
-            qz = 0.0
-        qq[0] = qw
-        qq[1] = qx
-        qq[2] = qy
-        qq[3] = qz
-        _rotation_matrix(qq, b.rot + 9 * i)
+    _seed_orient(b, vs, b.vox_start[r + 1], dt)
     return STATUS_OK
 
 
@@ -2041,7 +2090,7 @@ KERNEL_ARRAYS = (
     "vox_start", "link_start", "link_axis_count", "dt", "steps", "temp_amp", "period",
     "use_temp", "floor", "box_start", "boxes", "diverged", "diverged_time", "diverged_code",
     "init_done", "cm_init", "mass_total", "trace_n", "trace_t", "trace_cm",
-    "pos", "vel", "quat", "angvel", "rot", "force", "moment", "ext_force", "mass", "inv_mass",
+    "pos", "vel", "quat", "angvel", "rot", "force", "moment", "vox_out", "ext_force", "mass", "inv_mass",
     "inv_inertia", "scale", "cte", "cos_phase", "sin_phase", "temp", "k_floor", "c_floor",
     "c_global", "rot_damp", "mu_s", "mu_k", "fixed", "surface", "excl_start", "excl_idx",
     "seed_rank", "col_ref", "col_acc", "col_vmax", "obs_start", "obs", "obs_rank",
@@ -2104,6 +2153,7 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.angvel = _f(a, "angvel")
     b.rot = _f(a, "rot")
     b.force = _f(a, "force")
+    b.vox_out = _f(a, "vox_out")
     b.moment = _f(a, "moment")
     b.ext_force = _f(a, "ext_force")
     b.mass = _f(a, "mass")
