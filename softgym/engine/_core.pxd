@@ -102,7 +102,7 @@ cdef struct Batch:
     float64_t* c_torsion     # (n_links,) torsional damping (N m s/rad)
     float64_t* c_bend        # (n_links,) bending damping (N m s/rad)
     # model 0 (seed) only:
-    float64_t* c_seed        # (n_links, 8) 2 sqrt(k m) damping constants of voxel 1 then voxel 2:
+    float64_t* c_seed        # (8, n_links) 2 sqrt(k m) damping constants of voxel 1 then voxel 2:
                              #   a1 M, b2 FM, a2 I, b3 I (FM = M L / 2, I = M L^2 / 6)
     flag_t* homog            # (n_links,) 1: both voxels of one material (voxel 2 gets -F1)
     flag_t* link_sa          # (n_links,) 1: small-angle mode (state)
@@ -113,7 +113,8 @@ cdef struct Batch:
     intp_t* obs_start        # (n_robots + 1,) model 0: robot r's obstacle voxels [obs_start[r], obs_start[r+1])
     float64_t* obs           # (n_obs, 4) fixed obstacle voxel centre (m) and its 2 E L (N/m)
     intp_t* obs_rank         # (n_obs,) its index in the seed engine's voxel order
-    float64_t* link_last     # (n_links, 9) last Pos2, Angle1, Angle2 in the bond frame (state)
+    float64_t* link_last     # (9, n_links) last Pos2, Angle1, Angle2 in the bond frame (state;
+                             #   Simulation.get_state/set_state show it as (n_links, 9))
 
 
 # Self-collision candidates of one robot, rebuilt inside advance_robot (scratch

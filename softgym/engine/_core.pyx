@@ -137,7 +137,7 @@ cdef extern from *:
 
 
 cdef enum:
-    N_LINK_OUT = 23  # rows of the per-link scratch (see _link_kernel, _seed_links_along)
+    N_LINK_OUT = 25  # rows of the per-link scratch (see _link_kernel, _seed_links_along)
 
 
 cdef void _link_kernel(intp_t lo, intp_t hi, intp_t ax, intp_t p, intp_t q,
@@ -537,8 +537,9 @@ cdef intp_t _seed_modes(Batch* b, intp_t lo, intp_t hi, float64_t* o, intp_t n) 
     # First pass of _seed_links_along over its links [lo, hi): each link's
     # mode, small or large angle, with the seed's hysteresis (updates
     # link_sa), then the strain check. Row 9 (the transverse ratio) becomes
-    # the mode as 1.0 / 0.0 and row 22 1.0 on a mode-change step. Returns hi,
-    # or the first link whose extension is beyond max_strain.
+    # the mode as 1.0 / 0.0, row 22 1.0 on a mode-change step, row 23 1.0
+    # when voxel 2 takes -F1 (then or for a single material). Returns hi, or
+    # the first link whose extension is beyond max_strain.
     cdef:
         intp_t li
         float64_t max_ext = b.max_strain * b.L
@@ -549,6 +550,7 @@ cdef intp_t _seed_modes(Batch* b, intp_t lo, intp_t hi, float64_t* o, intp_t n) 
         float64_t st_out = HYSTERESIS * SA_BOND_BEND_RAD
         float64_t ex_out = HYSTERESIS * SA_BOND_EXT_PERC
         flag_t* link_sa = b.link_sa
+        const flag_t* homog = b.homog
         float64_t qw, p0, nom, st, ex, P0
         int32 sa, changed
     for li in range(lo, hi):
@@ -568,6 +570,7 @@ cdef intp_t _seed_modes(Batch* b, intp_t lo, intp_t hi, float64_t* o, intp_t n) 
         link_sa[li] = sa
         o[9 * n + li] = 1.0 if sa else 0.0
         o[22 * n + li] = 1.0 if changed else 0.0
+        o[23 * n + li] = 1.0 if changed or homog[li] else 0.0
         P0 = p0 - nom if sa else o[8 * n + li] - nom
         if not (fabs(P0) <= max_ext):
             return li  # also catches NaN
@@ -718,6 +721,154 @@ cdef extern from *:
                              float64_t* o_fix) noexcept nogil
 
 
+cdef extern from *:
+    # The forces pass of _seed_links_along, in C for the vectorising pragma:
+    # each link's forces and moments in the bond frame from its bond-frame
+    # quantities (stiffness; the seed's damping from the link's memory of the
+    # last step, skipped on a mode-change step), turned back by rq^-1 for a
+    # large-angle link, without branches. Outputs what the scatter turns to
+    # the world and adds: voxel 1's force, voxel 2's force (the first negated
+    # for a single material or on a mode-change step), voxel 1's and voxel 2's
+    # moments negated (the seed subtracts them; x - y is x + (-y) exactly, and
+    # a rotation of -v is exactly minus the rotation of v). Updates the memory
+    # unless the mode changed. The same operations as the seed's scalar code.
+    """
+    static void softgym_seed_forces(
+        Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double L, double bz, double bzh,
+        double inv_dt, const double *const *in, const double *k_axial,
+        const double *k_torsion, const double *k_bend, const double *c_seed,
+        double *link_last, double *const *out)
+    {
+        const double *P0_ = in[0], *P1_ = in[1], *P2_ = in[2], *a1y_ = in[3], *a1z_ = in[4];
+        const double *a2x_ = in[5], *a2y_ = in[6], *a2z_ = in[7], *rw_ = in[8], *ry_ = in[9];
+        const double *rz_ = in[10], *sa_ = in[11], *chg_ = in[12], *neg2_ = in[13];
+        double *o0 = out[0], *o1 = out[1], *o2 = out[2], *o3 = out[3], *o4 = out[4];
+        double *o5 = out[5], *o6 = out[6], *o7 = out[7], *o8 = out[8], *o9 = out[9];
+        double *o10 = out[10], *o11 = out[11];
+        Py_ssize_t li;
+        SOFTGYM_IVDEP
+        for (li = lo; li < hi; li++) {
+            long long sa = sa_[li] != 0.0, changed = chg_[li] != 0.0, neg2 = neg2_[li] != 0.0;
+            double P0 = P0_[li], P1 = P1_[li], P2 = P2_[li];
+            double a1x = 0.0, a1y = a1y_[li], a1z = a1z_[li];
+            double a2x = a2x_[li], a2y = a2y_[li], a2z = a2z_[li];
+            double rw = rw_[li], ry = ry_[li], rz = rz_[li];
+            double ka = k_axial[li], kt = k_torsion[li], kb = k_bend[li];
+            double b2 = 0.5 * ka * L;
+            double f1x = ka * P0;
+            double f1y = ka * P1 - b2 * (a1z + a2z);
+            double f1z = ka * P2 + b2 * (a1y + a2y);
+            double m1x = kt * (a1x - a2x);
+            double m1y = b2 * P2 + kb * (2.0 * a1y + a2y);
+            double m1z = -b2 * P1 + kb * (2.0 * a1z + a2z);
+            double m2x = -m1x;
+            double f2x = -f1x, f2y = -f1y, f2z = -f1z;
+            double m2y = b2 * P2 + kb * (a1y + 2.0 * a2y);
+            double m2z = -b2 * P1 + kb * (a1z + 2.0 * a2z);
+            /* damping: rates from the memory of the last step */
+            double l0 = link_last[li], l1 = link_last[n + li], l2 = link_last[2 * n + li];
+            double l3 = link_last[3 * n + li], l4 = link_last[4 * n + li];
+            double l5 = link_last[5 * n + li], l6 = link_last[6 * n + li];
+            double l7 = link_last[7 * n + li], l8 = link_last[8 * n + li];
+            double vx = (P0 - l0) * inv_dt, vy = (P1 - l1) * inv_dt, vz = (P2 - l2) * inv_dt;
+            double ra1x = (a1x - l3) * inv_dt, ra1y = (a1y - l4) * inv_dt;
+            double ra1z = (a1z - l5) * inv_dt, ra2x = (a2x - l6) * inv_dt;
+            double ra2y = (a2y - l7) * inv_dt, ra2z = (a2z - l8) * inv_dt;
+            double ca = c_seed[li], cb2 = c_seed[n + li];
+            double ca2 = c_seed[2 * n + li], cb3 = c_seed[3 * n + li];
+            double d1x = f1x + bz * (ca * vx);
+            double d1y = f1y + bz * (ca * vy - cb2 * (ra1z + ra2z));
+            double d1z = f1z + bz * (ca * vz + cb2 * (ra1y + ra2y));
+            double e1x = m1x + bzh * (-ca2 * (ra2x - ra1x));
+            double e1y = m1y + bzh * (cb2 * vz + cb3 * (2.0 * ra1y + ra2y));
+            double e1z = m1z + bzh * (-cb2 * vy + cb3 * (2.0 * ra1z + ra2z));
+            ca = c_seed[4 * n + li];
+            cb2 = c_seed[5 * n + li];
+            ca2 = c_seed[6 * n + li];
+            cb3 = c_seed[7 * n + li];
+            double d2x = f2x + bz * (-ca * vx);
+            double d2y = f2y + bz * (-ca * vy + cb2 * (ra1z + ra2z));
+            double d2z = f2z + bz * (-ca * vz - cb2 * (ra1y + ra2y));
+            double e2x = m2x + bzh * (ca2 * (ra2x - ra1x));
+            double e2y = m2y + bzh * (cb2 * vz + cb3 * (ra1y + 2.0 * ra2y));
+            double e2z = m2z + bzh * (-cb2 * vy + cb3 * (ra1z + 2.0 * ra2z));
+            link_last[li] = softgym_pick(changed, l0, P0);
+            link_last[n + li] = softgym_pick(changed, l1, P1);
+            link_last[2 * n + li] = softgym_pick(changed, l2, P2);
+            link_last[3 * n + li] = softgym_pick(changed, l3, a1x);
+            link_last[4 * n + li] = softgym_pick(changed, l4, a1y);
+            link_last[5 * n + li] = softgym_pick(changed, l5, a1z);
+            link_last[6 * n + li] = softgym_pick(changed, l6, a2x);
+            link_last[7 * n + li] = softgym_pick(changed, l7, a2y);
+            link_last[8 * n + li] = softgym_pick(changed, l8, a2z);
+            f1x = softgym_pick(changed, f1x, d1x);
+            f1y = softgym_pick(changed, f1y, d1y);
+            f1z = softgym_pick(changed, f1z, d1z);
+            m1x = softgym_pick(changed, m1x, e1x);
+            m1y = softgym_pick(changed, m1y, e1y);
+            m1z = softgym_pick(changed, m1z, e1z);
+            f2x = softgym_pick(neg2, f2x, d2x);
+            f2y = softgym_pick(neg2, f2y, d2y);
+            f2z = softgym_pick(neg2, f2z, d2z);
+            m2x = softgym_pick(changed, m2x, e2x);
+            m2y = softgym_pick(changed, m2y, e2y);
+            m2z = softgym_pick(changed, m2z, e2z);
+            /* large angle: G = RQ^T v rotates by rq^-1 (RQ the matrix of rq,
+               normalised by |rq|^2: the small-ratio rq is not exactly unit) */
+            double n2q = rw * rw + ry * ry + rz * rz;
+            double r0 = n2q - 2.0 * (ry * ry + rz * rz);
+            double r1 = 2.0 * (rw * rz);
+            double r2 = 2.0 * (rw * ry);
+            double r4 = n2q - 2.0 * (rz * rz);
+            double r5 = 2.0 * (ry * rz);
+            double r8 = n2q - 2.0 * (ry * ry);
+            double gx, gy, gz;
+            gx = r0 * f1x + r1 * f1y - r2 * f1z;
+            gy = -r1 * f1x + r4 * f1y + r5 * f1z;
+            gz = r2 * f1x + r5 * f1y + r8 * f1z;
+            f1x = softgym_pick(sa, f1x, gx);
+            f1y = softgym_pick(sa, f1y, gy);
+            f1z = softgym_pick(sa, f1z, gz);
+            gx = r0 * m1x + r1 * m1y - r2 * m1z;
+            gy = -r1 * m1x + r4 * m1y + r5 * m1z;
+            gz = r2 * m1x + r5 * m1y + r8 * m1z;
+            m1x = softgym_pick(sa, m1x, gx);
+            m1y = softgym_pick(sa, m1y, gy);
+            m1z = softgym_pick(sa, m1z, gz);
+            gx = r0 * m2x + r1 * m2y - r2 * m2z;
+            gy = -r1 * m2x + r4 * m2y + r5 * m2z;
+            gz = r2 * m2x + r5 * m2y + r8 * m2z;
+            m2x = softgym_pick(sa, m2x, gx);
+            m2y = softgym_pick(sa, m2y, gy);
+            m2z = softgym_pick(sa, m2z, gz);
+            gx = r0 * f2x + r1 * f2y - r2 * f2z;
+            gy = -r1 * f2x + r4 * f2y + r5 * f2z;
+            gz = r2 * f2x + r5 * f2y + r8 * f2z;
+            f2x = softgym_pick(sa, f2x, gx);
+            f2y = softgym_pick(sa, f2y, gy);
+            f2z = softgym_pick(sa, f2z, gz);
+            o0[li] = f1x;
+            o1[li] = f1y;
+            o2[li] = f1z;
+            o3[li] = softgym_pick(neg2, -f1x, f2x);
+            o4[li] = softgym_pick(neg2, -f1y, f2y);
+            o5[li] = softgym_pick(neg2, -f1z, f2z);
+            o6[li] = -m1x;
+            o7[li] = -m1y;
+            o8[li] = -m1z;
+            o9[li] = -m2x;
+            o10[li] = -m2y;
+            o11[li] = -m2z;
+        }
+    }
+    """
+    void softgym_seed_forces(intp_t lo, intp_t hi, intp_t n, float64_t L, float64_t bz,
+                             float64_t bzh, float64_t inv_dt, const float64_t* const* inp,
+                             const float64_t* k_axial, const float64_t* k_torsion,
+                             const float64_t* k_bend, const float64_t* c_seed,
+                             float64_t* link_last, float64_t* const* out) noexcept nogil
+
+
 cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n) noexcept nogil:
     # softgym_seed_frames for one link, with the seed's branches (its acos
     # approximation and the backward-chord rule)
@@ -804,20 +955,21 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
     #                        nominal length, chord length, transverse ratio
     #   _seed_modes          the mode (link_sa; row 9 becomes 1.0 small / 0.0
     #                        large angle), row 22 1.0 on a mode-change step,
-    #                        the strain check (stops at the first strained link)
+    #                        row 23 1.0 where voxel 2 takes -F1, the strain
+    #                        check (stops at the first strained link)
     #   softgym_seed_frames  rows 10-20: displacement P, rotation vectors a1
     #                        (y, z) and a2, the large-angle frame rq; row 21
     #                        marks links whose rotation needs the acos branch
     #   _seed_frame_one      redoes those links with the seed's branches
-    #   the loop below       forces and moments (stiffness, then the seed's
-    #                        damping from the link's memory), back to the
-    #                        world and scattered in link order
+    #   softgym_seed_forces  rows 0-9, 21, 24: forces and moments in the bond
+    #                        frame (stiffness, the seed's damping from the
+    #                        link's memory; rq^-1 for large angles)
+    #   the loop below       back to the world, scattered in link order
     # The bond frame is voxel 1's frame turned by the proper rotation P that
     # takes the link axis onto +x (the seed's ToXDirBond): (x, y, z) ->
     # (x, y, z), (y, -x, z), (z, y, -x) for ax 0, 1, 2.
     cdef:
-        intp_t li, i, j, end
-        float64_t L = b.L
+        intp_t li, i, j, k, end
         float64_t bz = 0.5 * b.bond_zeta
         float64_t bzh = 0.5 * bz
         const float64_t* rot = b.rot
@@ -827,26 +979,10 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
         float64_t* o = b.link_out
         float64_t* force = b.force
         float64_t* moment = b.moment
-        flag_t* link_sa = b.link_sa
-        const flag_t* homog = b.homog
-        const float64_t* k_axial = b.k_axial
-        const float64_t* k_torsion = b.k_torsion
-        const float64_t* k_bend = b.k_bend
-        const float64_t* c_seed = b.c_seed
-        float64_t* link_last = b.link_last
-        float64_t rw, ry, rz
-        float64_t a1x, a1y, a1z, a2x, a2y, a2z, P0, P1, P2
-        float64_t f1x, f1y, f1z, m1x, m1y, m1z, f2x, f2y, f2z, m2x, m2y, m2z
-        float64_t vx, vy, vz, ra1x, ra1y, ra1z, ra2x, ra2y, ra2z
-        float64_t r0, r1, r2, r4, r5, r8, n2q, gx, gy, gz
-        float64_t ka, kt, kb, b2, ca, cb2, ca2, cb3
+        const float64_t* inp[14]
+        float64_t* out[12]
         float64_t w[3]
-        float64_t* last
-        float64_t* fo
-        float64_t* mo
-        const float64_t* cs
         const float64_t* R1
-        int32 sa, changed, neg2
     if hi <= lo:
         return STATUS_OK
     _seed_geom(lo, hi, ax, v1, v2, b.pos, rot, b.quat, b.scale, o, o + n, o + 2 * n,
@@ -860,146 +996,39 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
     for li in range(lo, end):
         if o[21 * n + li] != 0.0:
             _seed_frame_one(li, o, n)
+    for k in range(11):
+        inp[k] = o + (10 + k) * n
+    inp[11] = o + 9 * n
+    inp[12] = o + 22 * n
+    inp[13] = o + 23 * n
+    for k in range(10):
+        out[k] = o + k * n
+    out[10] = o + 21 * n
+    out[11] = o + 24 * n
+    softgym_seed_forces(lo, end, n, b.L, bz, bzh, inv_dt, inp, b.k_axial, b.k_torsion,
+                        b.k_bend, b.c_seed, b.link_last, out)
     for li in range(lo, end):
+        # back to the world (the inverse axis turn, voxel 1's rotation) and
+        # the scatter, in link order (the seed's summation order)
         i = v1[li]
         j = v2[li]
         R1 = rot + 9 * i
-        sa = link_sa[li]
-        changed = o[22 * n + li] != 0.0
-        P0 = o[10 * n + li]
-        P1 = o[11 * n + li]
-        P2 = o[12 * n + li]
-        a1x = 0.0
-        a1y = o[13 * n + li]
-        a1z = o[14 * n + li]
-        a2x = o[15 * n + li]
-        a2y = o[16 * n + li]
-        a2z = o[17 * n + li]
-        rw = o[18 * n + li]
-        ry = o[19 * n + li]
-        rz = o[20 * n + li]
-        ka = k_axial[li]
-        kt = k_torsion[li]
-        kb = k_bend[li]
-        b2 = 0.5 * ka * L
-        f1x = ka * P0
-        f1y = ka * P1 - b2 * (a1z + a2z)
-        f1z = ka * P2 + b2 * (a1y + a2y)
-        m1x = kt * (a1x - a2x)
-        m1y = b2 * P2 + kb * (2.0 * a1y + a2y)
-        m1z = -b2 * P1 + kb * (2.0 * a1z + a2z)
-        m2x = -m1x
-        f2x = -f1x
-        f2y = -f1y
-        f2z = -f1z
-        m2y = b2 * P2 + kb * (a1y + 2.0 * a2y)
-        m2z = -b2 * P1 + kb * (a1z + 2.0 * a2z)
-        # voxel 2 gets -F1 on a mode-change step and for a single material
-        neg2 = changed or homog[li]
-        if not changed:
-            last = link_last + 9 * li
-            cs = c_seed + 8 * li
-            vx = (P0 - last[0]) * inv_dt
-            vy = (P1 - last[1]) * inv_dt
-            vz = (P2 - last[2]) * inv_dt
-            ra1x = (a1x - last[3]) * inv_dt
-            ra1y = (a1y - last[4]) * inv_dt
-            ra1z = (a1z - last[5]) * inv_dt
-            ra2x = (a2x - last[6]) * inv_dt
-            ra2y = (a2y - last[7]) * inv_dt
-            ra2z = (a2z - last[8]) * inv_dt
-            last[0] = P0
-            last[1] = P1
-            last[2] = P2
-            last[3] = a1x
-            last[4] = a1y
-            last[5] = a1z
-            last[6] = a2x
-            last[7] = a2y
-            last[8] = a2z
-            ca = cs[0]
-            cb2 = cs[1]
-            ca2 = cs[2]
-            cb3 = cs[3]
-            f1x = f1x + bz * (ca * vx)
-            f1y = f1y + bz * (ca * vy - cb2 * (ra1z + ra2z))
-            f1z = f1z + bz * (ca * vz + cb2 * (ra1y + ra2y))
-            m1x = m1x + bzh * (-ca2 * (ra2x - ra1x))
-            m1y = m1y + bzh * (cb2 * vz + cb3 * (2.0 * ra1y + ra2y))
-            m1z = m1z + bzh * (-cb2 * vy + cb3 * (2.0 * ra1z + ra2z))
-            ca = cs[4]
-            cb2 = cs[5]
-            ca2 = cs[6]
-            cb3 = cs[7]
-            if not neg2:
-                f2x = f2x + bz * (-ca * vx)
-                f2y = f2y + bz * (-ca * vy + cb2 * (ra1z + ra2z))
-                f2z = f2z + bz * (-ca * vz - cb2 * (ra1y + ra2y))
-            m2x = m2x + bzh * (ca2 * (ra2x - ra1x))
-            m2y = m2y + bzh * (cb2 * vz + cb3 * (ra1y + 2.0 * ra2y))
-            m2z = m2z + bzh * (-cb2 * vy + cb3 * (ra1z + 2.0 * ra2z))
-        # back to the world: undo rq (large angle), the axis turn and voxel
-        # 1's rotation
-        if not sa:
-            # G = RQ^T v rotates by rq^-1 (RQ the matrix of rq, normalised by
-            # |rq|^2: the small-ratio rq is not exactly unit)
-            n2q = rw * rw + ry * ry + rz * rz
-            r0 = n2q - 2.0 * (ry * ry + rz * rz)
-            r1 = 2.0 * (rw * rz)   # RQ[3] = -RQ[1]
-            r2 = 2.0 * (rw * ry)   # RQ[2] = -RQ[6]
-            r4 = n2q - 2.0 * (rz * rz)
-            r5 = 2.0 * (ry * rz)   # RQ[5] = RQ[7]
-            r8 = n2q - 2.0 * (ry * ry)
-            gx = r0 * f1x + r1 * f1y - r2 * f1z
-            gy = -r1 * f1x + r4 * f1y + r5 * f1z
-            gz = r2 * f1x + r5 * f1y + r8 * f1z
-            f1x = gx
-            f1y = gy
-            f1z = gz
-            gx = r0 * m1x + r1 * m1y - r2 * m1z
-            gy = -r1 * m1x + r4 * m1y + r5 * m1z
-            gz = r2 * m1x + r5 * m1y + r8 * m1z
-            m1x = gx
-            m1y = gy
-            m1z = gz
-            gx = r0 * m2x + r1 * m2y - r2 * m2z
-            gy = -r1 * m2x + r4 * m2y + r5 * m2z
-            gz = r2 * m2x + r5 * m2y + r8 * m2z
-            m2x = gx
-            m2y = gy
-            m2z = gz
-            if not neg2:
-                gx = r0 * f2x + r1 * f2y - r2 * f2z
-                gy = -r1 * f2x + r4 * f2y + r5 * f2z
-                gz = r2 * f2x + r5 * f2y + r8 * f2z
-                f2x = gx
-                f2y = gy
-                f2z = gz
-        fo = force + 3 * i
-        _bond_to_world(ax, R1, f1x, f1y, f1z, w)
-        fo[0] += w[0]
-        fo[1] += w[1]
-        fo[2] += w[2]
-        fo = force + 3 * j
-        if neg2:
-            fo[0] -= w[0]
-            fo[1] -= w[1]
-            fo[2] -= w[2]
-        else:
-            _bond_to_world(ax, R1, f2x, f2y, f2z, w)
-            fo[0] += w[0]
-            fo[1] += w[1]
-            fo[2] += w[2]
-        mo = moment + 3 * i
-        _bond_to_world(ax, R1, m1x, m1y, m1z, w)
-        mo[0] -= w[0]
-        mo[1] -= w[1]
-        mo[2] -= w[2]
-        mo = moment + 3 * j
-        _bond_to_world(ax, R1, m2x, m2y, m2z, w)
-        mo[0] -= w[0]
-        mo[1] -= w[1]
-        mo[2] -= w[2]
+        _bond_to_world(ax, R1, o[li], o[n + li], o[2 * n + li], w)
+        force[3 * i] += w[0]
+        force[3 * i + 1] += w[1]
+        force[3 * i + 2] += w[2]
+        _bond_to_world(ax, R1, o[3 * n + li], o[4 * n + li], o[5 * n + li], w)
+        force[3 * j] += w[0]
+        force[3 * j + 1] += w[1]
+        force[3 * j + 2] += w[2]
+        _bond_to_world(ax, R1, o[6 * n + li], o[7 * n + li], o[8 * n + li], w)
+        moment[3 * i] += w[0]
+        moment[3 * i + 1] += w[1]
+        moment[3 * i + 2] += w[2]
+        _bond_to_world(ax, R1, o[9 * n + li], o[21 * n + li], o[24 * n + li], w)
+        moment[3 * j] += w[0]
+        moment[3 * j + 1] += w[1]
+        moment[3 * j + 2] += w[2]
     return STATUS_OK if end == hi else STATUS_STRAIN
 
 

@@ -71,6 +71,8 @@ _VOXEL_STATE = ("pos", "vel", "quat", "angvel", "rot", "scale", "temp", "ext_for
 _ROBOT_STATE = ("diverged", "diverged_time", "diverged_code", "init_done", "cm_init", "use_temp",
                 "col_acc", "col_vmax", "aux_init")
 _LINK_STATE = ("link_sa", "link_last")  # the seed model's per-link mode and memory
+# kept as (rows, n_links) for the kernel's vector loops, shown as (n_links, rows) in states
+_TRANSPOSED = ("link_last",)
 _STATE = (*_VOXEL_STATE, *_ROBOT_STATE, *_LINK_STATE, "steps", "trace_n", "trace_t", "trace_cm",
           "trace_aux")
 
@@ -588,10 +590,11 @@ class Simulation:
             a[name] = np.ascontiguousarray(np.concatenate(parts))
         for name in ("v1", "v2"):
             a[name] = a[name].astype(np.intp)
-        a["c_seed"] = np.ascontiguousarray(a["c_seed"], dtype=np.float64).reshape(-1, 8)
+        # (8, n_links): one row per constant, for the kernel's vector loops
+        a["c_seed"] = np.ascontiguousarray(np.asarray(a["c_seed"], dtype=np.float64).reshape(-1, 8).T)
         a["homog"] = a["homog"].astype(np.int8)
         a["link_sa"] = np.ones(a["v1"].shape[0], dtype=np.int8)  # links start in small-angle mode
-        a["link_last"] = np.zeros((a["v1"].shape[0], 9))
+        a["link_last"] = np.zeros((9, a["v1"].shape[0]))  # see _TRANSPOSED
         a["axis"] = a["axis"].astype(np.int32)
         a["link_out"] = np.zeros((_core.LINK_SCRATCH_ROWS, a["v1"].shape[0]))  # kernel scratch
         a["quat"] = np.zeros((n_vox, 4))
@@ -1114,6 +1117,8 @@ class Simulation:
     def get_state(self) -> dict[str, np.ndarray]:
         """Copy of the full dynamic state (plain arrays, for checkpoints)."""
         state = {k: self._a[k].copy() for k in _STATE}
+        for k in _TRANSPOSED:
+            state[k] = np.ascontiguousarray(self._a[k].T)
         state["t_target"] = np.array(self._t_target)
         return state
 
@@ -1123,7 +1128,7 @@ class Simulation:
             if k not in state:
                 raise InvalidParameterError(f"state is missing array {k!r}")
             v = np.asarray(state[k])
-            cur = self._a[k]
+            cur = self._a[k].T if k in _TRANSPOSED else self._a[k]
             if k in ("trace_t", "trace_cm", "trace_aux"):
                 if v.shape[0] != cur.shape[0] or v.shape[2:] != cur.shape[2:]:
                     raise InvalidParameterError(f"state array {k!r} has shape {v.shape}")
@@ -1132,7 +1137,9 @@ class Simulation:
                     f"state array {k!r} has shape {v.shape}, expected {cur.shape}"
                 )
         for k in _STATE:
-            self._a[k] = np.array(state[k], dtype=self._a[k].dtype, order="C", copy=True)
+            v = np.asarray(state[k])
+            v = v.T if k in _TRANSPOSED else v
+            self._a[k] = np.array(v, dtype=self._a[k].dtype, order="C", copy=True)
         self._t_target = float(state.get("t_target", 0.0))
         self._state_changed()
 
@@ -1181,10 +1188,11 @@ class Simulation:
         lo = a["link_start"]
         for k in _LINK_STATE:
             src = np.asarray(state[k])
-            if src.shape != a[k].shape:
-                raise InvalidParameterError(f"state array {k!r} has shape {src.shape}, expected {a[k].shape}")
+            dst = a[k].T if k in _TRANSPOSED else a[k]  # a view: writes go to a[k]
+            if src.shape != dst.shape:
+                raise InvalidParameterError(f"state array {k!r} has shape {src.shape}, expected {dst.shape}")
             for r in ids:
                 s = slice(int(lo[r]), int(lo[r + 1]))
-                a[k][s] = src[s]
+                dst[s] = src[s]
         a["steps"][ids] = np.ceil(self._t_target / a["dt"][ids] - 1e-9).astype(np.int64)
         self._state_changed()

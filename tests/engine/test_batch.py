@@ -127,6 +127,31 @@ def test_restore_robots_resets_one_robot_on_the_shared_clock():
     assert np.abs(sim.positions(1)).max() > 0
 
 
+def test_the_seed_link_memory_round_trips_through_states():
+    # the kernel keeps the links' memory as (9, n_links) rows; states show it
+    # as (n_links, 9) and every way back in restores it exactly
+    sim = Simulation([reference_robot(3), reference_robot(4)])
+    first = Simulation(reference_robot(3)).n_links  # robot 0's links come first
+    sim.advance(1.3)
+    mid = sim.get_state()
+    assert mid["link_last"].shape == (sim.n_links, 9)
+    assert np.abs(mid["link_last"]).max() > 0
+    sim.advance(1.5)
+    later = sim.get_state()
+    ahead = sim.positions(1).copy()
+    sim.set_state(mid)
+    np.testing.assert_array_equal(sim.get_state()["link_last"], mid["link_last"])
+    sim.advance(1.5)
+    np.testing.assert_array_equal(sim.positions(1), ahead)
+    np.testing.assert_array_equal(sim.get_state()["link_last"], later["link_last"])
+    sim.set_state(mid)
+    sim.restore_robots(later, [1])
+    got = sim.get_state()["link_last"]
+    np.testing.assert_array_equal(got[:first], mid["link_last"][:first])
+    np.testing.assert_array_equal(got[first:], later["link_last"][first:])
+    assert not np.array_equal(mid["link_last"][first:], later["link_last"][first:])
+
+
 def test_rollout_take_reorders_every_per_robot_and_per_voxel_field():
     import numpy as np
 
