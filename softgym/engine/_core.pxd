@@ -91,7 +91,9 @@ cdef struct Batch:
 
     # ---- per link (beam between face neighbours v1 -> v2 along +axis) ------
     intp_t n_links           # links in the batch
-    float64_t* link_out      # (N_LINK_OUT, n_links) scratch (each link kernel names its rows)
+    float64_t* link_out      # scratch of the link kernels (each names its rows): row k of link li
+                             #   at link_out[k * link_stride + li], li among the robot's links
+    intp_t link_stride       # its row stride (the most links of one robot)
     intp_t* v1               # (n_links,) voxel on the negative side
     intp_t* v2               # (n_links,) voxel on the positive side
     int32* axis              # (n_links,) 0, 1, 2 for x, y, z

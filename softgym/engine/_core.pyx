@@ -31,7 +31,7 @@
 # The code walks flat arrays through raw pointers; bounds are checked by the
 # Python wrapper (simulation.py) once, never here.
 
-from cython.parallel cimport prange, parallel
+from cython.parallel cimport prange, parallel, threadid
 from libc.math cimport sin, cos, acos, sqrt, fabs, floor, M_PI
 from libc.stdint cimport int64_t
 from libc.stdlib cimport calloc, malloc, realloc, free, qsort
@@ -269,7 +269,7 @@ cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi,
     # check and the scatter of forces and moments in link order.
     cdef:
         intp_t li, i, j
-        intp_t n = b.n_links
+        intp_t n = b.link_stride  # the scratch's row stride
         float64_t max_ext = b.max_strain * b.L
         float64_t* o = b.link_out
         float64_t* force = b.force
@@ -975,7 +975,7 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
         const float64_t* rot = b.rot
         const intp_t* v1 = b.v1
         const intp_t* v2 = b.v2
-        intp_t n = b.n_links
+        intp_t n = b.link_stride  # the scratch's row stride
         float64_t* o = b.link_out
         float64_t* force = b.force
         float64_t* moment = b.moment
@@ -1005,7 +1005,7 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
         out[k] = o + k * n
     out[10] = o + 21 * n
     out[11] = o + 24 * n
-    softgym_seed_forces(lo, end, n, b.L, bz, bzh, inv_dt, inp, b.k_axial, b.k_torsion,
+    softgym_seed_forces(lo, end, b.n_links, b.L, bz, bzh, inv_dt, inp, b.k_axial, b.k_torsion,
                         b.k_bend, b.c_seed, b.link_last, out)
     for li in range(lo, end):
         # back to the world (the inverse axis turn, voxel 1's rotation) and
@@ -2113,8 +2113,6 @@ STATUS_NAMES = {
 
 #: The arrays that cross into the kernel (bound by _bind; shapes, dtypes and
 #: units in _core.pxd's Batch): the Python side must provide every one.
-LINK_SCRATCH_ROWS = N_LINK_OUT  # rows of arrays["link_out"] (n_links columns)
-
 KERNEL_ARRAYS = (
     "vox_start", "link_start", "link_axis_count", "dt", "steps", "temp_amp", "period",
     "use_temp", "floor", "box_start", "boxes", "diverged", "diverged_time", "diverged_code",
@@ -2123,7 +2121,7 @@ KERNEL_ARRAYS = (
     "inv_inertia", "scale", "cte", "cos_phase", "sin_phase", "temp", "k_floor", "c_floor",
     "c_global", "rot_damp", "mu_s", "mu_k", "fixed", "surface", "excl_start", "excl_idx",
     "seed_rank", "col_ref", "col_acc", "col_vmax", "obs_start", "obs", "obs_rank",
-    "link_out", "v1", "v2", "axis", "k_axial", "k_torsion", "k_bend", "c_axial", "c_torsion",
+    "v1", "v2", "axis", "k_axial", "k_torsion", "k_bend", "c_axial", "c_torsion",
     "c_bend", "c_seed", "homog", "link_sa", "link_last",
     "body_end", "aux_init", "trace_aux", "faces",
 )
@@ -2213,10 +2211,9 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.excl_idx = <intp_t*> _p(a, "excl_idx") if a["excl_idx"].shape[0] > 0 else NULL
     # links: a robot without links leaves these arrays empty (never dereferenced)
     b.n_links = a["v1"].shape[0]
+    b.link_out = NULL  # per thread, set by advance
+    b.link_stride = 0
     if a["v1"].shape[0] > 0:
-        if a["link_out"].shape[0] < N_LINK_OUT:
-            raise ValueError(f"link_out needs {N_LINK_OUT} rows (LINK_SCRATCH_ROWS)")
-        b.link_out = _f(a, "link_out")
         b.v1 = <intp_t*> _p(a, "v1")
         b.v2 = <intp_t*> _p(a, "v2")
         b.axis = <int32*> _p(a, "axis")
@@ -2290,16 +2287,36 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
     """
     cdef:
         Batch b
-        intp_t r
-        intp_t n
+        Batch bt
+        intp_t r, n, t, lo
+        intp_t stride = 0
+        float64_t* scratch
     _bind(&b, arrays, settings)
     n = b.n_robots
     if targets.shape[0] != n or cache.n != n:
         raise ValueError("targets and cache must hold one entry per robot")
-    with nogil, parallel(num_threads=n_threads):
-        # dynamic: robots of one batch differ in cost by 10x or more (bone shrinks dt)
-        for r in prange(n, schedule="dynamic", chunksize=1):
-            advance_robot(&b, r, targets[r], &cache.items[r])
+    n_threads = max(n_threads, 1)
+    # the link kernels' scratch, one block per thread, sized for the robot
+    # with the most links: it stays in the core's cache however large the batch
+    for r in range(n):
+        stride = max(stride, b.link_start[r + 1] - b.link_start[r])
+    b.link_stride = stride
+    scratch = <float64_t*> malloc(max(n_threads * N_LINK_OUT * stride, 1) * sizeof(float64_t))
+    if scratch == NULL:
+        raise MemoryError("no memory for the link kernels' scratch")
+    try:
+        with nogil, parallel(num_threads=n_threads):
+            # dynamic: robots of one batch differ in cost by 10x or more (bone shrinks dt)
+            for r in prange(n, schedule="dynamic", chunksize=1):
+                t = threadid()
+                bt = b
+                lo = b.link_start[r]
+                # row k of link li (robot r's links are lo..) sits at
+                # link_out[k * stride + li]: the block, offset by -lo
+                bt.link_out = scratch + t * N_LINK_OUT * stride - lo
+                advance_robot(&bt, r, targets[r], &cache.items[r])
+    finally:
+        free(scratch)
 
 
 def compute_energy(dict arrays, dict settings, float64_t[:, ::1] out):

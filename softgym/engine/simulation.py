@@ -596,7 +596,6 @@ class Simulation:
         a["link_sa"] = np.ones(a["v1"].shape[0], dtype=np.int8)  # links start in small-angle mode
         a["link_last"] = np.zeros((9, a["v1"].shape[0]))  # see _TRANSPOSED
         a["axis"] = a["axis"].astype(np.int32)
-        a["link_out"] = np.zeros((_core.LINK_SCRATCH_ROWS, a["v1"].shape[0]))  # kernel scratch
         a["quat"] = np.zeros((n_vox, 4))
         a["quat"][:, 0] = 1.0
         a["rot"] = np.zeros((n_vox, 9))
