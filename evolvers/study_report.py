@@ -201,6 +201,9 @@ def load_runs(root: str | os.PathLike[str]) -> dict[str, list[RunData]]:
         except CheckpointError as exc:  # one damaged run must not stop the report
             log.warning("skipping a run: %s", exc)
             continue
+        if not rows:  # started, no generation logged yet: nothing to report
+            log.info("skipping %s: no generation logged yet", run_dir)
+            continue
         best = None
         try:
             best = json.loads((run_dir / "best_designs.json").read_text())["best"][0]

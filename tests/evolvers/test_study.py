@@ -71,6 +71,13 @@ def test_study_runs_resumes_skips_and_reports(tmp_path, capsys):
     finals = by_id["tournament-vs-pareto"]["data"]["tournament"]
     assert len(finals) == 2 and all(math.isfinite(v) for v in finals)
     assert main(["study", "report", str(tmp_path / "nothing"), "--out", str(out)]) == 2
+    # a run that has started but logged no generation yet is left out, not a crash
+    started = root / "controller-pareto" / "seed-2"
+    started.mkdir()
+    (started / "config.json").write_text((root / "controller-pareto" / "seed-0" / "config.json").read_text())
+    (started / "log.jsonl").write_text("")
+    assert [r.path.name for r in load_runs(root)["controller-pareto"]] == ["seed-0", "seed-1"]
+    assert main(["study", "report", str(root), "--out", str(out)]) == 0
 
 
 def test_plan_defaults_and_errors(tmp_path):
