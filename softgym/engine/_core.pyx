@@ -472,6 +472,16 @@ cdef inline void _bond_to_world(const int ax, const float64_t* R, float64_t v0, 
     o[2] = R[6] * x + R[7] * y + R[8] * z
 
 
+cdef inline void _add_bond_to_world(const int ax, const float64_t* R, float64_t v0, float64_t v1,
+                                    float64_t v2, float64_t* acc) noexcept nogil:
+    # acc += R P^T v (_bond_to_world, then the sum)
+    cdef float64_t w[3]
+    _bond_to_world(ax, R, v0, v1, v2, w)
+    acc[0] += w[0]
+    acc[1] += w[1]
+    acc[2] += w[2]
+
+
 cdef void _seed_geom(intp_t lo, intp_t hi, intp_t ax, cintp_rp v1, cintp_rp v2,
                      cf64_rp pos, cf64_rp rot, cf64_rp quat, cf64_rp scale,
                      f64_rp o_p0, f64_rp o_p1, f64_rp o_p2, f64_rp o_qw,
@@ -615,14 +625,19 @@ cdef extern from *:
     #else
     #define SOFTGYM_ALWAYS_INLINE static inline __attribute__((always_inline))
     #endif
+    /* the frames pass's rows: geometry and mode in, frame quantities out */
+    #define SOFTGYM_FRAME_ROWS \
+        const double *p0_, const double *p1_, const double *p2_, const double *qw_, \
+        const double *n1_, const double *n2_, const double *n3_, const double *nom_, \
+        const double *len_, const double *sa_, \
+        double *o_P0, double *o_P1, double *o_P2, double *o_a1y, double *o_a1z, \
+        double *o_a2x, double *o_a2y, double *o_a2z, double *o_rw, double *o_ry, \
+        double *o_rz, double *o_fix
+    #define SOFTGYM_FRAME_ROW_NAMES p0_, p1_, p2_, qw_, n1_, n2_, n3_, nom_, len_, sa_, o_P0, \
+        o_P1, o_P2, o_a1y, o_a1z, o_a2x, o_a2y, o_a2z, o_rw, o_ry, o_rz, o_fix
     SOFTGYM_ALWAYS_INLINE void softgym_seed_frames_impl(
         const int all_small, Py_ssize_t lo, Py_ssize_t hi, double sa_rad, double thr,
-        const double *p0_, const double *p1_, const double *p2_, const double *qw_,
-        const double *n1_, const double *n2_, const double *n3_, const double *nom_,
-        const double *len_, const double *sa_,
-        double *o_P0, double *o_P1, double *o_P2, double *o_a1y, double *o_a1z,
-        double *o_a2x, double *o_a2y, double *o_a2z, double *o_rw, double *o_ry,
-        double *o_rz, double *o_fix)
+        SOFTGYM_FRAME_ROWS)
     {
         Py_ssize_t li;
         SOFTGYM_IVDEP
@@ -683,13 +698,7 @@ cdef extern from *:
         }
     }
     static void softgym_seed_frames(
-        Py_ssize_t lo, Py_ssize_t hi, double sa_rad, double thr,
-        const double *p0_, const double *p1_, const double *p2_, const double *qw_,
-        const double *n1_, const double *n2_, const double *n3_, const double *nom_,
-        const double *len_, const double *sa_,
-        double *o_P0, double *o_P1, double *o_P2, double *o_a1y, double *o_a1z,
-        double *o_a2x, double *o_a2y, double *o_a2z, double *o_rw, double *o_ry,
-        double *o_rz, double *o_fix)
+        Py_ssize_t lo, Py_ssize_t hi, double sa_rad, double thr, SOFTGYM_FRAME_ROWS)
     {
         /* blocks of links all in small-angle mode (a settled or gently
            actuated body: most of them) skip the large-angle candidates */
@@ -700,13 +709,9 @@ cdef extern from *:
             for (li = blo; li < bhi; li++)
                 all_small &= sa_[li] != 0.0;
             if (all_small)
-                softgym_seed_frames_impl(1, blo, bhi, sa_rad, thr, p0_, p1_, p2_, qw_, n1_, n2_,
-                                         n3_, nom_, len_, sa_, o_P0, o_P1, o_P2, o_a1y, o_a1z,
-                                         o_a2x, o_a2y, o_a2z, o_rw, o_ry, o_rz, o_fix);
+                softgym_seed_frames_impl(1, blo, bhi, sa_rad, thr, SOFTGYM_FRAME_ROW_NAMES);
             else
-                softgym_seed_frames_impl(0, blo, bhi, sa_rad, thr, p0_, p1_, p2_, qw_, n1_, n2_,
-                                         n3_, nom_, len_, sa_, o_P0, o_P1, o_P2, o_a1y, o_a1z,
-                                         o_a2x, o_a2y, o_a2z, o_rw, o_ry, o_rz, o_fix);
+                softgym_seed_frames_impl(0, blo, bhi, sa_rad, thr, SOFTGYM_FRAME_ROW_NAMES);
         }
     }
     """
@@ -801,18 +806,16 @@ cdef extern from *:
             link_last[6 * n + li] = softgym_pick(changed, l6, a2x);
             link_last[7 * n + li] = softgym_pick(changed, l7, a2y);
             link_last[8 * n + li] = softgym_pick(changed, l8, a2z);
-            f1x = softgym_pick(changed, f1x, d1x);
-            f1y = softgym_pick(changed, f1y, d1y);
-            f1z = softgym_pick(changed, f1z, d1z);
-            m1x = softgym_pick(changed, m1x, e1x);
-            m1y = softgym_pick(changed, m1y, e1y);
-            m1z = softgym_pick(changed, m1z, e1z);
-            f2x = softgym_pick(neg2, f2x, d2x);
-            f2y = softgym_pick(neg2, f2y, d2y);
-            f2z = softgym_pick(neg2, f2z, d2z);
-            m2x = softgym_pick(changed, m2x, e2x);
-            m2y = softgym_pick(changed, m2y, e2y);
-            m2z = softgym_pick(changed, m2z, e2z);
+            /* (x, y, z) stays where c holds, else becomes (dx, dy, dz) */
+    #define SOFTGYM_KEEP3(c, x, y, z, dx, dy, dz) do { \
+                x = softgym_pick(c, x, dx); \
+                y = softgym_pick(c, y, dy); \
+                z = softgym_pick(c, z, dz); \
+            } while (0)
+            SOFTGYM_KEEP3(changed, f1x, f1y, f1z, d1x, d1y, d1z);
+            SOFTGYM_KEEP3(changed, m1x, m1y, m1z, e1x, e1y, e1z);
+            SOFTGYM_KEEP3(neg2, f2x, f2y, f2z, d2x, d2y, d2z);
+            SOFTGYM_KEEP3(changed, m2x, m2y, m2z, e2x, e2y, e2z);
             /* large angle: G = RQ^T v rotates by rq^-1 (RQ the matrix of rq,
                normalised by |rq|^2: the small-ratio rq is not exactly unit) */
             double n2q = rw * rw + ry * ry + rz * rz;
@@ -822,31 +825,18 @@ cdef extern from *:
             double r4 = n2q - 2.0 * (rz * rz);
             double r5 = 2.0 * (ry * rz);
             double r8 = n2q - 2.0 * (ry * ry);
-            double gx, gy, gz;
-            gx = r0 * f1x + r1 * f1y - r2 * f1z;
-            gy = -r1 * f1x + r4 * f1y + r5 * f1z;
-            gz = r2 * f1x + r5 * f1y + r8 * f1z;
-            f1x = softgym_pick(sa, f1x, gx);
-            f1y = softgym_pick(sa, f1y, gy);
-            f1z = softgym_pick(sa, f1z, gz);
-            gx = r0 * m1x + r1 * m1y - r2 * m1z;
-            gy = -r1 * m1x + r4 * m1y + r5 * m1z;
-            gz = r2 * m1x + r5 * m1y + r8 * m1z;
-            m1x = softgym_pick(sa, m1x, gx);
-            m1y = softgym_pick(sa, m1y, gy);
-            m1z = softgym_pick(sa, m1z, gz);
-            gx = r0 * m2x + r1 * m2y - r2 * m2z;
-            gy = -r1 * m2x + r4 * m2y + r5 * m2z;
-            gz = r2 * m2x + r5 * m2y + r8 * m2z;
-            m2x = softgym_pick(sa, m2x, gx);
-            m2y = softgym_pick(sa, m2y, gy);
-            m2z = softgym_pick(sa, m2z, gz);
-            gx = r0 * f2x + r1 * f2y - r2 * f2z;
-            gy = -r1 * f2x + r4 * f2y + r5 * f2z;
-            gz = r2 * f2x + r5 * f2y + r8 * f2z;
-            f2x = softgym_pick(sa, f2x, gx);
-            f2y = softgym_pick(sa, f2y, gy);
-            f2z = softgym_pick(sa, f2z, gz);
+    #define SOFTGYM_UNTURN(x, y, z) do { \
+                double gx_ = r0 * x + r1 * y - r2 * z; \
+                double gy_ = -r1 * x + r4 * y + r5 * z; \
+                double gz_ = r2 * x + r5 * y + r8 * z; \
+                SOFTGYM_KEEP3(sa, x, y, z, gx_, gy_, gz_); \
+            } while (0)
+            SOFTGYM_UNTURN(f1x, f1y, f1z);
+            SOFTGYM_UNTURN(m1x, m1y, m1z);
+            SOFTGYM_UNTURN(m2x, m2y, m2z);
+            SOFTGYM_UNTURN(f2x, f2y, f2z);
+    #undef SOFTGYM_UNTURN
+    #undef SOFTGYM_KEEP3
             o0[li] = f1x;
             o1[li] = f1y;
             o2[li] = f1z;
@@ -981,7 +971,6 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
         float64_t* moment = b.moment
         const float64_t* inp[14]
         float64_t* out[12]
-        float64_t w[3]
         const float64_t* R1
     if hi <= lo:
         return STATUS_OK
@@ -1013,22 +1002,10 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
         i = v1[li]
         j = v2[li]
         R1 = rot + 9 * i
-        _bond_to_world(ax, R1, o[li], o[n + li], o[2 * n + li], w)
-        force[3 * i] += w[0]
-        force[3 * i + 1] += w[1]
-        force[3 * i + 2] += w[2]
-        _bond_to_world(ax, R1, o[3 * n + li], o[4 * n + li], o[5 * n + li], w)
-        force[3 * j] += w[0]
-        force[3 * j + 1] += w[1]
-        force[3 * j + 2] += w[2]
-        _bond_to_world(ax, R1, o[6 * n + li], o[7 * n + li], o[8 * n + li], w)
-        moment[3 * i] += w[0]
-        moment[3 * i + 1] += w[1]
-        moment[3 * i + 2] += w[2]
-        _bond_to_world(ax, R1, o[9 * n + li], o[21 * n + li], o[24 * n + li], w)
-        moment[3 * j] += w[0]
-        moment[3 * j + 1] += w[1]
-        moment[3 * j + 2] += w[2]
+        _add_bond_to_world(ax, R1, o[li], o[n + li], o[2 * n + li], force + 3 * i)
+        _add_bond_to_world(ax, R1, o[3 * n + li], o[4 * n + li], o[5 * n + li], force + 3 * j)
+        _add_bond_to_world(ax, R1, o[6 * n + li], o[7 * n + li], o[8 * n + li], moment + 3 * i)
+        _add_bond_to_world(ax, R1, o[9 * n + li], o[21 * n + li], o[24 * n + li], moment + 3 * j)
     return STATUS_OK if end == hi else STATUS_STRAIN
 
 
