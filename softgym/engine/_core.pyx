@@ -2213,11 +2213,14 @@ cdef class ContactCache:
     Owned by a :class:`~softgym.engine.Simulation`; :meth:`invalidate` must be
     called whenever voxels are moved from outside the kernel (set_state, reset).
     Whether and when a list is rebuilt never changes results: a list always
-    holds every touching pair, in sorted order.
+    holds every touching pair, in sorted order. Also holds the link kernels'
+    scratch (one block per thread), reused from call to call.
     """
 
     cdef Contacts* items
     cdef intp_t n
+    cdef float64_t* link_scratch
+    cdef intp_t link_scratch_size
 
     def __cinit__(self, intp_t n_robots):
         self.n = n_robots
@@ -2243,6 +2246,18 @@ cdef class ContactCache:
                 free(self.items[r].opairs)
                 free(self.items[r].ocells)
             free(self.items)
+        free(self.link_scratch)
+
+    cdef float64_t* scratch(self, intp_t size) except NULL:
+        # at least `size` doubles of link scratch (contents undefined)
+        cdef float64_t* p
+        if size > self.link_scratch_size:
+            p = <float64_t*> realloc(self.link_scratch, size * sizeof(float64_t))
+            if p == NULL:
+                raise MemoryError("no memory for the link kernels' scratch")
+            self.link_scratch = p
+            self.link_scratch_size = size
+        return self.link_scratch
 
 
 def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, ContactCache cache):
@@ -2274,26 +2289,22 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
         raise ValueError("targets and cache must hold one entry per robot")
     n_threads = max(n_threads, 1)
     # the link kernels' scratch, one block per thread, sized for the robot
-    # with the most links: it stays in the core's cache however large the batch
+    # with the most links: it stays in the core's cache however large the
+    # batch (kept in the cache object from call to call)
     for r in range(n):
         stride = max(stride, b.link_start[r + 1] - b.link_start[r])
     b.link_stride = stride
-    scratch = <float64_t*> malloc(max(n_threads * N_LINK_OUT * stride, 1) * sizeof(float64_t))
-    if scratch == NULL:
-        raise MemoryError("no memory for the link kernels' scratch")
-    try:
-        with nogil, parallel(num_threads=n_threads):
-            # dynamic: robots of one batch differ in cost by 10x or more (bone shrinks dt)
-            for r in prange(n, schedule="dynamic", chunksize=1):
-                t = threadid()
-                bt = b
-                lo = b.link_start[r]
-                # row k of link li (robot r's links are lo..) sits at
-                # link_out[k * stride + li]: the block, offset by -lo
-                bt.link_out = scratch + t * N_LINK_OUT * stride - lo
-                advance_robot(&bt, r, targets[r], &cache.items[r])
-    finally:
-        free(scratch)
+    scratch = cache.scratch(max(n_threads * N_LINK_OUT * stride, 1))
+    with nogil, parallel(num_threads=n_threads):
+        # dynamic: robots of one batch differ in cost by 10x or more (bone shrinks dt)
+        for r in prange(n, schedule="dynamic", chunksize=1):
+            t = threadid()
+            bt = b
+            lo = b.link_start[r]
+            # row k of link li (robot r's links are lo..) sits at
+            # link_out[k * stride + li]: the block, offset by -lo
+            bt.link_out = scratch + t * N_LINK_OUT * stride - lo
+            advance_robot(&bt, r, targets[r], &cache.items[r])
 
 
 def compute_energy(dict arrays, dict settings, float64_t[:, ::1] out):
