@@ -620,6 +620,19 @@ cdef extern from *:
         memcpy(&r, &ua, sizeof r);
         return r;
     }
+    /* _rotvec_k(w) where the seed takes its square-root branch (0 < sl <
+       thr), and whether it takes the acos branch instead */
+    static inline double softgym_rotvec_k_sqrt(double w)
+    {
+        double sl = 1.0 - w * w;
+        double ks = 2.0 * sqrt((2.0 - 2.0 * w) / sl);
+        return sl <= 0.0 ? 0.0 : ks;
+    }
+    static inline long long softgym_rotvec_needs_acos(double w, double thr)
+    {
+        double sl = 1.0 - w * w;
+        return (sl > 0.0) & (sl >= thr);
+    }
     #if defined(_MSC_VER)
     #define SOFTGYM_ALWAYS_INLINE static __forceinline
     #else
@@ -645,11 +658,9 @@ cdef extern from *:
             double p0 = p0_[li], p1 = p1_[li], p2 = p2_[li], qw = qw_[li];
             double n1 = n1_[li], n2 = n2_[li], n3 = n3_[li], nom = nom_[li], cl = len_[li];
             long long is_sa = all_small ? 1 : sa_[li] != 0.0;
-            /* small angle: k of qw (_rotvec_k without its acos branch) */
-            double sl = 1.0 - qw * qw;
-            double ks = 2.0 * sqrt((2.0 - 2.0 * qw) / sl);
-            double k = sl <= 0.0 ? 0.0 : ks;
-            long long fix = is_sa & (sl > 0.0) & (sl >= thr);
+            /* small angle: k of qw */
+            double k = softgym_rotvec_k_sqrt(qw);
+            long long fix = is_sa & softgym_rotvec_needs_acos(qw, thr);
             /* large angle: rq onto the chord (exactly along it when the
                transverse ratios are small) */
             long long zero = (p0 == 0.0) & (p1 == 0.0) & (p2 == 0.0);
@@ -666,20 +677,16 @@ cdef extern from *:
             double rw = zero ? 1.0 : (small ? rw_s : ch);
             double ry = zero ? 0.0 : (small ? ry_s : ry_l);
             double rz = zero ? 0.0 : (small ? rz_s : rz_l);
-            sl = 1.0 - rw * rw;
-            ks = 2.0 * sqrt((2.0 - 2.0 * rw) / sl);
-            double k1 = sl <= 0.0 ? 0.0 : ks;
-            fix |= (1 - is_sa) & (1 - zero) & (sl > 0.0) & (sl >= thr);
+            double k1 = softgym_rotvec_k_sqrt(rw);
+            fix |= (1 - is_sa) & (1 - zero) & softgym_rotvec_needs_acos(rw, thr);
             double a1y = ry * k1, a1z = rz * k1;
             /* tq = rq nq (rq's x part is zero) */
             double tw = rw * qw - ry * n2 - rz * n3;
             double tx = rw * n1 + ry * n3 - rz * n2;
             double ty = rw * n2 + ry * qw + rz * n1;
             double tz = rw * n3 - ry * n1 + rz * qw;
-            sl = 1.0 - tw * tw;
-            ks = 2.0 * sqrt((2.0 - 2.0 * tw) / sl);
-            double k2 = sl <= 0.0 ? 0.0 : ks;
-            fix |= (1 - is_sa) & (sl > 0.0) & (sl >= thr);
+            double k2 = softgym_rotvec_k_sqrt(tw);
+            fix |= (1 - is_sa) & softgym_rotvec_needs_acos(tw, thr);
             double P0_s = p0 - nom, P0_l = cl - nom;
             double a2x_s = n1 * k, a2y_s = n2 * k, a2z_s = n3 * k;
             double a2x_l = tx * k2, a2y_l = ty * k2, a2z_l = tz * k2;

@@ -1115,9 +1115,7 @@ class Simulation:
 
     def get_state(self) -> dict[str, np.ndarray]:
         """Copy of the full dynamic state (plain arrays, for checkpoints)."""
-        state = {k: self._a[k].copy() for k in _STATE}
-        for k in _TRANSPOSED:
-            state[k] = np.ascontiguousarray(self._a[k].T)
+        state = {k: self._state_view(k).copy() for k in _STATE}
         state["t_target"] = np.array(self._t_target)
         return state
 
@@ -1127,7 +1125,7 @@ class Simulation:
             if k not in state:
                 raise InvalidParameterError(f"state is missing array {k!r}")
             v = np.asarray(state[k])
-            cur = self._a[k].T if k in _TRANSPOSED else self._a[k]
+            cur = self._state_view(k)
             if k in ("trace_t", "trace_cm", "trace_aux"):
                 if v.shape[0] != cur.shape[0] or v.shape[2:] != cur.shape[2:]:
                     raise InvalidParameterError(f"state array {k!r} has shape {v.shape}")
@@ -1141,6 +1139,10 @@ class Simulation:
             self._a[k] = np.array(v, dtype=self._a[k].dtype, order="C", copy=True)
         self._t_target = float(state.get("t_target", 0.0))
         self._state_changed()
+
+    def _state_view(self, k: str) -> np.ndarray:
+        # kernel array k as states show it (a view; see _TRANSPOSED)
+        return self._a[k].T if k in _TRANSPOSED else self._a[k]
 
     def _state_changed(self) -> None:
         # voxels were moved from outside the kernel: re-derive the rotation
@@ -1187,7 +1189,7 @@ class Simulation:
         lo = a["link_start"]
         for k in _LINK_STATE:
             src = np.asarray(state[k])
-            dst = a[k].T if k in _TRANSPOSED else a[k]  # a view: writes go to a[k]
+            dst = self._state_view(k)  # writes go to a[k]
             if src.shape != dst.shape:
                 raise InvalidParameterError(f"state array {k!r} has shape {src.shape}, expected {dst.shape}")
             for r in ids:
