@@ -66,7 +66,9 @@ cdef struct Batch:
     float64_t* rot           # (n_voxels, 9) rotation matrix of quat, row-major (derived)
     float64_t* force         # (n_voxels, 3) scratch: accumulated force (N)
     float64_t* moment        # (n_voxels, 3) scratch: accumulated moment (N m)
-    float64_t* vox_out       # (4, n_voxels) scratch: the seed model's new orientations
+    float64_t* vox_out       # scratch of the seed model's new orientations: row k of voxel i at
+                             #   vox_out[k * vox_stride + i], i among the robot's voxels
+    intp_t vox_stride        # its row stride (the most voxels of one robot)
     float64_t* ext_force     # (n_voxels, 3) constant external force (N)
     float64_t* mass          # (n_voxels,) rho L^3 (kg)
     float64_t* inv_mass      # (n_voxels,) 1 / mass

@@ -138,6 +138,7 @@ cdef extern from *:
 
 cdef enum:
     N_LINK_OUT = 25  # rows of the per-link scratch (see _link_kernel, _seed_links_along)
+    N_VOX_OUT = 4    # rows of the per-voxel scratch (see _seed_orient)
 
 
 cdef void _link_kernel(intp_t lo, intp_t hi, intp_t ax, intp_t p, intp_t q,
@@ -1343,7 +1344,7 @@ cdef inline void _seed_orient(Batch* b, intp_t lo, intp_t hi, float64_t dt) noex
     # keep theirs): new quaternions, then their rotation matrices
     cdef:
         intp_t i
-        intp_t n = b.vox_start[b.n_robots]  # voxels in the batch: the row stride
+        intp_t n = b.vox_stride  # the scratch's row stride
         float64_t* qo = b.vox_out
         float64_t* qq
     softgym_seed_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
@@ -2101,7 +2102,7 @@ KERNEL_ARRAYS = (
     "vox_start", "link_start", "link_axis_count", "dt", "steps", "temp_amp", "period",
     "use_temp", "floor", "box_start", "boxes", "diverged", "diverged_time", "diverged_code",
     "init_done", "cm_init", "mass_total", "trace_n", "trace_t", "trace_cm",
-    "pos", "vel", "quat", "angvel", "rot", "force", "moment", "vox_out", "ext_force", "mass", "inv_mass",
+    "pos", "vel", "quat", "angvel", "rot", "force", "moment", "ext_force", "mass", "inv_mass",
     "inv_inertia", "scale", "cte", "cos_phase", "sin_phase", "temp", "k_floor", "c_floor",
     "c_global", "rot_damp", "mu_s", "mu_k", "fixed", "surface", "excl_start", "excl_idx",
     "seed_rank", "col_ref", "col_acc", "col_vmax", "obs_start", "obs", "obs_rank",
@@ -2164,7 +2165,8 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.angvel = _f(a, "angvel")
     b.rot = _f(a, "rot")
     b.force = _f(a, "force")
-    b.vox_out = _f(a, "vox_out")
+    b.vox_out = NULL  # per thread, set by advance
+    b.vox_stride = 0
     b.moment = _f(a, "moment")
     b.ext_force = _f(a, "ext_force")
     b.mass = _f(a, "mass")
@@ -2220,7 +2222,7 @@ cdef class ContactCache:
     Owned by a :class:`~softgym.engine.Simulation`; :meth:`invalidate` must be
     called whenever voxels are moved from outside the kernel (set_state, reset).
     Whether and when a list is rebuilt never changes results: a list always
-    holds every touching pair, in sorted order. Also holds the link kernels'
+    holds every touching pair, in sorted order. Also holds the kernels'
     scratch (one block per thread), reused from call to call.
     """
 
@@ -2256,12 +2258,12 @@ cdef class ContactCache:
         free(self.link_scratch)
 
     cdef float64_t* scratch(self, intp_t size) except NULL:
-        # at least `size` doubles of link scratch (contents undefined)
+        # at least `size` doubles of scratch (contents undefined)
         cdef float64_t* p
         if size > self.link_scratch_size:
             p = <float64_t*> realloc(self.link_scratch, size * sizeof(float64_t))
             if p == NULL:
-                raise MemoryError("no memory for the link kernels' scratch")
+                raise MemoryError("no memory for the kernels' scratch")
             self.link_scratch = p
             self.link_scratch_size = size
         return self.link_scratch
@@ -2287,30 +2289,34 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
     cdef:
         Batch b
         Batch bt
-        intp_t r, n, t, lo
-        intp_t stride = 0
+        intp_t r, n, t
+        intp_t stride = 0, vstride = 0, block
         float64_t* scratch
     _bind(&b, arrays, settings)
     n = b.n_robots
     if targets.shape[0] != n or cache.n != n:
         raise ValueError("targets and cache must hold one entry per robot")
     n_threads = max(n_threads, 1)
-    # the link kernels' scratch, one block per thread, sized for the robot
-    # with the most links: it stays in the core's cache however large the
-    # batch (kept in the cache object from call to call)
+    # the kernels' scratch, one block per thread, sized for the robot with
+    # the most links and voxels: it stays in the core's cache however large
+    # the batch (kept in the cache object from call to call)
     for r in range(n):
         stride = max(stride, b.link_start[r + 1] - b.link_start[r])
+        vstride = max(vstride, b.vox_start[r + 1] - b.vox_start[r])
     b.link_stride = stride
-    scratch = cache.scratch(max(n_threads * N_LINK_OUT * stride, 1))
+    b.vox_stride = vstride
+    block = N_LINK_OUT * stride + N_VOX_OUT * vstride
+    scratch = cache.scratch(max(n_threads * block, 1))
     with nogil, parallel(num_threads=n_threads):
         # dynamic: robots of one batch differ in cost by 10x or more (bone shrinks dt)
         for r in prange(n, schedule="dynamic", chunksize=1):
             t = threadid()
             bt = b
-            lo = b.link_start[r]
-            # row k of link li (robot r's links are lo..) sits at
-            # link_out[k * stride + li]: the block, offset by -lo
-            bt.link_out = scratch + t * N_LINK_OUT * stride - lo
+            # row k of link li sits at link_out[k * stride + li], of voxel i
+            # at vox_out[k * vstride + i]: the thread's block, offset by the
+            # robot's first link and voxel
+            bt.link_out = scratch + t * block - b.link_start[r]
+            bt.vox_out = scratch + t * block + N_LINK_OUT * stride - b.vox_start[r]
             advance_robot(&bt, r, targets[r], &cache.items[r])
 
 

@@ -602,7 +602,6 @@ class Simulation:
         a["rot"][:, [0, 4, 8]] = 1.0
         for name in ("vel", "angvel", "force", "moment"):
             a[name] = np.zeros((n_vox, 3))
-        a["vox_out"] = np.zeros((4, n_vox))  # kernel scratch (the seed model's orientations)
         a["ext_force"] = np.ascontiguousarray(a["ext_force"], dtype=np.float64).reshape(-1, 3)
         a["faces"] = a["faces"].astype(np.int8)
         a["body_end"] = np.asarray(body_end, dtype=np.intp)
