@@ -1,0 +1,153 @@
+#!/usr/bin/env python3
+"""Carry a study's run folders between machines: what resuming needs, nothing more.
+
+A study (``softgym study``) runs for many hours and is resumed many times, but
+the machines it runs on do not keep their disks between sessions. This script
+copies the part of each run folder that resuming and ``softgym study report``
+need into a folder that can be committed or copied (``save``), and puts it back
+into a run root (``restore``):
+
+* per run: ``config.json``, ``log.jsonl``, ``log.csv``, ``notes.jsonl``,
+  ``best_designs.json``, ``best_design.json``, ``final_population.json`` and
+  the newest *intact* checkpoint (its ``.json`` and ``.npz``; checked with
+  :func:`softgym.io.load_latest_intact`, so a checkpoint half written by a
+  running study is never taken);
+* per scenario and study: ``scenario.json`` and ``study.json``.
+
+Figures, ``.vxa`` files, the ``best_designs/`` folder and older checkpoints are
+left out: the run writes them again when it resumes. Files in the saved copy
+that the run no longer has (an older checkpoint) are removed, and files whose
+bytes did not change are not rewritten, so a committed copy only changes where
+the study moved on.
+
+``restore`` never moves a run back: a run folder whose newest checkpoint is at
+or past the saved one is left alone (the message says so).
+
+    python scripts/study_state.py save /work/runs/study benchmarks/data/study/runs
+    python scripts/study_state.py restore benchmarks/data/study/runs /work/runs/study
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import sys
+from pathlib import Path
+
+from softgym.exceptions import CheckpointError
+from softgym.io import list_checkpoints, load_latest_intact
+
+RUN_FILES = (
+    "config.json",
+    "log.jsonl",
+    "log.csv",
+    "notes.jsonl",
+    "best_designs.json",
+    "best_design.json",
+    "final_population.json",
+)
+ROOT_FILES = ("scenario.json", "study.json")
+
+
+def _run_dirs(root: Path) -> list[Path]:
+    return sorted(p.parent for p in root.rglob("config.json") if p.parent != root)
+
+
+def _copy_if_changed(src: Path, dst: Path) -> bool:
+    """Copy ``src`` to ``dst`` unless ``dst`` holds the same bytes; True if written."""
+    if dst.exists() and dst.read_bytes() == src.read_bytes():
+        return False
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    tmp = dst.with_name(dst.name + ".tmp")
+    shutil.copyfile(src, tmp)
+    tmp.replace(dst)
+    return True
+
+
+def _selected(run: Path) -> list[Path]:
+    """The files of one run folder that are kept (relative to it)."""
+    keep = [Path(n) for n in RUN_FILES if (run / n).is_file()]
+    ckdir = run / "checkpoints"
+    if ckdir.is_dir() and list_checkpoints(ckdir):
+        try:
+            ck = load_latest_intact(ckdir).path
+        except CheckpointError as exc:
+            raise SystemExit(f"study_state: {run}: {exc}") from None
+        keep += [Path("checkpoints") / ck.name, Path("checkpoints") / ck.with_suffix(".npz").name]
+    return keep
+
+
+def _step(run: Path) -> int:
+    """Newest checkpoint step of a run folder, -1 if none."""
+    ckdir = run / "checkpoints"
+    if not ckdir.is_dir() or not list_checkpoints(ckdir):
+        return -1
+    try:
+        return int(load_latest_intact(ckdir).state["step"])
+    except CheckpointError:
+        return -1
+
+
+def _mirror(src_root: Path, dst_root: Path, runs: list[Path], prune: bool) -> tuple[int, int]:
+    written = removed = 0
+    for name in ROOT_FILES:
+        for f in sorted(src_root.rglob(name)):
+            rel = f.relative_to(src_root)
+            written += _copy_if_changed(f, dst_root / rel)
+    for run in runs:
+        rel = run.relative_to(src_root)
+        files = _selected(run)
+        for f in files:
+            written += _copy_if_changed(run / f, dst_root / rel / f)
+        if prune:
+            wanted = {dst_root / rel / f for f in files}
+            for old in sorted((dst_root / rel).rglob("*")):
+                if old.is_file() and old not in wanted:
+                    old.unlink()
+                    removed += 1
+    return written, removed
+
+
+def save(runs_root: Path, dest: Path) -> str:
+    """Copy what resuming needs from ``runs_root`` into ``dest``; one line of what changed."""
+    if not runs_root.is_dir():
+        raise SystemExit(f"study_state: {runs_root} is not a folder")
+    runs = _run_dirs(runs_root)
+    written, removed = _mirror(runs_root, dest, runs, prune=True)
+    return f"saved {len(runs)} run folders into {dest}: {written} files written, {removed} removed"
+
+
+def restore(saved: Path, runs_root: Path) -> str:
+    """Put a saved study back under ``runs_root``, never moving a run folder backwards."""
+    if not saved.is_dir():
+        raise SystemExit(f"study_state: {saved} is not a folder")
+    runs = _run_dirs(saved)
+    newer = [r for r in runs if _step(runs_root / r.relative_to(saved)) >= _step(r) >= 0]
+    todo = [r for r in runs if r not in newer]
+    written, _ = _mirror(saved, runs_root, todo, prune=False)
+    msg = f"restored {len(todo)} run folders into {runs_root} ({written} files)"
+    if newer:
+        msg += f"; left {len(newer)} alone (already at or past the saved checkpoint)"
+    return msg
+
+
+def main(argv: list[str] | None = None) -> int:
+    """The command line: ``save RUNS DEST`` or ``restore SAVED RUNS``."""
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    sub = ap.add_subparsers(dest="verb", required=True)
+    s = sub.add_parser("save", help="copy a study's resumable state out of its run root")
+    s.add_argument("runs", type=Path)
+    s.add_argument("dest", type=Path)
+    r = sub.add_parser("restore", help="put a saved study back into a run root")
+    r.add_argument("saved", type=Path)
+    r.add_argument("runs", type=Path)
+    args = ap.parse_args(argv)
+    if args.verb == "save":
+        print(save(args.runs, args.dest))
+    else:
+        print(restore(args.saved, args.runs))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
