@@ -6,14 +6,22 @@ L 0.01 m, floor and gravity, seed damping, dT 14, period 0.25 s, 5 s simulated.
 
 Prints voxel-steps/s for batches of 1, 16 and 64 robots with 1 and 2 threads,
 robot sizes 4^3, 6^3 and 10^3, peak memory per robot, and ratios to the
-reference engines measured on this machine kind (quoted, not re-measured here:
-the seed's engine at -O3 ~2.3 M voxel-steps/s per core, the 2015 Voxelyze
-library 1.4-2.1 M), for the default "seed" preset (SimConfig.model, the seed
+reference engines, for the default "seed" preset (SimConfig.model, the seed
 engine's step) and rows of the "corotational" preset. Appends a table to
 benchmarks/RESULTS.md.
 
+The seed's own engine is timed in the same run when its program is given
+(``--seed-engine PATH/seed_oracle.py``, the oracle of issue 16; not part of the
+project): the reference robot as a .vxa (``softgym.design.vxa.to_vxa``, the
+seed's settings, self-collision on as the seed always ran), best of 3, against
+softgym's seed preset on the same robot, alone, one thread, self-collision on.
+Without it the ratios use figures quoted from an earlier machine of this kind
+(the seed's engine at -O3 ~2.3 M voxel-steps/s per core, the 2015 Voxelyze
+library 1.4-2.1 M) and say so.
+
     python benchmarks/bench_engine.py            # full table (about 2 minutes)
     python benchmarks/bench_engine.py --quick --json   # < 60 s, last line is JSON
+    python benchmarks/bench_engine.py --seed-engine ../shared/oracle/seed_oracle.py
 """
 
 from __future__ import annotations
@@ -81,11 +89,64 @@ def measure(n: int, batch: int, threads: int, seconds: float, repeats: int,
     }
 
 
+def reference_design():
+    """The reference robot as a design of the seed palette (Active_+ x < 3, Active_- x >= 3)."""
+    from softgym.design import RobotDesign
+
+    grid = np.full((6, 6, 6), 3, dtype=np.int8)  # Active_+ (CTE +0.01)
+    grid[3:] = 4  # Active_- (CTE -0.01)
+    return RobotDesign(grid)
+
+
+def seed_engine_ratio(oracle_py: str, repeats: int = 3) -> dict:
+    """Voxel-steps/s of the seed's engine and of softgym on the same robot, in this run.
+
+    ``oracle_py`` is the oracle's ``seed_oracle.py`` (issue 16); its ``run_vxa``
+    runs one .vxa in the seed's program (one process, one thread) and reports
+    the wall time. softgym runs the same design alone on one thread with the
+    seed preset and self-collision on (the .vxa's settings). Both take the same
+    steps (the seed preset's time step is the seed's), counted by softgym.
+    """
+    import importlib.util
+    from pathlib import Path
+
+    from softgym.design.vxa import to_vxa
+
+    spec = importlib.util.spec_from_file_location("seed_oracle", Path(oracle_py))
+    oracle = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(oracle)
+    design = reference_design()
+    text = to_vxa(design)
+    walls = []
+    for _ in range(repeats):
+        res = oracle.run_vxa(text)
+        if res.get("hung") or "error" in res:
+            raise SystemExit(f"bench_engine: the seed's engine did not finish: {res}")
+        walls.append(res["wall_s"])
+    ours = []
+    for _ in range(repeats):
+        sim = Simulation([design.to_body()], SimConfig(self_collision=True), n_threads=1)
+        t0 = time.perf_counter()
+        rollout = sim.run(5.0)
+        ours.append(time.perf_counter() - t0)
+    vsteps = float(design.n_voxels * rollout.steps[0])
+    return {
+        "seed_engine_voxel_steps_per_s": vsteps / min(walls),
+        "softgym_voxel_steps_per_s": vsteps / min(ours),
+        "ratio": min(walls) / min(ours),
+        "seed_engine_wall_s": min(walls),
+        "softgym_wall_s": min(ours),
+        "steps": int(rollout.steps[0]),
+    }
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="short runs, finishes in < 60 s")
     ap.add_argument("--json", action="store_true", help="print one JSON object as the last line")
     ap.add_argument("--no-append", action="store_true", help="do not append to RESULTS.md")
+    ap.add_argument("--seed-engine", metavar="SEED_ORACLE_PY",
+                    help="time the seed's own engine (../shared/oracle/seed_oracle.py) in this run")  # fmt: skip
     args = ap.parse_args(argv)
 
     seconds = 5.0
@@ -127,6 +188,12 @@ def main(argv: list[str] | None = None) -> int:
     v1, v2 = find("6^3", 1, False), find("6^3", 2, False)
     vc = find("6^3", 1, True)
     vco = find("6^3", 1, False, model="corotational")
+    measured = seed_engine_ratio(args.seed_engine) if args.seed_engine else None
+    # measured: the same robot with the same settings in both engines; quoted: batch 16 vs a
+    # figure from an earlier machine
+    vs_seed = measured["ratio"] if measured else v1 / SEED_ENGINE_O3
+    how = ("same robot and settings, measured in this run" if measured
+           else "its speed quoted from an earlier machine, not measured")  # fmt: skip
     summary = {
         "voxel_steps_per_s_1thread": v1,
         "voxel_steps_per_s_2threads": v2,
@@ -134,7 +201,8 @@ def main(argv: list[str] | None = None) -> int:
         "voxel_steps_per_s_1thread_corotational": vco,
         "seed_vs_corotational": v1 / vco,
         "thread_scaling": v2 / v1,
-        "vs_seed_engine_O3_per_core": v1 / SEED_ENGINE_O3,
+        "vs_seed_engine_O3_per_core": vs_seed,
+        "seed_engine_measured": measured,
         "vs_voxelyze_2015_per_core": [v1 / VOXELYZE_2015[1], v1 / VOXELYZE_2015[0]],
         "seconds_per_soft_robot_5s_1thread": 216 * (5.0 / Simulation(reference_robot()).dt[0]) / v1,
         "openmp": openmp_enabled(),
@@ -144,8 +212,8 @@ def main(argv: list[str] | None = None) -> int:
           f"{v2 / 1e6:.2f} M on 2 threads ({v2 / v1:.2f}x), {vc / 1e6:.2f} M on 1 thread "
           f"with self-collision (seed preset); the corotational preset {vco / 1e6:.2f} M "
           f"(seed preset = {v1 / vco:.2f}x it); "
-          f"{v1 / SEED_ENGINE_O3:.1f}x the seed's engine at -O3 per core, "
-          f"{v1 / VOXELYZE_2015[1]:.1f}-{v1 / VOXELYZE_2015[0]:.1f}x Voxelyze 2015 per core; "
+          f"{vs_seed:.1f}x the seed's engine at -O3 per core ({how}), "
+          f"{v1 / VOXELYZE_2015[1]:.1f}-{v1 / VOXELYZE_2015[0]:.1f}x Voxelyze 2015 per core (quoted); "
           f"{summary['seconds_per_soft_robot_5s_1thread'] * 1000:.0f} ms per 6^3 soft robot "
           f"(5 s simulated) on one core", file=sys.stderr)
 
@@ -163,7 +231,16 @@ def main(argv: list[str] | None = None) -> int:
         lines.append(f"\n2 threads / 1 thread (6^3, batch 16): {v2 / v1:.2f}x; with self-collision "
                      f"{vc / 1e6:.2f} M voxel-steps/s on 1 thread; "
                      f"seed preset / corotational preset: {v1 / vco:.2f}x; "
-                     f"vs the seed's engine at -O3: {v1 / SEED_ENGINE_O3:.1f}x per core.\n")
+                     f"vs the seed's engine at -O3: {vs_seed:.1f}x per core ({how}).")
+        if measured:
+            lines.append(
+                f"The seed's own engine on this machine, in this run (`--seed-engine`): the "
+                f"reference robot alone, self-collision on, {measured['steps']} steps: "
+                f"{measured['seed_engine_wall_s']:.3f} s ({measured['seed_engine_voxel_steps_per_s'] / 1e6:.2f} M "
+                f"voxel-steps/s) against softgym's seed preset {measured['softgym_wall_s']:.3f} s "
+                f"({measured['softgym_voxel_steps_per_s'] / 1e6:.2f} M), one thread each: "
+                f"{measured['ratio']:.1f}x (best of 3 each).")
+        lines.append("")
         results_log.append("\n".join(lines))
     if args.json:
         print(json.dumps(summary))
