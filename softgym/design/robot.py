@@ -876,7 +876,7 @@ class RobotDesign:
             Naming the file, if its content is not a valid design.
         """
         path = os.fspath(path)
-        data = _read_capped(path, MAX_DESIGN_JSON_BYTES, "design")
+        data = read_capped(path, MAX_DESIGN_JSON_BYTES, "design")
         try:
             text = data.decode("utf-8")
         except UnicodeDecodeError:
@@ -887,7 +887,7 @@ class RobotDesign:
             raise InvalidDesignError(f"design file {path!r}: {exc}") from exc
 
 
-def _read_capped(path: str, cap: int, what: str) -> bytes:
+def read_capped(path: str, cap: int, what: str) -> bytes:
     """The bytes of ``path``; any problem raises :class:`DesignFileError` naming the file."""
     try:
         with open(path, "rb") as fh:

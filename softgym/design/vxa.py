@@ -52,7 +52,7 @@ import numpy as np
 
 from softgym.design.controller import Controller
 from softgym.design.material import MAX_MATERIAL_ID, Material, Palette
-from softgym.design.robot import RobotDesign, _read_capped, check_grid_shape
+from softgym.design.robot import RobotDesign, check_grid_shape, read_capped
 from softgym.exceptions import InvalidDesignError, InvalidParameterError
 
 if TYPE_CHECKING:
@@ -423,7 +423,7 @@ def load_vxa(path: str | os.PathLike[str]) -> RobotDesign:
         Naming the file, if its content is not a valid ``.vxa`` design.
     """
     path = os.fspath(path)
-    data = _read_capped(path, MAX_VXA_BYTES, "VXA")
+    data = read_capped(path, MAX_VXA_BYTES, "VXA")
     try:
         return parse_vxa(data).design
     except InvalidDesignError as exc:
