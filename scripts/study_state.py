@@ -7,15 +7,21 @@ copies the part of each run folder that resuming and ``softgym study report``
 need into a folder that can be committed or copied (``save``), and puts it back
 into a run root (``restore``):
 
-* per run: ``config.json``, ``log.jsonl``, ``log.csv``, ``notes.jsonl``,
-  ``best_designs.json``, ``best_design.json``, ``final_population.json`` and
-  the newest *intact* checkpoint (its ``.json`` and ``.npz``; checked with
-  :func:`softgym.io.load_latest_intact`, so a checkpoint half written by a
-  running study is never taken);
+* per run: ``config.json``, ``log.jsonl``, ``notes.jsonl``,
+  ``best_designs.json``, ``best_design.json``, ``final_population.json``;
+* for a run that is not complete (``evolvers.study.run_status`` against its
+  scenario's generations), the newest *intact* checkpoint too (its ``.json``
+  and ``.npz``; checked with :func:`softgym.io.load_latest_intact`, so a
+  checkpoint half written by a running study is never taken). A complete run
+  needs none (the study skips it; the report reads its log), and checkpoints
+  are most of a run folder's bytes: the phenotype cache holds the trajectory of
+  every robot simulated. Extending a complete run to more generations after a
+  restore starts it again from generation 0 (same seed, same result);
 * per scenario and study: ``scenario.json`` and ``study.json``.
 
-Figures, ``.vxa`` files, the ``best_designs/`` folder and older checkpoints are
-left out: the run writes them again when it resumes. Files in the saved copy
+Figures, ``.vxa`` files, ``log.csv`` (``log.jsonl`` holds the same rows), the
+``best_designs/`` folder and older checkpoints are left out: a run writes them
+again when it resumes. Files in the saved copy
 that the run no longer has (an older checkpoint) are removed, and files whose
 bytes did not change are not rewritten, so a committed copy only changes where
 the study moved on.
@@ -34,13 +40,13 @@ import shutil
 import sys
 from pathlib import Path
 
+from evolvers.study import run_status
 from softgym.exceptions import CheckpointError
-from softgym.io import list_checkpoints, load_latest_intact
+from softgym.io import list_checkpoints, load_latest_intact, read_json
 
 RUN_FILES = (
     "config.json",
     "log.jsonl",
-    "log.csv",
     "notes.jsonl",
     "best_designs.json",
     "best_design.json",
@@ -68,6 +74,8 @@ def _selected(run: Path) -> list[Path]:
     """The files of one run folder that are kept (relative to it)."""
     keep = [Path(n) for n in RUN_FILES if (run / n).is_file()]
     ckdir = run / "checkpoints"
+    if _complete(run):
+        return keep
     if ckdir.is_dir() and list_checkpoints(ckdir):
         try:
             ck = load_latest_intact(ckdir).path
@@ -75,6 +83,15 @@ def _selected(run: Path) -> list[Path]:
             raise SystemExit(f"study_state: {run}: {exc}") from None
         keep += [Path("checkpoints") / ck.name, Path("checkpoints") / ck.with_suffix(".npz").name]
     return keep
+
+
+def _complete(run: Path) -> bool:
+    """Whether the run reached its scenario's generations (False without a scenario.json)."""
+    scenario = run.parent / "scenario.json"
+    if not scenario.is_file():
+        return False
+    generations = read_json(scenario).get("generations")
+    return isinstance(generations, int) and run_status(run, generations) == "complete"
 
 
 def _step(run: Path) -> int:
@@ -122,7 +139,12 @@ def restore(saved: Path, runs_root: Path) -> str:
     if not saved.is_dir():
         raise SystemExit(f"study_state: {saved} is not a folder")
     runs = _run_dirs(saved)
-    newer = [r for r in runs if _step(runs_root / r.relative_to(saved)) >= _step(r) >= 0]
+    newer = [
+        r
+        for r in runs
+        if _complete(runs_root / r.relative_to(saved))
+        or _step(runs_root / r.relative_to(saved)) >= _step(r) >= 0
+    ]
     todo = [r for r in runs if r not in newer]
     written, _ = _mirror(saved, runs_root, todo, prune=False)
     msg = f"restored {len(todo)} run folders into {runs_root} ({written} files)"

@@ -24,6 +24,12 @@ def test_saved_study_resumes_exactly_elsewhere(tmp_path):
     first, saved, second, straight = (tmp_path / n for n in ("a", "saved", "b", "straight"))
     assert main([*STUDY, "--generations", "1", "--out", str(first)]) == 0
     assert main([*STUDY, "--generations", "2", "--out", str(first)]) == 0  # 3 checkpoints now
+    # a complete run keeps its log and designs, not its checkpoints (the study skips it)
+    study_state.save(first, tmp_path / "complete")
+    done = tmp_path / "complete" / "basic" / "seed-0"
+    assert (done / "final_population.json").is_file() and not (done / "checkpoints").exists()
+    # a run killed before its end (no final_population.json yet, as after a kill -9)
+    (first / "basic" / "seed-0" / "final_population.json").unlink()
     # only what resuming needs: the newest checkpoint, no figures, no .vxa
     print(study_state.save(first, saved))
     run = saved / "basic" / "seed-0"
@@ -39,9 +45,8 @@ def test_saved_study_resumes_exactly_elsewhere(tmp_path):
     assert main([*STUDY, "--generations", "4", "--out", str(straight)]) == 0
     assert _rows(second / "basic" / "seed-0") == _rows(straight / "basic" / "seed-0")
     assert len(_rows(straight / "basic" / "seed-0")) == 5
-    # restore never moves a run back; saving again prunes the older checkpoint
+    # restore never moves a run back; saving the now complete run drops its checkpoint
     assert "left 1 alone" in study_state.restore(saved, second)
     assert _rows(second / "basic" / "seed-0") == _rows(straight / "basic" / "seed-0")
-    msg = study_state.save(second, saved)
-    assert "2 removed" in msg
-    assert sorted(p.name for p in (run / "checkpoints").iterdir())[0] == "ckpt-000004.json"
+    assert "2 removed" in study_state.save(second, saved)
+    assert not list((run / "checkpoints").glob("*")) and (run / "final_population.json").is_file()
