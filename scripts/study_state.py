@@ -55,6 +55,10 @@ RUN_FILES = (
 ROOT_FILES = ("scenario.json", "study.json")
 
 
+class StudyStateError(Exception):
+    """A folder that is not there, or a run whose checkpoints are all damaged."""
+
+
 def _run_dirs(root: Path) -> list[Path]:
     return sorted(p.parent for p in root.rglob("config.json") if p.parent != root)
 
@@ -80,7 +84,7 @@ def _selected(run: Path) -> list[Path]:
         try:
             ck = load_latest_intact(ckdir).path
         except CheckpointError as exc:
-            raise SystemExit(f"study_state: {run}: {exc}") from None
+            raise StudyStateError(f"{run}: {exc}") from None
         keep += [Path("checkpoints") / ck.name, Path("checkpoints") / ck.with_suffix(".npz").name]
     return keep
 
@@ -128,7 +132,7 @@ def _mirror(src_root: Path, dst_root: Path, runs: list[Path], prune: bool) -> tu
 def save(runs_root: Path, dest: Path) -> str:
     """Copy what resuming needs from ``runs_root`` into ``dest``; one line of what changed."""
     if not runs_root.is_dir():
-        raise SystemExit(f"study_state: {runs_root} is not a folder")
+        raise StudyStateError(f"{runs_root} is not a folder")
     runs = _run_dirs(runs_root)
     written, removed = _mirror(runs_root, dest, runs, prune=True)
     return f"saved {len(runs)} run folders into {dest}: {written} files written, {removed} removed"
@@ -137,7 +141,7 @@ def save(runs_root: Path, dest: Path) -> str:
 def restore(saved: Path, runs_root: Path) -> str:
     """Put a saved study back under ``runs_root``, never moving a run folder backwards."""
     if not saved.is_dir():
-        raise SystemExit(f"study_state: {saved} is not a folder")
+        raise StudyStateError(f"{saved} is not a folder")
     runs = _run_dirs(saved)
     newer = [
         r
@@ -164,10 +168,14 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("saved", type=Path)
     r.add_argument("runs", type=Path)
     args = ap.parse_args(argv)
-    if args.verb == "save":
-        print(save(args.runs, args.dest))
-    else:
-        print(restore(args.saved, args.runs))
+    try:
+        if args.verb == "save":
+            print(save(args.runs, args.dest))
+        else:
+            print(restore(args.saved, args.runs))
+    except StudyStateError as exc:
+        print(f"study_state: {exc}", file=sys.stderr)
+        return 2
     return 0
 
 

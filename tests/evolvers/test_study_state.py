@@ -50,3 +50,11 @@ def test_saved_study_resumes_exactly_elsewhere(tmp_path):
     assert _rows(second / "basic" / "seed-0") == _rows(straight / "basic" / "seed-0")
     assert "2 removed" in study_state.save(second, saved)
     assert not list((run / "checkpoints").glob("*")) and (run / "final_population.json").is_file()
+
+
+def test_missing_folders_are_one_line_and_exit_2(tmp_path, capsys):
+    assert study_state.main(["restore", str(tmp_path / "nothing"), str(tmp_path / "runs")]) == 2
+    assert study_state.main(["save", str(tmp_path / "nothing"), str(tmp_path / "saved")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 2 and all(e.startswith("study_state: ") for e in err)
+    assert not (tmp_path / "runs").exists() and not (tmp_path / "saved").exists()
