@@ -494,16 +494,31 @@ def run_study(
     one_thread = [replace(s, n_threads=1) if s.n_threads is None else s for s in ordered]
     tag = uuid.uuid4().hex[:8]
     with dask_client(scheduler or "local", n_workers=workers) as client:
-        futures = {
-            client.submit(
-                run_one, s.to_dict(), pure=False, retries=2, key=f"{s.scenario}-seed-{s.seed}-{tag}"
-            ): s
-            for s in one_thread
-        }
-        for fut in distributed.as_completed(list(futures)):
+        # a window of as many runs as the cluster has threads, the next one submitted as one
+        # ends: runs start in run_order (all seed 0 runs before any seed 1), which Dask does
+        # not keep when everything is submitted at once (its workers take tasks as they are
+        # placed and stolen, and a study's last seeds started before its first ones ended)
+        window = max(1, sum(client.nthreads().values()))
+        pending = iter(one_thread)
+        futures: dict[Any, RunSpec] = {}
+        ac = distributed.as_completed()
+
+        def submit_next() -> None:
+            s = next(pending, None)
+            if s is None:
+                return
+            key = f"{s.scenario}-seed-{s.seed}-{tag}"
+            fut = client.submit(run_one, s.to_dict(), pure=False, retries=2, key=key)
+            futures[fut] = s
+            ac.add(fut)
+
+        for _ in range(window):
+            submit_next()
+        for fut in ac:
             try:
                 res = fut.result()
             except Exception as exc:
                 res = failed(futures[fut], exc)
             done(res)
+            submit_next()
     return results

@@ -151,3 +151,21 @@ def test_seeds_run_in_parallel_on_a_local_cluster(tmp_path):
     assert sorted(r["status"] for r in res) == ["ran", "ran"]
     runs = load_runs(tmp_path)["controller-tournament"]
     assert [r.seed for r in runs] == [0, 1] and all(r.complete for r in runs)
+
+
+def test_parallel_runs_start_in_run_order(tmp_path):
+    # 2 workers, 4 runs: they start in run_order, the third only once a run has ended
+    pytest.importorskip("distributed")
+    specs = plan(tmp_path, scenarios=["basic", "controller-tournament"], seeds=2, generations=1,
+                 pop_size=4, seconds=1.0, shape=(3, 3, 3))  # fmt: skip
+    res = run_study(specs, workers=2)
+    assert sorted(r["status"] for r in res) == ["ran"] * 4
+    ordered = run_order(specs)
+    started = [(s.out / "config.json").stat().st_mtime for s in ordered]
+    ended = [(s.out / "final_population.json").stat().st_mtime for s in ordered]
+    assert max(started[:2]) <= started[2] <= started[3]
+    assert started[2] >= min(ended[:2]) and started[3] >= sorted(ended[:3])[1]
+    # completion order: every result is reported, each run once
+    assert sorted((r["scenario"], r["seed"]) for r in res) == sorted(
+        (s.scenario, s.seed) for s in specs
+    )
