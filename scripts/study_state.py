@@ -143,12 +143,15 @@ def restore(saved: Path, runs_root: Path) -> str:
     if not saved.is_dir():
         raise StudyStateError(f"{saved} is not a folder")
     runs = _run_dirs(saved)
-    newer = [
-        r
-        for r in runs
-        if _complete(runs_root / r.relative_to(saved))
-        or _step(runs_root / r.relative_to(saved)) >= _step(r) >= 0
-    ]
+
+    def already_there(run: Path) -> bool:
+        there = runs_root / run.relative_to(saved)
+        if _complete(there):
+            return True
+        saved_step = _step(run)
+        return saved_step >= 0 and _step(there) >= saved_step
+
+    newer = [r for r in runs if already_there(r)]
     todo = [r for r in runs if r not in newer]
     written, _ = _mirror(saved, runs_root, todo, prune=False)
     msg = f"restored {len(todo)} run folders into {runs_root} ({written} files)"
