@@ -51,6 +51,7 @@ __all__ = [
     "RunData",
     "a12",
     "claims",
+    "finished_runs",
     "load_runs",
     "permutation_pvalue",
     "write_report",
@@ -513,7 +514,9 @@ def claim_t1_materials(runs: Mapping[str, list[RunData]]) -> Claim:
     return Claim(
         cid, sec, rep,
         f"muscle |CTE| {_summary(cte)} (>= 0.035 in {at_bound}/{n}); muscle density "
-        f"{_summary(dens)}; tissue density {_summary(tdens)}; tissue E {_summary(tE)} Pa",
+        f"{_summary(dens)}; "
+        + (f"tissue (in {_finite(tdens).size}/{n} winners) density {_summary(tdens)}, "
+           f"E {_summary(tE)} Pa" if _finite(tdens).size else f"no winner uses tissue (0/{n})"),
         verdict,
         "CTE part: most winners' muscles within 0.005 of the 0.04 bound; density part: medians "
         "above the initial 1e6 kg/m^3 (the report's own fastest muscle, 586 635, is below it)",
@@ -810,20 +813,48 @@ def claims(runs: Mapping[str, list[RunData]]) -> list[Claim]:
     A claim read on runs shorter than the report's (:data:`REPORT_GENERATIONS`)
     says so in its ``why`` ("provisional").
     """
+    used, left_out = finished_runs(runs)
     out = []
     for f in CLAIMS:
-        c = f(runs)
+        c = f(used)
+        names = CLAIM_SCENARIOS.get(c.id, ())
         short = [
-            f"{n} reached generation {min(r.generation for r in runs[n])} of the report's "
+            f"{n} reached generation {min(r.generation for r in used[n])} of the report's "
             f"{REPORT_GENERATIONS[n]}"
-            for n in CLAIM_SCENARIOS.get(c.id, ())
-            if runs.get(n) and n in REPORT_GENERATIONS
-            and min(r.generation for r in runs[n]) < REPORT_GENERATIONS[n]
+            for n in names
+            if used.get(n) and n in REPORT_GENERATIONS
+            and min(r.generation for r in used[n]) < REPORT_GENERATIONS[n]
         ]  # fmt: skip
-        if short and c.verdict != UNTESTED:
-            c.why = f"{c.why}. Provisional: {'; '.join(short)}"
+        skipped = [
+            f"{n} {', '.join(str(s) for s in left_out[n])}" for n in names if left_out.get(n)
+        ]
+        if c.verdict != UNTESTED:
+            if short:
+                c.why = f"{c.why}. Provisional: {'; '.join(short)}"
+            if skipped:
+                c.why = f"{c.why}. Unfinished seeds left out: {'; '.join(skipped)}"
         out.append(c)
     return out
+
+
+def finished_runs(
+    runs: Mapping[str, list[RunData]],
+) -> tuple[dict[str, list[RunData]], dict[str, list[int]]]:
+    """The runs the claims read, and the seeds left out, by scenario.
+
+    A scenario with at least one complete run is read on its complete runs
+    only (an unfinished seed would compare an early generation with other
+    seeds' last one); a scenario with none is read on all its runs, and its
+    claims are marked provisional.
+    """
+    used: dict[str, list[RunData]] = {}
+    left_out: dict[str, list[int]] = {}
+    for name, rs in runs.items():
+        done = [r for r in rs if r.complete]
+        used[name] = done or list(rs)
+        if done and len(done) < len(rs):
+            left_out[name] = [r.seed for r in rs if not r.complete]
+    return used, left_out
 
 
 # ---------------------------------------------------------------------------- figures
@@ -1164,6 +1195,10 @@ def write_report(
         "the share is over generations >= 1.",
         "* **Verdicts**: comparisons use a one-sided permutation test of the Mann-Whitney statistic "
         "(p < 0.05 holds; right direction but p >= 0.05 partly) and A12; other rules are in each row.",
+        "* **Unfinished seeds**: a scenario with complete runs is judged on those only (an "
+        "unfinished seed's early generation is not compared with other seeds' last one; the row "
+        "names the seeds left out); a scenario with none is judged on what has run, marked "
+        "provisional. The figures show every seed.",
         "",
     ]
     readme = out / "README.md"

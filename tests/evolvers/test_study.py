@@ -74,10 +74,26 @@ def test_study_runs_resumes_skips_and_reports(tmp_path, capsys):
     # a run that has started but logged no generation yet is left out, not a crash
     started = root / "controller-pareto" / "seed-2"
     started.mkdir()
-    (started / "config.json").write_text((root / "controller-pareto" / "seed-0" / "config.json").read_text())
+    (started / "config.json").write_text(
+        (root / "controller-pareto" / "seed-0" / "config.json").read_text()
+    )
     (started / "log.jsonl").write_text("")
     assert [r.path.name for r in load_runs(root)["controller-pareto"]] == ["seed-0", "seed-1"]
     assert main(["study", "report", str(root), "--out", str(out)]) == 0
+    # an unfinished seed beside complete ones is listed, and left out of the claims (its early
+    # generation would be compared with the other seeds' last one)
+    first_row = (root / "controller-pareto" / "seed-0" / "log.jsonl").read_text().splitlines()[0]
+    (started / "log.jsonl").write_text(first_row + "\n")
+    cfg = json.loads((started / "config.json").read_text())
+    (started / "config.json").write_text(json.dumps({**cfg, "seed": 2}))
+    assert [r.complete for r in load_runs(root)["controller-pareto"]] == [True, True, False]
+    assert main(["study", "report", str(root), "--out", str(out)]) == 0
+    text = (out / "README.md").read_text()
+    assert "controller-pareto seed 2 (generation 0 of 2)" in text
+    by_id = {c["id"]: c for c in json.loads((out / "claims.json").read_text())}
+    assert len(by_id["tournament-vs-pareto"]["data"]["pareto"]) == 2
+    assert "best at generation 2:" in by_id["tournament-vs-pareto"]["measured"]
+    assert "Unfinished seeds left out: controller-pareto 2" in by_id["tournament-vs-pareto"]["why"]
 
 
 def test_plan_defaults_and_errors(tmp_path):
