@@ -69,6 +69,7 @@ __all__ = [
     "run_order",
     "run_status",
     "run_study",
+    "time_to_go",
 ]
 
 log = logging.getLogger("evolvers")
@@ -325,6 +326,65 @@ def _last_generation(run_dir: Path) -> int:
             except (ValueError, KeyError, TypeError):
                 return -1
     return last
+
+
+def _generation_seconds(run_dir: Path) -> tuple[int, float]:
+    """(last generation logged, wall seconds its generations took); (-1, 0) without a log."""
+    path = run_dir / "log.jsonl"
+    last, total = -1, 0.0
+    if not path.exists():
+        return last, total
+    for line in path.read_text().splitlines():
+        try:
+            row = json.loads(line)
+            last = int(row["generation"])
+            total += float(row.get("wall_time") or 0.0)
+        except (ValueError, KeyError, TypeError):
+            continue
+    return last, total
+
+
+def _settings_key(spec: RunSpec) -> tuple[str, str]:
+    """A scenario and its settings, all but the number of generations."""
+    exp = {k: v for k, v in spec.experiment.to_dict().items() if k != "generations"}
+    return spec.scenario, json.dumps(exp, sort_keys=True, default=str)
+
+
+def time_to_go(specs: Sequence[RunSpec]) -> list[tuple[float, str]]:
+    """Seconds each run still needs, and where the figure comes from, in ``specs``' order.
+
+    A run with logged generations is timed by its own seconds per generation
+    ("measured"); a new run by the median rate of its scenario's runs in
+    ``specs`` that have logged generations with the same settings ("scenario");
+    otherwise by :attr:`RunSpec.cost` ("estimate"). Rates are wall seconds of
+    one run on one worker, i.e. CPU seconds when each worker has a core.
+    Complete runs need 0.
+    """
+    logged = {id(s): _generation_seconds(s.out) for s in specs}
+    rates: dict[tuple[str, str], list[float]] = {}
+    for s in specs:
+        last, total = logged[id(s)]
+        if last >= 1 and total > 0:  # a rate from a single generation 0 is mostly set-up
+            key = _settings_key(s)
+            rates.setdefault(key, []).append(total / (last + 1))
+    out = []
+    for s in specs:
+        last, total = logged[id(s)]
+        if run_status(s.out, s.generations) == "complete":
+            out.append((0.0, "complete"))
+            continue
+        left = s.generations - last
+        if last >= 1 and total > 0:
+            out.append((left * total / (last + 1), "measured"))
+            continue
+        key = _settings_key(s)
+        if key in rates:
+            r = sorted(rates[key])
+            median = (r[(len(r) - 1) // 2] + r[len(r) // 2]) / 2
+            out.append((left * median, "scenario"))
+        else:
+            out.append((s.cost * left / (s.generations + 1), "estimate"))
+    return out
 
 
 def run_status(run_dir: str | Path, generations: int) -> str:

@@ -448,7 +448,7 @@ def _cmd_experiments(args: argparse.Namespace) -> int:
 def _cmd_study(args: argparse.Namespace) -> int:
     if getattr(args, "study_command", None) == "report":
         return _cmd_study_report(args)
-    from evolvers.study import get_study, plan, run_order, run_status, run_study
+    from evolvers.study import get_study, plan, run_order, run_status, run_study, time_to_go
     from softgym.exceptions import SoftGymError
 
     overrides = {}
@@ -470,13 +470,19 @@ def _cmd_study(args: argparse.Namespace) -> int:
         print(f"softgym study: {exc}", file=sys.stderr)
         return 2
     if args.plan:
-        todo = 0.0
-        for s in run_order(specs):  # the order the runs start in
+        ordered = run_order(specs)  # the order the runs start in
+        togo = time_to_go(ordered)
+        for s, (left, source) in zip(ordered, togo):
             status = run_status(s.out, s.generations)
-            todo += 0.0 if status == "complete" else s.cost
+            left_text = "" if status == "complete" else f"~{left / 3600:5.2f} CPU h to go ({source})"
             print(f"{s.scenario:24s} seed {s.seed:<4d} {s.generations:4d} generations  "
-                  f"{status:8s} ~{s.cost / 3600:5.2f} CPU h  {s.out}")  # fmt: skip
-        print(f"{len(specs)} runs; ~{todo / 3600:.1f} CPU hours to go (whole runs, estimated)")
+                  f"{status:8s} {left_text:32s}  {s.out}")  # fmt: skip
+        todo = sum(left for left, _ in togo)
+        timed = sum(src in ("measured", "scenario") for _, src in togo)
+        unfinished = sum(src != "complete" for _, src in togo)
+        print(f"{len(specs)} runs, {unfinished} unfinished; ~{todo / 3600:.1f} CPU hours to go "
+              f"({timed} timed from logged generations, the rest from the scenarios' "
+              f"estimates)")  # fmt: skip
         return 0
 
     def report(res):

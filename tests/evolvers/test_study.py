@@ -9,7 +9,7 @@ from evolver_helpers import tiny
 from evolvers.evaluation import EvalStats
 from evolvers.genome import Individual
 from evolvers.recorder import add_run_note, obstacle_footprint, read_run_notes, study_columns
-from evolvers.study import SEED_REPORT, plan, run_order, run_status, run_study
+from evolvers.study import SEED_REPORT, plan, run_order, run_status, run_study, time_to_go
 from evolvers.study_report import a12, load_runs, permutation_pvalue
 from softgym.cli import main
 from softgym.exceptions import InvalidParameterError
@@ -185,3 +185,21 @@ def test_parallel_runs_start_in_run_order(tmp_path):
     assert sorted((r["scenario"], r["seed"]) for r in res) == sorted(
         (s.scenario, s.seed) for s in specs
     )
+
+
+def test_time_to_go_uses_logged_generations(tmp_path):
+    # a partial run is timed by its own generations, a new one by its scenario's rate, a
+    # scenario with nothing logged by the static estimate; complete runs need nothing
+    specs = plan(tmp_path, scenarios=["basic", "controller-tournament"], seeds=2, generations=9)
+    basic0, basic1, tourn0, _ = sorted(specs, key=lambda s: (s.scenario, s.seed))
+    basic0.out.mkdir(parents=True)
+    rows = [{"generation": g, "wall_time": 2.0} for g in range(4)]
+    (basic0.out / "log.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+    togo = dict(zip([id(s) for s in specs], time_to_go(specs)))
+    assert togo[id(basic0)] == (pytest.approx(6 * 2.0), "measured")
+    assert togo[id(basic1)] == (pytest.approx(10 * 2.0), "scenario")
+    assert togo[id(tourn0)] == (pytest.approx(tourn0.cost), "estimate")
+    rows += [{"generation": g, "wall_time": 2.0} for g in range(4, 10)]
+    (basic0.out / "log.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
+    (basic0.out / "final_population.json").write_text("{}")
+    assert time_to_go([basic0])[0] == (0.0, "complete")
