@@ -900,6 +900,18 @@ def _plot_reference(ax: Any, name: str, color: Any) -> None:
         ax.plot(x, y, "--", color=color, linewidth=1.2, label=f"{name}: the report's single run")
 
 
+def _log_if_wide(ax: Any, decades: float = 2.0) -> None:
+    """Log y axis when the plotted values span more than ``decades`` (e.g. a run that found the
+    low-density flying exploit next to the report's curve), so the smaller curves stay readable.
+    """
+    ys = [np.asarray(line.get_ydata(), dtype=float) for line in ax.get_lines()]
+    ys = [y[np.isfinite(y) & (y > 0)] for y in ys]
+    y = np.concatenate(ys) if ys else np.empty(0)
+    if y.size and np.log10(y.max() / y.min()) > decades:
+        ax.set_yscale("log")
+        ax.set_ylabel(f"{ax.get_ylabel()}, log scale")
+
+
 def fitness_figure(name: str, rs: Sequence[RunData], path: Path) -> Path:
     """Best-of-generation fitness of one scenario: median and IQR over seeds, seeds thin, report dashed."""
     plt = _plt()
@@ -912,6 +924,7 @@ def fitness_figure(name: str, rs: Sequence[RunData], path: Path) -> Path:
     _plot_reference(ax, name, "C3")
     ax.set_xlabel("generation")
     ax.set_ylabel(f"best {rs[0].fitness} (voxel lengths)")
+    _log_if_wide(ax)
     ax.set_title(f"{name}: best of generation over {len(rs)} seeds")
     ax.legend(fontsize=7, loc="best")
     fig.tight_layout()
@@ -933,6 +946,7 @@ def group_figure(
         _plot_reference(ax, n, f"C{i}")
     ax.set_xlabel("generation")
     ax.set_ylabel("best fitness (voxel lengths)")
+    _log_if_wide(ax)
     ax.set_title(title)
     ax.legend(fontsize=7, loc="best")
     fig.tight_layout()
