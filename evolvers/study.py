@@ -45,6 +45,7 @@ from __future__ import annotations
 import json
 import logging
 import math
+import statistics
 import time
 import uuid
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -360,28 +361,25 @@ def time_to_go(specs: Sequence[RunSpec]) -> list[tuple[float, str]]:
     one run on one worker, i.e. CPU seconds when each worker has a core.
     Complete runs need 0.
     """
-    logged = {id(s): _generation_seconds(s.out) for s in specs}
-    rates: dict[tuple[str, str], list[float]] = {}
+    rate: dict[int, float] = {}  # seconds per generation of the runs with logged generations
     for s in specs:
-        last, total = logged[id(s)]
+        last, total = _generation_seconds(s.out)
         if last >= 1 and total > 0:  # a rate from a single generation 0 is mostly set-up
-            key = _settings_key(s)
-            rates.setdefault(key, []).append(total / (last + 1))
+            rate[id(s)] = total / (last + 1)
+    by_settings: dict[tuple[str, str], list[float]] = {}
+    for s in specs:
+        if id(s) in rate:
+            by_settings.setdefault(_settings_key(s), []).append(rate[id(s)])
     out = []
     for s in specs:
-        last, total = logged[id(s)]
         if run_status(s.out, s.generations) == "complete":
             out.append((0.0, "complete"))
             continue
-        left = s.generations - last
-        if last >= 1 and total > 0:
-            out.append((left * total / (last + 1), "measured"))
-            continue
-        key = _settings_key(s)
-        if key in rates:
-            r = sorted(rates[key])
-            median = (r[(len(r) - 1) // 2] + r[len(r) // 2]) / 2
-            out.append((left * median, "scenario"))
+        left = s.generations - _last_generation(s.out)
+        if id(s) in rate:
+            out.append((left * rate[id(s)], "measured"))
+        elif (key := _settings_key(s)) in by_settings:
+            out.append((left * statistics.median(by_settings[key]), "scenario"))
         else:
             out.append((s.cost * left / (s.generations + 1), "estimate"))
     return out
