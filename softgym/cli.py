@@ -478,11 +478,12 @@ def _cmd_study(args: argparse.Namespace) -> int:
             print(f"{s.scenario:24s} seed {s.seed:<4d} {s.generations:4d} generations  "
                   f"{status:8s} {left_text:32s}  {s.out}")  # fmt: skip
         todo = sum(left for left, _ in togo)
-        timed = sum(src in ("measured", "scenario") for _, src in togo)
-        unfinished = sum(src != "complete" for _, src in togo)
+        count = {k: sum(src == k for _, src in togo) for k in ("measured", "scenario", "estimate")}
+        unfinished = sum(count.values())
         print(f"{len(specs)} runs, {unfinished} unfinished; ~{todo / 3600:.1f} CPU hours to go "
-              f"({timed} timed from logged generations, the rest from the scenarios' "
-              f"estimates)")  # fmt: skip
+              f"({count['measured']} timed from their own logged generations, "
+              f"{count['scenario']} from their scenario's, {count['estimate']} from the "
+              f"static estimate)")  # fmt: skip
         return 0
 
     def report(res):

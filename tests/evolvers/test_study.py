@@ -31,6 +31,9 @@ def test_study_runs_resumes_skips_and_reports(tmp_path, capsys):
     capsys.readouterr()
     main([*study, "--generations", "1", "--plan"])
     assert capsys.readouterr().out.count("complete") == 4
+    main([*study, "--generations", "2", "--plan"])  # each run has logged generations 0 and 1
+    assert "4 runs, 4 unfinished" in (last := capsys.readouterr().out.splitlines()[-1])
+    assert "(4 timed from their own logged generations, 0 from their scenario's, 0 " in last
     # a larger --generations resumes each run from its checkpoint; then everything is complete
     logging_off = [a for a in study if a != "--quiet"]
     assert main([*logging_off, "--generations", "2"]) == 0
@@ -203,3 +206,39 @@ def test_time_to_go_uses_logged_generations(tmp_path):
     (basic0.out / "log.jsonl").write_text("".join(json.dumps(r) + "\n" for r in rows))
     (basic0.out / "final_population.json").write_text("{}")
     assert time_to_go([basic0])[0] == (0.0, "complete")
+
+
+def _fake_run(scenario, seed, voxels, target):
+    """A RunData whose best robot has ``voxels[g]`` voxels at generation g."""
+    from pathlib import Path
+
+    from evolvers.study_report import RunData
+
+    rows = [{"generation": g, "top_n_voxels": v, "norm_final_dist_best": 1.0 + g}
+            for g, v in enumerate(voxels)]  # fmt: skip
+    exp = {"name": scenario, "objectives": [{"name": "norm_final_dist"}]}
+    cfg = {"seed": seed, "generations": target, "experiment": exp}
+    return RunData(scenario, Path(f"{scenario}/seed-{seed}"), cfg, rows, None,
+                   len(voxels) - 1 >= target)  # fmt: skip
+
+
+def test_fixed_generation_claim_counts_unfinished_runs_past_it():
+    # T2-voxels reads T1 at T2's last generation (3 here): T1 seeds that passed it count,
+    # complete or not; a seed short of it is left out and named
+    from evolvers.study_report import claims
+
+    t2 = [_fake_run("materials-t2", s, [200, 150, 100, 50 + s], 3) for s in range(4)]
+    t1 = [
+        _fake_run("materials-t1", 0, [216] * 11, 10),  # complete
+        _fake_run("materials-t1", 1, [210] * 6, 10),  # unfinished, past generation 3
+        _fake_run("materials-t1", 2, [1] * 3, 10),  # unfinished, at generation 2
+    ]
+    by_id = {c.id: c for c in claims({"materials-t2": t2, "materials-t1": t1})}
+    c = by_id["T2-voxels"]
+    assert c.data["t1"] == [216.0, 210.0] and c.data["t2"] == [50.0, 51.0, 52.0, 53.0]
+    assert "at generation 3:" in c.measured and "n=2" in c.measured
+    assert "Unfinished T1 seed 1 past generation 3 counted" in c.why
+    assert "T1 seed 2 left out (not yet at generation 3)" in c.why
+    assert "Unfinished seeds left out" not in c.why
+    # the claims that read T1's last generation still use its complete run only
+    assert "Unfinished seeds left out: materials-t1 1, 2" in by_id["T1-final"].why
