@@ -242,3 +242,23 @@ def test_fixed_generation_claim_counts_unfinished_runs_past_it():
     assert "Unfinished seeds left out" not in c.why
     # the claims that read T1's last generation still use its complete run only
     assert "Unfinished seeds left out: materials-t1 1, 2" in by_id["T1-final"].why
+
+
+def test_t1_final_names_the_flying_winners():
+    # the committed study data: materials-t1 seed 0's winner has muscles at the density floor and
+    # flies (thousands of body lengths); the claim says so and which seeds
+    from pathlib import Path
+
+    from evolvers.study_report import LIGHT_MUSCLE, claims, winner_of
+
+    root = Path(__file__).resolve().parents[2] / "benchmarks" / "data" / "study" / "runs"
+    runs = load_runs(root / "materials-t1")
+    seed0 = next(r for r in runs["materials-t1"] if r.seed == 0)
+    assert seed0.complete and winner_of(seed0).muscle_density < LIGHT_MUSCLE
+    c = next(c for c in claims(runs) if c.id == "T1-final")
+    assert 0 in c.data["flying_seeds"]
+    assert "winners fly: muscles lighter than 1e+05 kg/m^3" in c.why
+    # runs without a recorded winner name none
+    t1 = [_fake_run("materials-t1", 0, [216] * 11, 10)]
+    fake = next(c for c in claims({"materials-t1": t1}) if c.id == "T1-final")
+    assert fake.data["flying_seeds"] == []
