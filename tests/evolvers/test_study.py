@@ -208,13 +208,15 @@ def test_time_to_go_uses_logged_generations(tmp_path):
     assert time_to_go([basic0])[0] == (0.0, "complete")
 
 
-def _fake_run(scenario, seed, voxels, target):
-    """A RunData whose best robot has ``voxels[g]`` voxels at generation g."""
+def _fake_run(scenario, seed, voxels, target, best=1.0, repeats=0):
+    """A RunData whose best robot has ``voxels[g]`` voxels at generation g and fitness
+    ``best + g``; each generation >= 1 has 10 new robots of which ``repeats`` were seen before."""
     from pathlib import Path
 
     from evolvers.study_report import RunData
 
-    rows = [{"generation": g, "top_n_voxels": v, "norm_final_dist_best": 1.0 + g}
+    rows = [{"generation": g, "top_n_voxels": v, "norm_final_dist_best": best + g,
+             "new_individuals": 10, "repeated_phenotypes": repeats}
             for g, v in enumerate(voxels)]  # fmt: skip
     exp = {"name": scenario, "objectives": [{"name": "norm_final_dist"}]}
     cfg = {"seed": seed, "generations": target, "experiment": exp}
@@ -262,3 +264,35 @@ def test_t1_final_names_the_flying_winners():
     t1 = [_fake_run("materials-t1", 0, [216] * 11, 10)]
     fake = next(c for c in claims({"materials-t1": t1}) if c.id == "T1-final")
     assert fake.data["flying_seeds"] == []
+
+
+def test_novelty_claims_compare_with_the_reports_baselines():
+    # novelty-fitness: the report compares novelty with "the other two evolution techniques"
+    # (materials and controller evolution); basic evolution with the same generations is context
+    from evolvers.study_report import claims
+
+    def runs(name, best, repeats=0, n=5):
+        return [_fake_run(name, k, [100] * 4, 3, best=best + k, repeats=repeats) for k in range(n)]
+
+    data = {
+        "novelty": runs("novelty", 3.0, repeats=6),
+        "novelty-archive": runs("novelty-archive", 3.0, repeats=3),
+        "basic-200": runs("basic-200", 3.5, repeats=4),  # as good as novelty
+        "materials-t2": runs("materials-t2", 30.0),
+        "controller-tournament": runs("controller-tournament", 60.0),
+    }
+    by_id = {c.id: c for c in claims(data)}
+    c = by_id["novelty-fitness"]
+    assert c.verdict == "holds", c.why
+    assert "materials evolution (T1, T2) 35 [34, 36], n=5" in c.measured
+    assert "controller evolution (tournament, Pareto) 65 [64, 66], n=5" in c.measured
+    assert "(not the report's comparison) basic evolution" in c.measured
+    # novelty at most half as good as one technique but not the other: partly
+    data["materials-t2"] = runs("materials-t2", 5.0)
+    assert {c.id: c for c in claims(data)}["novelty-fitness"].verdict == "partly"
+    # the loop: novelty without archive repeats more than fitness-based and than with the archive
+    loop = by_id["novelty-loop"]
+    assert loop.verdict == "holds"
+    assert loop.data["novelty"] == [0.6] * 5 and loop.data["basic-200"] == [0.4] * 5
+    data["basic-200"] = runs("basic-200", 3.5, repeats=8)  # fitness-based repeats more
+    assert {c.id: c for c in claims(data)}["novelty-loop"].verdict == "partly"
