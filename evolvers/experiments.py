@@ -84,6 +84,13 @@ class Experiment:
         Robot grid (6, 6, 6).
     sim : dict
         :class:`~softgym.engine.SimConfig` overrides.
+    seed_centre_of_mass : bool
+        Score on the seed's centre of mass, which counts the obstacles' 1-kg
+        wall voxels (``Task(seed_centre_of_mass=True)``,
+        :func:`softgym.metrics.dilute`): the MaxXYDist and L coefficient the
+        seed's obstacle runs selected on. Off by default (the robot's own
+        voxels); the study's obstacle scenarios turn it on. Traces, and so a
+        crossing of the wall, stay the robot's own.
     """
 
     name: str
@@ -104,6 +111,7 @@ class Experiment:
     crossover_rate: float = 0.4
     shape: tuple[int, int, int] = (6, 6, 6)
     sim: dict[str, Any] = field(default_factory=dict)
+    seed_centre_of_mass: bool = False
 
     def __post_init__(self) -> None:
         if self.selection not in SELECTIONS:
@@ -147,6 +155,7 @@ class Experiment:
             trace_interval=self.trace_interval,
             sim=dict(self.sim),
             n_threads=n_threads,
+            seed_centre_of_mass=self.seed_centre_of_mass,
         )
 
     def replace(self, **changes: Any) -> Experiment:

@@ -61,6 +61,7 @@ __all__ = [
     "RecordedRun",
     "RunRecorder",
     "add_run_note",
+    "config_difference",
     "log_row",
     "obstacle_footprint",
     "population_summary",

@@ -37,7 +37,14 @@ scenario                          experiment              gens   seeds  claims (
 ``obstacles-attempt1``            obstacles-attempt1      80     5      III-D attempt 1
 ``obstacles-attempt2``            obstacles-attempt2      80     5      III-D attempt 2
 ``obstacles``                     obstacles               120    10     III-D final setup
+``obstacles-attempt1-robot-com``  obstacles-attempt1      80     5      (the same on the robot's
+``obstacles-attempt2-robot-com``  obstacles-attempt2      80     5      own centre of mass)
+``obstacles-robot-com``           obstacles               120    3
 ================================  ======================  =====  =====  ==============================
+
+The three obstacle scenarios score on the seed's centre of mass, which counts the
+fence's wall voxels (:data:`SEED_COM`), as the seed's runs did; the ``-robot-com``
+ones are the same experiments on the robot's own centre of mass (softgym's default).
 """
 
 from __future__ import annotations
@@ -70,6 +77,7 @@ __all__ = [
     "run_order",
     "run_status",
     "run_study",
+    "settings_difference",
     "time_to_go",
 ]
 
@@ -162,6 +170,11 @@ class Study:
         return [s.name for s in self.scenarios]
 
 
+#: The seed's obstacle runs scored MaxXYDist and the L coefficient on a centre of mass that
+#: counts the 44 one-kilogram wall voxels (SEED_REFERENCE §3.6); the study's obstacle scenarios
+#: do the same (:attr:`evolvers.experiments.Experiment.seed_centre_of_mass`).
+SEED_COM: Mapping[str, Any] = {"seed_centre_of_mass": True}
+
 #: The seed report's claims (SEED_REFERENCE §3.9; issue 15): >= 10 seeds for the Fig. 4 trio,
 #: materials T2 and the obstacle final setup, >= 5 for the long runs and the obstacle attempts.
 #: ``cpu_per_generation``: CPU s of generations 1-4 of one seed (6x6x6, pop 15, 5 s, one thread,
@@ -185,11 +198,22 @@ SEED_REPORT = Study(
         Scenario("controller-pareto", "controller-pareto", 40, 10,
                  "controller evolution, Pareto on distance and muscles (report Fig. 4)", cpu_per_generation=12.8),
         Scenario("obstacles-attempt1", "obstacles-attempt1", 80, 5,
-                 "wall, attempt 1: default controller, Pareto on MaxXYDist and muscles", cpu_per_generation=5.8),
+                 "wall, attempt 1: default controller, Pareto on MaxXYDist and muscles",
+                 SEED_COM, cpu_per_generation=5.8),
         Scenario("obstacles-attempt2", "obstacles-attempt2", 80, 5,
-                 "wall, attempt 2: controller evolution, fitness tournament on MaxXYDist", cpu_per_generation=13.8),
+                 "wall, attempt 2: controller evolution, fitness tournament on MaxXYDist",
+                 SEED_COM, cpu_per_generation=13.8),
         Scenario("obstacles", "obstacles", 120, 10,
-                 "wall, final setup: MaxXYDist, L coefficient, age, composition rules", cpu_per_generation=52.3),
+                 "wall, final setup: MaxXYDist, L coefficient, age, composition rules",
+                 SEED_COM, cpu_per_generation=52.3),
+        # the same on the robot's own centre of mass (softgym's default): does the seed's
+        # wall-diluted score change what evolves?
+        Scenario("obstacles-attempt1-robot-com", "obstacles-attempt1", 80, 5,
+                 "attempt 1 scored on the robot's own centre of mass", cpu_per_generation=5.8),
+        Scenario("obstacles-attempt2-robot-com", "obstacles-attempt2", 80, 5,
+                 "attempt 2 scored on the robot's own centre of mass", cpu_per_generation=13.8),
+        Scenario("obstacles-robot-com", "obstacles", 120, 3,
+                 "final setup scored on the robot's own centre of mass", cpu_per_generation=52.3),
     ),
 )  # fmt: skip
 
@@ -400,6 +424,29 @@ def run_status(run_dir: str | Path, generations: int) -> str:
     return "new"
 
 
+def settings_difference(spec: RunSpec) -> str | None:
+    """Where the run folder's config.json differs from ``spec`` (experiment or seed), or None.
+
+    None also when the folder has no readable config.json yet (nothing ran).
+    A complete run with other settings (e.g. a scenario whose overrides
+    changed) must not be counted as this spec's run.
+    """
+    from evolvers.recorder import config_difference
+
+    try:
+        cfg = json.loads((Path(spec.out) / "config.json").read_text())
+        recorded = Experiment.from_dict(cfg["experiment"]).to_dict()
+        seed = int(cfg["seed"])
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    if seed != spec.seed:
+        return f"seed: {seed} (recorded) != {spec.seed}"
+    given = spec.experiment.to_dict()
+    for d in (recorded, given):  # a run may be extended to more generations
+        d.pop("generations", None)
+    return config_difference(recorded, given, "experiment")
+
+
 def run_one(spec: Mapping[str, Any] | RunSpec) -> dict[str, Any]:
     """Run (or resume, or skip) one run of a study; the function a Dask worker calls.
 
@@ -415,6 +462,12 @@ def run_one(spec: Mapping[str, Any] | RunSpec) -> dict[str, Any]:
     spec = spec if isinstance(spec, RunSpec) else RunSpec.from_dict(spec)
     out = {"scenario": spec.scenario, "seed": spec.seed, "out": str(spec.out)}
     before = run_status(spec.out, spec.generations)
+    if (diff := settings_difference(spec)) is not None:  # never skip or extend another's run
+        return {
+            **out, "status": "failed", "generation": _last_generation(spec.out), "wall": 0.0,
+            "error": f"{spec.out} was run with other settings ({diff}); move it aside or "
+                     "choose another --out",
+        }  # fmt: skip
     if before == "complete":
         return {**out, "status": "skipped", "generation": _last_generation(spec.out), "wall": 0.0}
     t0 = time.perf_counter()

@@ -76,7 +76,7 @@ REPORT_CURVES: dict[str, list[tuple[int, float]]] = {
 REPORT_GENERATIONS: dict[str, int] = {
     "materials-t1": 300, "materials-t2": 50, "novelty": 200, "novelty-archive": 200,
     "basic-200": 200, "basic": 40, "controller-tournament": 40, "controller-pareto": 40,
-    "obstacles": 80,
+    "obstacles": 80, "obstacles-robot-com": 80,
 }  # fmt: skip
 
 #: The scenarios each claim reads (a claim on shorter runs than the report's is provisional).
@@ -104,7 +104,9 @@ CLAIM_SCENARIOS: dict[str, tuple[str, ...]] = {
 }
 
 #: Obstacle scenarios and the report's crossing generation of the final setup.
+#: Each has a ``<name>-robot-com`` twin scored on the robot's own centre of mass, not the seed's.
 OBSTACLE_SCENARIOS = ("obstacles-attempt1", "obstacles-attempt2", "obstacles")
+ROBOT_COM = "-robot-com"
 REPORT_CROSSING_GENERATION = 80
 
 HOLDS, PARTLY, FAILS, UNTESTED = "holds", "partly", "does not hold", "not run"
@@ -866,20 +868,53 @@ def _crossing(runs: Mapping[str, list[RunData]], name: str) -> tuple[list[float]
     return [crossing_generation(r) for r in rs], len(rs)
 
 
+def _decided(rs: Sequence[RunData], horizon: int) -> tuple[list[RunData], list[int]]:
+    """The runs that crossed or ran ``horizon`` generations, and the seeds still undecided."""
+    done = [r for r in rs if math.isfinite(crossing_generation(r)) or r.generation >= horizon]
+    return done, [r.seed for r in rs if r not in done]
+
+
+def _undecided_note(seeds: Sequence[int], horizon: int) -> str:
+    return (f". Left out: {_seeds(seeds)}, not yet crossed nor at generation {horizon}"
+            if seeds else "")  # fmt: skip
+
+
+def _robot_com_note(runs: Mapping[str, list[RunData]], name: str) -> str:
+    """How the scenario's twin on the robot's own centre of mass did, if it ran."""
+    twin = name + ROBOT_COM
+    if not runs.get(twin):
+        return ""
+    rs, undecided = _decided(runs[twin], REPORT_CROSSING_GENERATION)
+    gens = [crossing_generation(r) for r in rs]
+    k = sum(math.isfinite(g) for g in gens)
+    first = f", first at generation {_summary(gens, '{:.0f}')}" if k else ""
+    more = f" ({_seeds(undecided)} undecided)" if undecided else ""
+    return (f"; selected on the robot's own centre of mass instead ({twin}): crossed in "
+            f"{k}/{len(rs)} seeds{first}{more}")  # fmt: skip
+
+
 def claim_attempt1(runs: Mapping[str, list[RunData]]) -> Claim:
     """Obstacles attempt 1 never crosses the wall."""
     cid, sec = "obstacles-attempt1", "III-D"
     rep = "Attempt 1 (default controller, Pareto with muscle count): 'not enough energy to overcome the wall'."
     if m := _missing(runs, "obstacles-attempt1"):
         return _untested(cid, sec, rep, m)
-    gens, n = _crossing(runs, "obstacles-attempt1")
+    horizon = REPORT_CROSSING_GENERATION
+    rs, undecided = _decided(runs["obstacles-attempt1"], horizon)
+    if not rs:
+        return _untested(cid, sec, rep, [f"obstacles-attempt1 at generation {horizon}"])
+    gens, n = [crossing_generation(r) for r in rs], len(rs)
     k = sum(math.isfinite(g) for g in gens)
     verdict = HOLDS if k == 0 else PARTLY if k * 2 < n else FAILS
     return Claim(
         cid, sec, rep,
-        f"crossed in {k}/{n} seeds within {_gens(runs['obstacles-attempt1'])} generations"
-        + (f" (first at generation {_summary(gens, '{:.0f}')})" if k else ""),
-        verdict, "holds when no seed crosses; partly when a minority does", {"crossing": gens},
+        f"crossed in {k}/{n} seeds within {_gens(rs)} generations"
+        + (f" (first at generation {_summary(gens, '{:.0f}')})" if k else "")
+        + _robot_com_note(runs, "obstacles-attempt1"),
+        verdict,
+        "holds when no seed crosses; partly when a minority does"
+        + _undecided_note(undecided, horizon),
+        {"crossing": gens},
     )  # fmt: skip
 
 
@@ -898,7 +933,8 @@ def claim_attempt2(runs: Mapping[str, list[RunData]]) -> Claim:
     return Claim(
         cid, sec, rep,
         f"crossed in {k}/{n} seeds (first at generation {_summary(gens, '{:.0f}')}); muscle share of "
-        f"the first robot past the wall {_summary(frac, '{:.2f}')}, all-muscle in {all_muscle}/{k}",
+        f"the first robot past the wall {_summary(frac, '{:.2f}')}, all-muscle in {all_muscle}/{k}"
+        + _robot_com_note(runs, "obstacles-attempt2"),
         verdict, "holds when some seeds cross and most crossing robots are all muscle",
         {"crossing": gens, "muscle_fraction": frac},
     )  # fmt: skip
@@ -911,20 +947,25 @@ def claim_obstacles_final(runs: Mapping[str, list[RunData]]) -> Claim:
            "crossed the wall 'in 80 generations', using its bone as a pivot.")  # fmt: skip
     if m := _missing(runs, "obstacles"):
         return _untested(cid, sec, rep, m)
-    gens, n = _crossing(runs, "obstacles")
-    k80 = sum(math.isfinite(g) and g <= REPORT_CROSSING_GENERATION for g in gens)
+    horizon = REPORT_CROSSING_GENERATION
+    rs, undecided = _decided(runs["obstacles"], horizon)
+    if not rs:
+        return _untested(cid, sec, rep, [f"obstacles at generation {horizon}"])
+    gens, n = [crossing_generation(r) for r in rs], len(rs)
+    k80 = sum(math.isfinite(g) and g <= horizon for g in gens)
     k = sum(math.isfinite(g) for g in gens)
-    robots = [c for c in (crossing_robot(r) for r in runs["obstacles"]) if c]
+    robots = [c for c in (crossing_robot(r) for r in rs) if c]
     bone = [c["n_bone"] for c in robots]
     verdict = HOLDS if k80 * 2 >= n else PARTLY if k else FAILS
     return Claim(
         cid, sec, rep,
         f"crossed by generation {REPORT_CROSSING_GENERATION} in {k80}/{n} seeds, at all in {k}/{n} "
-        f"within {_gens(runs['obstacles'])} generations (first crossing {_summary(gens, '{:.0f}')}); "
-        f"bone voxels of the first robot past the wall {_summary(bone, '{:.0f}')}",
+        f"within {_gens(rs)} generations (first crossing {_summary(gens, '{:.0f}')}); "
+        f"bone voxels of the first robot past the wall {_summary(bone, '{:.0f}')}"
+        + _robot_com_note(runs, "obstacles"),
         verdict,
         "holds when at least half the seeds cross by generation 80; bone is required by the rules "
-        "(its use as a pivot is not measured)",
+        "(its use as a pivot is not measured)" + _undecided_note(undecided, horizon),
         {"crossing": gens, "n_bone": bone},
     )  # fmt: skip
 
@@ -1205,11 +1246,11 @@ def controller_figure(runs: Mapping[str, list[RunData]], path: Path) -> Path | N
 
 def crossing_figure(runs: Mapping[str, list[RunData]], path: Path) -> Path | None:
     """First generation with a robot past the wall, one point per seed; seeds that never crossed on top."""
-    names = [n for n in OBSTACLE_SCENARIOS if runs.get(n)]
+    names = [m for n in OBSTACLE_SCENARIOS for m in (n, n + ROBOT_COM) if runs.get(m)]
     if not names:
         return None
     plt = _plt()
-    fig, ax = plt.subplots(figsize=(6.4, 3.6))
+    fig, ax = plt.subplots(figsize=(3.2 + 1.1 * len(names), 3.6))
     rng = np.random.default_rng(0)
     top = max(REPORT_CROSSING_GENERATION, *(r.generation for n in names for r in runs[n])) + 5
     for i, n in enumerate(names):
@@ -1222,7 +1263,7 @@ def crossing_figure(runs: Mapping[str, list[RunData]], path: Path) -> Path | Non
     ax.axhline(REPORT_CROSSING_GENERATION, color="C3", linestyle="--", linewidth=1,
                label=f"report: final setup crossed at generation {REPORT_CROSSING_GENERATION}")  # fmt: skip
     ax.set_xticks(range(len(names)))
-    ax.set_xticklabels(names, fontsize=8)
+    ax.set_xticklabels([n.replace(ROBOT_COM, "\n(robot CoM)") for n in names], fontsize=7)
     ax.set_ylabel("first generation past the wall (x: never)")
     ax.set_ylim(-2, top + 8)
     ax.legend(fontsize=7, loc="lower right")
@@ -1239,7 +1280,8 @@ def _settings(rs: Sequence[RunData]) -> str:
     e = rs[0].experiment
     sim = e.get("sim") or {}
     return (f"pop {e['pop_size']}, {e['seconds']:g} s, shape {'x'.join(map(str, e['shape']))}, "
-            f"{e['selection']}" + (f", sim {json.dumps(sim)}" if sim else ""))  # fmt: skip
+            f"{e['selection']}" + (f", sim {json.dumps(sim)}" if sim else "")
+            + (", seed's centre of mass" if e.get("seed_centre_of_mass") else ""))  # fmt: skip
 
 
 def write_report(
@@ -1346,6 +1388,11 @@ def write_report(
         "* **Crossed the wall**: a robot's final centre of mass lies outside the footprint of the "
         "fence (past its outer face); the log's `crossed` column counts them per generation; the "
         "crossing generation is the first generation whose population holds one.",
+        "* **Obstacle scores**: the obstacle scenarios select on the seed's centre of mass, "
+        "which counts the fence's 44 one-kilogram wall voxels (MaxXYDist scaled by m_robot / "
+        "(m_robot + 44 kg)), as the seed's runs did; the `-robot-com` scenarios are the same "
+        "experiments selected on the robot's own centre of mass. Crossing the wall is judged "
+        "on the robot's own centre of mass in both.",
         "* **Repeated phenotype**: a robot evaluated for the first time (child or newcomer) whose "
         "phenotype (body, used materials, controller) was already simulated earlier in the run; "
         "the share is over generations >= 1.",

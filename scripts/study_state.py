@@ -22,7 +22,8 @@ into a run root (``restore``):
 Figures, ``.vxa`` files, ``log.csv`` (``log.jsonl`` holds the same rows), the
 ``best_designs/`` folder and older checkpoints are left out: a run writes them
 again when it resumes. Files in the saved copy
-that the run no longer has (an older checkpoint) are removed, and files whose
+that the run no longer has (an older checkpoint), and run folders and scenarios
+that the run root no longer has (moved aside or renamed), are removed; files whose
 bytes did not change are not rewritten, so a committed copy only changes where
 the study moved on.
 
@@ -126,7 +127,31 @@ def _mirror(src_root: Path, dst_root: Path, runs: list[Path], prune: bool) -> tu
                 if old.is_file() and old not in wanted:
                     old.unlink()
                     removed += 1
+    if prune and dst_root.is_dir():
+        removed += _prune_gone(src_root, dst_root, runs)
     return written, removed
+
+
+def _prune_gone(src_root: Path, dst_root: Path, runs: list[Path]) -> int:
+    """Remove the run folders and scenario files that ``src_root`` no longer has.
+
+    E.g. a scenario renamed or moved aside. Returns the number of files removed.
+    """
+    keep = {run.relative_to(src_root) for run in runs}
+    removed = 0
+    for run in _run_dirs(dst_root):
+        if run.relative_to(dst_root) not in keep:
+            removed += sum(f.is_file() for f in run.rglob("*"))
+            shutil.rmtree(run)
+    for name in ROOT_FILES:
+        for f in sorted(dst_root.rglob(name)):
+            if not (src_root / f.relative_to(dst_root)).is_file():
+                f.unlink()
+                removed += 1
+    for d in sorted((p for p in dst_root.rglob("*") if p.is_dir()), reverse=True):
+        if not any(d.iterdir()):
+            d.rmdir()
+    return removed
 
 
 def save(runs_root: Path, dest: Path) -> str:

@@ -118,3 +118,33 @@ def test_cache_with_columns_that_do_not_match_their_names_is_a_checkpoint_error(
     arrays["cache_values"] = arrays["cache_values"][:, :-1]
     with pytest.raises(CheckpointError, match="cache_values"):
         PhenotypeCache.from_arrays(arrays)
+
+
+def test_seed_centre_of_mass_scores_obstacle_runs_as_the_seed_did():
+    # the seed's centre of mass counts the fence's 1-kg wall voxels: MaxXYDist shrinks by
+    # m_robot / (m_robot + m_walls), the L coefficient by its square (the time of the maximum
+    # stays within a trace sample); the trace stays the robot's own
+    from evolvers.experiments import Experiment
+
+    exp = tiny("obstacles-attempt2", shape=(6, 6, 6), seconds=2.0)
+    seed = exp.replace(seed_centre_of_mass=True)
+    assert Experiment.from_dict(seed.to_dict()) == seed and seed.make_task().seed_centre_of_mass
+    assert Experiment.from_dict({k: v for k, v in exp.to_dict().items()
+                                 if k != "seed_centre_of_mass"}) == exp  # fmt: skip
+    ind = Individual.from_dict(
+        Individual.random(np.random.default_rng(3), 0, exp.shape, rules=exp.rules).to_dict()
+    )
+    twin = Individual.from_dict(ind.to_dict())
+    Evaluator(exp).evaluate([ind])
+    Evaluator(seed).evaluate([twin])
+    np.testing.assert_array_equal(ind.trace, twin.trace)
+    walls = sum(
+        float(np.prod(np.subtract(b.hi, b.lo)))
+        for b in exp.make_task().terrain_for(exp.shape).boxes
+    )
+    m = ind.objectives["n_voxels"]  # 1 kg voxels (density 1e6 kg/m^3, 1 cm)
+    assert walls == 44 and ind.objectives["max_xy_dist"] > 1e-3
+    f = m / (m + walls)
+    assert twin.objectives["max_xy_dist"] == pytest.approx(
+        f * ind.objectives["max_xy_dist"], rel=1e-6
+    )

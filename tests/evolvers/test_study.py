@@ -9,7 +9,15 @@ from evolver_helpers import tiny
 from evolvers.evaluation import EvalStats
 from evolvers.genome import Individual
 from evolvers.recorder import add_run_note, obstacle_footprint, read_run_notes, study_columns
-from evolvers.study import SEED_REPORT, plan, run_order, run_status, run_study, time_to_go
+from evolvers.study import (
+    SEED_REPORT,
+    plan,
+    run_order,
+    run_status,
+    run_study,
+    settings_difference,
+    time_to_go,
+)
 from evolvers.study_report import a12, load_runs, permutation_pvalue
 from softgym.cli import main
 from softgym.exceptions import InvalidParameterError
@@ -131,6 +139,15 @@ def test_a_run_started_with_other_settings_fails_alone(tmp_path):
     res = run_study(plan(root, scenarios=["basic"], seeds=1, generations=2, pop_size=5,
                          seconds=1.0, shape=(4, 4, 4)))  # fmt: skip
     assert res[0]["status"] == "failed" and "pop_size" in res[0]["error"]
+    # a complete run is not counted as another setting's either (e.g. a scenario's changed
+    # overrides): it fails, naming the setting, instead of being skipped
+    res = run_study(plan(root, scenarios=["basic"], seeds=1, generations=1, pop_size=4,
+                         seconds=1.0, shape=(4, 4, 4), seed_centre_of_mass=True))  # fmt: skip
+    assert res[0]["status"] == "failed"
+    assert "experiment.seed_centre_of_mass: False (recorded) != True" in res[0]["error"]
+    same = plan(root, scenarios=["basic"], seeds=1, generations=1, pop_size=4, seconds=1.0,
+                shape=(4, 4, 4))  # fmt: skip
+    assert settings_difference(same[0]) is None and run_study(same)[0]["status"] == "skipped"
 
 
 def test_statistics():
@@ -296,3 +313,24 @@ def test_novelty_claims_compare_with_the_reports_baselines():
     assert loop.data["novelty"] == [0.6] * 5 and loop.data["basic-200"] == [0.4] * 5
     data["basic-200"] = runs("basic-200", 3.5, repeats=8)  # fitness-based repeats more
     assert {c.id: c for c in claims(data)}["novelty-loop"].verdict == "partly"
+
+
+def test_obstacle_claims_wait_for_seeds_that_have_not_decided():
+    # a seed that has neither crossed nor run 80 generations says nothing yet about crossing
+    # "in 80 generations": it is left out (named), not counted as a failure
+    from evolvers.study_report import claims
+
+    def run(seed, generations, crossed_at=None):
+        r = _fake_run("obstacles", seed, [100] * (generations + 1), 120)
+        for row in r.rows:
+            row["crossed"] = int(crossed_at is not None and row["generation"] >= crossed_at)
+        return r
+
+    data = {"obstacles": [run(0, 100), run(1, 30), run(2, 25, crossed_at=20)]}
+    c = {c.id: c for c in claims(data)}["obstacles-final"]
+    assert c.verdict == "holds" and math.isnan(c.data["crossing"][0])
+    assert c.data["crossing"][1:] == [20.0]
+    assert "by generation 80 in 1/2 seeds" in c.measured
+    assert "Left out: seed 1, not yet crossed nor at generation 80" in c.why
+    data = {"obstacles": [run(1, 30)]}
+    assert {c.id: c for c in claims(data)}["obstacles-final"].verdict == "not run"

@@ -50,6 +50,13 @@ def test_saved_study_resumes_exactly_elsewhere(tmp_path):
     assert _rows(second / "basic" / "seed-0") == _rows(straight / "basic" / "seed-0")
     assert "2 removed" in study_state.save(second, saved)
     assert not list((run / "checkpoints").glob("*")) and (run / "final_population.json").is_file()
+    # a scenario moved aside in the run root (e.g. renamed when its settings changed) leaves
+    # the saved copy too, and its new name arrives
+    (second / "basic").rename(second / "basic-old")
+    n_files = sum(f.is_file() for f in (saved / "basic").rglob("*"))
+    msg = study_state.save(second, saved)
+    assert msg.endswith(f"{n_files} removed") and not (saved / "basic").exists()
+    assert (saved / "basic-old" / "seed-0" / "log.jsonl").is_file()
 
 
 def test_missing_folders_are_one_line_and_exit_2(tmp_path, capsys):
