@@ -448,7 +448,15 @@ def _cmd_experiments(args: argparse.Namespace) -> int:
 def _cmd_study(args: argparse.Namespace) -> int:
     if getattr(args, "study_command", None) == "report":
         return _cmd_study_report(args)
-    from evolvers.study import get_study, plan, run_order, run_status, run_study, time_to_go
+    from evolvers.study import (
+        get_study,
+        plan,
+        run_order,
+        run_status,
+        run_study,
+        settings_difference,
+        time_to_go,
+    )
     from softgym.exceptions import SoftGymError
 
     overrides = {}
@@ -475,6 +483,8 @@ def _cmd_study(args: argparse.Namespace) -> int:
         for s, (left, source) in zip(ordered, togo):
             status = run_status(s.out, s.generations)
             left_text = "" if status == "complete" else f"~{left / 3600:5.2f} CPU h to go ({source})"
+            if (diff := settings_difference(s)) is not None:  # the study will refuse it
+                status, left_text = "other", f"run with other settings: {diff}"
             print(f"{s.scenario:24s} seed {s.seed:<4d} {s.generations:4d} generations  "
                   f"{status:8s} {left_text:32s}  {s.out}")  # fmt: skip
         todo = sum(left for left, _ in togo)

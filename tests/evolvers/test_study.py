@@ -132,7 +132,7 @@ def test_plan_defaults_and_errors(tmp_path):
         plan(tmp_path, seeds=0)
 
 
-def test_a_run_started_with_other_settings_fails_alone(tmp_path):
+def test_a_run_started_with_other_settings_fails_alone(tmp_path, capsys):
     root = tmp_path / "s"
     assert not run_study(plan(root, scenarios=["basic"], seeds=1, generations=1, pop_size=4,
                               seconds=1.0, shape=(4, 4, 4)))[0]["status"] == "failed"  # fmt: skip
@@ -148,6 +148,14 @@ def test_a_run_started_with_other_settings_fails_alone(tmp_path):
     same = plan(root, scenarios=["basic"], seeds=1, generations=1, pop_size=4, seconds=1.0,
                 shape=(4, 4, 4))  # fmt: skip
     assert settings_difference(same[0]) is None and run_study(same)[0]["status"] == "skipped"
+    # --plan says so before anything runs
+    main(["study", "--scenarios", "basic", "--seeds", "1", "--generations", "1", "--pop", "4",
+          "--seconds", "1", "--shape", "4", "4", "4", "--out", str(root), "--plan"])  # fmt: skip
+    assert "run with other settings: experiment.pop_size" not in capsys.readouterr().out
+    main(["study", "--scenarios", "basic", "--seeds", "1", "--generations", "1", "--pop", "6",
+          "--seconds", "1", "--shape", "4", "4", "4", "--out", str(root), "--plan"])  # fmt: skip
+    line = capsys.readouterr().out.splitlines()[0]
+    assert " other " in line and "run with other settings: experiment.pop_size: 4" in line
 
 
 def test_statistics():
