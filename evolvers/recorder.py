@@ -462,9 +462,13 @@ class RunRecorder:
         if key != "experiment":
             return recorded == self.config[key]
         try:  # read through Experiment: older folders spell some fields differently
-            return Experiment.from_dict(recorded).to_dict() == self.config[key]
+            was = Experiment.from_dict(recorded).to_dict()
         except Exception:
             return False
+        now = dict(self.config[key])
+        for d in (was, now):  # a reworded description does not change a run
+            d.pop("description", None)
+        return was == now
 
     def resume(self, generations: int) -> tuple[dict[str, Any], dict[str, np.ndarray]] | None:
         """Load the latest intact checkpoint of the run folder and the recorder's part of it.

@@ -442,8 +442,9 @@ def settings_difference(spec: RunSpec) -> str | None:
     if seed != spec.seed:
         return f"seed: {seed} (recorded) != {spec.seed}"
     given = spec.experiment.to_dict()
-    for d in (recorded, given):  # a run may be extended to more generations
+    for d in (recorded, given):  # a run may be extended; a description is not a setting
         d.pop("generations", None)
+        d.pop("description", None)
     return config_difference(recorded, given, "experiment")
 
 

@@ -22,15 +22,16 @@ into a run root (``restore``):
 Figures, ``.vxa`` files, ``log.csv`` (``log.jsonl`` holds the same rows), the
 ``best_designs/`` folder and older checkpoints are left out: a run writes them
 again when it resumes. Files in the saved copy
-that the run no longer has (an older checkpoint), and run folders and scenarios
-that the run root no longer has (moved aside or renamed), are removed; files whose
+that the run no longer has (an older checkpoint) are removed; run folders and
+scenarios that the run root no longer has (moved aside or renamed) only with
+``--prune`` (a partly restored root would otherwise empty the copy); files whose
 bytes did not change are not rewritten, so a committed copy only changes where
 the study moved on.
 
 ``restore`` never moves a run back: a run folder whose newest checkpoint is at
 or past the saved one is left alone (the message says so).
 
-    python scripts/study_state.py save /work/runs/study benchmarks/data/study/runs
+    python scripts/study_state.py save /work/runs/study benchmarks/data/study/runs [--prune]
     python scripts/study_state.py restore benchmarks/data/study/runs /work/runs/study
 """
 
@@ -127,9 +128,15 @@ def _mirror(src_root: Path, dst_root: Path, runs: list[Path], prune: bool) -> tu
                 if old.is_file() and old not in wanted:
                     old.unlink()
                     removed += 1
-    if prune and dst_root.is_dir():
-        removed += _prune_gone(src_root, dst_root, runs)
     return written, removed
+
+
+def _gone(src_root: Path, dst_root: Path, runs: list[Path]) -> list[Path]:
+    """Run folders of ``dst_root`` that ``src_root`` does not have."""
+    if not dst_root.is_dir():
+        return []
+    keep = {run.relative_to(src_root) for run in runs}
+    return [r for r in _run_dirs(dst_root) if r.relative_to(dst_root) not in keep]
 
 
 def _prune_gone(src_root: Path, dst_root: Path, runs: list[Path]) -> int:
@@ -137,12 +144,10 @@ def _prune_gone(src_root: Path, dst_root: Path, runs: list[Path]) -> int:
 
     E.g. a scenario renamed or moved aside. Returns the number of files removed.
     """
-    keep = {run.relative_to(src_root) for run in runs}
     removed = 0
-    for run in _run_dirs(dst_root):
-        if run.relative_to(dst_root) not in keep:
-            removed += sum(f.is_file() for f in run.rglob("*"))
-            shutil.rmtree(run)
+    for run in _gone(src_root, dst_root, runs):
+        removed += sum(f.is_file() for f in run.rglob("*"))
+        shutil.rmtree(run)
     for name in ROOT_FILES:
         for f in sorted(dst_root.rglob(name)):
             if not (src_root / f.relative_to(dst_root)).is_file():
@@ -154,13 +159,25 @@ def _prune_gone(src_root: Path, dst_root: Path, runs: list[Path]) -> int:
     return removed
 
 
-def save(runs_root: Path, dest: Path) -> str:
-    """Copy what resuming needs from ``runs_root`` into ``dest``; one line of what changed."""
+def save(runs_root: Path, dest: Path, prune: bool = False) -> str:
+    """Copy what resuming needs from ``runs_root`` into ``dest``; one line of what changed.
+
+    With ``prune``, also remove the run folders and scenario files of ``dest``
+    that ``runs_root`` no longer has; without, the line counts them.
+    """
     if not runs_root.is_dir():
         raise StudyStateError(f"{runs_root} is not a folder")
     runs = _run_dirs(runs_root)
     written, removed = _mirror(runs_root, dest, runs, prune=True)
-    return f"saved {len(runs)} run folders into {dest}: {written} files written, {removed} removed"
+    msg = f"saved {len(runs)} run folders into {dest}: {written} files written, {removed} removed"
+    gone = _gone(runs_root, dest, runs)
+    if gone and prune:
+        n = _prune_gone(runs_root, dest, runs)
+        msg += f"; pruned {len(gone)} run folders {runs_root} no longer has ({n} files)"
+    elif gone:
+        msg += (f"; {len(gone)} run folders in {dest} are not in {runs_root} (moved or "
+                "renamed?): --prune removes them")  # fmt: skip
+    return msg
 
 
 def restore(saved: Path, runs_root: Path) -> str:
@@ -192,13 +209,18 @@ def main(argv: list[str] | None = None) -> int:
     s = sub.add_parser("save", help="copy a study's resumable state out of its run root")
     s.add_argument("runs", type=Path)
     s.add_argument("dest", type=Path)
+    s.add_argument(
+        "--prune",
+        action="store_true",
+        help="also remove the run folders of DEST that RUNS no longer has (moved or renamed)",
+    )
     r = sub.add_parser("restore", help="put a saved study back into a run root")
     r.add_argument("saved", type=Path)
     r.add_argument("runs", type=Path)
     args = ap.parse_args(argv)
     try:
         if args.verb == "save":
-            print(save(args.runs, args.dest))
+            print(save(args.runs, args.dest, prune=args.prune))
         else:
             print(restore(args.saved, args.runs))
     except StudyStateError as exc:

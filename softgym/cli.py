@@ -479,19 +479,25 @@ def _cmd_study(args: argparse.Namespace) -> int:
         return 2
     if args.plan:
         ordered = run_order(specs)  # the order the runs start in
-        togo = time_to_go(ordered)
-        for s, (left, source) in zip(ordered, togo):
-            status = run_status(s.out, s.generations)
-            left_text = "" if status == "complete" else f"~{left / 3600:5.2f} CPU h to go ({source})"
-            if (diff := settings_difference(s)) is not None:  # the study will refuse it
-                status, left_text = "other", f"run with other settings: {diff}"
+        other = {id(s): d for s in ordered if (d := settings_difference(s)) is not None}
+        ok = [s for s in ordered if id(s) not in other]  # the study refuses the others
+        togo = dict(zip(map(id, ok), time_to_go(ok)))
+        for s in ordered:
+            if id(s) in other:
+                status, left_text = "other", f"run with other settings: {other[id(s)]}"
+            else:
+                status = run_status(s.out, s.generations)
+                left, source = togo[id(s)]
+                left_text = "" if status == "complete" else f"~{left / 3600:5.2f} CPU h to go ({source})"
             print(f"{s.scenario:24s} seed {s.seed:<4d} {s.generations:4d} generations  "
                   f"{status:8s} {left_text:32s}  {s.out}")  # fmt: skip
-        todo = sum(left for left, _ in togo)
-        count = {k: sum(src == k for _, src in togo) for k in ("measured", "scenario", "estimate")}
+        todo = sum(left for left, _ in togo.values())
+        count = {k: sum(src == k for _, src in togo.values())
+                 for k in ("measured", "scenario", "estimate")}  # fmt: skip
         unfinished = sum(count.values())
-        print(f"{len(specs)} runs, {unfinished} unfinished; ~{todo / 3600:.1f} CPU hours to go "
-              f"({count['measured']} timed from their own logged generations, "
+        refused = f"; {len(other)} made with other settings, refused" if other else ""
+        print(f"{len(specs)} runs, {unfinished} unfinished{refused}; ~{todo / 3600:.1f} CPU hours "
+              f"to go ({count['measured']} timed from their own logged generations, "
               f"{count['scenario']} from their scenario's, {count['estimate']} from the "
               f"static estimate)")  # fmt: skip
         return 0

@@ -1,3 +1,4 @@
+import dataclasses
 import json
 import math
 import re
@@ -148,14 +149,17 @@ def test_a_run_started_with_other_settings_fails_alone(tmp_path, capsys):
     same = plan(root, scenarios=["basic"], seeds=1, generations=1, pop_size=4, seconds=1.0,
                 shape=(4, 4, 4))  # fmt: skip
     assert settings_difference(same[0]) is None and run_study(same)[0]["status"] == "skipped"
+    reworded = same[0].experiment.replace(description="reworded")  # not a setting
+    assert settings_difference(dataclasses.replace(same[0], experiment=reworded)) is None
     # --plan says so before anything runs
     main(["study", "--scenarios", "basic", "--seeds", "1", "--generations", "1", "--pop", "4",
           "--seconds", "1", "--shape", "4", "4", "4", "--out", str(root), "--plan"])  # fmt: skip
     assert "run with other settings: experiment.pop_size" not in capsys.readouterr().out
     main(["study", "--scenarios", "basic", "--seeds", "1", "--generations", "1", "--pop", "6",
           "--seconds", "1", "--shape", "4", "4", "4", "--out", str(root), "--plan"])  # fmt: skip
-    line = capsys.readouterr().out.splitlines()[0]
-    assert " other " in line and "run with other settings: experiment.pop_size: 4" in line
+    lines = capsys.readouterr().out.splitlines()
+    assert " other " in lines[0] and "run with other settings: experiment.pop_size: 4" in lines[0]
+    assert lines[-1].startswith("1 runs, 0 unfinished; 1 made with other settings, refused")
 
 
 def test_statistics():
@@ -284,6 +288,10 @@ def test_t1_final_names_the_flying_winners():
     assert seed0.complete and winner_of(seed0).muscle_density < LIGHT_MUSCLE
     c = next(c for c in claims(runs) if c.id == "T1-final")
     assert 0 in c.data["flying_seeds"]
+    # improving only by flying is not the report's "increasingly better" robots
+    alone = {c.id: c for c in claims({"materials-t1": [seed0]})}["T1-improves"]
+    assert alone.verdict == "does not hold" and alone.data["improving_walkers"] == []
+    assert "1 of the 1 improving seeds improve only by flying" in alone.why
     assert "winners fly: muscles lighter than 1e+05 kg/m^3" in c.why
     # runs without a recorded winner name none
     t1 = [_fake_run("materials-t1", 0, [216] * 11, 10)]
@@ -321,6 +329,12 @@ def test_novelty_claims_compare_with_the_reports_baselines():
     assert loop.data["novelty"] == [0.6] * 5 and loop.data["basic-200"] == [0.4] * 5
     data["basic-200"] = runs("basic-200", 3.5, repeats=8)  # fitness-based repeats more
     assert {c.id: c for c in claims(data)}["novelty-loop"].verdict == "partly"
+    # logs without the repeat columns: nothing to compare, so "not run" (not "partly")
+    for name in ("novelty", "novelty-archive", "basic-200"):
+        for r in data[name]:
+            for row in r.rows:
+                del row["new_individuals"], row["repeated_phenotypes"]
+    assert {c.id: c for c in claims(data)}["novelty-loop"].verdict == "not run"
 
 
 def test_obstacle_claims_wait_for_seeds_that_have_not_decided():
@@ -342,3 +356,9 @@ def test_obstacle_claims_wait_for_seeds_that_have_not_decided():
     assert "Left out: seed 1, not yet crossed nor at generation 80" in c.why
     data = {"obstacles": [run(1, 30)]}
     assert {c.id: c for c in claims(data)}["obstacles-final"].verdict == "not run"
+    # a complete run shorter than 80 generations (a short study) is read, marked provisional
+    short = _fake_run("obstacles", 0, [100] * 11, 10)
+    for row in short.rows:
+        row["crossed"] = 0
+    c = {c.id: c for c in claims({"obstacles": [short]})}["obstacles-final"]
+    assert c.verdict == "does not hold" and "Provisional: obstacles reached generation 10" in c.why

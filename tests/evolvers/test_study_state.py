@@ -53,9 +53,13 @@ def test_saved_study_resumes_exactly_elsewhere(tmp_path):
     # a scenario moved aside in the run root (e.g. renamed when its settings changed) leaves
     # the saved copy too, and its new name arrives
     (second / "basic").rename(second / "basic-old")
-    n_files = sum(f.is_file() for f in (saved / "basic").rglob("*"))
-    msg = study_state.save(second, saved)
-    assert msg.endswith(f"{n_files} removed") and not (saved / "basic").exists()
+    n_files = sum(f.is_file() for f in (saved / "basic").rglob("*"))  # with scenario.json
+    msg = study_state.save(second, saved)  # without --prune: kept, and the line says so
+    assert "1 run folders in" in msg and "--prune removes them" in msg
+    assert (saved / "basic" / "seed-0" / "log.jsonl").is_file()
+    msg = study_state.save(second, saved, prune=True)
+    assert msg.endswith(f"pruned 1 run folders {second} no longer has ({n_files} files)")
+    assert not (saved / "basic").exists()
     assert (saved / "basic-old" / "seed-0" / "log.jsonl").is_file()
 
 
