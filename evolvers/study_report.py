@@ -1281,16 +1281,25 @@ def crossing_figure(runs: Mapping[str, list[RunData]], path: Path) -> Path | Non
     top = max(REPORT_CROSSING_GENERATION, *(r.generation for n in names for r in runs[n])) + 5
     for i, n in enumerate(names):
         g = np.array([crossing_generation(r) for r in runs[n]])
+        _, undecided = _decided(runs[n], REPORT_CROSSING_GENERATION)
+        running = np.array([r.seed in undecided for r in runs[n]], dtype=bool)
+        reached = np.array([r.generation for r in runs[n]], dtype=float)
         x = i + rng.uniform(-0.12, 0.12, g.size)
         hit = np.isfinite(g)
+        never = ~hit & ~running
         ax.scatter(x[hit], g[hit], s=18, color=f"C{i}", zorder=3)
-        ax.scatter(x[~hit], np.full((~hit).sum(), top), marker="x", s=22, color=f"C{i}", zorder=3)
-        ax.text(i, top + 2, f"{hit.sum()}/{g.size} crossed", ha="center", fontsize=7)
+        ax.scatter(x[never], np.full(never.sum(), top), marker="x", s=22, color=f"C{i}", zorder=3)
+        # a seed still running: an open circle at the generation it has reached
+        ax.scatter(x[running], reached[running], s=22, facecolors="none", edgecolors=f"C{i}",
+                   zorder=3)  # fmt: skip
+        more = f" ({running.sum()} running)" if running.any() else ""
+        ax.text(i, top + 2, f"{hit.sum()}/{(~running).sum()} crossed{more}", ha="center",
+                fontsize=7)  # fmt: skip
     ax.axhline(REPORT_CROSSING_GENERATION, color="C3", linestyle="--", linewidth=1,
                label=f"report: final setup crossed at generation {REPORT_CROSSING_GENERATION}")  # fmt: skip
     ax.set_xticks(range(len(names)))
     ax.set_xticklabels([n.replace(ROBOT_COM, "\n(robot CoM)") for n in names], fontsize=7)
-    ax.set_ylabel("first generation past the wall (x: never)")
+    ax.set_ylabel("first generation past the wall\n(x: never; o: running, not yet)")
     ax.set_ylim(-2, top + 8)
     ax.legend(fontsize=7, loc="lower right")
     fig.tight_layout()
