@@ -1299,7 +1299,7 @@ def crossing_figure(runs: Mapping[str, list[RunData]], path: Path) -> Path | Non
                label=f"report: final setup crossed at generation {REPORT_CROSSING_GENERATION}")  # fmt: skip
     ax.set_xticks(range(len(names)))
     ax.set_xticklabels([n.replace(ROBOT_COM, "\n(robot CoM)") for n in names], fontsize=7)
-    ax.set_ylabel("first generation past the wall\n(x: never; o: running, not yet)")
+    ax.set_ylabel("first generation past the wall\n(x: not crossed; o: running, before gen. 80)")
     ax.set_ylim(-2, top + 8)
     ax.legend(fontsize=7, loc="lower right")
     fig.tight_layout()
