@@ -175,6 +175,27 @@ class Study:
 #: do the same (:attr:`evolvers.experiments.Experiment.seed_centre_of_mass`).
 SEED_COM: Mapping[str, Any] = {"seed_centre_of_mass": True}
 
+#: The report's obstacle scenarios (section III-D), scored as the seed's runs were.
+_OBSTACLES = (
+    Scenario("obstacles-attempt1", "obstacles-attempt1", 80, 5,
+             "wall, attempt 1: default controller, Pareto on MaxXYDist and muscles",
+             SEED_COM, cpu_per_generation=5.8),
+    Scenario("obstacles-attempt2", "obstacles-attempt2", 80, 5,
+             "wall, attempt 2: controller evolution, fitness tournament on MaxXYDist",
+             SEED_COM, cpu_per_generation=13.8),
+    Scenario("obstacles", "obstacles", 120, 10,
+             "wall, final setup: MaxXYDist, L coefficient, age, composition rules",
+             SEED_COM, cpu_per_generation=52.3),
+)  # fmt: skip
+
+
+def _robot_com(s: Scenario, seeds: int) -> Scenario:
+    """``s`` scored on the robot's own centre of mass: ``<name>-robot-com``."""
+    overrides = {k: v for k, v in s.overrides.items() if k not in SEED_COM}
+    return replace(s, name=s.name + "-robot-com", seeds=seeds, overrides=overrides,
+                   description=f"{s.description}; scored on the robot's own centre of mass")  # fmt: skip
+
+
 #: The seed report's claims (SEED_REFERENCE §3.9; issue 15): >= 10 seeds for the Fig. 4 trio,
 #: materials T2 and the obstacle final setup, >= 5 for the long runs and the obstacle attempts.
 #: ``cpu_per_generation``: CPU s of generations 1-4 of one seed (6x6x6, pop 15, 5 s, one thread,
@@ -197,23 +218,10 @@ SEED_REPORT = Study(
                  "controller evolution, fitness tournament (report Fig. 4)", cpu_per_generation=12.8),
         Scenario("controller-pareto", "controller-pareto", 40, 10,
                  "controller evolution, Pareto on distance and muscles (report Fig. 4)", cpu_per_generation=12.8),
-        Scenario("obstacles-attempt1", "obstacles-attempt1", 80, 5,
-                 "wall, attempt 1: default controller, Pareto on MaxXYDist and muscles",
-                 SEED_COM, cpu_per_generation=5.8),
-        Scenario("obstacles-attempt2", "obstacles-attempt2", 80, 5,
-                 "wall, attempt 2: controller evolution, fitness tournament on MaxXYDist",
-                 SEED_COM, cpu_per_generation=13.8),
-        Scenario("obstacles", "obstacles", 120, 10,
-                 "wall, final setup: MaxXYDist, L coefficient, age, composition rules",
-                 SEED_COM, cpu_per_generation=52.3),
+        *_OBSTACLES,
         # the same on the robot's own centre of mass (softgym's default): does the seed's
         # wall-diluted score change what evolves?
-        Scenario("obstacles-attempt1-robot-com", "obstacles-attempt1", 80, 5,
-                 "attempt 1 scored on the robot's own centre of mass", cpu_per_generation=5.8),
-        Scenario("obstacles-attempt2-robot-com", "obstacles-attempt2", 80, 5,
-                 "attempt 2 scored on the robot's own centre of mass", cpu_per_generation=13.8),
-        Scenario("obstacles-robot-com", "obstacles", 120, 3,
-                 "final setup scored on the robot's own centre of mass", cpu_per_generation=52.3),
+        *(_robot_com(s, seeds) for s, seeds in zip(_OBSTACLES, (5, 5, 3))),
     ),
 )  # fmt: skip
 
