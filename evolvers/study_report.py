@@ -459,6 +459,12 @@ def _combine(verdicts: Sequence[str]) -> str:
     )
 
 
+def _ratio(a: Sequence[float], b: Sequence[float]) -> float:
+    """Ratio of the medians of ``a`` and ``b`` (NaN when ``b``'s is 0)."""
+    mb = _median(b)
+    return _median(a) / mb if mb else float("nan")
+
+
 def _untested(cid: str, section: str, report: str, missing: Sequence[str]) -> Claim:
     return Claim(cid, section, report, "-", UNTESTED, f"no run folder of {', '.join(missing)}")
 
@@ -507,7 +513,7 @@ def claim_t1_improves(runs: Mapping[str, list[RunData]]) -> Claim:
         half = len(s) // 2
         late_gain.append(float(best_so_far[-1] - best_so_far[half]))
     improving = [r.seed for r, g in zip(rs, late_gain) if g > 1e-9]
-    walking = [k for k in improving if not flies(next(r for r in rs if r.seed == k))]
+    walking = [r.seed for r, g in zip(rs, late_gain) if g > 1e-9 and not flies(r)]
     n = len(rs)
     k = len(improving)
     w = len(walking)
@@ -697,7 +703,7 @@ def claim_novelty_fitness(runs: Mapping[str, list[RunData]]) -> Claim:
     for label, rs in groups.items():
         ref = [best_ever(r) for r in rs]
         v, why, _, _ = _compare(nov, ref, larger=False)
-        ratio = _median(nov) / _median(ref) if _median(ref) else float("nan")
+        ratio = _ratio(nov, ref)
         if v == HOLDS and not ratio <= 0.5:
             v, why = PARTLY, f"{why}, lower but not 'much' (ratio of medians {ratio:.2f} > 0.5)"
         verdicts.append(v)
@@ -708,7 +714,7 @@ def claim_novelty_fitness(runs: Mapping[str, list[RunData]]) -> Claim:
     if basic := runs.get("basic-200"):  # the same 200 generations, fitness-based, no extra genes
         ref = [best_ever(r) for r in basic]
         _, why, _, _ = _compare(nov, ref, larger=False)
-        ratio = _median(nov) / _median(ref) if _median(ref) else float("nan")
+        ratio = _ratio(nov, ref)
         measured.append(f"(not the report's comparison) basic evolution over the same 200 "
                         f"generations {_summary(ref)}, ratio {ratio:.2f}")  # fmt: skip
         whys.append(f"novelty < basic-200 (context): {why}")
