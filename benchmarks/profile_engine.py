@@ -1,0 +1,130 @@
+"""Instructions per voxel-step of the engine, per function (callgrind).
+
+Counts instructions, not seconds: the count is the same on a loaded and on a
+quiet machine (for the same build and inputs), so a change to the kernel can be
+judged on a shared 2-core machine where wall-clock timings scatter by 10 %.
+Instructions are not time (a divide, a gather or a cache miss costs more than
+an add): confirm a gain with ``bench_engine.py`` before keeping it.
+
+Runs the reference robot of ``bench_engine.py`` (6x6x6, two muscle groups,
+5 s simulated, one thread) under ``valgrind --tool=callgrind``, collecting only
+inside the per-robot step function, and prints each kernel function's share,
+its instructions per voxel-step and per link-step:
+
+    python benchmarks/profile_engine.py                      # seed preset, self-collision on
+    python benchmarks/profile_engine.py --model corotational --no-collision
+    python benchmarks/profile_engine.py --json               # last line: the counts as JSON
+
+Profile the portable build (what a wheel carries) by building it first:
+``SOFTGYM_PORTABLE=1 pip install -e . --no-build-isolation``. Needs valgrind
+(``apt-get install valgrind``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+
+# the child: one reference robot, alone, one thread
+CHILD = r"""
+import sys
+sys.path.insert(0, {bench!r})
+from bench_engine import reference_robot
+from softgym.engine import SimConfig, Simulation
+sim = Simulation([reference_robot({n})], SimConfig(self_collision={coll}, model={model!r}),
+                 n_threads=1)
+r = sim.run({seconds})
+print("STEPS", int(r.steps[0]), sim.n_voxels, sim.n_links)
+"""
+
+# the per-robot step function: everything the engine does per step runs under it
+TOGGLE = "*advance_robot*"
+
+
+def demangle(name: str) -> str:
+    """``__pyx_f_7softgym_6engine_5_core__links_seed`` -> ``_core._links_seed``."""
+    if not name.startswith("__pyx_f_"):
+        return name
+    rest, parts = name[len("__pyx_f_"):], []
+    while (m := re.match(r"(\d+)", rest)) is not None:
+        k = int(m.group(1))
+        start = len(m.group(1))
+        parts.append(rest[start:start + k])
+        rest = rest[start + k + 1:]
+    return f"{parts[-1]}.{rest}" if parts else name
+
+
+def profile(model: str, collisions: bool, seconds: float, n: int, toggle: str) -> dict:
+    """Run the child under callgrind; return totals and per-function counts."""
+    if shutil.which("valgrind") is None:
+        raise SystemExit("profile_engine: valgrind is not installed (apt-get install valgrind)")
+    with tempfile.TemporaryDirectory(prefix="softgym-cg-") as tmp:
+        out = os.path.join(tmp, "cg.out")
+        code = CHILD.format(bench=str(HERE), n=n, coll=collisions, model=model, seconds=seconds)
+        res = subprocess.run(
+            ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}",
+             f"--toggle-collect={toggle}", sys.executable, "-c", code],
+            capture_output=True, text=True, check=False,
+        )  # fmt: skip
+        m = re.search(r"STEPS (\d+) (\d+) (\d+)", res.stdout)
+        if res.returncode != 0 or m is None:
+            raise SystemExit(f"profile_engine: the profiled run failed:\n{res.stderr[-2000:]}")
+        steps, n_voxels, n_links = (int(g) for g in m.groups())
+        ann = subprocess.run(["callgrind_annotate", "--inclusive=no", out],
+                             capture_output=True, text=True, check=True).stdout  # fmt: skip
+    total = 0
+    funcs: dict[str, int] = {}
+    for line in ann.splitlines():
+        t = re.match(r"\s*([\d,]+)\s+(?:\([\s\d.]+%\)\s+)?PROGRAM TOTALS", line)
+        if t:
+            total = int(t.group(1).replace(",", ""))
+            continue
+        f = re.match(r"\s*([\d,]+)\s+(?:\([\s\d.]+%\)\s+)?\S+?:(\S+)", line)
+        if f and total:
+            name = demangle(f.group(2))
+            funcs[name] = funcs.get(name, 0) + int(f.group(1).replace(",", ""))
+    if total == 0:
+        raise SystemExit("profile_engine: nothing was collected (is the toggle pattern right?)")
+    return {"model": model, "collisions": collisions, "seconds": seconds, "steps": steps,
+            "n_voxels": n_voxels, "n_links": n_links, "instructions": total,
+            "per_voxel_step": total / (steps * n_voxels),
+            "functions": dict(sorted(funcs.items(), key=lambda kv: -kv[1]))}  # fmt: skip
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--model", default="seed", choices=("seed", "corotational"))
+    ap.add_argument("--no-collision", action="store_true", help="self-collision off")
+    ap.add_argument("--seconds", type=float, default=5.0, help="simulated time")
+    ap.add_argument("--size", type=int, default=6, help="robot edge in voxels")
+    ap.add_argument("--toggle", default=TOGGLE, help="callgrind --toggle-collect pattern")
+    ap.add_argument("--json", action="store_true", help="print one JSON object as the last line")
+    args = ap.parse_args(argv)
+    p = profile(args.model, not args.no_collision, args.seconds, args.size, args.toggle)
+    vs = p["steps"] * p["n_voxels"]
+    ls = p["steps"] * p["n_links"]
+    print(f"{p['model']} preset, {args.size}^3 reference robot, self-collision "
+          f"{'on' if p['collisions'] else 'off'}, {p['steps']} steps: "
+          f"{p['instructions']:,} instructions, {p['per_voxel_step']:.0f} per voxel-step")
+    print(f"{'function':40s} {'share':>7s} {'/voxel-step':>12s} {'/link-step':>11s}")
+    for name, count in p["functions"].items():
+        if count < 0.002 * p["instructions"]:
+            continue
+        print(f"{name[:40]:40s} {100 * count / p['instructions']:6.1f}% "
+              f"{count / vs:12.1f} {count / ls:11.1f}")
+    if args.json:
+        print(json.dumps(p))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
