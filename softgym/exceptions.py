@@ -14,6 +14,7 @@ __all__ = [
     "InvalidDesignError",
     "InvalidParameterError",
     "InvalidTerrainError",
+    "RunFolderLockedError",
     "SimulationDivergedError",
     "SoftGymError",
 ]
@@ -71,3 +72,7 @@ class SimulationDivergedError(SoftGymError, RuntimeError):
 
 class CheckpointError(SoftGymError, OSError):
     """A checkpoint or run file is corrupt, truncated, of an unknown version or missing."""
+
+
+class RunFolderLockedError(SoftGymError, RuntimeError):
+    """A run folder is already being written by another process (see :class:`softgym.io.RunLock`)."""

@@ -15,10 +15,19 @@ previous ``keep - 1`` checkpoints stay on disk, so a bad latest checkpoint
 never destroys the last good one: :func:`load_latest_intact` falls back to it
 and says so in one logged line.
 
-Reading never trusts the files: numpy bit generators are named from an
+Reading never trusts the files: only regular files are opened (a FIFO or a
+device is refused without blocking, :func:`read_capped`), each within a size
+cap checked before it is read, numpy bit generators are named from an
 allow-list (:data:`RNG_BIT_GENERATORS`), the array file must be an
 uncompressed npz whose array headers match their data sizes (checked before
 any array is allocated), and nothing is unpickled.
+
+A checkpoint knows its run: :func:`save_checkpoint` can record the run's
+identity (e.g. its id and the hash of its settings) and :func:`load_checkpoint`
+refuses one whose identity differs, whatever its file name; a checkpoint
+whose name disagrees with the step it records is refused too, so the newest
+checkpoint is always the one with the highest recorded step. :class:`RunLock`
+gives one writer at a time a run folder.
 """
 
 from __future__ import annotations
@@ -30,6 +39,10 @@ import logging
 import math
 import os
 import re
+import socket
+import stat
+import sys
+import time
 import zipfile
 from collections.abc import Mapping
 from pathlib import Path
@@ -37,13 +50,16 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from softgym.exceptions import CheckpointError, InvalidParameterError
+from softgym.exceptions import CheckpointError, InvalidParameterError, RunFolderLockedError
 
 __all__ = [
     "CHECKPOINT_SCHEMA",
     "CHECKPOINT_VERSION",
     "RNG_BIT_GENERATORS",
     "IntactCheckpoint",
+    "MAX_CHECKPOINT_BYTES",
+    "MAX_JSON_BYTES",
+    "RunLock",
     "atomic_write_bytes",
     "atomic_write_json",
     "atomic_write_text",
@@ -51,6 +67,8 @@ __all__ = [
     "list_checkpoints",
     "load_checkpoint",
     "load_latest_intact",
+    "loads_json",
+    "read_capped",
     "read_json",
     "rng_from_state",
     "rng_state",
@@ -77,7 +95,103 @@ RNG_BIT_GENERATORS: dict[str, type[np.random.BitGenerator]] = {
     "SFC64": np.random.SFC64,
 }
 
+#: Largest JSON document :func:`read_json` reads (bytes): a run's state of the
+#: biggest study population is under 1 MiB.
+MAX_JSON_BYTES = 64 * 2**20
+#: Largest array file of a checkpoint :func:`load_checkpoint` reads (bytes).
+MAX_CHECKPOINT_BYTES = 2 * 2**30
+
 logger = logging.getLogger(__name__)
+
+
+def read_capped(
+    path: str | os.PathLike[str],
+    cap: int,
+    what: str,
+    error: type[Exception] = CheckpointError,
+) -> bytes:
+    """The bytes of the regular file ``path``, refused beyond ``cap`` bytes.
+
+    The file is opened without blocking and checked to be a regular file
+    before a byte is read: a FIFO, a device or a socket given as a path is
+    refused at once instead of waiting for a writer forever. Its size is
+    checked against ``cap`` before it is read (and the read stops at
+    ``cap + 1`` bytes, should it grow meanwhile).
+
+    Parameters
+    ----------
+    path : path
+        The file.
+    cap : int
+        Largest accepted size (bytes).
+    what : str
+        What the file is, for the message ("design", "checkpoint"...).
+    error : type
+        The :class:`~softgym.exceptions.SoftGymError` subclass to raise.
+
+    Raises
+    ------
+    error
+        Naming the file, if it is missing, a folder or another non-regular
+        file, unreadable, or larger than ``cap``.
+    """
+    name = os.fspath(path)
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
+    try:
+        fd = os.open(name, flags)
+    except FileNotFoundError:
+        raise error(f"{what} file {name!r} does not exist") from None
+    except IsADirectoryError:
+        raise error(f"{what} file {name!r} is a folder, not a file") from None
+    except OSError as exc:
+        raise error(f"{what} file {name!r} cannot be read: {exc.strerror or exc}") from None
+    try:
+        st = os.fstat(fd)
+        if stat.S_ISDIR(st.st_mode):
+            raise error(f"{what} file {name!r} is a folder, not a file")
+        if not stat.S_ISREG(st.st_mode):
+            raise error(
+                f"{what} file {name!r} is not a regular file (a FIFO, device or socket); "
+                f"only regular files are read"
+            )
+        if st.st_size > cap:
+            raise error(
+                f"{what} file {name!r} has {st.st_size} bytes, more than the cap of {cap}"
+            )
+        chunks = []
+        n = 0
+        while n <= cap:
+            chunk = os.read(fd, min(1 << 20, cap + 1 - n))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            n += len(chunk)
+    except OSError as exc:
+        raise error(f"{what} file {name!r} cannot be read: {exc.strerror or exc}") from None
+    finally:
+        os.close(fd)
+    if n > cap:
+        raise error(f"{what} file {name!r} is larger than the cap of {cap} bytes")
+    return b"".join(chunks)
+
+
+def loads_json(text: str | bytes, what: str, error: type[Exception] = CheckpointError) -> Any:
+    """Parse JSON text; anything that is not valid JSON raises ``error`` naming ``what``.
+
+    Covers text that is not UTF-8, malformed JSON, integers too long to
+    convert, and documents nested too deeply for the parser (a RecursionError
+    in :func:`json.loads`): never a bare builtin exception or a traceback.
+    """
+    try:
+        if not isinstance(text, str):
+            text = bytes(text).decode("utf-8")
+        return json.loads(text)
+    except UnicodeDecodeError as exc:
+        raise error(f"{what}: not UTF-8 text ({exc!s:.120})") from None
+    except RecursionError:
+        raise error(f"{what}: JSON nested too deeply to be read") from None
+    except ValueError as exc:  # JSONDecodeError, an integer of more than 4300 digits
+        raise error(f"{what}: corrupt or truncated JSON ({exc!s:.200})") from None
 
 
 def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
@@ -113,21 +227,13 @@ def atomic_write_json(path: str | os.PathLike[str], obj: Any, indent: int | None
     atomic_write_text(path, json.dumps(obj, indent=indent, allow_nan=True) + "\n")
 
 
-def read_json(path: str | os.PathLike[str]) -> Any:
-    """Read a JSON file; a missing or malformed file raises :class:`CheckpointError` naming it."""
+def read_json(path: str | os.PathLike[str], cap: int = MAX_JSON_BYTES) -> Any:
+    """Read a JSON file; a missing, non-regular, oversized or malformed file raises
+    :class:`CheckpointError` naming it (see :func:`read_capped`, :func:`loads_json`).
+    """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise CheckpointError(f"{path}: file not found") from None
-    except UnicodeDecodeError as exc:
-        raise CheckpointError(f"{path}: corrupt file, not UTF-8 text ({exc})") from None
-    except OSError as exc:  # a folder, no permission...
-        raise CheckpointError(f"{path}: cannot be read ({exc.strerror or exc})") from None
-    try:
-        return json.loads(text)
-    except (ValueError, RecursionError) as exc:  # JSONDecodeError, too deep, huge ints
-        raise CheckpointError(f"{path}: corrupt or truncated JSON ({exc!s:.200})") from None
+    data = read_capped(path, cap, "JSON")
+    return loads_json(data, str(path))
 
 
 def _sha256(data: bytes) -> str:
@@ -163,6 +269,7 @@ def save_checkpoint(
     state: Mapping[str, Any],
     arrays: Mapping[str, np.ndarray] | None = None,
     keep: int = 3,
+    identity: Mapping[str, Any] | None = None,
 ) -> Path:
     """Write checkpoint ``step`` atomically and prune old ones.
 
@@ -180,6 +287,10 @@ def save_checkpoint(
     keep : int
         Checkpoints kept on disk after this one is written (>= 2 keeps the
         previous good one).
+    identity : mapping, optional
+        Plain-JSON data naming the run the checkpoint belongs to (e.g. its
+        run id and the hash of its settings); :func:`load_checkpoint` given
+        an identity refuses a checkpoint that records another one.
 
     Returns
     -------
@@ -215,6 +326,8 @@ def save_checkpoint(
         "state_sha256": state_digest,
         "state": state,
     }
+    if identity is not None:
+        doc["identity"] = dict(identity)
     path = directory / f"{stem}.json"
     atomic_write_json(path, doc, indent=None)
     ckpts = list_checkpoints(directory)
@@ -227,13 +340,18 @@ def save_checkpoint(
     return path
 
 
-def load_checkpoint(path: str | os.PathLike[str]) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+def load_checkpoint(
+    path: str | os.PathLike[str], identity: Mapping[str, Any] | None = None
+) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """Read and verify a checkpoint written by :func:`save_checkpoint`.
 
     Parameters
     ----------
     path : path
         The checkpoint's JSON file (or a folder: its latest checkpoint).
+    identity : mapping, optional
+        The run's identity: a checkpoint that records another identity (or
+        none) is refused, whatever its file name.
 
     Returns
     -------
@@ -244,8 +362,10 @@ def load_checkpoint(path: str | os.PathLike[str]) -> tuple[dict[str, Any], dict[
     Raises
     ------
     CheckpointError
-        Naming the file, if either half is missing, truncated, corrupt, of
-        another schema or of a newer version.
+        Naming the file, if either half is missing, not a regular file,
+        larger than :data:`MAX_CHECKPOINT_BYTES`, truncated, corrupt, of
+        another schema or of a newer version, if its name disagrees with the
+        step it records, or if it belongs to another run.
     """
     path = Path(path)
     if path.is_dir():
@@ -272,19 +392,26 @@ def load_checkpoint(path: str | os.PathLike[str]) -> tuple[dict[str, Any], dict[
     step = doc.get("step")
     if isinstance(step, bool) or not isinstance(step, int) or step < 0:
         raise CheckpointError(f"{path}: invalid checkpoint step {step!r:.40}")
+    named = _NAME.match(path.name)
+    if named and int(named.group(1)) != step:
+        # a copy renamed to look newer (or older) than it is
+        raise CheckpointError(
+            f"{path}: its name says step {int(named.group(1))} but it records step {step}; "
+            f"a renamed checkpoint is not resumed"
+        )
+    if identity is not None and doc.get("identity") != _to_json(dict(identity)):
+        raise CheckpointError(
+            f"{path}: belongs to another run (it records {_describe(doc.get('identity'))}, "
+            f"this run is {_describe(dict(identity))}); it is not resumed"
+        )
     npz_name = doc.get("npz")
     if not isinstance(npz_name, str) or not _NPZ_NAME.match(npz_name):
         # a plain ckpt-NNNNNN.npz beside the JSON: never a path to somewhere else
         raise CheckpointError(f"{path}: invalid array file name {npz_name!r:.80}")
     npz_path = path.with_name(npz_name)
-    try:
-        npz_bytes = npz_path.read_bytes()
-    except FileNotFoundError:
-        raise CheckpointError(
-            f"{npz_path}: array file of checkpoint {path.name} is missing"
-        ) from None
-    except OSError as exc:
-        raise CheckpointError(f"{npz_path}: cannot be read ({exc.strerror or exc})") from None
+    if not npz_path.exists():
+        raise CheckpointError(f"{npz_path}: array file of checkpoint {path.name} is missing")
+    npz_bytes = read_capped(npz_path, MAX_CHECKPOINT_BYTES, "checkpoint array")
     if _sha256(npz_bytes) != doc.get("npz_sha256"):
         raise CheckpointError(f"{npz_path}: corrupt or truncated array file (checksum mismatch)")
     _check_npz(npz_bytes, npz_path)
@@ -296,6 +423,13 @@ def load_checkpoint(path: str | os.PathLike[str]) -> tuple[dict[str, Any], dict[
     state = dict(state)
     state["step"] = step
     return state, arrays
+
+
+def _describe(identity: Any) -> str:
+    """A short description of a checkpoint's identity for a message."""
+    if not isinstance(identity, dict):
+        return "no run identity"
+    return ", ".join(f"{k} {str(v)[:16]}" for k, v in sorted(identity.items())) or "no run identity"
 
 
 def _check_npz(npz_bytes: bytes, npz_path: Path) -> None:
@@ -366,7 +500,9 @@ class IntactCheckpoint(NamedTuple):
         )
 
 
-def load_latest_intact(directory: str | os.PathLike[str]) -> IntactCheckpoint:
+def load_latest_intact(
+    directory: str | os.PathLike[str], identity: Mapping[str, Any] | None = None
+) -> IntactCheckpoint:
     """The newest checkpoint of ``directory`` that verifies, skipping corrupt newer ones.
 
     Each checkpoint holds the whole run state (generator states included), so
@@ -380,6 +516,11 @@ def load_latest_intact(directory: str | os.PathLike[str]) -> IntactCheckpoint:
     ----------
     directory : path
         A folder of checkpoints written by :func:`save_checkpoint`.
+    identity : mapping, optional
+        The run's identity (see :func:`load_checkpoint`). A checkpoint of
+        another run, or one renamed to a step it does not record, is skipped
+        like a corrupt one (and named in the message); a folder with none of
+        the run's own raises.
 
     Returns
     -------
@@ -399,7 +540,7 @@ def load_latest_intact(directory: str | os.PathLike[str]) -> IntactCheckpoint:
     skipped: list[tuple[Path, str]] = []
     for path in reversed(ckpts):
         try:
-            state, arrays = load_checkpoint(path)
+            state, arrays = load_checkpoint(path, identity)
         except CheckpointError as exc:
             skipped.append((path, str(exc)))
             continue
@@ -409,6 +550,92 @@ def load_latest_intact(directory: str | os.PathLike[str]) -> IntactCheckpoint:
         return found
     reasons = "; ".join(reason for _, reason in skipped)
     raise CheckpointError(f"{directory}: no intact checkpoint among {len(ckpts)}: {reasons}")
+
+
+class RunLock:
+    """An exclusive lock on a run folder: one writer at a time.
+
+    Used as a context manager around everything that writes a run folder. The
+    lock is an OS file lock (``fcntl.flock``; ``msvcrt.locking`` on Windows) on
+    ``<folder>/.lock``, released by the OS when the holder exits or is killed,
+    so a crashed run never leaves the folder locked. The file records the
+    holder (pid, host, start time) for the message a second writer gets.
+
+    Parameters
+    ----------
+    directory : path
+        The run folder (created if needed).
+
+    Raises
+    ------
+    RunFolderLockedError
+        On entry, if another process holds the folder; the message names it.
+    """
+
+    def __init__(self, directory: str | os.PathLike[str]) -> None:
+        self.directory = Path(directory)
+        self.path = self.directory / ".lock"
+        self._fd: int | None = None
+
+    def __enter__(self) -> RunLock:
+        self.acquire()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.release()
+
+    def acquire(self) -> None:
+        """Take the lock or raise :class:`RunFolderLockedError` naming the holder."""
+        self.directory.mkdir(parents=True, exist_ok=True)
+        fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            _lock_fd(fd)
+        except OSError:
+            try:
+                holder = os.read(fd, 4096).decode("utf-8", "replace").strip() or "another process"
+            finally:
+                os.close(fd)
+            raise RunFolderLockedError(
+                f"run folder {str(self.directory)!r} is in use by {holder}; wait for it to "
+                f"finish or choose another --out"
+            ) from None
+        info = (f"pid {os.getpid()} on {socket.gethostname()} since "
+                f"{time.strftime('%Y-%m-%d %H:%M:%S')}")  # fmt: skip
+        os.ftruncate(fd, 0)
+        os.lseek(fd, 0, os.SEEK_SET)
+        os.write(fd, info.encode("utf-8"))
+        os.lseek(fd, 0, os.SEEK_SET)
+        self._fd = fd
+
+    def release(self) -> None:
+        """Give the lock back (the file stays: removing it could race a new holder)."""
+        if self._fd is not None:
+            try:
+                _unlock_fd(self._fd)
+            finally:
+                os.close(self._fd)
+                self._fd = None
+
+
+if sys.platform == "win32":  # pragma: no cover - exercised on Windows only
+    import msvcrt
+
+    def _lock_fd(fd: int) -> None:
+        os.lseek(fd, 0, os.SEEK_SET)
+        msvcrt.locking(fd, msvcrt.LK_NBLCK, 1)
+
+    def _unlock_fd(fd: int) -> None:
+        os.lseek(fd, 0, os.SEEK_SET)
+        msvcrt.locking(fd, msvcrt.LK_UNLCK, 1)
+
+else:
+    import fcntl
+
+    def _lock_fd(fd: int) -> None:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+
+    def _unlock_fd(fd: int) -> None:
+        fcntl.flock(fd, fcntl.LOCK_UN)
 
 
 def _to_json(obj: Any) -> Any:

@@ -4,6 +4,9 @@ import hashlib
 import io
 import json
 import logging
+import os
+import subprocess
+import sys
 import zipfile
 
 import numpy as np
@@ -13,7 +16,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from softgym import io as sio
-from softgym.exceptions import CheckpointError, InvalidParameterError
+from softgym.exceptions import CheckpointError, InvalidParameterError, RunFolderLockedError
 
 
 def _save_three(directory):
@@ -128,8 +131,95 @@ def test_unreadable_checkpoint_paths_raise_checkpoint_errors(tmp_path):
         sio.load_checkpoint(tmp_path / "ckpt-000009.json")
     deep = tmp_path / "deep.json"
     deep.write_text("[" * 100000 + "]" * 100000)
-    with pytest.raises(CheckpointError, match="corrupt or truncated JSON"):
+    with pytest.raises(CheckpointError, match="nested too deeply"):
         sio.read_json(deep)
+    (tmp_path / "bad.json").write_text('{"a": ')
+    with pytest.raises(CheckpointError, match="corrupt or truncated JSON"):
+        sio.read_json(tmp_path / "bad.json")
+    big = tmp_path / "big.json"
+    big.write_text("[" + "0," * 600 + "0]")
+    with pytest.raises(CheckpointError, match="more than the cap of 1000"):
+        sio.read_json(big, cap=1000)
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs on this platform")
+def test_a_fifo_is_refused_at_once_not_waited_on(tmp_path):
+    # a FIFO with no writer blocks a plain open() forever; read_capped refuses it
+    # without opening it for a blocking read (run in a child with a timeout so a
+    # regression fails instead of hanging the suite)
+    fifo = tmp_path / "ckpt-000001.json"
+    os.mkfifo(fifo)
+    code = (
+        "import sys; from softgym import io\n"
+        "try:\n"
+        f"    io.read_json({str(fifo)!r})\n"
+        "except io.CheckpointError as e:\n"
+        "    print('REFUSED', e)\n"
+    )
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=60)  # fmt: skip
+    assert "REFUSED" in res.stdout and "not a regular file" in res.stdout, res.stderr
+
+
+def test_a_renamed_checkpoint_is_refused_not_taken_as_newest(tmp_path):
+    ckpts = _save_three(tmp_path)
+    # a copy of the oldest, renamed to look like the newest
+    newest = tmp_path / "ckpt-999999.json"
+    newest.write_text(ckpts[0].read_text())
+    with pytest.raises(CheckpointError, match="name says step 999999 but it records step"):
+        sio.load_checkpoint(tmp_path)
+    # the newest by recorded step is resumed, and the message names the skipped copy
+    found = sio.load_latest_intact(tmp_path)
+    assert found.path == ckpts[-1]
+    assert "ckpt-999999.json" in found.message and "renamed" in found.message
+
+
+def test_a_checkpoint_of_another_run_is_refused(tmp_path):
+    mine = {"run_id": "abc", "config_sha256": "1" * 64}
+    sio.save_checkpoint(tmp_path, 1, {"x": 1}, identity=mine)
+    state, _ = sio.load_checkpoint(tmp_path, identity=mine)
+    assert state["x"] == 1 and state["step"] == 1
+    other = {"run_id": "xyz", "config_sha256": "2" * 64}
+    with pytest.raises(CheckpointError, match="belongs to another run"):
+        sio.load_checkpoint(tmp_path, identity=other)
+    with pytest.raises(CheckpointError, match="no intact checkpoint.*belongs to another run"):
+        sio.load_latest_intact(tmp_path, identity=other)
+    # a foreign checkpoint copied in beside the run's own is skipped, never resumed
+    sio.save_checkpoint(tmp_path, 2, {"x": 2}, identity=other)
+    found = sio.load_latest_intact(tmp_path, identity=mine)
+    assert found.state["step"] == 1 and "belongs to another run" in found.message
+    # a checkpoint written without an identity is not taken for a run that has one
+    sio.save_checkpoint(tmp_path / "anon", 1, {"x": 1})
+    with pytest.raises(CheckpointError, match="no run identity"):
+        sio.load_checkpoint(tmp_path / "anon", identity=mine)
+
+
+def test_run_lock_refuses_a_second_writer_naming_the_holder(tmp_path):
+    with sio.RunLock(tmp_path / "run"):
+        with pytest.raises(RunFolderLockedError, match=f"in use by pid {os.getpid()}"):
+            with sio.RunLock(tmp_path / "run"):
+                pass
+    # released on exit: a new writer gets it
+    with sio.RunLock(tmp_path / "run"):
+        pass
+
+
+def test_run_lock_is_released_when_its_holder_is_killed(tmp_path):
+    code = (
+        "import sys, time; from softgym import io\n"
+        f"lock = io.RunLock({str(tmp_path)!r}); lock.acquire()\n"
+        "print('HELD', flush=True); time.sleep(60)\n"
+    )
+    child = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    try:
+        assert child.stdout.readline().strip() == "HELD"
+        with pytest.raises(RunFolderLockedError, match=f"pid {child.pid}"):
+            sio.RunLock(tmp_path).acquire()
+    finally:
+        child.kill()
+        child.wait()
+    with sio.RunLock(tmp_path):  # the OS released the dead holder's lock
+        pass
 
 
 # ------------------------------------------------------------------ fallback to the newest intact

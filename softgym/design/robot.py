@@ -40,6 +40,7 @@ from softgym.exceptions import (
     InvalidParameterError,
     SoftGymError,
 )
+from softgym.io import read_capped
 
 if TYPE_CHECKING:  # importing softgym.engine.* runs softgym/engine/__init__ (compiled code)
     from softgym.engine.body import Body
@@ -876,7 +877,7 @@ class RobotDesign:
             Naming the file, if its content is not a valid design.
         """
         path = os.fspath(path)
-        data = read_capped(path, MAX_DESIGN_JSON_BYTES, "design")
+        data = read_capped(path, MAX_DESIGN_JSON_BYTES, "design", DesignFileError)
         try:
             text = data.decode("utf-8")
         except UnicodeDecodeError:
@@ -885,24 +886,6 @@ class RobotDesign:
             return cls.from_json(text)
         except SoftGymError as exc:
             raise InvalidDesignError(f"design file {path!r}: {exc}") from exc
-
-
-def read_capped(path: str, cap: int, what: str) -> bytes:
-    """The bytes of ``path``; any problem raises :class:`DesignFileError` naming the file."""
-    try:
-        with open(path, "rb") as fh:
-            data = fh.read(cap + 1)
-    except FileNotFoundError:
-        raise DesignFileError(f"{what} file {path!r} does not exist") from None
-    except IsADirectoryError:
-        raise DesignFileError(f"{what} file {path!r} is a folder, not a file") from None
-    except OSError as exc:
-        raise DesignFileError(
-            f"{what} file {path!r} cannot be read: {exc.strerror or exc}"
-        ) from None
-    if len(data) > cap:
-        raise DesignFileError(f"{what} file {path!r} is larger than the cap of {cap} bytes")
-    return data
 
 
 def default_walker() -> RobotDesign:

@@ -52,8 +52,9 @@ import numpy as np
 
 from softgym.design.controller import Controller
 from softgym.design.material import MAX_MATERIAL_ID, Material, Palette
-from softgym.design.robot import RobotDesign, check_grid_shape, read_capped
-from softgym.exceptions import InvalidDesignError, InvalidParameterError
+from softgym.design.robot import RobotDesign, check_grid_shape
+from softgym.exceptions import DesignFileError, InvalidDesignError, InvalidParameterError
+from softgym.io import read_capped
 
 if TYPE_CHECKING:
     from softgym.terrain import Terrain
@@ -423,7 +424,7 @@ def load_vxa(path: str | os.PathLike[str]) -> RobotDesign:
         Naming the file, if its content is not a valid ``.vxa`` design.
     """
     path = os.fspath(path)
-    data = read_capped(path, MAX_VXA_BYTES, "VXA")
+    data = read_capped(path, MAX_VXA_BYTES, "VXA", DesignFileError)
     try:
         return parse_vxa(data).design
     except InvalidDesignError as exc:

@@ -20,7 +20,6 @@ Axes carry units (:func:`metric_label`).
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -104,22 +103,21 @@ def read_log(run_dir: str | os.PathLike[str]) -> list[dict[str, Any]]:
         written atomically, so this is damage, not a run still writing).
     """
     from softgym.exceptions import CheckpointError
+    from softgym.io import MAX_JSON_BYTES, loads_json, read_capped
 
     path = Path(run_dir) / "log.jsonl"
     if not path.exists():
         return []
+    data = read_capped(path, MAX_JSON_BYTES, "log")
     try:
-        text = path.read_text()
-    except (OSError, UnicodeDecodeError) as exc:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
         raise CheckpointError(f"{path}: cannot be read ({exc})") from None
     rows = []
     for n, line in enumerate(text.splitlines(), 1):
         if not line.strip():
             continue
-        try:
-            row = json.loads(line)
-        except ValueError as exc:
-            raise CheckpointError(f"{path}: line {n} is not JSON ({exc})") from None
+        row = loads_json(line, f"{path}: line {n}")
         if not isinstance(row, dict):
             raise CheckpointError(f"{path}: line {n} is not a JSON object")
         rows.append(row)
@@ -466,11 +464,12 @@ def run_figures(
     """
     from softgym.design import RobotDesign
     from softgym.engine import Simulation
+    from softgym.io import read_json
     from softgym.tasks import get_task
 
     run_dir = Path(run_dir)
     fig_dir = run_dir / "figures"
-    cfg = json.loads((run_dir / "config.json").read_text())
+    cfg = read_json(run_dir / "config.json")
     exp = cfg["experiment"]
     first = exp["objectives"][0]["name"]
     metric = first if first != "age" else "norm_final_dist"
@@ -484,7 +483,8 @@ def run_figures(
     objectives = exp["objectives"]
     final = run_dir / "final_population.json"
     if len(objectives) >= 2 and final.is_file():
-        pop = json.loads(final.read_text())["population"]
+        final_doc = read_json(final)
+        pop = final_doc["population"]
         names = [o["name"] for o in objectives]
         F = np.array(
             [[d["age"] if n == "age" else d["objectives"].get(n, np.nan) for n in names]
@@ -493,7 +493,7 @@ def run_figures(
         ).reshape(-1, len(names))  # fmt: skip
         out["pareto_front"] = plot_pareto_front(
             F, names, [bool(o["maximize"]) for o in objectives], fig_dir / "pareto_front.png",
-            title=f"{exp['name']}: final population, generation {json.loads(final.read_text())['generation']}",
+            title=f"{exp['name']}: final population, generation {final_doc['generation']}",
         )  # fmt: skip
     design = RobotDesign.load(run_dir / "best_design.json")
     out["best_robot"] = plot_robot(

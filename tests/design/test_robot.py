@@ -1,4 +1,7 @@
 import json
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -246,3 +249,27 @@ def test_json_version_and_malformed_files():
     bad["grid"]["layers"] = bad["grid"]["layers"][:5]
     with pytest.raises(InvalidDesignError, match="5 layers, shape says nz = 6"):
         RobotDesign.from_dict(bad)
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs on this platform")
+@pytest.mark.parametrize(
+    "load",
+    ["from softgym.design import RobotDesign as R; R.load",
+     "from softgym.design.vxa import load_vxa; load_vxa"],
+)  # fmt: skip
+def test_a_fifo_given_as_a_design_file_is_refused_at_once(tmp_path, load):
+    # a FIFO with no writer blocks a plain open() forever: the child would hang
+    fifo = tmp_path / "robot.json"
+    os.mkfifo(fifo)
+    imports, call = load.split("; ")
+    code = (
+        f"{imports}\n"
+        "from softgym.exceptions import DesignFileError\n"
+        "try:\n"
+        f"    {call}({str(fifo)!r})\n"
+        "except DesignFileError as e:\n"
+        "    print('REFUSED', e)\n"
+    )
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=60)  # fmt: skip
+    assert "REFUSED" in res.stdout and "not a regular file" in res.stdout, res.stderr
