@@ -37,6 +37,8 @@ __all__ = [
     "save_gif",
     "save_video",
     "simulation_frames",
+    "frame_count",
+    "FRAME_BUDGET_BYTES",
 ]
 
 
@@ -450,6 +452,69 @@ def overlay_text(frame: np.ndarray, lines: Sequence[str]) -> np.ndarray:
     return np.asarray(img)
 
 
+#: Memory budget (bytes) of the frames one recording may hold:
+#: :func:`frame_count` refuses a ``seconds`` x ``fps`` that needs more.
+FRAME_BUDGET_BYTES = 2 * 2**30
+
+
+def frame_count(
+    seconds: float,
+    fps: float,
+    dt: float,
+    frame_bytes: int,
+    max_bytes: int = FRAME_BUDGET_BYTES,
+) -> int:
+    """Frames of a recording of ``seconds`` at ``fps``, checked before any is made.
+
+    One frame every ``1 / fps`` simulated seconds, the first before the
+    simulation advances: ``floor(seconds fps) + 1`` frames.
+
+    Parameters
+    ----------
+    seconds : float
+        Simulated time (s), finite and >= 0.
+    fps : float
+        Frames per simulated second, finite, > 0 and at most one per engine
+        time step (``1 / dt``): a finer rate would repeat the same state.
+    dt : float
+        The engine's time step (s).
+    frame_bytes : int
+        Memory one frame takes (bytes).
+    max_bytes : int
+        Budget for all frames (bytes); :data:`FRAME_BUDGET_BYTES` by default.
+
+    Returns
+    -------
+    int
+        The number of frames.
+
+    Raises
+    ------
+    InvalidParameterError
+        Naming ``fps`` or ``seconds`` and the accepted range.
+    """
+    for name, v in (("seconds", seconds), ("fps", fps)):
+        if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
+            raise InvalidParameterError(f"{name} must be a number, got {type(v).__name__}")
+    if not (math.isfinite(fps) and fps > 0):
+        raise InvalidParameterError(f"fps must be finite and > 0, got {fps}")
+    if not (math.isfinite(seconds) and seconds >= 0):
+        raise InvalidParameterError(f"seconds must be finite and >= 0, got {seconds}")
+    if fps * dt > 1.0:
+        raise InvalidParameterError(
+            f"fps = {fps:g} is finer than the engine's time step ({dt:.3g} s): at most "
+            f"{1.0 / dt:.0f} frames per simulated second"
+        )
+    n = int(math.floor(seconds * fps + 1e-9)) + 1
+    if n * frame_bytes > max_bytes:
+        raise InvalidParameterError(
+            f"seconds x fps = {seconds:g} x {fps:g} gives {n} frames of {frame_bytes} bytes, "
+            f"more than the budget of {max_bytes / 2**30:.1f} GiB; lower seconds or fps "
+            f"(at most {max(1, max_bytes // max(frame_bytes, 1))} frames)"
+        )
+    return n
+
+
 def simulation_frames(
     sim: Simulation,
     seconds: float,
@@ -471,9 +536,8 @@ def simulation_frames(
     -------
     list of ndarray of shape (height, width, 3), uint8
     """
-    if not (math.isfinite(fps) and fps > 0):
-        raise InvalidParameterError(f"fps must be > 0, got {fps}")
     r = renderer or VoxelRenderer(voxel_size=sim.config.voxel_size)
+    n = frame_count(seconds, fps, float(np.max(sim.dt)), r.width * r.height * 3) - 1
     terrain = sim.terrains[robot]
     gi = sim.grid_index(robot)
     L = float(sim.config.voxel_size)
@@ -494,7 +558,6 @@ def simulation_frames(
         return overlay_text(img, [f"t = {float(sim.time[robot]):5.2f} s", f"d = {d:5.2f} voxels"])
 
     frames = [frame()]
-    n = int(math.floor(seconds * fps + 1e-9))
     for _ in range(n):
         sim.advance(1.0 / fps)
         frames.append(frame())

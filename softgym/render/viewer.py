@@ -13,7 +13,6 @@ in any browser without a network (``softgym view RUN_OR_DESIGN``).
 
 from __future__ import annotations
 
-import math
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,8 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from softgym.exceptions import InvalidParameterError
-from softgym.render.frames import OBSTACLE_COLOR, quaternion_to_matrix
+from softgym.render.frames import OBSTACLE_COLOR, frame_count, quaternion_to_matrix
 
 __all__ = ["VoxelRecording", "record_voxels", "viewer_figure", "write_viewer"]
 
@@ -110,21 +108,18 @@ def record_voxels(
     from softgym.engine import Simulation
     from softgym.tasks import get_task
 
-    if not (math.isfinite(fps) and fps > 0):
-        raise InvalidParameterError(f"fps must be > 0, got {fps}")
-    if not (math.isfinite(seconds) and seconds >= 0):
-        raise InvalidParameterError(f"seconds must be >= 0, got {seconds}")
     task = get_task(task)
     cfg = task.config() if config is None else config
     terrain = task.terrain_for(design.shape)
     sim = Simulation([design], config=cfg, terrain=terrain)
+    # positions (3), orientations (4), sizes (1) of every voxel, float64, per frame
+    n = frame_count(seconds, fps, float(sim.dt[0]), 8 * 8 * sim.n_voxels) - 1
     L = float(cfg.voxel_size)
     gi = sim.grid_index(0)
     grid = np.asarray(design.grid)
     colors = np.array([design.palette[int(m)].color[:3] for m in grid[tuple(gi.T)]])
     start = sim.center_of_mass()[0, :2].copy()
     times, pos, quat, scale, dist = [], [], [], [], []
-    n = int(math.floor(seconds * fps + 1e-9))
     for k in range(n + 1):
         if k:
             sim.advance(1.0 / fps)

@@ -9,6 +9,8 @@ import numpy as np
 import pytest
 
 from softgym.design import default_walker
+from softgym.exceptions import InvalidParameterError
+from softgym.render.frames import frame_count
 from softgym.render.viewer import record_voxels, write_viewer
 
 pytest.importorskip("plotly")
@@ -63,3 +65,23 @@ def test_viewer_renders_in_headless_chromium(tmp_path):
     cyan = (img[:, :, 0] < 60) & (img[:, :, 1] > 180) & (img[:, :, 2] > 180)
     green = (img[:, :, 0] < 60) & (img[:, :, 1] > 150) & (img[:, :, 2] < 60)
     assert cyan.sum() > 500 and green.sum() > 500
+
+
+def test_frame_count_refuses_rates_finer_than_a_step_and_recordings_past_the_budget():
+    dt = 6.4e-4
+    assert frame_count(5.0, 10.0, dt, 1000) == 51
+    with pytest.raises(InvalidParameterError, match="fps = 1e.09 is finer than the engine's time step"):
+        frame_count(1.0, 1e9, dt, 1000)
+    with pytest.raises(InvalidParameterError, match="seconds x fps .* more than the budget"):
+        frame_count(1e7, 100.0, dt, 1000)
+    with pytest.raises(InvalidParameterError, match="fps must be a number"):
+        frame_count(1.0, True, dt, 1000)
+    with pytest.raises(InvalidParameterError, match="seconds must be finite"):
+        frame_count(float("inf"), 10.0, dt, 1000)
+    assert frame_count(1.0, 10.0, dt, 1000, max_bytes=11_000) == 11  # the budget is explicit
+
+
+def test_the_viewer_refuses_a_billion_frames_in_one_line():
+    # issue 31: `softgym view good.json --fps 1e9 --seconds 1` crashed (exit 139)
+    with pytest.raises(InvalidParameterError, match="finer than the engine's time step"):
+        record_voxels(default_walker(), seconds=1.0, fps=1e9)
