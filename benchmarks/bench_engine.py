@@ -36,7 +36,7 @@ import time
 import numpy as np
 import results_log
 
-from softgym.engine import Body, SimConfig, Simulation, openmp_enabled
+from softgym.engine import Body, SimConfig, Simulation, kernel_build, openmp_enabled
 from softgym.terrain import Terrain
 
 SEED_ENGINE_O3 = 2.3e6  # voxel-steps/s per core, the seed's engine compiled with -O3 (issue 3)
@@ -181,7 +181,7 @@ def main(argv: list[str] | None = None) -> int:
     repeats = 1 if args.quick else 2  # best of
     rows = []
     print(f"softgym engine benchmark: OpenMP {'on' if openmp_enabled() else 'off'}, "
-          f"{seconds} s simulated per robot", file=sys.stderr)
+          f"kernel build {kernel_build()}, {seconds} s simulated per robot", file=sys.stderr)
 
     def run(n, batch, threads, collisions=False, world="flat", model="seed"):
         row = measure(n, batch, threads, seconds, repeats, collisions, world, model)
@@ -234,6 +234,7 @@ def main(argv: list[str] | None = None) -> int:
         "vs_voxelyze_2015_per_core": [v1 / VOXELYZE_2015[1], v1 / VOXELYZE_2015[0]],
         "seconds_per_soft_robot_5s_1thread": 216 * (5.0 / Simulation(reference_robot()).dt[0]) / v1,
         "openmp": openmp_enabled(),
+        "kernel_build": kernel_build(),
         "quick": args.quick,
     }
     print(f"reference robot, batch 16: {v1 / 1e6:.2f} M voxel-steps/s on 1 thread, "

@@ -16,6 +16,8 @@ each robot alone and the whole set as one batch, on 1 and 2 threads.
     PYTHONPATH=/work/main python benchmarks/check_bitident.py --save /tmp/speed_ref.npz
     # with the modified build: compare
     PYTHONPATH=. python benchmarks/check_bitident.py --compare /tmp/speed_ref.npz
+    # every build of the kernel (softgym/engine/_dispatch.py) against the same reference
+    SOFTGYM_KERNEL=baseline python benchmarks/check_bitident.py --compare /tmp/speed_ref.npz
 """
 
 from __future__ import annotations
@@ -134,9 +136,9 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--vxa", default=VXA)
     args = ap.parse_args(argv)
-    import softgym.engine._core as core
+    from softgym.engine._dispatch import core, kernel_build
 
-    print(f"engine: {core.__file__}", file=sys.stderr)
+    print(f"engine: {core.__file__} (kernel build {kernel_build()})", file=sys.stderr)
     res = run_all(args.seconds, args.quick, args.vxa, log=lambda s: print(s, file=sys.stderr))
     # alone vs batch must agree too (the kernel's own promise)
     bad = [k for k in res if k.startswith("batch/") and not k.endswith("/rollout_" + "")

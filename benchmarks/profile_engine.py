@@ -15,9 +15,9 @@ its instructions per voxel-step and per link-step:
     python benchmarks/profile_engine.py --model corotational --no-collision
     python benchmarks/profile_engine.py --json               # last line: the counts as JSON
 
-Profile the portable build (what a wheel carries) by building it first:
-``SOFTGYM_PORTABLE=1 pip install -e . --no-build-isolation``. Needs valgrind
-(``apt-get install valgrind``).
+Profile another build of the kernel with ``SOFTGYM_KERNEL=baseline`` (the
+portable one; ``x86-64-v3``, ``x86-64-v4``: ``softgym/engine/_dispatch.py``).
+Needs valgrind (``apt-get install valgrind``).
 """
 
 from __future__ import annotations
@@ -39,11 +39,11 @@ CHILD = r"""
 import sys
 sys.path.insert(0, {bench!r})
 from bench_engine import reference_robot
-from softgym.engine import SimConfig, Simulation
+from softgym.engine import SimConfig, Simulation, kernel_build
 sim = Simulation([reference_robot({n})], SimConfig(self_collision={coll}, model={model!r}),
                  n_threads=1)
 r = sim.run({seconds})
-print("STEPS", int(r.steps[0]), sim.n_voxels, sim.n_links)
+print("STEPS", int(r.steps[0]), sim.n_voxels, sim.n_links, kernel_build())
 """
 
 # the per-robot step function: everything the engine does per step runs under it
@@ -75,10 +75,11 @@ def profile(model: str, collisions: bool, seconds: float, n: int, toggle: str) -
              f"--toggle-collect={toggle}", sys.executable, "-c", code],
             capture_output=True, text=True, check=False,
         )  # fmt: skip
-        m = re.search(r"STEPS (\d+) (\d+) (\d+)", res.stdout)
+        m = re.search(r"STEPS (\d+) (\d+) (\d+) (\S+)", res.stdout)
         if res.returncode != 0 or m is None:
             raise SystemExit(f"profile_engine: the profiled run failed:\n{res.stderr[-2000:]}")
-        steps, n_voxels, n_links = (int(g) for g in m.groups())
+        steps, n_voxels, n_links = (int(g) for g in m.groups()[:3])
+        build = m.group(4)
         ann = subprocess.run(["callgrind_annotate", "--inclusive=no", out],
                              capture_output=True, text=True, check=True).stdout  # fmt: skip
     total = 0
@@ -94,7 +95,7 @@ def profile(model: str, collisions: bool, seconds: float, n: int, toggle: str) -
             funcs[name] = funcs.get(name, 0) + int(f.group(1).replace(",", ""))
     if total == 0:
         raise SystemExit("profile_engine: nothing was collected (is the toggle pattern right?)")
-    return {"model": model, "collisions": collisions, "seconds": seconds, "steps": steps,
+    return {"model": model, "kernel_build": build, "collisions": collisions, "seconds": seconds, "steps": steps,
             "n_voxels": n_voxels, "n_links": n_links, "instructions": total,
             "per_voxel_step": total / (steps * n_voxels),
             "functions": dict(sorted(funcs.items(), key=lambda kv: -kv[1]))}  # fmt: skip
@@ -112,7 +113,8 @@ def main(argv: list[str] | None = None) -> int:
     p = profile(args.model, not args.no_collision, args.seconds, args.size, args.toggle)
     vs = p["steps"] * p["n_voxels"]
     ls = p["steps"] * p["n_links"]
-    print(f"{p['model']} preset, {args.size}^3 reference robot, self-collision "
+    print(f"{p['model']} preset, kernel build {p['kernel_build']}, {args.size}^3 reference "
+          f"robot, self-collision "
           f"{'on' if p['collisions'] else 'off'}, {p['steps']} steps: "
           f"{p['instructions']:,} instructions, {p['per_voxel_step']:.0f} per voxel-step")
     print(f"{'function':40s} {'share':>7s} {'/voxel-step':>12s} {'/link-step':>11s}")

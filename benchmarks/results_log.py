@@ -7,7 +7,7 @@ import platform
 from collections.abc import Sequence
 from pathlib import Path
 
-from softgym.engine import openmp_enabled
+from softgym.engine import kernel_build, openmp_enabled
 
 RESULTS = Path(__file__).with_name("RESULTS.md")
 
@@ -15,7 +15,8 @@ RESULTS = Path(__file__).with_name("RESULTS.md")
 def heading(script: str, quick: bool = False, details: Sequence[str] = ()) -> str:
     """``### <script>[ --quick] — <UTC time>, <machine>, <details...>, OpenMP on|off``."""
     stamp = _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
-    parts = [stamp, platform.machine(), *details, f"OpenMP {'on' if openmp_enabled() else 'off'}"]
+    parts = [stamp, platform.machine(), f"kernel build {kernel_build()}", *details,
+             f"OpenMP {'on' if openmp_enabled() else 'off'}"]  # fmt: skip
     return f"\n### {script}{' --quick' if quick else ''} — {', '.join(parts)}\n"
 
 

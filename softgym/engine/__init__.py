@@ -5,6 +5,7 @@ advances them in parallel; :meth:`Simulation.run` returns a :class:`Rollout`.
 """
 
 from softgym.engine._core import AUX_NAMES
+from softgym.engine._dispatch import available_kernels, kernel_build
 from softgym.engine._openmp import omp_max_threads, openmp_enabled
 from softgym.engine.body import Body
 from softgym.engine.config import SimConfig
@@ -24,7 +25,9 @@ __all__ = [
     "SimConfig",
     "Simulation",
     "as_body",
+    "available_kernels",
     "default_num_threads",
+    "kernel_build",
     "omp_max_threads",
     "openmp_enabled",
     "time_step",
