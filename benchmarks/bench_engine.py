@@ -91,6 +91,61 @@ def measure(n: int, batch: int, threads: int, seconds: float, repeats: int,
     }
 
 
+SCALE_BATCHES = (1, 16, 256, 1024)
+
+
+def measure_scale(batch: int, threads: int, settle: float = 1.0, seconds: float = 1.0) -> dict:
+    """Voxel-steps/s and memory per robot of `batch` reference robots at scale.
+
+    The seed preset with self-collision on, each robot inside the seed's
+    fence. The robots settle for ``settle`` s (untimed: the drive starts
+    after SimConfig.init_time), then ``seconds`` of actuated motion are timed,
+    so a large batch costs a few minutes, not 5 s of simulation per robot.
+    """
+    cfg = SimConfig(self_collision=True)
+    terrain = Terrain.fence(inner=10, center=(3, 3))
+    sim = Simulation([reference_robot(6)] * batch, cfg, n_threads=threads, terrain=terrain)
+    sim.advance(settle)
+    t_start = sim.time
+    t0 = time.perf_counter()
+    sim.advance(seconds)
+    wall = time.perf_counter() - t0
+    steps = np.rint((sim.time - t_start) / sim.dt)
+    vsteps = float(np.sum(steps * np.diff(sim.voxel_offsets)))
+    return {"batch": batch, "threads": threads, "voxel_steps_per_s": vsteps / wall,
+            "bytes_per_robot": sim.nbytes / batch, "wall_s": wall,
+            "diverged": int(np.sum(sim.diverged))}  # fmt: skip
+
+
+def scale_table(log=print) -> list[dict]:
+    """The scale rows: batches of 1 to 1,024 robots on 1 and 2 threads."""
+    rows = []
+    for batch in SCALE_BATCHES:
+        for threads in (1, 2):
+            row = measure_scale(batch, threads)
+            rows.append(row)
+            log(f"  scale: batch {batch:5d} threads {threads}: "
+                f"{row['voxel_steps_per_s'] / 1e6:7.2f} M voxel-steps/s, "
+                f"{row['bytes_per_robot'] / 1024:7.1f} KiB/robot ({row['wall_s']:.1f} s)")
+    return rows
+
+
+def scale_lines(rows: list[dict]) -> list[str]:
+    """Markdown table of :func:`scale_table` with the 2-thread / 1-thread ratio per batch."""
+    lines = ["", "At scale (seed preset, 6^3 reference robot, self-collision on, in the seed's "
+             "fence; 1 s settled untimed, then 1 s actuated timed):", "",
+             "| batch | M voxel-steps/s, 1 thread | 2 threads | 2 / 1 | KiB per robot | diverged |",
+             "|---|---|---|---|---|---|"]  # fmt: skip
+    for batch in SCALE_BATCHES:
+        one = next(r for r in rows if r["batch"] == batch and r["threads"] == 1)
+        two = next(r for r in rows if r["batch"] == batch and r["threads"] == 2)
+        lines.append(f"| {batch} | {one['voxel_steps_per_s'] / 1e6:.2f} | "
+                     f"{two['voxel_steps_per_s'] / 1e6:.2f} | "
+                     f"{two['voxel_steps_per_s'] / one['voxel_steps_per_s']:.2f}x | "
+                     f"{one['bytes_per_robot'] / 1024:.1f} | {one['diverged'] + two['diverged']} |")
+    return lines
+
+
 def reference_design():
     """The reference robot as a design of the seed palette (Active_+ x < 3, Active_- x >= 3)."""
     from softgym.design import RobotDesign
@@ -162,6 +217,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="time the seed's own engine (../shared/oracle/seed_oracle.py) in this run")  # fmt: skip
     ap.add_argument("--ratio-only", action="store_true",
                     help="with --seed-engine: only the ratio to the seed's engine (no table)")
+    ap.add_argument("--scale", action="store_true",
+                    help="only the scale table (batches of 1 to 1,024 robots, 1 and 2 threads)")
     ap.add_argument("--repeats", type=int, default=3,
                     help="interleaved repeats of the ratio measurement (median taken)")
     args = ap.parse_args(argv)
@@ -176,6 +233,16 @@ def main(argv: list[str] | None = None) -> int:
               f"thread, median of {m['repeats']} interleaved repeats)")
         if args.json:
             print(json.dumps(m))
+        return 0
+    if args.scale:
+        srows = scale_table(log=lambda m: print(m, file=sys.stderr))
+        lines = scale_lines(srows)
+        print("\n".join(lines))
+        if not args.no_append:
+            results_log.append("\n".join([results_log.heading("bench_engine.py --scale"),
+                                          *lines[1:], ""]))  # fmt: skip
+        if args.json:
+            print(json.dumps(srows))
         return 0
     seconds = 5.0
     repeats = 1 if args.quick else 2  # best of
