@@ -136,7 +136,8 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--vxa", default=VXA)
     args = ap.parse_args(argv)
-    from softgym.engine._dispatch import core, kernel_build
+    import softgym.engine._core as core
+    from softgym.engine import kernel_build
 
     print(f"engine: {core.__file__} (kernel build {kernel_build()})", file=sys.stderr)
     res = run_all(args.seconds, args.quick, args.vxa, log=lambda s: print(s, file=sys.stderr))

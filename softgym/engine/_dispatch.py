@@ -1,57 +1,102 @@
-"""The build of the step kernel that runs: portable, or for a newer x86-64 level.
+"""The build of the compiled engine that runs: portable, or for a newer x86-64 level.
 
-``setup.py`` builds the kernel (``softgym.engine._core``) for the portable
-instruction set and, on x86-64, again for x86-64-v3 (AVX2) and x86-64-v4
-(AVX-512) as ``_core_v3`` and ``_core_v4``. :data:`core` is the newest build
-that this CPU runs and that was built; every build gives bit-identical results
-(no fused multiply-adds, no result-changing fast-math), only the speed differs.
+``setup.py`` compiles the engine's kernel modules (:data:`KERNEL_MODULES`) for
+the portable instruction set and, on x86-64, again from the same C with
+``-march=x86-64-v3`` (AVX2) and ``-march=x86-64-v4`` (AVX-512), into the
+folders ``_x86_64_v3/`` and ``_x86_64_v4/`` beside this file. :func:`install`
+(called by ``softgym/engine/__init__.py`` before any of them is imported)
+makes Python load the newest set this CPU runs under the modules' own names,
+so the modules' calls into one another stay within one build. Every build
+gives bit-identical results (no fused multiply-adds, no result-changing
+fast-math flag); only the speed differs.
 
 The environment variable ``SOFTGYM_KERNEL`` forces one (``baseline``,
 ``x86-64-v3`` or ``x86-64-v4``), e.g. to compare them; a build that was not
-made or that this CPU cannot run is refused with a clear error.
+made, or that this CPU cannot run, is refused with a clear error.
 """
 
 from __future__ import annotations
 
-import importlib
+import importlib.abc
+import importlib.machinery
+import importlib.util
 import os
-from types import ModuleType
+import sys
+from pathlib import Path
 
 from softgym.engine._cpu import cpu_level
 from softgym.exceptions import InvalidParameterError
 
-__all__ = ["KERNELS", "available_kernels", "core", "kernel_build", "load_kernel"]
+__all__ = ["KERNELS", "KERNEL_MODULES", "available_kernels", "install", "kernel_build"]
 
-#: Kernel builds by name: (module, x86-64 level it needs).
-KERNELS: dict[str, tuple[str, int]] = {
-    "baseline": ("softgym.engine._core", 0),
-    "x86-64-v3": ("softgym.engine._core_v3", 3),
-    "x86-64-v4": ("softgym.engine._core_v4", 4),
+#: The engine's modules built once per kernel build (setup.py's list).
+KERNEL_MODULES = ("softgym.engine._core",)
+
+#: Kernel builds by name: (folder beside this file, x86-64 level it needs).
+KERNELS: dict[str, tuple[str | None, int]] = {
+    "baseline": (None, 0),
+    "x86-64-v3": ("_x86_64_v3", 3),
+    "x86-64-v4": ("_x86_64_v4", 4),
 }
 
+_HERE = Path(__file__).resolve().parent
+_chosen: str | None = None
 
-def _built(name: str) -> ModuleType | None:
-    try:
-        return importlib.import_module(KERNELS[name][0])
-    except ImportError:
-        return None
+
+def _files(name: str) -> dict[str, Path] | None:
+    """The compiled files of build ``name`` by module, or None if it was not built."""
+    folder = KERNELS[name][0]
+    if folder is None:
+        return {}
+    found = {}
+    for module in KERNEL_MODULES:
+        stem = module.rpartition(".")[2]
+        for suffix in importlib.machinery.EXTENSION_SUFFIXES:
+            path = _HERE / folder / f"{stem}{suffix}"
+            if path.is_file():
+                found[module] = path
+                break
+        else:
+            return None
+    return found
 
 
 def available_kernels() -> list[str]:
-    """The kernel builds present in this installation that this CPU can run, oldest first."""
+    """The kernel builds present in this installation that this CPU runs, oldest first."""
     level = cpu_level()
-    return [n for n, (_, need) in KERNELS.items() if level >= need and _built(n) is not None]
+    return [n for n, (_, need) in KERNELS.items() if level >= need and _files(n) is not None]
 
 
-def load_kernel(name: str | None = None) -> tuple[str, ModuleType]:
-    """``(name, module)`` of the kernel build ``name``, or of the newest one available.
+class _KernelFinder(importlib.abc.MetaPathFinder):
+    """Finds the engine's kernel modules in the chosen build's folder."""
+
+    def __init__(self, files: dict[str, Path]) -> None:
+        self.files = files
+
+    def find_spec(self, fullname, path=None, target=None):  # noqa: D102
+        where = self.files.get(fullname)
+        if where is None:
+            return None
+        loader = importlib.machinery.ExtensionFileLoader(fullname, str(where))
+        return importlib.util.spec_from_file_location(fullname, where, loader=loader)
+
+
+def install(name: str | None = None) -> str:
+    """Choose the kernel build (``name``, else ``SOFTGYM_KERNEL``, else the newest available).
+
+    Must run before the kernel modules are first imported (the engine's
+    ``__init__`` does it); later calls return the build already chosen.
 
     Raises
     ------
     InvalidParameterError
-        If ``name`` is not a kernel build, was not built, or needs
-        instructions this CPU does not have.
+        If the build named is unknown, was not built, or needs instructions
+        this CPU does not have.
     """
+    global _chosen
+    if _chosen is not None:
+        return _chosen
+    name = name or os.environ.get("SOFTGYM_KERNEL") or None
     if name is None:
         name = available_kernels()[-1]
     if name not in KERNELS:
@@ -60,21 +105,25 @@ def load_kernel(name: str | None = None) -> tuple[str, ModuleType]:
         )
     if cpu_level() < KERNELS[name][1]:
         raise InvalidParameterError(
-            f"kernel build {name!r} needs an x86-64-v{KERNELS[name][1]} CPU; this one is "
-            f"level {cpu_level()} (available: {', '.join(available_kernels())})"
+            f"kernel build {name!r} needs an x86-64-v{KERNELS[name][1]} CPU; this one runs "
+            f"{', '.join(available_kernels())}"
         )
-    module = _built(name)
-    if module is None:
+    files = _files(name)
+    if files is None:
         raise InvalidParameterError(
             f"kernel build {name!r} was not built in this installation "
             f"(available: {', '.join(available_kernels())})"
         )
-    return name, module
-
-
-_name, core = load_kernel(os.environ.get("SOFTGYM_KERNEL") or None)
+    loaded = [m for m in KERNEL_MODULES if m in sys.modules]
+    if files and loaded:
+        raise InvalidParameterError(f"the kernel modules {loaded} were imported before the "
+                                    f"kernel build was chosen")  # fmt: skip
+    if files:
+        sys.meta_path.insert(0, _KernelFinder(files))
+    _chosen = name
+    return name
 
 
 def kernel_build() -> str:
-    """The name of the kernel build in use (``baseline``, ``x86-64-v3`` or ``x86-64-v4``)."""
-    return _name
+    """The name of the kernel build in use: ``baseline``, ``x86-64-v3`` or ``x86-64-v4``."""
+    return install()

@@ -47,7 +47,7 @@ from typing import Any
 
 import numpy as np
 
-from softgym.engine._dispatch import core as _core
+from softgym.engine import _core
 from softgym.engine._openmp import openmp_enabled
 from softgym.engine.body import Body
 from softgym.engine.config import SimConfig
