@@ -1,6 +1,6 @@
 """The build of the compiled engine that runs: portable, or for a newer x86-64 level.
 
-``setup.py`` compiles the engine's kernel modules (:data:`KERNEL_MODULES`) for
+``setup.py`` compiles the engine's kernel modules (its ``KERNEL_MODULES``) for
 the portable instruction set and, on x86-64, again from the same C with
 ``-march=x86-64-v3`` (AVX2) and ``-march=x86-64-v4`` (AVX-512), into the
 folders ``_x86_64_v3/`` and ``_x86_64_v4/`` beside this file. :func:`install`
@@ -27,10 +27,7 @@ from pathlib import Path
 from softgym.engine._cpu import cpu_level
 from softgym.exceptions import InvalidParameterError
 
-__all__ = ["KERNELS", "KERNEL_MODULES", "available_kernels", "install", "kernel_build"]
-
-#: The engine's modules built once per kernel build (setup.py's list).
-KERNEL_MODULES = ("softgym.engine._core",)
+__all__ = ["KERNELS", "available_kernels", "install", "kernel_build"]
 
 #: Kernel builds by name: (folder beside this file, x86-64 level it needs).
 KERNELS: dict[str, tuple[str | None, int]] = {
@@ -44,21 +41,21 @@ _chosen: str | None = None
 
 
 def _files(name: str) -> dict[str, Path] | None:
-    """The compiled files of build ``name`` by module, or None if it was not built."""
+    """The compiled modules of build ``name`` (full name -> file), None if it was not built.
+
+    The build's folder holds one library per kernel module, named as the
+    module (``_core.cpython-311-x86_64-linux-gnu.so``...).
+    """
     folder = KERNELS[name][0]
     if folder is None:
         return {}
     found = {}
-    for module in KERNEL_MODULES:
-        stem = module.rpartition(".")[2]
+    if (_HERE / folder).is_dir():
         for suffix in importlib.machinery.EXTENSION_SUFFIXES:
-            path = _HERE / folder / f"{stem}{suffix}"
-            if path.is_file():
-                found[module] = path
-                break
-        else:
-            return None
-    return found
+            for path in sorted((_HERE / folder).glob(f"*{suffix}")):
+                stem = path.name[: -len(suffix)]
+                found.setdefault(f"{__package__}.{stem}", path)
+    return found or None
 
 
 def available_kernels() -> list[str]:
@@ -114,7 +111,7 @@ def install(name: str | None = None) -> str:
             f"kernel build {name!r} was not built in this installation "
             f"(available: {', '.join(available_kernels())})"
         )
-    loaded = [m for m in KERNEL_MODULES if m in sys.modules]
+    loaded = [m for m in files if m in sys.modules]
     if files and loaded:
         raise InvalidParameterError(f"the kernel modules {loaded} were imported before the "
                                     f"kernel build was chosen")  # fmt: skip
