@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from softgym.engine.config import DENSITY_RANGE, YOUNGS_MODULUS_RANGE
 from softgym.exceptions import InvalidDesignError, InvalidParameterError
 
 __all__ = [
@@ -142,10 +143,16 @@ class Material:
         cte = _finite(f"{label}: cte", self.cte)
         mus = _finite(f"{label}: mu_static", self.mu_static)
         muk = _finite(f"{label}: mu_kinetic", self.mu_kinetic)
-        if E <= 0:
-            raise InvalidParameterError(f"{label}: youngs_modulus must be > 0 Pa, got {E}")
-        if rho <= 0:
-            raise InvalidParameterError(f"{label}: density must be > 0 kg/m^3, got {rho}")
+        lo, hi = YOUNGS_MODULUS_RANGE
+        if not lo <= E <= hi:
+            raise InvalidParameterError(
+                f"{label}: youngs_modulus must lie in [{lo:g}, {hi:g}] Pa, got {E:g}"
+            )
+        lo, hi = DENSITY_RANGE
+        if not lo <= rho <= hi:
+            raise InvalidParameterError(
+                f"{label}: density must lie in [{lo:g}, {hi:g}] kg/m^3, got {rho:g}"
+            )
         if not 0.0 <= nu < 0.5:
             raise InvalidParameterError(f"{label}: poisson must lie in [0, 0.5), got {nu}")
         if abs(cte) > MAX_ABS_CTE:

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from softgym.engine.config import DENSITY_RANGE, YOUNGS_MODULUS_RANGE
 from softgym.exceptions import InvalidDesignError, InvalidParameterError
 
 __all__ = ["Body"]
@@ -102,10 +103,15 @@ class Body:
         for name, arr in tables.items():
             if not np.isfinite(arr[used]).all():
                 raise InvalidParameterError(f"{name} is not finite for a material in use")
-        if (tables["youngs_modulus"][used] <= 0).any():
-            raise InvalidParameterError("youngs_modulus must be > 0 Pa for every material in use")
-        if (tables["density"][used] <= 0).any():
-            raise InvalidParameterError("density must be > 0 kg/m^3 for every material in use")
+        for name, (lo, hi), unit in (("youngs_modulus", YOUNGS_MODULUS_RANGE, "Pa"),
+                                     ("density", DENSITY_RANGE, "kg/m^3")):  # fmt: skip
+            values = tables[name][used]
+            if ((values < lo) | (values > hi)).any():
+                bad = values[(values < lo) | (values > hi)][0]
+                raise InvalidParameterError(
+                    f"{name} must lie in [{lo:g}, {hi:g}] {unit} for every material in use, "
+                    f"got {bad:g}"
+                )
         nu = tables["poisson"][used]
         if ((nu < 0) | (nu >= 0.5)).any():
             raise InvalidParameterError("poisson must lie in [0, 0.5) for every material in use")

@@ -8,7 +8,19 @@ from typing import Any, Literal
 
 from softgym.exceptions import InvalidParameterError
 
-__all__ = ["SimConfig"]
+__all__ = ["DENSITY_RANGE", "SimConfig", "VOXEL_SIZE_RANGE", "YOUNGS_MODULUS_RANGE"]
+
+# Physical ranges no real robot leaves, and within which every derived quantity
+# (mass rho L^3, stiffness E L, time step ~ L sqrt(rho / E)) stays a normal
+# double: outside them a time step can round to 0 (a run that never advances)
+# or a buffer size to infinity. The seed's tissue (5e6 Pa, 1e6 kg/m^3, 1 cm)
+# and bone (5e8 Pa) lie well inside.
+#: Young's modulus (Pa): soft gels (~10 Pa) to diamond (~1e12 Pa), with margin.
+YOUNGS_MODULUS_RANGE = (1.0, 1e13)
+#: Density (kg/m^3): aerogels to 1e3 x the seed's (non-physical) 1e6.
+DENSITY_RANGE = (1e-3, 1e9)
+#: Voxel edge (m): 0.1 mm to 10 m.
+VOXEL_SIZE_RANGE = (1e-4, 10.0)
 
 
 @dataclass(frozen=True)
@@ -124,16 +136,20 @@ class SimConfig:
 
         def finite(name: str) -> float:
             value = getattr(self, name)
+            # a real number: never a bool, a string ("9.81") or a container
+            if isinstance(value, (bool, str, bytes)):
+                raise InvalidParameterError(f"SimConfig.{name} must be a number, got {value!r}")
             try:
                 v = float(value)
-            except (TypeError, ValueError):
+            except (TypeError, ValueError, OverflowError):
                 raise InvalidParameterError(
                     f"SimConfig.{name} must be a number, got {value!r}"
                 ) from None
             check(name, math.isfinite(v), "finite")
             return v
 
-        check("voxel_size", finite("voxel_size") > 0, "> 0 m")
+        lo, hi = VOXEL_SIZE_RANGE
+        check("voxel_size", lo <= finite("voxel_size") <= hi, f"in [{lo:g}, {hi:g}] m")
         check("dt_frac", 0 < finite("dt_frac") <= 10, "in (0, 10]")
         check("gravity", finite("gravity") >= 0, ">= 0 m/s^2 (it pulls along -z)")
         for name in ("bond_damping", "collision_damping", "global_damping"):

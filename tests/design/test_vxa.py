@@ -167,7 +167,7 @@ def replace(pattern, repl, count=1):
         ),
         (
             replace(r"<Density>1e\+006</Density>", "<Density>-5</Density>"),
-            '<Material ID="1">: .*density must be > 0',
+            '<Material ID="1">: .*density must lie in',
         ),
         (replace(r"<MatModel>0</MatModel>", "<MatModel>1</MatModel>"), "only linear materials"),
         (replace(r'<Material ID="2">', '<Material ID="1">'), 'defines <Material ID="1"> twice'),
