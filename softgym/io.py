@@ -197,16 +197,28 @@ def loads_json(text: str | bytes, what: str, error: type[Exception] = Checkpoint
 def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
     """Write ``data`` to ``path`` through a temporary file, fsync and rename.
 
-    A reader sees either the old file or the complete new one, never a part.
+    A reader sees either the old file or the complete new one, never a part;
+    on failure the temporary file is removed. A folder at ``path`` raises
+    :class:`CheckpointError` naming it.
     """
     path = Path(path)
+    if path.is_dir():
+        raise CheckpointError(f"{path} is a folder: cannot write a file there")
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
-    with open(tmp, "wb") as fh:
-        fh.write(data)
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, path)
+    try:
+        with open(tmp, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        # never leave the temporary file behind (a full disk, a folder in the way...)
+        try:
+            tmp.unlink()
+        except OSError:
+            pass
+        raise
     try:  # make the rename durable (best effort: not every filesystem allows it)
         fd = os.open(path.parent, os.O_RDONLY)
         try:

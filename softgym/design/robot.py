@@ -35,12 +35,13 @@ from softgym.design.material import (
     default_palette,
 )
 from softgym.exceptions import (
+    CheckpointError,
     DesignFileError,
     InvalidDesignError,
     InvalidParameterError,
     SoftGymError,
 )
-from softgym.io import read_capped
+from softgym.io import atomic_write_text, read_capped
 
 if TYPE_CHECKING:  # importing softgym.engine.* runs softgym/engine/__init__ (compiled code)
     from softgym.engine.body import Body
@@ -857,12 +858,10 @@ class RobotDesign:
 
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write the design to ``path`` as JSON (via a temporary file, then rename)."""
-        path = os.fspath(path)
-        tmp = f"{path}.tmp{os.getpid()}"
-        with open(tmp, "w", encoding="utf-8") as fh:
-            fh.write(self.to_json())
-            fh.write("\n")
-        os.replace(tmp, path)
+        try:
+            atomic_write_text(path, self.to_json() + "\n")
+        except CheckpointError as exc:
+            raise DesignFileError(f"design file {os.fspath(path)!r}: {exc}") from None
 
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> RobotDesign:

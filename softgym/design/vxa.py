@@ -53,8 +53,13 @@ import numpy as np
 from softgym.design.controller import Controller
 from softgym.design.material import MAX_MATERIAL_ID, Material, Palette
 from softgym.design.robot import RobotDesign, check_grid_shape
-from softgym.exceptions import DesignFileError, InvalidDesignError, InvalidParameterError
-from softgym.io import read_capped
+from softgym.exceptions import (
+    CheckpointError,
+    DesignFileError,
+    InvalidDesignError,
+    InvalidParameterError,
+)
+from softgym.io import atomic_write_bytes, read_capped
 
 if TYPE_CHECKING:
     from softgym.terrain import Terrain
@@ -649,6 +654,14 @@ def to_vxa(
 
 
 def save_vxa(design: RobotDesign, path: str | os.PathLike[str], **kwargs: float | bool) -> None:
-    """Write :func:`to_vxa` of ``design`` to ``path`` (ISO-8859-1); keyword arguments go to :func:`to_vxa`."""
-    with open(os.fspath(path), "w", encoding="latin-1") as fh:
-        fh.write(to_vxa(design, **kwargs))  # type: ignore[arg-type]
+    """Write :func:`to_vxa` of ``design`` to ``path`` (ISO-8859-1), atomically.
+
+    Keyword arguments go to :func:`to_vxa`. A folder or an unwritable place at
+    ``path`` raises :class:`DesignFileError` naming it; no temporary file is
+    left behind.
+    """
+    data = to_vxa(design, **kwargs).encode("latin-1")  # type: ignore[arg-type]
+    try:
+        atomic_write_bytes(path, data)
+    except CheckpointError as exc:
+        raise DesignFileError(f"VXA file {os.fspath(path)!r}: {exc}") from None

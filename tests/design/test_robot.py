@@ -273,3 +273,18 @@ def test_a_fifo_given_as_a_design_file_is_refused_at_once(tmp_path, load):
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          timeout=60)  # fmt: skip
     assert "REFUSED" in res.stdout and "not a regular file" in res.stdout, res.stderr
+
+
+def test_saving_onto_a_folder_raises_and_leaves_no_temporary_file(tmp_path):
+    # issue 31: `softgym convert` into a folder left a .tmp<pid> file behind
+    from softgym.design import default_walker
+    from softgym.design.vxa import save_vxa
+    from softgym.exceptions import DesignFileError
+
+    target = tmp_path / "out"
+    target.mkdir()
+    with pytest.raises(DesignFileError, match="is a folder"):
+        default_walker().save(target)
+    with pytest.raises(DesignFileError, match="is a folder"):
+        save_vxa(default_walker(), target)
+    assert sorted(p.name for p in tmp_path.rglob("*")) == ["out"]
