@@ -119,8 +119,11 @@ else:
     # (the seed kernel's vectorised bond-frame pass); it changes no result
     opt = ["-O3", "-ffp-contract=off", "-fno-math-errno", "-fno-trapping-math", *_native_flags()]
 
+# the engine's C helpers (static inline kernels) live in softgym/engine/include
+ENGINE_INCLUDE = os.path.join("softgym", "engine", "include")
+
 ext_kwargs = dict(
-    include_dirs=[np.get_include()],
+    include_dirs=[np.get_include(), ENGINE_INCLUDE],
     define_macros=[
         ("NPY_NO_DEPRECATED_API", "NPY_1_7_API_VERSION"),
         ("SOFTGYM_OPENMP", "1" if omp is not None else "0"),
