@@ -140,8 +140,22 @@ if sys.platform != "win32":
         ("CYTHON_INLINE", "__inline__ __attribute__((always_inline))"),
     ]
 
+# the engine, one extension module per concept (each .pyx with its .pxd contract;
+# a call across modules goes through a function pointer, so only per-robot
+# functions cross them: per-link and per-voxel code inlines within a module, or
+# comes inline from a .pxd or an include/*.h header)
+ENGINE_MODULES = (
+    "_core",          # the step loop and the Python entry points
+    "_corotational",  # model 1's link forces
+    "_seed",          # model 0's link forces (C passes in include/softgym_seed.h)
+    "_contact",       # self-collision (one spatial hash); floor/box laws inline in the .pxd
+    "_integrate",     # the voxel update of both models
+    "_record",        # centre of mass, trace, aux, energy
+)
+
 extensions = [
-    Extension("softgym.engine._core", ["softgym/engine/_core.pyx"], **core_kwargs),
+    *(Extension(f"softgym.engine.{m}", [f"softgym/engine/{m}.pyx"], **core_kwargs)
+      for m in ENGINE_MODULES),
     Extension("softgym.engine._openmp", ["softgym/engine/_openmp.pyx"], **ext_kwargs),
 ]
 
