@@ -34,6 +34,18 @@ cdef struct Contacts:
     KeyIndex* ocells         # (n_obs_r,) obstacles sorted by spatial-hash cell
 
 
+# The spatial hash of the candidate lists (_contact.pyx, _hash_*): points in
+# cubic cells, sorted by cell; a query walks the 27 cells around a point's.
+cdef struct SpatialHash:
+    KeyIndex* cells          # (n,) the points sorted by (cell key, index) (storage not owned)
+    intp_t n                 # points in the hash
+    float64_t inv_cell       # 1 / the cells' edge (1/m)
+    float64_t x0             # origin (m): cell coordinates are floor((x - x0) / edge) + offset
+    float64_t y0
+    float64_t z0
+    int64_t offset           # keeps the packed cell coordinates (20 bits each) non-negative
+
+
 # Candidate lists (called once per robot per rebuild; each returns a STATUS_*).
 cdef int contacts_corotational(Batch* b, intp_t r, Contacts* c) noexcept nogil
     # model 1: surface pairs within the horizon of the current positions

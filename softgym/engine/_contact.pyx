@@ -10,7 +10,7 @@
 #
 # Both models' candidate lists (contacts_corotational, contacts_seed: the
 # seed's own rule and schedule, with its obstacle voxels) come from one
-# spatial hash; collide / collide_obstacles apply the contact law. The
+# spatial hash (_hash_*); collide / collide_obstacles apply the contact law. The
 # contact laws with the floor and terrain boxes are inline in _contact.pxd.
 
 from libc.math cimport sqrt, floor
@@ -19,10 +19,20 @@ from libc.stdlib cimport malloc, realloc, qsort
 from libc.string cimport memcpy
 
 from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_MEMORY
-from softgym.engine._typedefs cimport float64_t, intp_t, int32
+from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t
+
+# ---------------------------------------------------------------------------
+# The spatial hash (SpatialHash, _contact.pxd): points binned in cubic cells
+# of one edge, keyed by their packed cell coordinates, sorted by (key, index);
+# a query walks the 27 cells around a point's cell (_hash_cell, then
+# _hash_first of each neighbour's key), cells in (di, dj, dk) order, each
+# cell's points in index order. Used for the voxel pairs of both models and
+# for the seed's voxel-obstacle pairs.
 
 cdef enum:
-    CELL_BITS = 20
+    CELL_BITS = 20           # bits of each packed cell coordinate
+    VOXEL_OFF = 1            # cell offset of a robot's voxel hash (origin: its lowest centre)
+    OBS_OFF = 1 << 19        # cell offset of the obstacle hash (origin 0): cells within +-2^19 cells
 
 
 cdef int _cmp_key_index(const void* a, const void* b) noexcept nogil:
@@ -36,6 +46,13 @@ cdef int _cmp_key_index(const void* a, const void* b) noexcept nogil:
 cdef int _cmp_intp(const void* a, const void* b) noexcept nogil:
     cdef intp_t x = (<const intp_t*> a)[0]
     cdef intp_t y = (<const intp_t*> b)[0]
+    return -1 if x < y else (1 if x > y else 0)
+
+
+cdef int _cmp_intp2(const void* a, const void* b) noexcept nogil:
+    # (i, m) pairs of one row: by m
+    cdef intp_t x = (<const intp_t*> a)[1]
+    cdef intp_t y = (<const intp_t*> b)[1]
     return -1 if x < y else (1 if x > y else 0)
 
 
@@ -62,81 +79,128 @@ cdef inline intp_t _lower_bound(const KeyIndex* cells, intp_t n, int64_t key) no
     return lo
 
 
-cdef int contacts_corotational(Batch* b, intp_t r, Contacts* c) noexcept nogil:
-    # OUT: c.pairs, sorted candidate pairs within the horizon. Returns a STATUS.
+cdef inline int64_t _pack(int64_t ci, int64_t cj, int64_t ck) noexcept nogil:
+    return (ci << (2 * CELL_BITS)) | (cj << CELL_BITS) | ck
+
+
+cdef inline void _hash_init(SpatialHash* h, KeyIndex* cells, float64_t cell, float64_t x0,
+                            float64_t y0, float64_t z0, int64_t offset) noexcept nogil:
+    # an empty hash over the storage `cells`, cells of edge `cell` (m) from
+    # the origin (x0, y0, z0), coordinates shifted by `offset`
+    h.cells = cells
+    h.n = 0
+    h.inv_cell = 1.0 / cell
+    h.x0 = x0
+    h.y0 = y0
+    h.z0 = z0
+    h.offset = offset
+
+
+cdef inline void _hash_cell(const SpatialHash* h, const float64_t* p, int64_t* cijk) noexcept nogil:
+    # OUT: cijk, the (offset) cell coordinates of point p
+    cijk[0] = <int64_t> floor((p[0] - h.x0) * h.inv_cell) + h.offset
+    cijk[1] = <int64_t> floor((p[1] - h.y0) * h.inv_cell) + h.offset
+    cijk[2] = <int64_t> floor((p[2] - h.z0) * h.inv_cell) + h.offset
+
+
+cdef inline void _hash_fill(SpatialHash* h, const float64_t* P, intp_t stride,
+                            const flag_t* mask, intp_t lo, intp_t hi) noexcept nogil:
+    # the points P + stride * i of i in [lo, hi) (those with mask[i] only,
+    # unless mask is NULL), sorted by cell
     cdef:
-        intp_t vs = b.vox_start[r]
-        intp_t ve = b.vox_start[r + 1]
-        intp_t n = ve - vs
-        intp_t i, j, k, m, pos_, n_row, n_surf
-        int64_t ci, cj, ck, key
-        int di, dj, dk
-        float64_t L = b.L
-        float64_t smax = L, env, horizon, h2, inv_cell, x0, y0, z0, dx, dy, dz
-        const float64_t* P = b.pos
-        intp_t* grown
+        intp_t i
+        int64_t c[3]
+    h.n = 0
+    for i in range(lo, hi):
+        if mask != NULL and not mask[i]:
+            continue
+        _hash_cell(h, P + stride * i, c)
+        h.cells[h.n].key = _pack(c[0], c[1], c[2])
+        h.cells[h.n].index = i
+        h.n += 1
+    qsort(h.cells, h.n, sizeof(KeyIndex), _cmp_key_index)
+
+
+cdef inline intp_t _hash_first(const SpatialHash* h, int64_t key) noexcept nogil:
+    # the first point of cell `key` (its points run while h.cells[k].key == key)
+    return _lower_bound(h.cells, h.n, key)
+
+
+# ---------------------------------------------------------------------------
+# Candidate lists
+
+cdef inline int _alloc_lists(Contacts* c, intp_t n) noexcept nogil:
+    # the per-voxel scratch of a robot of n voxels (once)
     if c.cells == NULL:
         c.cells = <KeyIndex*> malloc(n * sizeof(KeyIndex))
         c.row = <intp_t*> malloc(n * sizeof(intp_t))
         c.ref = <float64_t*> malloc(3 * n * sizeof(float64_t))
         if c.cells == NULL or c.row == NULL or c.ref == NULL:
             return STATUS_MEMORY
-    memcpy(c.ref, P + 3 * vs, 3 * n * sizeof(float64_t))
+    return STATUS_OK
+
+
+cdef inline int _voxel_pairs(Batch* b, intp_t r, Contacts* c, const float64_t* P, intp_t stride,
+                             float64_t horizon, const int32 seed_rule) noexcept nogil:
+    # OUT: c.pairs (appended to c.n_pairs), robot r's surface voxel pairs
+    # i < j, not excluded, whose centres P + stride * i (m) are closer than
+    # `horizon` (the hash's cell edge), sorted by (i, j). seed_rule (a
+    # compile-time constant once inlined): instead of the horizon, the
+    # seed's rule, closer than 3 L and than twice the size (P[stride * i + 3])
+    # of the pair's first voxel in the seed's order. Returns a STATUS.
+    cdef:
+        intp_t vs = b.vox_start[r]
+        intp_t ve = b.vox_start[r + 1]
+        intp_t i, j, k, m, n_row
+        float64_t L = b.L
+        float64_t h2 = horizon * horizon, x0, y0, z0, dx, dy, dz, d2, act
+        intp_t first
+        int di, dj, dk
+        int64_t key
+        int64_t ijk[3]
+        intp_t* grown
+        SpatialHash h
+    x0 = P[stride * vs]
+    y0 = P[stride * vs + 1]
+    z0 = P[stride * vs + 2]
     for i in range(vs, ve):
-        if b.scale[i] > smax:
-            smax = b.scale[i]
-    env = 1.5 * smax                 # the largest envelope 0.75 (s1 + s2)
-    c.margin = 0.5 * L
-    horizon = env + c.margin
-    h2 = horizon * horizon
-    inv_cell = 1.0 / horizon
-    c.built_scale = smax
-    c.stale = 0
-    c.n_pairs = 0
-    x0 = P[3 * vs]
-    y0 = P[3 * vs + 1]
-    z0 = P[3 * vs + 2]
-    for i in range(vs, ve):
-        if P[3 * i] < x0:
-            x0 = P[3 * i]
-        if P[3 * i + 1] < y0:
-            y0 = P[3 * i + 1]
-        if P[3 * i + 2] < z0:
-            z0 = P[3 * i + 2]
+        if P[stride * i] < x0:
+            x0 = P[stride * i]
+        if P[stride * i + 1] < y0:
+            y0 = P[stride * i + 1]
+        if P[stride * i + 2] < z0:
+            z0 = P[stride * i + 2]
     # only surface voxels (missing a face bond) collide, as the seed intended:
     # an interior voxel is shielded by its six bonded neighbours
-    n_surf = 0
+    _hash_init(&h, c.cells, horizon, x0, y0, z0, VOXEL_OFF)
+    _hash_fill(&h, P, stride, b.surface, vs, ve)
     for i in range(vs, ve):
         if not b.surface[i]:
             continue
-        ci = <int64_t> floor((P[3 * i] - x0) * inv_cell) + 1
-        cj = <int64_t> floor((P[3 * i + 1] - y0) * inv_cell) + 1
-        ck = <int64_t> floor((P[3 * i + 2] - z0) * inv_cell) + 1
-        c.cells[n_surf].key = (ci << (2 * CELL_BITS)) | (cj << CELL_BITS) | ck
-        c.cells[n_surf].index = i
-        n_surf += 1
-    qsort(c.cells, n_surf, sizeof(KeyIndex), _cmp_key_index)
-    for i in range(vs, ve):
-        if not b.surface[i]:
-            continue
-        ci = <int64_t> floor((P[3 * i] - x0) * inv_cell) + 1
-        cj = <int64_t> floor((P[3 * i + 1] - y0) * inv_cell) + 1
-        ck = <int64_t> floor((P[3 * i + 2] - z0) * inv_cell) + 1
         n_row = 0
+        _hash_cell(&h, P + stride * i, ijk)
         for di in range(-1, 2):
             for dj in range(-1, 2):
                 for dk in range(-1, 2):
-                    key = ((ci + di) << (2 * CELL_BITS)) | ((cj + dj) << CELL_BITS) | (ck + dk)
-                    pos_ = _lower_bound(c.cells, n_surf, key)
-                    while pos_ < n_surf and c.cells[pos_].key == key:
-                        j = c.cells[pos_].index
-                        pos_ += 1
+                    key = _pack(ijk[0] + di, ijk[1] + dj, ijk[2] + dk)
+                    k = _hash_first(&h, key)
+                    while k < h.n and h.cells[k].key == key:
+                        j = h.cells[k].index
+                        k += 1
                         if j <= i:
                             continue
-                        dx = P[3 * j] - P[3 * i]
-                        dy = P[3 * j + 1] - P[3 * i + 1]
-                        dz = P[3 * j + 2] - P[3 * i + 2]
-                        if dx * dx + dy * dy + dz * dz >= h2:
+                        dx = P[stride * j] - P[stride * i]
+                        dy = P[stride * j + 1] - P[stride * i + 1]
+                        dz = P[stride * j + 2] - P[stride * i + 2]
+                        d2 = dx * dx + dy * dy + dz * dz
+                        if seed_rule:
+                            if d2 >= 9.0 * L * L:
+                                continue
+                            first = i if b.seed_rank[i] < b.seed_rank[j] else j
+                            act = 2.0 * P[stride * first + 3]
+                            if d2 >= act * act:
+                                continue
+                        elif d2 >= h2:
                             continue
                         if _excluded(b, i, j):
                             continue
@@ -159,30 +223,48 @@ cdef int contacts_corotational(Batch* b, intp_t r, Contacts* c) noexcept nogil:
     return STATUS_OK
 
 
-cdef int contacts_seed(Batch* b, intp_t r, Contacts* c, int32 snapshot) noexcept nogil:
-    # The seed's collision list (CalcL1Bonds with its horizon 2): surface voxel
-    # pairs more than the exclusion hops apart whose centres are closer than
-    # 3 L and than twice the size of the pair's first voxel in the seed's
-    # order, measured at the rebuild. snapshot: 1 copies the current positions
-    # and sizes into col_ref first (a rebuild); 0 rebuilds the list of the
-    # last rebuild from col_ref (after the state was restored).
+cdef int contacts_corotational(Batch* b, intp_t r, Contacts* c) noexcept nogil:
+    # OUT: c.pairs, sorted candidate pairs within the horizon. Returns a STATUS.
     cdef:
         intp_t vs = b.vox_start[r]
         intp_t ve = b.vox_start[r + 1]
         intp_t n = ve - vs
-        intp_t i, j, k, m, pos_, n_row, n_surf, first
-        int64_t ci, cj, ck, key
-        int di, dj, dk
+        intp_t i
         float64_t L = b.L
-        float64_t smax = 0.0, horizon, inv_cell, x0, y0, z0, dx, dy, dz, d2, act
+        float64_t smax = L, env, horizon
+    if _alloc_lists(c, n) != STATUS_OK:
+        return STATUS_MEMORY
+    memcpy(c.ref, b.pos + 3 * vs, 3 * n * sizeof(float64_t))
+    for i in range(vs, ve):
+        if b.scale[i] > smax:
+            smax = b.scale[i]
+    env = 1.5 * smax                 # the largest envelope 0.75 (s1 + s2)
+    c.margin = 0.5 * L
+    horizon = env + c.margin
+    c.built_scale = smax
+    c.stale = 0
+    c.n_pairs = 0
+    return _voxel_pairs(b, r, c, b.pos, 3, horizon, 0)
+
+
+cdef int contacts_seed(Batch* b, intp_t r, Contacts* c, int32 snapshot) noexcept nogil:
+    # The seed's collision list (CalcL1Bonds with its horizon 2): surface voxel
+    # pairs more than the exclusion hops apart whose centres are closer than
+    # 3 L and than twice the size of the pair's first voxel in the seed's
+    # order, measured at the rebuild; then its obstacle pairs. snapshot: 1
+    # copies the current positions and sizes into col_ref first (a rebuild);
+    # 0 rebuilds the list of the last rebuild from col_ref (after the state
+    # was restored).
+    cdef:
+        intp_t vs = b.vox_start[r]
+        intp_t ve = b.vox_start[r + 1]
+        intp_t i
+        int status
+        float64_t L = b.L
+        float64_t smax = 0.0, horizon
         float64_t* R = b.col_ref
-        intp_t* grown
-    if c.cells == NULL:
-        c.cells = <KeyIndex*> malloc(n * sizeof(KeyIndex))
-        c.row = <intp_t*> malloc(n * sizeof(intp_t))
-        c.ref = <float64_t*> malloc(3 * n * sizeof(float64_t))
-        if c.cells == NULL or c.row == NULL or c.ref == NULL:
-            return STATUS_MEMORY
+    if _alloc_lists(c, ve - vs) != STATUS_OK:
+        return STATUS_MEMORY
     if snapshot:
         for i in range(vs, ve):
             R[4 * i] = b.pos[3 * i]
@@ -203,85 +285,13 @@ cdef int contacts_seed(Batch* b, intp_t r, Contacts* c, int32 snapshot) noexcept
         horizon = 3.0 * L
     if horizon <= 0.0:
         return STATUS_OK
-    inv_cell = 1.0 / horizon
-    x0 = R[4 * vs]
-    y0 = R[4 * vs + 1]
-    z0 = R[4 * vs + 2]
-    for i in range(vs, ve):
-        if R[4 * i] < x0:
-            x0 = R[4 * i]
-        if R[4 * i + 1] < y0:
-            y0 = R[4 * i + 1]
-        if R[4 * i + 2] < z0:
-            z0 = R[4 * i + 2]
-    n_surf = 0
-    for i in range(vs, ve):
-        if not b.surface[i]:
-            continue
-        ci = <int64_t> floor((R[4 * i] - x0) * inv_cell) + 1
-        cj = <int64_t> floor((R[4 * i + 1] - y0) * inv_cell) + 1
-        ck = <int64_t> floor((R[4 * i + 2] - z0) * inv_cell) + 1
-        c.cells[n_surf].key = (ci << (2 * CELL_BITS)) | (cj << CELL_BITS) | ck
-        c.cells[n_surf].index = i
-        n_surf += 1
-    qsort(c.cells, n_surf, sizeof(KeyIndex), _cmp_key_index)
-    for i in range(vs, ve):
-        if not b.surface[i]:
-            continue
-        ci = <int64_t> floor((R[4 * i] - x0) * inv_cell) + 1
-        cj = <int64_t> floor((R[4 * i + 1] - y0) * inv_cell) + 1
-        ck = <int64_t> floor((R[4 * i + 2] - z0) * inv_cell) + 1
-        n_row = 0
-        for di in range(-1, 2):
-            for dj in range(-1, 2):
-                for dk in range(-1, 2):
-                    key = ((ci + di) << (2 * CELL_BITS)) | ((cj + dj) << CELL_BITS) | (ck + dk)
-                    pos_ = _lower_bound(c.cells, n_surf, key)
-                    while pos_ < n_surf and c.cells[pos_].key == key:
-                        j = c.cells[pos_].index
-                        pos_ += 1
-                        if j <= i:
-                            continue
-                        dx = R[4 * j] - R[4 * i]
-                        dy = R[4 * j + 1] - R[4 * i + 1]
-                        dz = R[4 * j + 2] - R[4 * i + 2]
-                        d2 = dx * dx + dy * dy + dz * dz
-                        if d2 >= 9.0 * L * L:
-                            continue
-                        first = i if b.seed_rank[i] < b.seed_rank[j] else j
-                        act = 2.0 * R[4 * first + 3]
-                        if d2 >= act * act:
-                            continue
-                        if _excluded(b, i, j):
-                            continue
-                        c.row[n_row] = j
-                        n_row += 1
-        if n_row == 0:
-            continue
-        qsort(c.row, n_row, sizeof(intp_t), _cmp_intp)
-        if c.n_pairs + n_row > c.capacity:
-            m = 2 * (c.n_pairs + n_row) + 64
-            grown = <intp_t*> realloc(c.pairs, 2 * m * sizeof(intp_t))
-            if grown == NULL:
-                return STATUS_MEMORY
-            c.pairs = grown
-            c.capacity = m
-        for k in range(n_row):
-            c.pairs[2 * c.n_pairs] = i
-            c.pairs[2 * c.n_pairs + 1] = c.row[k]
-            c.n_pairs += 1
-    return _seed_obstacle_candidates(b, r, c, horizon)
+    status = _voxel_pairs(b, r, c, R, 4, horizon, 1)
+    if status != STATUS_OK:
+        return status
+    return _obstacle_pairs(b, r, c, horizon)
 
 
-cdef enum:
-    OBS_OFF = 1 << 19  # cell offset of the obstacle hash: cells within +-2^19 horizons
-
-
-cdef inline int64_t _okey(int64_t ci, int64_t cj, int64_t ck) noexcept nogil:
-    return ((ci + OBS_OFF) << 40) | ((cj + OBS_OFF) << 20) | (ck + OBS_OFF)
-
-
-cdef int _seed_obstacle_candidates(Batch* b, intp_t r, Contacts* c, float64_t horizon) noexcept nogil:
+cdef int _obstacle_pairs(Batch* b, intp_t r, Contacts* c, float64_t horizon) noexcept nogil:
     # The seed's collision candidates between robot r's surface voxels (at
     # col_ref) and its fixed obstacle voxels (the seed's walls), with the same
     # rule as between voxels: closer than 3 L and than twice the size of the
@@ -290,13 +300,15 @@ cdef int _seed_obstacle_candidates(Batch* b, intp_t r, Contacts* c, float64_t ho
         intp_t o0 = b.obs_start[r]
         intp_t o1 = b.obs_start[r + 1]
         intp_t n_o = o1 - o0
-        intp_t i, m, k, pos_, n_row, mm
-        int64_t ci, cj, ck, key
+        intp_t i, m, k, n_row, mm
         int di, dj, dk
+        int64_t key
+        int64_t ijk[3]
         float64_t L = b.L
-        float64_t inv_cell, dx, dy, dz, d2, act, s_first
+        float64_t dx, dy, dz, d2, act, s_first
         float64_t* R = b.col_ref
         intp_t* grown
+        SpatialHash h
     c.n_opairs = 0
     if n_o == 0 or horizon <= 0.0:
         return STATUS_OK
@@ -304,28 +316,21 @@ cdef int _seed_obstacle_candidates(Batch* b, intp_t r, Contacts* c, float64_t ho
         c.ocells = <KeyIndex*> malloc(n_o * sizeof(KeyIndex))
         if c.ocells == NULL:
             return STATUS_MEMORY
-    inv_cell = 1.0 / horizon
-    for m in range(o0, o1):
-        c.ocells[m - o0].key = _okey(<int64_t> floor(b.obs[4 * m] * inv_cell),
-                                     <int64_t> floor(b.obs[4 * m + 1] * inv_cell),
-                                     <int64_t> floor(b.obs[4 * m + 2] * inv_cell))
-        c.ocells[m - o0].index = m
-    qsort(c.ocells, n_o, sizeof(KeyIndex), _cmp_key_index)
+    _hash_init(&h, c.ocells, horizon, 0.0, 0.0, 0.0, OBS_OFF)
+    _hash_fill(&h, b.obs, 4, NULL, o0, o1)
     for i in range(b.vox_start[r], b.vox_start[r + 1]):
         if not b.surface[i]:
             continue
-        ci = <int64_t> floor(R[4 * i] * inv_cell)
-        cj = <int64_t> floor(R[4 * i + 1] * inv_cell)
-        ck = <int64_t> floor(R[4 * i + 2] * inv_cell)
         n_row = 0
+        _hash_cell(&h, R + 4 * i, ijk)
         for di in range(-1, 2):
             for dj in range(-1, 2):
                 for dk in range(-1, 2):
-                    key = _okey(ci + di, cj + dj, ck + dk)
-                    pos_ = _lower_bound(c.ocells, n_o, key)
-                    while pos_ < n_o and c.ocells[pos_].key == key:
-                        m = c.ocells[pos_].index
-                        pos_ += 1
+                    key = _pack(ijk[0] + di, ijk[1] + dj, ijk[2] + dk)
+                    k = _hash_first(&h, key)
+                    while k < h.n and h.cells[k].key == key:
+                        m = h.cells[k].index
+                        k += 1
                         dx = b.obs[4 * m] - R[4 * i]
                         dy = b.obs[4 * m + 1] - R[4 * i + 1]
                         dz = b.obs[4 * m + 2] - R[4 * i + 2]
@@ -351,13 +356,6 @@ cdef int _seed_obstacle_candidates(Batch* b, intp_t r, Contacts* c, float64_t ho
             # the row's obstacles in index order (results independent of the hash)
             qsort(c.opairs + 2 * (c.n_opairs - n_row), n_row, 2 * sizeof(intp_t), _cmp_intp2)
     return STATUS_OK
-
-
-cdef int _cmp_intp2(const void* a, const void* b) noexcept nogil:
-    # (i, m) pairs of one row: by m
-    cdef intp_t x = (<const intp_t*> a)[1]
-    cdef intp_t y = (<const intp_t*> b)[1]
-    return -1 if x < y else (1 if x > y else 0)
 
 
 cdef void collide_obstacles(Batch* b, Contacts* c) noexcept nogil:
