@@ -296,154 +296,146 @@ class Layout:
     obstacle_cm: np.ndarray
 
 
-def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layout:
-    """Lay out robots and their terrains (one each, validated) for the kernel.
+def _robot_entry(body: Body, terrain: Any, cfg: SimConfig) -> dict[str, Any]:
+    """One robot's entry of the batch: its voxels, then its terrain's movable blocks.
 
-    Each robot's entry holds its voxels (C order of its grid), then its
-    terrain's movable blocks; links join face neighbours within a component,
-    sorted by axis. Pure: the inputs are not modified.
+    Each part is a component with its own links (none between components).
+    Returns its per-voxel arrays (``vox``) and per-link arrays (``link``;
+    voxel indices local to the entry), its counts, time step, mass, grid
+    indices and exclusion lists (CSR columns, local).
     """
-    cfg = config
     L = float(cfg.voxel_size)
-    n_robots = len(bodies)
-    per_vox: dict[str, list[np.ndarray]] = {}
-    per_link: dict[str, list[np.ndarray]] = {}
-    vox_start = [0]
-    link_start = [0]
-    dts, masses, axis_counts, excl, body_end = [], [], [], [], []
-    grid_index = []
+    vox: dict[str, np.ndarray] = {}
+    link: dict[str, np.ndarray] = {}
+    parts = [_component(body, None, L)]
+    parts += [_component(None, blk, L) for blk in terrain.objects]
+    idx = np.concatenate([p["idx"] for p in parts])
+    n = idx.shape[0]
+    n_own = parts[0]["idx"].shape[0]
+    E = np.concatenate([p["E"] for p in parts])
+    rho = np.concatenate([p["rho"] for p in parts])
+    nu = np.concatenate([p["nu"] for p in parts])
+    mat = np.concatenate([p["mat"] for p in parts])
+    m = rho * L**3
+    inertia = m * L**2 / 6.0
+    fixed = np.concatenate([p["fixed"] for p in parts])
+    # links along +x, +y, +z between filled face neighbours of each component
+    v1s, v2s, axes = [], [], []
+    off = 0
+    for p in parts:
+        v1s += [a + off for a in p["v1"]]
+        v2s += [b + off for b in p["v2"]]
+        axes += [np.full(a.size, ax, dtype=np.int32) for ax, a in enumerate(p["v1"])]
+        off += p["idx"].shape[0]
+    v1 = np.concatenate(v1s)
+    v2 = np.concatenate(v2s)
+    axis = np.concatenate(axes)
+    if len(parts) > 1:  # links stay sorted by axis, each component's in order
+        order = np.argsort(axis, kind="stable")
+        v1, v2, axis = v1[order], v2[order], axis[order]
+    keep = ~((fixed[v1] == 1) & (fixed[v2] == 1))
+    v1, v2, axis = v1[keep], v2[keep], axis[keep]
+    Eh = _harmonic(E[v1], E[v2])
+    nuh = _harmonic(nu[v1], nu[v2])
+    mr = _harmonic(m[v1], m[v2])
+    Ir = _harmonic(inertia[v1], inertia[v2])
+    k_axial = Eh * L
+    k_torsion = Eh * L**3 / (12.0 * (1.0 + nuh))
+    k_bend = Eh * L**3 / 6.0
+    zb = cfg.bond_damping
+    link["v1"] = v1  # local: build_layout adds the entry's first voxel
+    link["v2"] = v2
+    link["axis"] = axis
+    link["k_axial"] = k_axial
+    link["k_torsion"] = k_torsion
+    link["k_bend"] = k_bend
+    link["c_axial"] = zb * np.sqrt(k_axial * mr)
+    link["c_bend"] = 0.5 * zb * np.sqrt(k_bend * Ir)
+    link["c_torsion"] = 0.5 * zb * np.sqrt(k_torsion * Ir)
+    # the seed model's damping constants 2 sqrt(k m) for each end:
+    # (a1 M, b2 FM, a2 I, b3 I), b2 = E L^2 / 2, FM = M L / 2
+    b2 = 0.5 * k_axial * L
+    ends = []
+    for v in (v1, v2):
+        ends += [2.0 * np.sqrt(k_axial * m[v]), 2.0 * np.sqrt(b2 * 0.5 * m[v] * L),
+                 2.0 * np.sqrt(k_torsion * inertia[v]), 2.0 * np.sqrt(k_bend * inertia[v])]
+    link["c_seed"] = np.stack(ends, axis=1).reshape(-1, 8)
+    link["homog"] = (mat[v1] == mat[v2]).astype(np.int8)
+    dt = _time_step(k_axial, m, E, v1, v2, cfg)
+    crit = 2.0 * np.sqrt(m * E * L)
+    origin = np.concatenate([np.broadcast_to(p["origin"], p["idx"].shape) for p in parts])
+    if cfg.model == "seed":
+        # the seed's lattice positions carry its 1e-6 L offset in x and y
+        # (VX_Object::GetXYZ), which decides exact-zero tests downstream
+        pos = origin + L * ((idx + 0.5) + np.array([1e-6, 1e-6, 0.0]))
+    else:
+        pos = origin + (idx + 0.5) * L
+    vox["pos"] = pos
+    faces = np.concatenate([p["faces"] for p in parts])
+    vox["faces"] = faces
+    vox["mass"] = m
+    vox["inv_mass"] = 1.0 / m
+    vox["inv_inertia"] = 1.0 / inertia
+    cte = np.zeros(n)
+    cte[:n_own] = body.cte[mat[:n_own]]
+    phase = np.zeros(n)
+    phase[:n_own] = body.phase[mat[:n_own]]
+    vox["cte"] = cte
+    vox["cos_phase"] = np.cos(phase)
+    vox["sin_phase"] = np.sin(phase)
+    vox["k_floor"] = 2.0 * E * L
+    vox["c_floor"] = cfg.collision_damping * crit
+    vox["c_global"] = cfg.global_damping * crit
+    rot_damp = 1.0 - 10.0 * cfg.global_damping * 2.0 * np.sqrt(inertia * E * L**3) / inertia * dt
+    vox["rot_damp"] = np.clip(rot_damp, 0.0, 1.0)
+    mu_s = np.concatenate([p["mu_s"] for p in parts])
+    mu_k = np.concatenate([p["mu_k"] for p in parts])
+    if cfg.friction != 1.0:
+        mu_s = mu_s * float(cfg.friction)
+        mu_k = mu_k * float(cfg.friction)
+    vox["mu_s"] = mu_s
+    vox["mu_k"] = mu_k
+    if cfg.incline != 0.0:  # the slope's pull along -x, per voxel
+        ext = np.zeros((n, 3))
+        ext[:, 0] = -m * float(cfg.gravity) * math.sin(math.radians(cfg.incline))
+    else:
+        ext = np.zeros((n, 3))
+    vox["ext_force"] = ext
+    vox["fixed"] = fixed
+    degree = np.bincount(np.concatenate([v1, v2]), minlength=n)
+    vox["surface"] = (degree < 6).astype(np.int8)
+    # the seed engine's voxel order (x fastest, then y, then z) over
+    # the world lattice: it decides which voxel of a pair sets the
+    # seed's candidate horizon
+    lattice = np.concatenate(
+        [np.broadcast_to(np.rint(p["origin"] / L).astype(np.int64), p["idx"].shape) for p in parts]
+    )
+    vox["seed_rank"] = _seed_rank(lattice + idx)
+    ex_start, ex_idx = _hop_neighbours(n, v1, v2, cfg.collision_exclusion)
+    vox["excl_count"] = np.diff(ex_start)
+    return {
+        "vox": vox,
+        "link": link,
+        "n": n,
+        "n_own": n_own,
+        "n_links": v1.size,
+        "axis_count": np.bincount(axis, minlength=3),  # links stay sorted by axis
+        "dt": dt,
+        "mass": float(m[:n_own].sum()),
+        "grid_index": idx,
+        "excl_idx": ex_idx,  # local, as v1 and v2
+    }
 
-    def add(store, name, value):
-        store.setdefault(name, []).append(np.asarray(value))
 
-    for body, terrain in zip(bodies, terrains):
-        # the entry: the robot's voxels, then its terrain's movable blocks, each
-        # a component with its own links (none between components)
-        parts = [_component(body, None, L)]
-        parts += [_component(None, blk, L) for blk in terrain.objects]
-        idx = np.concatenate([p["idx"] for p in parts])
-        n = idx.shape[0]
-        n_own = parts[0]["idx"].shape[0]
-        E = np.concatenate([p["E"] for p in parts])
-        rho = np.concatenate([p["rho"] for p in parts])
-        nu = np.concatenate([p["nu"] for p in parts])
-        mat = np.concatenate([p["mat"] for p in parts])
-        m = rho * L**3
-        inertia = m * L**2 / 6.0
-        fixed = np.concatenate([p["fixed"] for p in parts])
-        # links along +x, +y, +z between filled face neighbours of each component
-        v1s, v2s, axes = [], [], []
-        off = 0
-        for p in parts:
-            v1s += [a + off for a in p["v1"]]
-            v2s += [b + off for b in p["v2"]]
-            axes += [np.full(a.size, ax, dtype=np.int32) for ax, a in enumerate(p["v1"])]
-            off += p["idx"].shape[0]
-        v1 = np.concatenate(v1s)
-        v2 = np.concatenate(v2s)
-        axis = np.concatenate(axes)
-        if len(parts) > 1:  # links stay sorted by axis, each component's in order
-            order = np.argsort(axis, kind="stable")
-            v1, v2, axis = v1[order], v2[order], axis[order]
-        keep = ~((fixed[v1] == 1) & (fixed[v2] == 1))
-        v1, v2, axis = v1[keep], v2[keep], axis[keep]
-        axis_counts.append(np.bincount(axis, minlength=3))  # links stay sorted by axis
-        Eh = _harmonic(E[v1], E[v2])
-        nuh = _harmonic(nu[v1], nu[v2])
-        mr = _harmonic(m[v1], m[v2])
-        Ir = _harmonic(inertia[v1], inertia[v2])
-        k_axial = Eh * L
-        k_torsion = Eh * L**3 / (12.0 * (1.0 + nuh))
-        k_bend = Eh * L**3 / 6.0
-        zb = cfg.bond_damping
-        add(per_link, "v1", v1 + vox_start[-1])
-        add(per_link, "v2", v2 + vox_start[-1])
-        add(per_link, "axis", axis)
-        add(per_link, "k_axial", k_axial)
-        add(per_link, "k_torsion", k_torsion)
-        add(per_link, "k_bend", k_bend)
-        add(per_link, "c_axial", zb * np.sqrt(k_axial * mr))
-        add(per_link, "c_bend", 0.5 * zb * np.sqrt(k_bend * Ir))
-        add(per_link, "c_torsion", 0.5 * zb * np.sqrt(k_torsion * Ir))
-        # the seed model's damping constants 2 sqrt(k m) for each end:
-        # (a1 M, b2 FM, a2 I, b3 I), b2 = E L^2 / 2, FM = M L / 2
-        b2 = 0.5 * k_axial * L
-        ends = []
-        for v in (v1, v2):
-            ends += [2.0 * np.sqrt(k_axial * m[v]), 2.0 * np.sqrt(b2 * 0.5 * m[v] * L),
-                     2.0 * np.sqrt(k_torsion * inertia[v]), 2.0 * np.sqrt(k_bend * inertia[v])]
-        add(per_link, "c_seed", np.stack(ends, axis=1).reshape(-1, 8))
-        add(per_link, "homog", (mat[v1] == mat[v2]).astype(np.int8))
-        dt = _time_step(k_axial, m, E, v1, v2, cfg)
-        dts.append(dt)
-        masses.append(float(m[:n_own].sum()))
-        body_end.append(vox_start[-1] + n_own)
-        crit = 2.0 * np.sqrt(m * E * L)
-        origin = np.concatenate([np.broadcast_to(p["origin"], p["idx"].shape) for p in parts])
-        if cfg.model == "seed":
-            # the seed's lattice positions carry its 1e-6 L offset in x and y
-            # (VX_Object::GetXYZ), which decides exact-zero tests downstream
-            pos = origin + L * ((idx + 0.5) + np.array([1e-6, 1e-6, 0.0]))
-        else:
-            pos = origin + (idx + 0.5) * L
-        add(per_vox, "pos", pos)
-        faces = np.concatenate([p["faces"] for p in parts])
-        add(per_vox, "faces", faces)
-        add(per_vox, "mass", m)
-        add(per_vox, "inv_mass", 1.0 / m)
-        add(per_vox, "inv_inertia", 1.0 / inertia)
-        cte = np.zeros(n)
-        cte[:n_own] = body.cte[mat[:n_own]]
-        phase = np.zeros(n)
-        phase[:n_own] = body.phase[mat[:n_own]]
-        add(per_vox, "cte", cte)
-        add(per_vox, "cos_phase", np.cos(phase))
-        add(per_vox, "sin_phase", np.sin(phase))
-        add(per_vox, "k_floor", 2.0 * E * L)
-        add(per_vox, "c_floor", cfg.collision_damping * crit)
-        add(per_vox, "c_global", cfg.global_damping * crit)
-        rot_damp = 1.0 - 10.0 * cfg.global_damping * 2.0 * np.sqrt(inertia * E * L**3) / inertia * dt
-        add(per_vox, "rot_damp", np.clip(rot_damp, 0.0, 1.0))
-        mu_s = np.concatenate([p["mu_s"] for p in parts])
-        mu_k = np.concatenate([p["mu_k"] for p in parts])
-        if cfg.friction != 1.0:
-            mu_s = mu_s * float(cfg.friction)
-            mu_k = mu_k * float(cfg.friction)
-        add(per_vox, "mu_s", mu_s)
-        add(per_vox, "mu_k", mu_k)
-        if cfg.incline != 0.0:  # the slope's pull along -x, per voxel
-            ext = np.zeros((n, 3))
-            ext[:, 0] = -m * float(cfg.gravity) * math.sin(math.radians(cfg.incline))
-        else:
-            ext = np.zeros((n, 3))
-        add(per_vox, "ext_force", ext)
-        add(per_vox, "fixed", fixed)
-        grid_index.append(idx)
-        degree = np.bincount(np.concatenate([v1, v2]), minlength=n)
-        add(per_vox, "surface", (degree < 6).astype(np.int8))
-        # the seed engine's voxel order (x fastest, then y, then z) over
-        # the world lattice: it decides which voxel of a pair sets the
-        # seed's candidate horizon
-        lattice = np.concatenate(
-            [np.broadcast_to(np.rint(p["origin"] / L).astype(np.int64), p["idx"].shape) for p in parts]
-        )
-        add(per_vox, "seed_rank", _seed_rank(lattice + idx))
-        ex_start, ex_idx = _hop_neighbours(n, v1, v2, cfg.collision_exclusion)
-        add(per_vox, "excl_count", np.diff(ex_start))
-        excl.append(ex_idx + vox_start[-1])
-        vox_start.append(vox_start[-1] + n)
-        link_start.append(link_start[-1] + v1.size)
+def _terrain_arrays(terrains: list, cfg: SimConfig) -> dict[str, np.ndarray]:
+    """The terrains' boxes, obstacle voxels and floors, robot after robot.
 
-    n_vox = vox_start[-1]
+    The seed model: lattice boxes become the seed's fixed obstacle voxels
+    (contact through its self-collision law), other boxes keep the penalty
+    contact.
+    """
+    L = float(cfg.voxel_size)
     a: dict[str, np.ndarray] = {}
-    for name, parts in per_vox.items():
-        a[name] = np.ascontiguousarray(np.concatenate(parts))
-    a["fixed"] = a["fixed"].astype(np.int8)
-    a["surface"] = a["surface"].astype(np.int8)
-    a["excl_start"] = np.concatenate([[0], np.cumsum(a.pop("excl_count"))]).astype(np.intp)
-    a["excl_idx"] = np.ascontiguousarray(np.concatenate(excl), dtype=np.intp)
-    # the seed model: lattice boxes become the seed's fixed obstacle voxels
-    # (contact through its self-collision law), other boxes keep the penalty contact
     boxes, obs, obs_rank, obs_start = [], [], [], [0]
     k_obs = 2.0 * OBSTACLE_YOUNGS_MODULUS * L
     for t in terrains:
@@ -463,6 +455,51 @@ def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layou
     a["box_start"] = np.concatenate([[0], np.cumsum([len(b) for b in boxes])]).astype(np.intp)
     a["boxes"] = np.ascontiguousarray(np.concatenate(boxes), dtype=np.float64).reshape(-1, 6)
     a["floor"] = np.array([int(t.floor and cfg.floor) for t in terrains], dtype=np.int8)
+    return a
+
+
+def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layout:
+    """Lay out robots and their terrains (one each, validated) for the kernel.
+
+    Each robot's entry holds its voxels (C order of its grid), then its
+    terrain's movable blocks; links join face neighbours within a component,
+    sorted by axis. Pure: the inputs are not modified.
+    """
+    cfg = config
+    L = float(cfg.voxel_size)
+    n_robots = len(bodies)
+    per_vox: dict[str, list[np.ndarray]] = {}
+    per_link: dict[str, list[np.ndarray]] = {}
+    vox_start = [0]
+    link_start = [0]
+    dts, masses, axis_counts, excl, body_end = [], [], [], [], []
+    grid_index = []
+
+    entries = [_robot_entry(body, terrain, cfg) for body, terrain in zip(bodies, terrains)]
+    for e in entries:
+        for name, value in e["vox"].items():
+            per_vox.setdefault(name, []).append(value)
+        for name, value in e["link"].items():
+            # the entry's voxel indices, offset to the batch's
+            per_link.setdefault(name, []).append(value + vox_start[-1] if name in ("v1", "v2") else value)
+        axis_counts.append(e["axis_count"])
+        dts.append(e["dt"])
+        masses.append(e["mass"])
+        body_end.append(vox_start[-1] + e["n_own"])
+        grid_index.append(e["grid_index"])
+        excl.append(e["excl_idx"] + vox_start[-1])
+        vox_start.append(vox_start[-1] + e["n"])
+        link_start.append(link_start[-1] + e["n_links"])
+
+    n_vox = vox_start[-1]
+    a: dict[str, np.ndarray] = {}
+    for name, parts in per_vox.items():
+        a[name] = np.ascontiguousarray(np.concatenate(parts))
+    a["fixed"] = a["fixed"].astype(np.int8)
+    a["surface"] = a["surface"].astype(np.int8)
+    a["excl_start"] = np.concatenate([[0], np.cumsum(a.pop("excl_count"))]).astype(np.intp)
+    a["excl_idx"] = np.ascontiguousarray(np.concatenate(excl), dtype=np.intp)
+    a.update(_terrain_arrays(terrains, cfg))
     for name, parts in per_link.items():
         a[name] = np.ascontiguousarray(np.concatenate(parts))
     for name in ("v1", "v2"):
