@@ -7,7 +7,7 @@
 #                           since the last collision-list rebuild
 #   integrate_seed          model 0 (the seed's EulerStep)
 
-from libc.math cimport sqrt, fabs
+from libc.math cimport fabs
 from libc.string cimport memset
 
 from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_NONFINITE

@@ -30,7 +30,7 @@
 # collision list in _contact.pyx, the drive and the step loop in _core.pyx.
 # The vectorised passes are C in include/softgym_seed.h.
 
-from libc.math cimport sin, cos, acos, sqrt, fabs
+from libc.math cimport cos, acos, sqrt, fabs
 
 cimport numpy as cnp
 import numpy as np
