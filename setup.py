@@ -165,8 +165,11 @@ else:
     # (the seed kernel's vectorised bond-frame pass); it changes no result
     opt = ["-O3", "-ffp-contract=off", "-fno-math-errno", "-fno-trapping-math", *_native_flags()]
 
+# the engine's C helpers (static inline kernels) live in softgym/engine/include
+ENGINE_INCLUDE = os.path.join("softgym", "engine", "include")
+
 ext_kwargs = dict(
-    include_dirs=[np.get_include()],
+    include_dirs=[np.get_include(), ENGINE_INCLUDE],
     define_macros=[
         ("NPY_NO_DEPRECATED_API", "NPY_1_7_API_VERSION"),
         ("SOFTGYM_OPENMP", "1" if omp is not None else "0"),
@@ -183,11 +186,24 @@ if sys.platform != "win32":
         ("CYTHON_INLINE", "__inline__ __attribute__((always_inline))"),
     ]
 
+# the engine, one extension module per concept (each .pyx with its .pxd contract;
+# a call across modules goes through a function pointer, so only per-robot
+# functions cross them: per-link and per-voxel code inlines within a module, or
+# comes inline from a .pxd or an include/*.h header)
+ENGINE_MODULES = (
+    "_core",          # the step loop and the Python entry points
+    "_corotational",  # model 1's link forces
+    "_seed",          # model 0's link forces (C passes in include/softgym_seed.h)
+    "_contact",       # self-collision (one spatial hash); floor/box laws inline in the .pxd
+    "_integrate",     # the voxel update of both models
+    "_record",        # centre of mass, trace, aux, energy
+)
+
 extensions = [
-    Extension("softgym.engine._core", ["softgym/engine/_core.pyx"], **core_kwargs),
+    *(Extension(f"softgym.engine.{m}", [f"softgym/engine/{m}.pyx"], **core_kwargs)
+      for m in ENGINE_MODULES),
     Extension("softgym.engine._openmp", ["softgym/engine/_openmp.pyx"], **ext_kwargs),
-    Extension("softgym.engine._cpu", ["softgym/engine/_cpu.pyx"],
-              **{**ext_kwargs, "include_dirs": [*ext_kwargs["include_dirs"], "softgym/engine"]}),
+    Extension("softgym.engine._cpu", ["softgym/engine/_cpu.pyx"], **ext_kwargs),
 ]
 directives = {
     "language_level": 3,
@@ -199,12 +215,12 @@ directives = {
     "embedsignature": True,
 }
 
-# The kernel's modules: built again for each newer x86-64 level, from the same C
-KERNEL_MODULES = ("softgym.engine._core",)
-
 extensions = cythonize(extensions, compiler_directives=directives)
+# every engine module again for each newer x86-64 level, from the same C (their
+# calls into one another resolve within one build: softgym/engine/_dispatch.py)
+base = [e for e in extensions if e.name in {f"softgym.engine.{m}" for m in ENGINE_MODULES}]
 for level in _kernel_levels():
-    for ext in [e for e in extensions if e.name in KERNEL_MODULES]:
+    for ext in base:
         # softgym.engine._x86_64_v3._core: the generated C of softgym.engine._core
         # compiled with the level's flags (softgym/engine/_dispatch.py loads it
         # under its own name)

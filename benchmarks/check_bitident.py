@@ -18,6 +18,8 @@ each robot alone and the whole set as one batch, on 1 and 2 threads.
     PYTHONPATH=. python benchmarks/check_bitident.py --compare /tmp/speed_ref.npz
     # every build of the kernel (softgym/engine/_dispatch.py) against the same reference
     SOFTGYM_KERNEL=baseline python benchmarks/check_bitident.py --compare /tmp/speed_ref.npz
+    # the same for the corotational preset's kernel
+    python benchmarks/check_bitident.py --model corotational --save /tmp/corot_ref.npz
 """
 
 from __future__ import annotations
@@ -96,7 +98,7 @@ def state_of(sim: Simulation, robot: int, rollout) -> dict[str, np.ndarray]:
     return out
 
 
-def run_all(seconds: float, quick: bool, vxa: str | None, log=print):
+def run_all(seconds: float, quick: bool, vxa: str | None, log=print, model: str = "seed"):
     """{key: array} of every case alone (1 and 2 threads) and all in batches."""
     res = {}
     cs = cases(quick, vxa)
@@ -106,7 +108,7 @@ def run_all(seconds: float, quick: bool, vxa: str | None, log=print):
             # each robot alone
             for name, d, terr, _ in group:
                 t0 = time.perf_counter()
-                sim = Simulation([d], SimConfig(model="seed", self_collision=col),
+                sim = Simulation([d], SimConfig(model=model, self_collision=col),
                                  n_threads=threads, terrain=terr)  # fmt: skip
                 ro = sim.run(seconds)
                 for k, v in state_of(sim, 0, ro).items():
@@ -118,7 +120,7 @@ def run_all(seconds: float, quick: bool, vxa: str | None, log=print):
                         f"{int((sa == 0).sum()):4d} diverged {bool(sim.diverged[0])} "
                         f"({time.perf_counter() - t0:.1f} s)")  # fmt: skip
             # all of them in one batch (per-robot terrains)
-            sim = Simulation([d for _, d, _, _ in group], SimConfig(model="seed", self_collision=col),
+            sim = Simulation([d for _, d, _, _ in group], SimConfig(model=model, self_collision=col),
                              n_threads=threads, terrain=[t or Terrain.flat() for _, _, t, _ in group])  # fmt: skip
             ro = sim.run(seconds)
             for r, (name, _, _, _) in enumerate(group):
@@ -135,12 +137,15 @@ def main(argv=None) -> int:
     ap.add_argument("--seconds", type=float, default=1.5, help="simulated time per run")
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--vxa", default=VXA)
+    ap.add_argument("--model", default="seed", choices=("seed", "corotational"),
+                    help="preset whose kernel is checked (a reference holds one preset)")
     args = ap.parse_args(argv)
     import softgym.engine._core as core
     from softgym.engine import kernel_build
 
     print(f"engine: {core.__file__} (kernel build {kernel_build()})", file=sys.stderr)
-    res = run_all(args.seconds, args.quick, args.vxa, log=lambda s: print(s, file=sys.stderr))
+    res = run_all(args.seconds, args.quick, args.vxa, log=lambda s: print(s, file=sys.stderr),
+                  model=args.model)
     # alone vs batch must agree too (the kernel's own promise)
     bad = [k for k in res if k.startswith("batch/") and not k.endswith("/rollout_" + "")
            and k.replace("batch/", "alone/", 1) in res

@@ -1,7 +1,7 @@
-# The running CPU's x86-64 level (C in cpu_level.h), read once by
+# The running CPU's x86-64 level (C in include/softgym_cpu.h), read once by
 # softgym/engine/_dispatch.py to pick the step kernel's build.
 
-cdef extern from "cpu_level.h":
+cdef extern from "softgym_cpu.h":
     int softgym_cpu_level() noexcept nogil
 
 

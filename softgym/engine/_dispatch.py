@@ -1,6 +1,6 @@
 """The build of the compiled engine that runs: portable, or for a newer x86-64 level.
 
-``setup.py`` compiles the engine's kernel modules (its ``KERNEL_MODULES``) for
+``setup.py`` compiles the engine's kernel modules (its ``ENGINE_MODULES``) for
 the portable instruction set and, on x86-64, again from the same C with
 ``-march=x86-64-v3`` (AVX2) and ``-march=x86-64-v4`` (AVX-512), into the
 folders ``_x86_64_v3/`` and ``_x86_64_v4/`` beside this file. :func:`install`

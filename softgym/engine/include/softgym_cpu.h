@@ -4,8 +4,8 @@
    (x86-64-v3: AVX2, FMA, BMI1/2, F16C, LZCNT, MOVBE) or 4 (x86-64-v4:
    AVX-512 F, BW, CD, DQ, VL). __builtin_cpu_supports also checks that the
    operating system saves the wide registers (XSAVE / OSXSAVE). */
-#ifndef SOFTGYM_CPU_LEVEL_H
-#define SOFTGYM_CPU_LEVEL_H
+#ifndef SOFTGYM_CPU_H
+#define SOFTGYM_CPU_H
 
 static int softgym_cpu_level(void)
 {

@@ -1,0 +1,410 @@
+# Self-collision (SEED_REFERENCE 1.7): surface voxels more than
+# `collision_exclusion` bond hops apart repel when their spherical envelopes, of diameter
+# 1.5 x their actuated size, overlap: F = E_h L (0.75 (s1 + s2) - |d|) along d,
+# E_h the harmonic mean of their moduli; no damping, no friction. Candidate
+# pairs come from a spatial hash (cells of the candidate horizon) and are kept
+# until some voxel may have crossed the horizon's slack, so the cost grows
+# about linearly with the number of voxels. The candidate list is always a
+# superset of the touching pairs and is sorted, so forces do not depend on
+# when it was rebuilt: results stay bit-identical.
+#
+# Both models' candidate lists (contacts_corotational, contacts_seed: the
+# seed's own rule and schedule, with its obstacle voxels) come from one
+# spatial hash (_hash_*); collide / collide_obstacles apply the contact law. The
+# contact laws with the floor and terrain boxes are inline in _contact.pxd.
+
+from libc.math cimport sqrt, floor
+from libc.stdint cimport int64_t
+from libc.stdlib cimport malloc, realloc, qsort
+from libc.string cimport memcpy
+
+from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_MEMORY
+from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t
+
+# ---------------------------------------------------------------------------
+# The spatial hash (SpatialHash, _contact.pxd): points binned in cubic cells
+# of one edge, keyed by their packed cell coordinates, sorted by (key, index);
+# a query walks the 27 cells around a point's cell (_hash_cell, then
+# _hash_first of each neighbour's key), cells in (di, dj, dk) order, each
+# cell's points in index order. Used for the voxel pairs of both models and
+# for the seed's voxel-obstacle pairs.
+
+cdef enum:
+    CELL_BITS = 20           # bits of each packed cell coordinate
+    VOXEL_OFF = 1            # cell offset of a robot's voxel hash (origin: its lowest centre)
+    OBS_OFF = 1 << 19        # cell offset of the obstacle hash (origin 0): cells within +-2^19 cells
+
+
+cdef int _cmp_key_index(const void* a, const void* b) noexcept nogil:
+    cdef const KeyIndex* x = <const KeyIndex*> a
+    cdef const KeyIndex* y = <const KeyIndex*> b
+    if x.key != y.key:
+        return -1 if x.key < y.key else 1
+    return -1 if x.index < y.index else (1 if x.index > y.index else 0)
+
+
+cdef int _cmp_intp(const void* a, const void* b) noexcept nogil:
+    cdef intp_t x = (<const intp_t*> a)[0]
+    cdef intp_t y = (<const intp_t*> b)[0]
+    return -1 if x < y else (1 if x > y else 0)
+
+
+cdef int _cmp_intp2(const void* a, const void* b) noexcept nogil:
+    # (i, m) pairs of one row: by m
+    cdef intp_t x = (<const intp_t*> a)[1]
+    cdef intp_t y = (<const intp_t*> b)[1]
+    return -1 if x < y else (1 if x > y else 0)
+
+
+cdef inline bint _excluded(Batch* b, intp_t i, intp_t j) noexcept nogil:
+    # binary search of j in voxel i's sorted exclusion row
+    cdef intp_t lo = b.excl_start[i], hi = b.excl_start[i + 1], mid
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if b.excl_idx[mid] < j:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo < b.excl_start[i + 1] and b.excl_idx[lo] == j
+
+
+cdef inline intp_t _lower_bound(const KeyIndex* cells, intp_t n, int64_t key) noexcept nogil:
+    cdef intp_t lo = 0, hi = n, mid
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if cells[mid].key < key:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+cdef inline int64_t _pack(int64_t ci, int64_t cj, int64_t ck) noexcept nogil:
+    return (ci << (2 * CELL_BITS)) | (cj << CELL_BITS) | ck
+
+
+cdef inline void _hash_init(SpatialHash* h, KeyIndex* cells, float64_t cell, float64_t x0,
+                            float64_t y0, float64_t z0, int64_t offset) noexcept nogil:
+    # an empty hash over the storage `cells`, cells of edge `cell` (m) from
+    # the origin (x0, y0, z0), coordinates shifted by `offset`
+    h.cells = cells
+    h.n = 0
+    h.inv_cell = 1.0 / cell
+    h.x0 = x0
+    h.y0 = y0
+    h.z0 = z0
+    h.offset = offset
+
+
+cdef inline void _hash_cell(const SpatialHash* h, const float64_t* p, int64_t* cijk) noexcept nogil:
+    # OUT: cijk, the (offset) cell coordinates of point p
+    cijk[0] = <int64_t> floor((p[0] - h.x0) * h.inv_cell) + h.offset
+    cijk[1] = <int64_t> floor((p[1] - h.y0) * h.inv_cell) + h.offset
+    cijk[2] = <int64_t> floor((p[2] - h.z0) * h.inv_cell) + h.offset
+
+
+cdef inline void _hash_fill(SpatialHash* h, const float64_t* P, intp_t stride,
+                            const flag_t* mask, intp_t lo, intp_t hi) noexcept nogil:
+    # the points P + stride * i of i in [lo, hi) (those with mask[i] only,
+    # unless mask is NULL), sorted by cell
+    cdef:
+        intp_t i
+        int64_t c[3]
+    h.n = 0
+    for i in range(lo, hi):
+        if mask != NULL and not mask[i]:
+            continue
+        _hash_cell(h, P + stride * i, c)
+        h.cells[h.n].key = _pack(c[0], c[1], c[2])
+        h.cells[h.n].index = i
+        h.n += 1
+    qsort(h.cells, h.n, sizeof(KeyIndex), _cmp_key_index)
+
+
+cdef inline intp_t _hash_first(const SpatialHash* h, int64_t key) noexcept nogil:
+    # the first point of cell `key` (its points run while h.cells[k].key == key)
+    return _lower_bound(h.cells, h.n, key)
+
+
+# ---------------------------------------------------------------------------
+# Candidate lists
+
+cdef inline int _alloc_lists(Contacts* c, intp_t n) noexcept nogil:
+    # the per-voxel scratch of a robot of n voxels (once)
+    if c.cells == NULL:
+        c.cells = <KeyIndex*> malloc(n * sizeof(KeyIndex))
+        c.row = <intp_t*> malloc(n * sizeof(intp_t))
+        c.ref = <float64_t*> malloc(3 * n * sizeof(float64_t))
+        if c.cells == NULL or c.row == NULL or c.ref == NULL:
+            return STATUS_MEMORY
+    return STATUS_OK
+
+
+cdef inline int _voxel_pairs(Batch* b, intp_t r, Contacts* c, const float64_t* P, intp_t stride,
+                             float64_t horizon, const int32 seed_rule) noexcept nogil:
+    # OUT: c.pairs (appended to c.n_pairs), robot r's surface voxel pairs
+    # i < j, not excluded, whose centres P + stride * i (m) are closer than
+    # `horizon` (the hash's cell edge), sorted by (i, j). seed_rule (a
+    # compile-time constant once inlined): instead of the horizon, the
+    # seed's rule, closer than 3 L and than twice the size (P[stride * i + 3])
+    # of the pair's first voxel in the seed's order. Returns a STATUS.
+    cdef:
+        intp_t vs = b.vox_start[r]
+        intp_t ve = b.vox_start[r + 1]
+        intp_t i, j, k, m, n_row
+        float64_t L = b.L
+        float64_t h2 = horizon * horizon, x0, y0, z0, dx, dy, dz, d2, act
+        intp_t first
+        int di, dj, dk
+        int64_t key
+        int64_t ijk[3]
+        intp_t* grown
+        SpatialHash h
+    x0 = P[stride * vs]
+    y0 = P[stride * vs + 1]
+    z0 = P[stride * vs + 2]
+    for i in range(vs, ve):
+        if P[stride * i] < x0:
+            x0 = P[stride * i]
+        if P[stride * i + 1] < y0:
+            y0 = P[stride * i + 1]
+        if P[stride * i + 2] < z0:
+            z0 = P[stride * i + 2]
+    # only surface voxels (missing a face bond) collide, as the seed intended:
+    # an interior voxel is shielded by its six bonded neighbours
+    _hash_init(&h, c.cells, horizon, x0, y0, z0, VOXEL_OFF)
+    _hash_fill(&h, P, stride, b.surface, vs, ve)
+    for i in range(vs, ve):
+        if not b.surface[i]:
+            continue
+        n_row = 0
+        _hash_cell(&h, P + stride * i, ijk)
+        for di in range(-1, 2):
+            for dj in range(-1, 2):
+                for dk in range(-1, 2):
+                    key = _pack(ijk[0] + di, ijk[1] + dj, ijk[2] + dk)
+                    k = _hash_first(&h, key)
+                    while k < h.n and h.cells[k].key == key:
+                        j = h.cells[k].index
+                        k += 1
+                        if j <= i:
+                            continue
+                        dx = P[stride * j] - P[stride * i]
+                        dy = P[stride * j + 1] - P[stride * i + 1]
+                        dz = P[stride * j + 2] - P[stride * i + 2]
+                        d2 = dx * dx + dy * dy + dz * dz
+                        if seed_rule:
+                            if d2 >= 9.0 * L * L:
+                                continue
+                            first = i if b.seed_rank[i] < b.seed_rank[j] else j
+                            act = 2.0 * P[stride * first + 3]
+                            if d2 >= act * act:
+                                continue
+                        elif d2 >= h2:
+                            continue
+                        if _excluded(b, i, j):
+                            continue
+                        c.row[n_row] = j
+                        n_row += 1
+        if n_row == 0:
+            continue
+        qsort(c.row, n_row, sizeof(intp_t), _cmp_intp)
+        if c.n_pairs + n_row > c.capacity:
+            m = 2 * (c.n_pairs + n_row) + 64
+            grown = <intp_t*> realloc(c.pairs, 2 * m * sizeof(intp_t))
+            if grown == NULL:
+                return STATUS_MEMORY
+            c.pairs = grown
+            c.capacity = m
+        for k in range(n_row):
+            c.pairs[2 * c.n_pairs] = i
+            c.pairs[2 * c.n_pairs + 1] = c.row[k]
+            c.n_pairs += 1
+    return STATUS_OK
+
+
+cdef int contacts_corotational(Batch* b, intp_t r, Contacts* c) noexcept nogil:
+    # OUT: c.pairs, sorted candidate pairs within the horizon. Returns a STATUS.
+    cdef:
+        intp_t vs = b.vox_start[r]
+        intp_t ve = b.vox_start[r + 1]
+        intp_t n = ve - vs
+        intp_t i
+        float64_t L = b.L
+        float64_t smax = L, env, horizon
+    if _alloc_lists(c, n) != STATUS_OK:
+        return STATUS_MEMORY
+    memcpy(c.ref, b.pos + 3 * vs, 3 * n * sizeof(float64_t))
+    for i in range(vs, ve):
+        if b.scale[i] > smax:
+            smax = b.scale[i]
+    env = 1.5 * smax                 # the largest envelope 0.75 (s1 + s2)
+    c.margin = 0.5 * L
+    horizon = env + c.margin
+    c.built_scale = smax
+    c.stale = 0
+    c.n_pairs = 0
+    return _voxel_pairs(b, r, c, b.pos, 3, horizon, 0)
+
+
+cdef int contacts_seed(Batch* b, intp_t r, Contacts* c, int32 snapshot) noexcept nogil:
+    # The seed's collision list (CalcL1Bonds with its horizon 2): surface voxel
+    # pairs more than the exclusion hops apart whose centres are closer than
+    # 3 L and than twice the size of the pair's first voxel in the seed's
+    # order, measured at the rebuild; then its obstacle pairs. snapshot: 1
+    # copies the current positions and sizes into col_ref first (a rebuild);
+    # 0 rebuilds the list of the last rebuild from col_ref (after the state
+    # was restored).
+    cdef:
+        intp_t vs = b.vox_start[r]
+        intp_t ve = b.vox_start[r + 1]
+        intp_t i
+        int status
+        float64_t L = b.L
+        float64_t smax = 0.0, horizon
+        float64_t* R = b.col_ref
+    if _alloc_lists(c, ve - vs) != STATUS_OK:
+        return STATUS_MEMORY
+    if snapshot:
+        for i in range(vs, ve):
+            R[4 * i] = b.pos[3 * i]
+            R[4 * i + 1] = b.pos[3 * i + 1]
+            R[4 * i + 2] = b.pos[3 * i + 2]
+            R[4 * i + 3] = b.scale[i]
+    c.stale = 0
+    c.n_pairs = 0
+    c.built_scale = 1.0e300  # model 0 rebuilds on its own schedule, never for sizes
+    c.margin = 1.0e300
+    for i in range(vs, ve):
+        if R[4 * i + 3] > smax:
+            smax = R[4 * i + 3]
+    horizon = 2.0 * smax
+    if horizon < 2.0 * L and b.obs_start[r + 1] > b.obs_start[r]:
+        horizon = 2.0 * L  # an obstacle voxel keeps its size L
+    if horizon > 3.0 * L:
+        horizon = 3.0 * L
+    if horizon <= 0.0:
+        return STATUS_OK
+    status = _voxel_pairs(b, r, c, R, 4, horizon, 1)
+    if status != STATUS_OK:
+        return status
+    return _obstacle_pairs(b, r, c, horizon)
+
+
+cdef int _obstacle_pairs(Batch* b, intp_t r, Contacts* c, float64_t horizon) noexcept nogil:
+    # The seed's collision candidates between robot r's surface voxels (at
+    # col_ref) and its fixed obstacle voxels (the seed's walls), with the same
+    # rule as between voxels: closer than 3 L and than twice the size of the
+    # pair's first voxel in the seed's order (an obstacle keeps its size L).
+    cdef:
+        intp_t o0 = b.obs_start[r]
+        intp_t o1 = b.obs_start[r + 1]
+        intp_t n_o = o1 - o0
+        intp_t i, m, k, n_row, mm
+        int di, dj, dk
+        int64_t key
+        int64_t ijk[3]
+        float64_t L = b.L
+        float64_t dx, dy, dz, d2, act, s_first
+        float64_t* R = b.col_ref
+        intp_t* grown
+        SpatialHash h
+    c.n_opairs = 0
+    if n_o == 0 or horizon <= 0.0:
+        return STATUS_OK
+    if c.ocells == NULL:
+        c.ocells = <KeyIndex*> malloc(n_o * sizeof(KeyIndex))
+        if c.ocells == NULL:
+            return STATUS_MEMORY
+    _hash_init(&h, c.ocells, horizon, 0.0, 0.0, 0.0, OBS_OFF)
+    _hash_fill(&h, b.obs, 4, NULL, o0, o1)
+    for i in range(b.vox_start[r], b.vox_start[r + 1]):
+        if not b.surface[i]:
+            continue
+        n_row = 0
+        _hash_cell(&h, R + 4 * i, ijk)
+        for di in range(-1, 2):
+            for dj in range(-1, 2):
+                for dk in range(-1, 2):
+                    key = _pack(ijk[0] + di, ijk[1] + dj, ijk[2] + dk)
+                    k = _hash_first(&h, key)
+                    while k < h.n and h.cells[k].key == key:
+                        m = h.cells[k].index
+                        k += 1
+                        dx = b.obs[4 * m] - R[4 * i]
+                        dy = b.obs[4 * m + 1] - R[4 * i + 1]
+                        dz = b.obs[4 * m + 2] - R[4 * i + 2]
+                        d2 = dx * dx + dy * dy + dz * dz
+                        if d2 >= 9.0 * L * L:
+                            continue
+                        s_first = R[4 * i + 3] if b.seed_rank[i] < b.obs_rank[m] else L
+                        act = 2.0 * s_first
+                        if d2 >= act * act:
+                            continue
+                        if c.n_opairs + 1 > c.ocapacity:
+                            mm = 2 * (c.n_opairs + 1) + 64
+                            grown = <intp_t*> realloc(c.opairs, 2 * mm * sizeof(intp_t))
+                            if grown == NULL:
+                                return STATUS_MEMORY
+                            c.opairs = grown
+                            c.ocapacity = mm
+                        c.opairs[2 * c.n_opairs] = i
+                        c.opairs[2 * c.n_opairs + 1] = m
+                        c.n_opairs += 1
+                        n_row += 1
+        if n_row > 1:
+            # the row's obstacles in index order (results independent of the hash)
+            qsort(c.opairs + 2 * (c.n_opairs - n_row), n_row, 2 * sizeof(intp_t), _cmp_intp2)
+    return STATUS_OK
+
+
+cdef void collide_obstacles(Batch* b, Contacts* c) noexcept nogil:
+    # OUT (accumulated): force on the voxels touching an obstacle voxel (the
+    # seed's contact law; the obstacle is fixed and takes no force)
+    cdef:
+        intp_t k, i, m
+        float64_t dx, dy, dz, d2, env, dist, kk, fmag
+    for k in range(c.n_opairs):
+        i = c.opairs[2 * k]
+        m = c.opairs[2 * k + 1]
+        dx = b.pos[3 * i] - b.obs[4 * m]
+        dy = b.pos[3 * i + 1] - b.obs[4 * m + 1]
+        dz = b.pos[3 * i + 2] - b.obs[4 * m + 2]
+        d2 = dx * dx + dy * dy + dz * dz
+        env = 0.75 * (b.scale[i] + b.L)
+        if d2 >= env * env or d2 == 0.0:
+            continue
+        dist = sqrt(d2)
+        kk = b.k_floor[i] * b.obs[4 * m + 3] / (b.k_floor[i] + b.obs[4 * m + 3])
+        fmag = kk * (env - dist) / dist
+        b.force[3 * i] += fmag * dx
+        b.force[3 * i + 1] += fmag * dy
+        b.force[3 * i + 2] += fmag * dz
+
+
+cdef void collide(Batch* b, Contacts* c) noexcept nogil:
+    # OUT (accumulated): force of the touching candidate pairs.
+    cdef:
+        intp_t k, i, j
+        float64_t dx, dy, dz, d2, env, dist, kk, fmag
+        const float64_t* P = b.pos
+    for k in range(c.n_pairs):
+        i = c.pairs[2 * k]
+        j = c.pairs[2 * k + 1]
+        dx = P[3 * j] - P[3 * i]
+        dy = P[3 * j + 1] - P[3 * i + 1]
+        dz = P[3 * j + 2] - P[3 * i + 2]
+        d2 = dx * dx + dy * dy + dz * dz
+        env = 0.75 * (b.scale[i] + b.scale[j])
+        if d2 >= env * env or d2 == 0.0:
+            continue
+        dist = sqrt(d2)
+        # E_h L = harmonic mean of the voxels' E L = k1 k2 / (k1 + k2), k = 2 E L
+        kk = b.k_floor[i] * b.k_floor[j] / (b.k_floor[i] + b.k_floor[j])
+        fmag = kk * (env - dist) / dist
+        b.force[3 * j] += fmag * dx
+        b.force[3 * j + 1] += fmag * dy
+        b.force[3 * j + 2] += fmag * dz
+        b.force[3 * i] -= fmag * dx
+        b.force[3 * i + 1] -= fmag * dy
+        b.force[3 * i + 2] -= fmag * dz

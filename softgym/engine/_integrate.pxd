@@ -1,0 +1,16 @@
+# The voxel update of both models, see _integrate.pyx.
+
+from softgym.engine._batch cimport Batch
+from softgym.engine._typedefs cimport float64_t, intp_t
+
+
+cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
+                                float64_t* dmax2) noexcept nogil
+    # model 1. IN: force, moment (cleared on the way). OUT: pos, vel, quat,
+    # angvel, rot; dmax2: the largest squared displacement from ref (the
+    # positions of the last candidate rebuild, NULL: none). Returns a STATUS_*.
+cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
+                        float64_t* dmax2) noexcept nogil
+    # model 0 (the seed's EulerStep), same contract.
+cdef void clear_robot(Batch* b, intp_t r) noexcept nogil
+    # zero robot r's force and moment scratch (after an early exit)

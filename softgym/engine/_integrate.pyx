@@ -1,0 +1,281 @@
+# The voxel update of both models (symplectic Euler): forces and moments
+# accumulated by the link and collision kernels, plus gravity, global
+# damping, external forces, fluid drag and contact with the floor and
+# terrain boxes (the contact laws are inline in _contact.pxd), become new
+# velocities, positions and orientations.
+#   integrate_corotational  model 1 (co-rotational), with the displacement
+#                           since the last collision-list rebuild
+#   integrate_seed          model 0 (the seed's EulerStep)
+
+from libc.math cimport fabs
+from libc.string cimport memset
+
+from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_NONFINITE
+from softgym.engine._contact cimport surface_contact, box_penetration, seed_floor
+from softgym.engine._typedefs cimport float64_t, intp_t, int32
+
+cdef float64_t RUNAWAY = 1.0e6  # |coordinate| (m) beyond which a robot diverged
+
+
+cdef inline void _rotation_matrix(const float64_t* q, float64_t* R) noexcept nogil:
+    # R = rotation matrix of the unit quaternion q = (w, x, y, z), row-major.
+    cdef float64_t w = q[0], x = q[1], y = q[2], z = q[3]
+    R[0] = 1.0 - 2.0 * (y * y + z * z)
+    R[1] = 2.0 * (x * y - w * z)
+    R[2] = 2.0 * (x * z + w * y)
+    R[3] = 2.0 * (x * y + w * z)
+    R[4] = 1.0 - 2.0 * (x * x + z * z)
+    R[5] = 2.0 * (y * z - w * x)
+    R[6] = 2.0 * (x * z - w * y)
+    R[7] = 2.0 * (y * z + w * x)
+    R[8] = 1.0 - 2.0 * (x * x + y * y)
+
+
+cdef inline void _fluid_drag(Batch* b, intp_t i, float64_t* f) noexcept nogil:
+    # Quadratic fluid drag on voxel i's exposed faces (b.faces): a face of area
+    # s^2 moving into the fluid along its outward normal n at speed v.n > 0 takes
+    # -fluid_drag s^2 (v.n)^2 n (fluid_drag = rho C_d / 2); a face moving away
+    # takes none. Applied at the voxel's centre. IN/OUT: f.
+    cdef:
+        const float64_t* R = b.rot + 9 * i
+        const float64_t* v = b.vel + 3 * i
+        float64_t k = b.fluid_drag * b.scale[i] * b.scale[i]
+        float64_t vn, g
+        int32 a, bit
+        int32 exposed = b.faces[i]
+    for a in range(3):
+        vn = v[0] * R[a] + v[1] * R[3 + a] + v[2] * R[6 + a]
+        bit = 2 * a + 1 if vn > 0.0 else 2 * a
+        if exposed & (1 << bit):
+            g = k * vn * fabs(vn)
+            f[0] -= g * R[a]
+            f[1] -= g * R[3 + a]
+            f[2] -= g * R[6 + a]
+
+
+cdef inline void _clear(Batch* b, intp_t i) noexcept nogil:
+    b.force[3 * i] = 0.0
+    b.force[3 * i + 1] = 0.0
+    b.force[3 * i + 2] = 0.0
+    b.moment[3 * i] = 0.0
+    b.moment[3 * i + 1] = 0.0
+    b.moment[3 * i + 2] = 0.0
+
+
+cdef void clear_robot(Batch* b, intp_t r) noexcept nogil:
+    # zero the robot's force/moment scratch (after an early exit)
+    cdef intp_t vs = b.vox_start[r], ve = b.vox_start[r + 1]
+    memset(b.force + 3 * vs, 0, 3 * (ve - vs) * sizeof(float64_t))
+    memset(b.moment + 3 * vs, 0, 3 * (ve - vs) * sizeof(float64_t))
+
+
+cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
+                                float64_t* dmax2) noexcept nogil:
+    # IN: force, moment. OUT: pos, vel, quat, angvel, rot (symplectic Euler).
+    # If ref (the robot's positions when its contact list was built) is not
+    # NULL, dmax2 gets the largest squared displacement from it, relative to
+    # the first voxel's (any common shift c bounds the approach of two voxels:
+    # |dp_i - dp_j| <= |dp_i - c| + |dp_j - c|).
+    cdef:
+        intp_t i, k
+        float64_t dt = b.dt[r]
+        float64_t m, h, pen, cg, rd, d2, mx, my, mz
+        float64_t c0 = 0.0, c1 = 0.0, c2 = 0.0
+        float64_t wx, wy, wz, qw, qx, qy, qz, nq
+        float64_t f[3]
+        float64_t n[3]
+        float64_t* pos = b.pos
+        float64_t* vel = b.vel
+        float64_t* av = b.angvel
+        float64_t* qq
+        float64_t g = b.gravity
+        int32 has_floor = b.floor[r]
+        int32 has_fluid = b.fluid_drag > 0.0
+        intp_t k0 = b.box_start[r]
+        intp_t k1 = b.box_start[r + 1]
+        intp_t vs = b.vox_start[r]
+    dmax2[0] = 0.0
+    for i in range(b.vox_start[r], b.vox_start[r + 1]):
+        if b.fixed[i]:
+            vel[3 * i] = 0.0
+            vel[3 * i + 1] = 0.0
+            vel[3 * i + 2] = 0.0
+            av[3 * i] = 0.0
+            av[3 * i + 1] = 0.0
+            av[3 * i + 2] = 0.0
+            _clear(b, i)
+            continue
+        m = b.mass[i]
+        cg = b.c_global[i]
+        f[0] = b.force[3 * i] + b.ext_force[3 * i] - cg * vel[3 * i]
+        f[1] = b.force[3 * i + 1] + b.ext_force[3 * i + 1] - cg * vel[3 * i + 1]
+        f[2] = b.force[3 * i + 2] + b.ext_force[3 * i + 2] - cg * vel[3 * i + 2] + m * g
+        mx = b.moment[3 * i]
+        my = b.moment[3 * i + 1]
+        mz = b.moment[3 * i + 2]
+        _clear(b, i)  # the scratch is zero again for the next step
+        if has_fluid:
+            _fluid_drag(b, i, f)
+        if has_floor:
+            pen = 0.5 * b.scale[i] - pos[3 * i + 2]
+            if pen > 0.0:
+                surface_contact(b, i, 0.0, 0.0, 1.0, pen, dt, f)
+        for k in range(k0, k1):
+            pen = box_penetration(b.boxes + 6 * k, pos + 3 * i, 0.5 * b.scale[i], n)
+            if pen > 0.0:
+                surface_contact(b, i, n[0], n[1], n[2], pen, dt, f)
+        h = dt * b.inv_mass[i]
+        vel[3 * i] += f[0] * h
+        vel[3 * i + 1] += f[1] * h
+        vel[3 * i + 2] += f[2] * h
+        pos[3 * i] += vel[3 * i] * dt
+        pos[3 * i + 1] += vel[3 * i + 1] * dt
+        pos[3 * i + 2] += vel[3 * i + 2] * dt
+        if not (fabs(pos[3 * i]) + fabs(pos[3 * i + 1]) + fabs(pos[3 * i + 2]) < RUNAWAY):
+            clear_robot(b, r)
+            return STATUS_NONFINITE
+        if ref != NULL:
+            # displacement since the rebuild, less the first voxel's: a common
+            # translation does not bring voxels closer, so walking costs no rebuild
+            k = 3 * (i - vs)
+            if i == vs:
+                c0 = pos[3 * i] - ref[k]
+                c1 = pos[3 * i + 1] - ref[k + 1]
+                c2 = pos[3 * i + 2] - ref[k + 2]
+            d2 = ((pos[3 * i] - ref[k] - c0) ** 2 + (pos[3 * i + 1] - ref[k + 1] - c1) ** 2
+                  + (pos[3 * i + 2] - ref[k + 2] - c2) ** 2)
+            if d2 > dmax2[0]:
+                dmax2[0] = d2
+        # rotation: w += M dt / I, global damping, q += 0.5 dt (0, w) q
+        h = dt * b.inv_inertia[i]
+        rd = b.rot_damp[i]
+        av[3 * i] = (av[3 * i] + mx * h) * rd
+        av[3 * i + 1] = (av[3 * i + 1] + my * h) * rd
+        av[3 * i + 2] = (av[3 * i + 2] + mz * h) * rd
+        wx = av[3 * i] * 0.5 * dt
+        wy = av[3 * i + 1] * 0.5 * dt
+        wz = av[3 * i + 2] * 0.5 * dt
+        qq = b.quat + 4 * i
+        qw = qq[0] - wx * qq[1] - wy * qq[2] - wz * qq[3]
+        qx = qq[1] + wx * qq[0] + wy * qq[3] - wz * qq[2]
+        qy = qq[2] + wy * qq[0] + wz * qq[1] - wx * qq[3]
+        qz = qq[3] + wz * qq[0] + wx * qq[2] - wy * qq[1]
+        # renormalise: |q|^2 = 1 + O((w dt)^2), so one Newton step of 1/sqrt
+        # from 1 is exact to rounding
+        nq = 1.5 - 0.5 * (qw * qw + qx * qx + qy * qy + qz * qz)
+        qq[0] = qw * nq
+        qq[1] = qx * nq
+        qq[2] = qy * nq
+        qq[3] = qz * nq
+        _rotation_matrix(qq, b.rot + 9 * i)
+    return STATUS_OK
+
+
+cdef extern from "softgym_seed.h":
+    # the seed's orientation step (C, for the vectorising pragma; documented in
+    # include/softgym_seed.h)
+    void softgym_seed_quats(intp_t lo, intp_t hi, intp_t n, float64_t dt, const float64_t* av,
+                            const float64_t* quat, float64_t* q_out) noexcept nogil
+
+
+cdef inline void _seed_orient(Batch* b, intp_t lo, intp_t hi, float64_t dt) noexcept nogil:
+    # the orientation step of integrate_seed for voxels lo..hi (fixed voxels
+    # keep theirs): new quaternions, then their rotation matrices
+    cdef:
+        intp_t i
+        intp_t n = b.vox_stride  # the scratch's row stride
+        float64_t* qo = b.vox_out
+        float64_t* qq
+    softgym_seed_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
+    for i in range(lo, hi):
+        if b.fixed[i]:
+            continue
+        qq = b.quat + 4 * i
+        qq[0] = qo[i]
+        qq[1] = qo[n + i]
+        qq[2] = qo[2 * n + i]
+        qq[3] = qo[3 * n + i]
+        _rotation_matrix(qq, b.rot + 9 * i)
+
+
+cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
+                        float64_t* dmax2) noexcept nogil:
+    # Model 0's voxel update (the seed's EulerStep): as integrate_corotational, with the
+    # seed's floor and exact quaternion renormalisation snapped to the identity
+    # at w >= 1 (_seed_orient, after the loop: no voxel's update reads
+    # another's orientation). Terrain boxes use the common surface contact.
+    cdef:
+        intp_t i, k
+        float64_t dt = b.dt[r]
+        float64_t h, pen, cg, rd, d2, mx, my, mz
+        float64_t c0 = 0.0, c1 = 0.0, c2 = 0.0
+        float64_t f[3]
+        float64_t n[3]
+        float64_t* pos = b.pos
+        float64_t* vel = b.vel
+        float64_t* av = b.angvel
+        int32 has_floor = b.floor[r]
+        int32 has_fluid = b.fluid_drag > 0.0
+        intp_t k0 = b.box_start[r]
+        intp_t k1 = b.box_start[r + 1]
+        intp_t vs = b.vox_start[r]
+    dmax2[0] = 0.0
+    for i in range(b.vox_start[r], b.vox_start[r + 1]):
+        if b.fixed[i]:
+            for k in range(3):
+                vel[3 * i + k] = 0.0
+                av[3 * i + k] = 0.0
+            _clear(b, i)
+            continue
+        cg = b.c_global[i]
+        f[0] = -cg * vel[3 * i] + b.force[3 * i] + b.ext_force[3 * i]
+        f[1] = -cg * vel[3 * i + 1] + b.force[3 * i + 1] + b.ext_force[3 * i + 1]
+        f[2] = -cg * vel[3 * i + 2] + b.force[3 * i + 2] + b.mass[i] * b.gravity + b.ext_force[3 * i + 2]
+        mx = b.moment[3 * i]
+        my = b.moment[3 * i + 1]
+        mz = b.moment[3 * i + 2]
+        _clear(b, i)
+        if has_fluid:
+            _fluid_drag(b, i, f)
+        for k in range(k0, k1):
+            pen = box_penetration(b.boxes + 6 * k, pos + 3 * i, 0.5 * b.scale[i], n)
+            if pen > 0.0:
+                surface_contact(b, i, n[0], n[1], n[2], pen, dt, f)
+        if has_floor:
+            seed_floor(b, i, dt, f)
+        h = dt * b.inv_mass[i]
+        vel[3 * i] += f[0] * h
+        vel[3 * i + 1] += f[1] * h
+        vel[3 * i + 2] += f[2] * h
+        pos[3 * i] += vel[3 * i] * dt
+        pos[3 * i + 1] += vel[3 * i + 1] * dt
+        pos[3 * i + 2] += vel[3 * i + 2] * dt
+        if not (fabs(pos[3 * i]) + fabs(pos[3 * i + 1]) + fabs(pos[3 * i + 2]) < RUNAWAY):
+            _seed_orient(b, vs, i, dt)  # the voxels before it were stepped
+            clear_robot(b, r)
+            return STATUS_NONFINITE
+        if ref != NULL:
+            k = 3 * (i - vs)
+            if i == vs:
+                c0 = pos[3 * i] - ref[k]
+                c1 = pos[3 * i + 1] - ref[k + 1]
+                c2 = pos[3 * i + 2] - ref[k + 2]
+            d2 = ((pos[3 * i] - ref[k] - c0) ** 2 + (pos[3 * i + 1] - ref[k + 1] - c1) ** 2
+                  + (pos[3 * i + 2] - ref[k + 2] - c2) ** 2)
+            if d2 > dmax2[0]:
+                dmax2[0] = d2
+        h = dt * b.inv_inertia[i]
+        rd = b.rot_damp[i]
+        av[3 * i] = (av[3 * i] + mx * h) * rd
+        av[3 * i + 1] = (av[3 * i + 1] + my * h) * rd
+        av[3 * i + 2] = (av[3 * i + 2] + mz * h) * rd
+    _seed_orient(b, vs, b.vox_start[r + 1], dt)
+    return STATUS_OK
+
+
+def refresh_rotations(float64_t[:, ::1] quat, float64_t[:, ::1] rot):
+    """Recompute ``rot`` (n_voxels, 9) from ``quat`` (n_voxels, 4) after the state was set."""
+    cdef intp_t i
+    with nogil:
+        for i in range(quat.shape[0]):
+            _rotation_matrix(&quat[i, 0], &rot[i, 0])

@@ -1,0 +1,10 @@
+# Model 0's link forces (the seed engine's bonds), see _seed.pyx.
+
+from softgym.engine._batch cimport Batch
+from softgym.engine._typedefs cimport intp_t
+
+
+cdef int links_seed(Batch* b, intp_t r) noexcept nogil
+    # IN: positions, orientations, sizes, the links' mode and memory of robot r.
+    # OUT (accumulated): force, moment; the links' mode (link_sa) and memory
+    # (link_last). Returns STATUS_OK or STATUS_STRAIN.

@@ -1,0 +1,436 @@
+# Model 0, "seed": the step of the seed study's engine (evosoro's bundled
+# VoxCAD-era Voxelyze, SEED_REFERENCE section 1), written anew from its
+# documented behaviour and checked against that engine's output
+# (benchmarks/fidelity_seed.py):
+# - each link is a beam measured in the frame of its first voxel (the one on
+#   the negative side): rotate the relative position and voxel 2's
+#   orientation into voxel 1's frame (the link axis turned onto +x); while the
+#   relative rotation stays under ~1 degree, the transverse offset is under
+#   5 % of the axial distance and the extension under 30 % (with 10 %
+#   hysteresis on leaving) the "small-angle" beam applies (voxel 1's angle is
+#   zero, offsets taken along voxel 1's axes); otherwise the "large-angle"
+#   beam is measured from the chord (offsets zero, both ends' angles relative
+#   to it);
+# - link damping acts on finite differences of those bond-frame quantities
+#   (so it also sees the rate of the actuated rest length), and is skipped,
+#   with its memory left untouched, on a step where the link changed mode;
+# - a link between voxels of two materials gives voxel 2 its own damping
+#   (with voxel 2's mass); one of a single material gives voxel 2 exactly -F1;
+# - floor: normal force 2 E L pen without clamping, damping on top, friction
+#   bounded by mu 2 E L pen (damping excluded); static friction zeroes the
+#   in-plane force of a voxel whose in-plane velocity is exactly zero;
+# - orientations renormalised exactly and snapped to the identity when
+#   w >= 1; voxel sizes follow the drive at the end of the step (so the
+#   link forces of a step use the previous step's sizes);
+# - every voxel is a self-collision candidate (the seed's surface test is
+#   always true), the drive's 2 pi is the single-precision constant.
+#
+# This module holds the seed's link forces (links_seed); its voxel update
+# (integrate_seed, the floor law) is in _integrate.pyx / _contact.pxd, its
+# collision list in _contact.pyx, the drive and the step loop in _core.pyx.
+# The vectorised passes are C in include/softgym_seed.h.
+
+from libc.math cimport cos, acos, sqrt, fabs
+
+cimport numpy as cnp
+import numpy as np
+
+from softgym.engine._batch cimport (Batch, STATUS_OK, STATUS_STRAIN, N_LINK_OUT, f64_rp,
+                                    cf64_rp, cintp_rp)
+from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t
+
+cnp.import_array()
+
+cdef float64_t SEED_PI = 3.14159265358979         # the seed's PI macro
+cdef float64_t SMALL_ANGLE_RAD = 1.732e-2          # relative rotation of a small-angle link
+cdef float64_t HYSTERESIS = 1.1
+cdef float64_t SMALL_ANGLE_W = cos(0.5 * SMALL_ANGLE_RAD)
+cdef float64_t SMALLISH_ANGLE_W = cos(HYSTERESIS * SMALL_ANGLE_RAD * 0.5)
+cdef float64_t SLTHRESH_ACOS2SQRT = 1.0 - 0.9988 * 0.9988
+cdef float64_t DISCARD_ANGLE_RAD = 1.0e-7
+cdef float64_t SA_BOND_BEND_RAD = 0.05
+cdef float64_t SA_BOND_EXT_PERC = 1.30
+
+
+cdef inline float64_t _rotvec_k(float64_t w) noexcept nogil:
+    # the seed's rotation vector of a unit quaternion (w, x, y, z) is k (x, y, z)
+    # (angle from w, with its acos approximation near the identity)
+    cdef float64_t sl = 1.0 - w * w
+    if sl <= 0.0:
+        return 0.0
+    if w > 1.0:
+        w = 1.0
+    if sl < SLTHRESH_ACOS2SQRT:
+        return 2.0 * sqrt((2.0 - 2.0 * w) / sl)
+    return 2.0 * acos(w) / sqrt(sl)
+
+
+cdef inline void _bond_to_world(const int ax, const float64_t* R, float64_t v0, float64_t v1,
+                                float64_t v2, float64_t* o) noexcept nogil:
+    # o = R P^T v: a bond-frame vector v back to the world through the inverse
+    # axis turn P^T (ax: a compile-time constant once inlined) and the voxel
+    # rotation R (row-major 3x3)
+    cdef float64_t x, y, z
+    if ax == 0:
+        x = v0
+        y = v1
+        z = v2
+    elif ax == 1:
+        x = -v1
+        y = v0
+        z = v2
+    else:
+        x = -v2
+        y = v1
+        z = v0
+    o[0] = R[0] * x + R[1] * y + R[2] * z
+    o[1] = R[3] * x + R[4] * y + R[5] * z
+    o[2] = R[6] * x + R[7] * y + R[8] * z
+
+
+cdef inline void _add_bond_to_world(const int ax, const float64_t* R, float64_t v0, float64_t v1,
+                                    float64_t v2, float64_t* acc) noexcept nogil:
+    # acc += R P^T v (_bond_to_world, then the sum)
+    cdef float64_t w[3]
+    _bond_to_world(ax, R, v0, v1, v2, w)
+    acc[0] += w[0]
+    acc[1] += w[1]
+    acc[2] += w[2]
+
+
+cdef void _seed_geom(intp_t lo, intp_t hi, intp_t ax, cintp_rp v1, cintp_rp v2,
+                     cf64_rp pos, cf64_rp rot, cf64_rp quat, cf64_rp scale,
+                     f64_rp o_p0, f64_rp o_p1, f64_rp o_p2, f64_rp o_qw,
+                     f64_rp o_n1, f64_rp o_n2, f64_rp o_n3, f64_rp o_nom,
+                     f64_rp o_len, f64_rp o_st) noexcept nogil:
+    # Model 0's link geometry for links lo..hi, all along axis ax, without
+    # branches so the loop vectorises: the relative position p and voxel 2's
+    # orientation relative to voxel 1 (q1* q2 = (qw, n)), both in the bond
+    # frame (voxel 1's frame turned by the proper rotation P that takes the
+    # link axis onto +x, the seed's ToXDirBond: (x, y, z) -> (x, y, z),
+    # (y, -x, z), (z, y, -x) for ax 0, 1, 2); the nominal length, the chord
+    # length and the transverse ratio. Component c of a bond-frame vector is
+    # s_c times local component a_c (s = +-1: exact).
+    cdef:
+        intp_t li, i, j
+        intp_t a0 = ax
+        intp_t a1 = 0 if ax == 1 else 1
+        intp_t a2 = 0 if ax == 2 else 2
+        float64_t s1 = -1.0 if ax == 1 else 1.0
+        float64_t s2 = -1.0 if ax == 2 else 1.0
+        # n = W (qx, qy, qz): W's rows one-hot (x 1 + y 0 + z 0 = x exactly)
+        float64_t w00 = 1.0 if a0 == 0 else 0.0
+        float64_t w01 = 1.0 if a0 == 1 else 0.0
+        float64_t w02 = 1.0 if a0 == 2 else 0.0
+        float64_t w10 = s1 if a1 == 0 else 0.0
+        float64_t w11 = s1 if a1 == 1 else 0.0
+        float64_t w12 = s1 if a1 == 2 else 0.0
+        float64_t w20 = s2 if a2 == 0 else 0.0
+        float64_t w21 = s2 if a2 == 1 else 0.0
+        float64_t w22 = s2 if a2 == 2 else 0.0
+        float64_t dx, dy, dz, qw, qx, qy, qz, p0, p1, p2
+    for li in range(lo, hi):
+        i = v1[li]
+        j = v2[li]
+        dx = pos[3 * j] - pos[3 * i]
+        dy = pos[3 * j + 1] - pos[3 * i + 1]
+        dz = pos[3 * j + 2] - pos[3 * i + 2]
+        # relative position in voxel 1's frame (column a of its rotation . d)
+        p0 = rot[9 * i + a0] * dx + rot[9 * i + 3 + a0] * dy + rot[9 * i + 6 + a0] * dz
+        p1 = s1 * (rot[9 * i + a1] * dx + rot[9 * i + 3 + a1] * dy + rot[9 * i + 6 + a1] * dz)
+        p2 = s2 * (rot[9 * i + a2] * dx + rot[9 * i + 3 + a2] * dy + rot[9 * i + 6 + a2] * dz)
+        qw = (quat[4 * i] * quat[4 * j] + quat[4 * i + 1] * quat[4 * j + 1]
+              + quat[4 * i + 2] * quat[4 * j + 2] + quat[4 * i + 3] * quat[4 * j + 3])
+        qx = (quat[4 * i] * quat[4 * j + 1] - quat[4 * i + 1] * quat[4 * j]
+              - quat[4 * i + 2] * quat[4 * j + 3] + quat[4 * i + 3] * quat[4 * j + 2])
+        qy = (quat[4 * i] * quat[4 * j + 2] + quat[4 * i + 1] * quat[4 * j + 3]
+              - quat[4 * i + 2] * quat[4 * j] - quat[4 * i + 3] * quat[4 * j + 1])
+        qz = (quat[4 * i] * quat[4 * j + 3] - quat[4 * i + 1] * quat[4 * j + 2]
+              + quat[4 * i + 2] * quat[4 * j + 1] - quat[4 * i + 3] * quat[4 * j])
+        o_p0[li] = p0
+        o_p1[li] = p1
+        o_p2[li] = p2
+        o_qw[li] = qw
+        o_n1[li] = qx * w00 + qy * w01 + qz * w02
+        o_n2[li] = qx * w10 + qy * w11 + qz * w12
+        o_n3[li] = qx * w20 + qy * w21 + qz * w22
+        o_nom[li] = 0.5 * (scale[i] + scale[j])
+        o_len[li] = sqrt(dx * dx + dy * dy + dz * dz)
+        o_st[li] = (fabs(p2) + fabs(p1)) / p0
+
+
+cdef intp_t _seed_modes(Batch* b, intp_t lo, intp_t hi, float64_t* o, intp_t n) noexcept nogil:
+    # First pass of _seed_links_along over its links [lo, hi): each link's
+    # mode, small or large angle, with the seed's hysteresis (updates
+    # link_sa), then the strain check. Row 9 (the transverse ratio) becomes
+    # the mode as 1.0 / 0.0, row 22 1.0 on a mode-change step, row 23 1.0
+    # when voxel 2 takes -F1 (then or for a single material). Returns hi, or
+    # the first link whose extension is beyond max_strain.
+    cdef:
+        intp_t li
+        float64_t max_ext = b.max_strain * b.L
+        float64_t sa_w = SMALL_ANGLE_W
+        float64_t sah_w = SMALLISH_ANGLE_W
+        float64_t st_in = SA_BOND_BEND_RAD
+        float64_t ex_in = SA_BOND_EXT_PERC
+        float64_t st_out = HYSTERESIS * SA_BOND_BEND_RAD
+        float64_t ex_out = HYSTERESIS * SA_BOND_EXT_PERC
+        flag_t* link_sa = b.link_sa
+        const flag_t* homog = b.homog
+        float64_t qw, p0, nom, st, ex, P0
+        int32 sa, changed
+    for li in range(lo, hi):
+        p0 = o[li]
+        qw = o[3 * n + li]
+        nom = o[7 * n + li]
+        st = o[9 * n + li]
+        ex = p0 / nom
+        sa = link_sa[li]
+        changed = 0
+        if not sa and qw > sa_w and st < st_in and ex < ex_in:
+            sa = 1
+            changed = 1
+        elif sa and (not (qw > sah_w) or st > st_out or ex > ex_out):
+            sa = 0
+            changed = 1
+        link_sa[li] = sa
+        o[9 * n + li] = 1.0 if sa else 0.0
+        o[22 * n + li] = 1.0 if changed else 0.0
+        o[23 * n + li] = 1.0 if changed or homog[li] else 0.0
+        P0 = p0 - nom if sa else o[8 * n + li] - nom
+        if not (fabs(P0) <= max_ext):
+            return li  # also catches NaN
+    return hi
+
+
+cdef extern from "softgym_seed.h":
+    # the second and third passes of _seed_links_along (C, for the
+    # vectorising pragma; documented in include/softgym_seed.h)
+    void softgym_seed_frames(intp_t lo, intp_t hi, float64_t sa_rad, float64_t thr,
+                             const float64_t* p0_, const float64_t* p1_, const float64_t* p2_,
+                             const float64_t* qw_, const float64_t* n1_, const float64_t* n2_,
+                             const float64_t* n3_, const float64_t* nom_, const float64_t* len_,
+                             const float64_t* sa_, float64_t* o_P0, float64_t* o_P1,
+                             float64_t* o_P2, float64_t* o_a1y, float64_t* o_a1z,
+                             float64_t* o_a2x, float64_t* o_a2y, float64_t* o_a2z,
+                             float64_t* o_rw, float64_t* o_ry, float64_t* o_rz,
+                             float64_t* o_fix) noexcept nogil
+    void softgym_seed_forces(intp_t lo, intp_t hi, intp_t n, float64_t L, float64_t bz,
+                             float64_t bzh, float64_t inv_dt, const float64_t* const* inp,
+                             const float64_t* k_axial, const float64_t* k_torsion,
+                             const float64_t* k_bend, const float64_t* c_seed,
+                             float64_t* link_last, float64_t* const* out) noexcept nogil
+
+
+cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n) noexcept nogil:
+    # softgym_seed_frames for one link, with the seed's branches (its acos
+    # approximation and the backward-chord rule)
+    cdef:
+        float64_t sa_rad = SMALL_ANGLE_RAD
+        float64_t th_discard = SEED_PI - DISCARD_ANGLE_RAD
+        float64_t p0 = o[li], p1 = o[n + li], p2 = o[2 * n + li], qw = o[3 * n + li]
+        float64_t n1 = o[4 * n + li], n2 = o[5 * n + li], n3 = o[6 * n + li]
+        float64_t nom = o[7 * n + li]
+        float64_t k, rw = 1.0, ry = 0.0, rz = 0.0, tw, tx, ty, tz
+        float64_t a1y = 0.0, a1z = 0.0, a2x, a2y, a2z, P0, P1, P2
+        float64_t len_, nx, ny, nz, rho, ch, sh, yx, zx
+    if o[9 * n + li] != 0.0:
+        # small angle: voxel 1's frame, offsets along its axes
+        k = _rotvec_k(qw)
+        a2x = n1 * k
+        a2y = n2 * k
+        a2z = n3 * k
+        P0 = p0 - nom
+        P1 = p1
+        P2 = p2
+    else:
+        # large angle: the frame turned by rq = (rw, 0, ry, rz) onto the
+        # chord (the seed's ToXDirBond of the relative position)
+        if not (p0 == 0.0 and p1 == 0.0 and p2 == 0.0):
+            yx = p1 / p0
+            zx = p2 / p0
+            if yx < sa_rad and yx > -sa_rad and zx < sa_rad and zx > -sa_rad:
+                ry = 0.5 * zx
+                rz = -0.5 * yx
+                rw = 1.0 + 0.5 * (-ry * ry - rz * rz)
+            else:
+                len_ = sqrt(p0 * p0 + p1 * p1 + p2 * p2)
+                nx = p0 / len_
+                ny = p1 / len_
+                nz = p2 / len_
+                # acos(nx) > pi - 1e-7 (acos(x) <= acos(-0.5) < 2.1 for x >= -0.5)
+                if nx < -0.5 and acos(nx) > th_discard:
+                    rw = 0.0
+                    ry = 1.0
+                else:
+                    rho = 1.0 / sqrt(nz * nz + ny * ny)
+                    ch = sqrt(0.5 * (1.0 + nx))  # cos(th / 2)
+                    sh = sqrt(0.5 * (1.0 - nx))  # sin(th / 2)
+                    rw = ch
+                    ry = nz * rho * sh
+                    rz = -ny * rho * sh
+            k = _rotvec_k(rw)  # the seed's, with its acos approximation
+            a1y = ry * k
+            a1z = rz * k
+        # tq = rq nq (rq's x part is zero)
+        tw = rw * qw - ry * n2 - rz * n3
+        tx = rw * n1 + ry * n3 - rz * n2
+        ty = rw * n2 + ry * qw + rz * n1
+        tz = rw * n3 - ry * n1 + rz * qw
+        k = _rotvec_k(tw)
+        a2x = tx * k
+        a2y = ty * k
+        a2z = tz * k
+        P0 = o[8 * n + li] - nom
+        P1 = 0.0
+        P2 = 0.0
+    o[10 * n + li] = P0
+    o[11 * n + li] = P1
+    o[12 * n + li] = P2
+    o[13 * n + li] = a1y
+    o[14 * n + li] = a1z
+    o[15 * n + li] = a2x
+    o[16 * n + li] = a2y
+    o[17 * n + li] = a2z
+    o[18 * n + li] = rw
+    o[19 * n + li] = ry
+    o[20 * n + li] = rz
+
+
+cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
+                                  float64_t inv_dt) noexcept nogil:
+    # links_seed for its links [lo, hi), all along axis ax (a compile-time
+    # constant once inlined), in passes over the link scratch b.link_out
+    # (profiled: the square roots and divisions of the large-angle frames
+    # dominated the step; one branch-free vector loop does them for many links
+    # at once, the same IEEE operations as the seed's scalar code):
+    #   _seed_geom           rows 0-9: relative position p, orientation (qw, n),
+    #                        nominal length, chord length, transverse ratio
+    #   _seed_modes          the mode (link_sa; row 9 becomes 1.0 small / 0.0
+    #                        large angle), row 22 1.0 on a mode-change step,
+    #                        row 23 1.0 where voxel 2 takes -F1, the strain
+    #                        check (stops at the first strained link)
+    #   softgym_seed_frames  rows 10-20: displacement P, rotation vectors a1
+    #                        (y, z) and a2, the large-angle frame rq; row 21
+    #                        marks links whose rotation needs the acos branch
+    #   _seed_frame_one      redoes those links with the seed's branches
+    #   softgym_seed_forces  rows 0-9, 21, 24: forces and moments in the bond
+    #                        frame (stiffness, the seed's damping from the
+    #                        link's memory; rq^-1 for large angles)
+    #   the loop below       back to the world, scattered in link order
+    # The bond frame is voxel 1's frame turned by the proper rotation P that
+    # takes the link axis onto +x (the seed's ToXDirBond): (x, y, z) ->
+    # (x, y, z), (y, -x, z), (z, y, -x) for ax 0, 1, 2.
+    cdef:
+        intp_t li, i, j, k, end
+        float64_t bz = 0.5 * b.bond_zeta
+        float64_t bzh = 0.5 * bz
+        const float64_t* rot = b.rot
+        const intp_t* v1 = b.v1
+        const intp_t* v2 = b.v2
+        intp_t n = b.link_stride  # the scratch's row stride
+        float64_t* o = b.link_out
+        float64_t* force = b.force
+        float64_t* moment = b.moment
+        const float64_t* inp[14]
+        float64_t* out[12]
+        const float64_t* R1
+    if hi <= lo:
+        return STATUS_OK
+    _seed_geom(lo, hi, ax, v1, v2, b.pos, rot, b.quat, b.scale, o, o + n, o + 2 * n,
+               o + 3 * n, o + 4 * n, o + 5 * n, o + 6 * n, o + 7 * n, o + 8 * n, o + 9 * n)
+    end = _seed_modes(b, lo, hi, o, n)
+    softgym_seed_frames(lo, end, SMALL_ANGLE_RAD, SLTHRESH_ACOS2SQRT, o, o + n, o + 2 * n,
+                        o + 3 * n, o + 4 * n, o + 5 * n, o + 6 * n, o + 7 * n, o + 8 * n,
+                        o + 9 * n, o + 10 * n, o + 11 * n, o + 12 * n, o + 13 * n, o + 14 * n,
+                        o + 15 * n, o + 16 * n, o + 17 * n, o + 18 * n, o + 19 * n, o + 20 * n,
+                        o + 21 * n)
+    for li in range(lo, end):
+        if o[21 * n + li] != 0.0:
+            _seed_frame_one(li, o, n)
+    for k in range(11):
+        inp[k] = o + (10 + k) * n
+    inp[11] = o + 9 * n
+    inp[12] = o + 22 * n
+    inp[13] = o + 23 * n
+    for k in range(10):
+        out[k] = o + k * n
+    out[10] = o + 21 * n
+    out[11] = o + 24 * n
+    softgym_seed_forces(lo, end, b.n_links, b.L, bz, bzh, inv_dt, inp, b.k_axial, b.k_torsion,
+                        b.k_bend, b.c_seed, b.link_last, out)
+    for li in range(lo, end):
+        # back to the world (the inverse axis turn, voxel 1's rotation) and
+        # the scatter, in link order (the seed's summation order)
+        i = v1[li]
+        j = v2[li]
+        R1 = rot + 9 * i
+        _add_bond_to_world(ax, R1, o[li], o[n + li], o[2 * n + li], force + 3 * i)
+        _add_bond_to_world(ax, R1, o[3 * n + li], o[4 * n + li], o[5 * n + li], force + 3 * j)
+        _add_bond_to_world(ax, R1, o[6 * n + li], o[7 * n + li], o[8 * n + li], moment + 3 * i)
+        _add_bond_to_world(ax, R1, o[9 * n + li], o[21 * n + li], o[24 * n + li], moment + 3 * j)
+    return STATUS_OK if end == hi else STATUS_STRAIN
+
+
+cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
+    # IN: positions, orientations, sizes, the links' mode and memory.
+    # OUT (accumulated): force, moment; the links' mode and memory.
+    # Quantities are those of the seed's bond frame (the link axis turned
+    # onto +x, voxel 1's orientation removed); rotations back to the world
+    # go through voxel 1's rotation matrix. A robot's links are sorted by
+    # axis (x, then y, then z): each run gets a copy with the axis constant.
+    cdef:
+        intp_t lo = b.link_start[r]
+        intp_t hi = b.link_start[r + 1]
+        intp_t nx = b.link_axis_count[3 * r]
+        intp_t ny = b.link_axis_count[3 * r + 1]
+        float64_t inv_dt = 1.0 / b.dt[r]
+    if _seed_links_along(b, lo, lo + nx, 0, inv_dt) != STATUS_OK:
+        return STATUS_STRAIN
+    if _seed_links_along(b, lo + nx, lo + nx + ny, 1, inv_dt) != STATUS_OK:
+        return STATUS_STRAIN
+    return _seed_links_along(b, lo + nx + ny, hi, 2, inv_dt)
+
+
+# ---------------------------------------------------------------------------
+# Python entry point (re-exported by _core)
+
+def seed_frames(float64_t[:, ::1] geom, bint scalar=False):
+    """The seed model's bond-frame pass on given link geometry (for tests).
+
+    ``geom`` is (10, n): rows 0-9 of the link scratch as ``_seed_geom`` and
+    ``_seed_modes`` leave them (relative position p0, p1, p2; relative
+    orientation qw, n1, n2, n3; nominal length; chord length; the mode, 1.0
+    small / 0.0 large angle). Returns (11, n): the displacement P, voxel 1's
+    rotation vector (y, z), voxel 2's, the large-angle frame (rw, ry, rz),
+    from the vectorised kernel with its scalar fix-ups, or (``scalar``) from
+    the seed's branchy scalar code for every link. The two must be equal bit
+    for bit.
+    """
+    cdef:
+        intp_t n = geom.shape[1], li, k
+        cnp.ndarray[float64_t, ndim=2] o = np.zeros((N_LINK_OUT, max(n, 1)))
+        float64_t* op = <float64_t*> cnp.PyArray_DATA(o)
+        intp_t stride = o.shape[1]
+    if geom.shape[0] != 10:
+        raise ValueError("geom must have 10 rows")
+    for k in range(10):
+        for li in range(n):
+            op[k * stride + li] = geom[k, li]
+    with nogil:
+        if scalar:
+            for li in range(n):
+                _seed_frame_one(li, op, stride)
+        else:
+            softgym_seed_frames(0, n, SMALL_ANGLE_RAD, SLTHRESH_ACOS2SQRT, op, op + stride,
+                                op + 2 * stride, op + 3 * stride, op + 4 * stride,
+                                op + 5 * stride, op + 6 * stride, op + 7 * stride,
+                                op + 8 * stride, op + 9 * stride, op + 10 * stride,
+                                op + 11 * stride, op + 12 * stride, op + 13 * stride,
+                                op + 14 * stride, op + 15 * stride, op + 16 * stride,
+                                op + 17 * stride, op + 18 * stride, op + 19 * stride,
+                                op + 20 * stride, op + 21 * stride)
+            for li in range(n):
+                if op[21 * stride + li] != 0.0:
+                    _seed_frame_one(li, op, stride)
+    return o[10:21, :n].copy()

@@ -1,0 +1,278 @@
+/* The seed model's vectorised link and voxel passes (softgym/engine/_seed.pyx
+   calls them; declared for Cython in _seed.pyx's `cdef extern from`).
+   Compiled with -ffp-contract=off: the same IEEE operations as the seed's
+   scalar code, bit for bit. Py_ssize_t comes from Python.h, which Cython
+   includes first. */
+#ifndef SOFTGYM_SEED_H
+#define SOFTGYM_SEED_H
+
+#include <math.h>
+#include "softgym_simd.h"
+
+/* The second pass of _seed_links_along, in C for one pragma: the bond-frame
+   quantities of links lo..hi in the mode the first pass gave them, without
+   branches so the loop vectorises (the outputs are distinct rows of the
+   scratch: no two iterations touch the same element). Every candidate
+   value is computed and one is selected, the same IEEE result as the
+   branchy scalar code (_seed_frame_one; -ffp-contract=off: no fused
+   multiply-adds). Outputs: the displacement P, voxel 1's rotation vector
+   (y, z; its x is 0), voxel 2's, the large-angle frame rq = (rw, 0, ry,
+   rz). A link whose rotation vector needs the seed's acos branch (angles
+   beyond ~5.6 degrees), or whose chord points backwards, gets fix = 1 and
+   is redone by _seed_frame_one. */
+/* _rotvec_k(w) where the seed takes its square-root branch (0 < sl <
+   thr), and whether it takes the acos branch instead */
+static inline double softgym_rotvec_k_sqrt(double w)
+{
+    double sl = 1.0 - w * w;
+    double ks = 2.0 * sqrt((2.0 - 2.0 * w) / sl);
+    return sl <= 0.0 ? 0.0 : ks;
+}
+static inline long long softgym_rotvec_needs_acos(double w, double thr)
+{
+    double sl = 1.0 - w * w;
+    return (sl > 0.0) & (sl >= thr);
+}
+/* the frames pass's rows: geometry and mode in, frame quantities out */
+#define SOFTGYM_FRAME_ROWS \
+    const double *p0_, const double *p1_, const double *p2_, const double *qw_, \
+    const double *n1_, const double *n2_, const double *n3_, const double *nom_, \
+    const double *len_, const double *sa_, \
+    double *o_P0, double *o_P1, double *o_P2, double *o_a1y, double *o_a1z, \
+    double *o_a2x, double *o_a2y, double *o_a2z, double *o_rw, double *o_ry, \
+    double *o_rz, double *o_fix
+#define SOFTGYM_FRAME_ROW_NAMES p0_, p1_, p2_, qw_, n1_, n2_, n3_, nom_, len_, sa_, o_P0, \
+    o_P1, o_P2, o_a1y, o_a1z, o_a2x, o_a2y, o_a2z, o_rw, o_ry, o_rz, o_fix
+SOFTGYM_ALWAYS_INLINE void softgym_seed_frames_impl(
+    const int all_small, Py_ssize_t lo, Py_ssize_t hi, double sa_rad, double thr,
+    SOFTGYM_FRAME_ROWS)
+{
+    Py_ssize_t li;
+    SOFTGYM_IVDEP
+    for (li = lo; li < hi; li++) {
+        double p0 = p0_[li], p1 = p1_[li], p2 = p2_[li], qw = qw_[li];
+        double n1 = n1_[li], n2 = n2_[li], n3 = n3_[li], nom = nom_[li], cl = len_[li];
+        long long is_sa = all_small ? 1 : sa_[li] != 0.0;
+        /* small angle: k of qw */
+        double k = softgym_rotvec_k_sqrt(qw);
+        long long fix = is_sa & softgym_rotvec_needs_acos(qw, thr);
+        /* large angle: rq onto the chord (exactly along it when the
+           transverse ratios are small) */
+        long long zero = (p0 == 0.0) & (p1 == 0.0) & (p2 == 0.0);
+        double yx = p1 / p0, zx = p2 / p0;
+        long long small = (yx < sa_rad) & (yx > -sa_rad) & (zx < sa_rad) & (zx > -sa_rad);
+        double ry_s = 0.5 * zx, rz_s = -0.5 * yx;
+        double rw_s = 1.0 + 0.5 * (-ry_s * ry_s - rz_s * rz_s);
+        double ln = sqrt(p0 * p0 + p1 * p1 + p2 * p2);
+        double nx = p0 / ln, ny = p1 / ln, nz = p2 / ln;
+        double rho = 1.0 / sqrt(nz * nz + ny * ny);
+        double ch = sqrt(0.5 * (1.0 + nx)), sh = sqrt(0.5 * (1.0 - nx));
+        double ry_l = nz * rho * sh, rz_l = -ny * rho * sh;
+        fix |= (1 - is_sa) & (1 - zero) & (1 - small) & (nx < -0.5);
+        double rw = zero ? 1.0 : (small ? rw_s : ch);
+        double ry = zero ? 0.0 : (small ? ry_s : ry_l);
+        double rz = zero ? 0.0 : (small ? rz_s : rz_l);
+        double k1 = softgym_rotvec_k_sqrt(rw);
+        fix |= (1 - is_sa) & (1 - zero) & softgym_rotvec_needs_acos(rw, thr);
+        double a1y = ry * k1, a1z = rz * k1;
+        /* tq = rq nq (rq's x part is zero) */
+        double tw = rw * qw - ry * n2 - rz * n3;
+        double tx = rw * n1 + ry * n3 - rz * n2;
+        double ty = rw * n2 + ry * qw + rz * n1;
+        double tz = rw * n3 - ry * n1 + rz * qw;
+        double k2 = softgym_rotvec_k_sqrt(tw);
+        fix |= (1 - is_sa) & softgym_rotvec_needs_acos(tw, thr);
+        double P0_s = p0 - nom, P0_l = cl - nom;
+        double a2x_s = n1 * k, a2y_s = n2 * k, a2z_s = n3 * k;
+        double a2x_l = tx * k2, a2y_l = ty * k2, a2z_l = tz * k2;
+        o_P0[li] = softgym_pick(is_sa, P0_s, P0_l);
+        o_P1[li] = softgym_pick(is_sa, p1, 0.0);
+        o_P2[li] = softgym_pick(is_sa, p2, 0.0);
+        o_a1y[li] = softgym_pick(is_sa | zero, 0.0, a1y);
+        o_a1z[li] = softgym_pick(is_sa | zero, 0.0, a1z);
+        o_a2x[li] = softgym_pick(is_sa, a2x_s, a2x_l);
+        o_a2y[li] = softgym_pick(is_sa, a2y_s, a2y_l);
+        o_a2z[li] = softgym_pick(is_sa, a2z_s, a2z_l);
+        o_rw[li] = softgym_pick(is_sa, 1.0, rw);  /* unused in small-angle mode */
+        o_ry[li] = softgym_pick(is_sa, 0.0, ry);
+        o_rz[li] = softgym_pick(is_sa, 0.0, rz);
+        o_fix[li] = softgym_pick(fix, 1.0, 0.0);
+    }
+}
+static void softgym_seed_frames(
+    Py_ssize_t lo, Py_ssize_t hi, double sa_rad, double thr, SOFTGYM_FRAME_ROWS)
+{
+    /* blocks of links all in small-angle mode (a settled or gently
+       actuated body: most of them) skip the large-angle candidates */
+    Py_ssize_t blo, bhi, li;
+    for (blo = lo; blo < hi; blo = bhi) {
+        int all_small = 1;
+        bhi = blo + 64 < hi ? blo + 64 : hi;
+        for (li = blo; li < bhi; li++)
+            all_small &= sa_[li] != 0.0;
+        if (all_small)
+            softgym_seed_frames_impl(1, blo, bhi, sa_rad, thr, SOFTGYM_FRAME_ROW_NAMES);
+        else
+            softgym_seed_frames_impl(0, blo, bhi, sa_rad, thr, SOFTGYM_FRAME_ROW_NAMES);
+    }
+}
+
+/* The forces pass of _seed_links_along, in C for the vectorising pragma:
+   each link's forces and moments in the bond frame from its bond-frame
+   quantities (stiffness; the seed's damping from the link's memory of the
+   last step, skipped on a mode-change step), turned back by rq^-1 for a
+   large-angle link, without branches. Outputs what the scatter turns to
+   the world and adds: voxel 1's force, voxel 2's force (the first negated
+   for a single material or on a mode-change step), voxel 1's and voxel 2's
+   moments negated (the seed subtracts them; x - y is x + (-y) exactly, and
+   a rotation of -v is exactly minus the rotation of v). Updates the memory
+   unless the mode changed. The same operations as the seed's scalar code. */
+static void softgym_seed_forces(
+    Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double L, double bz, double bzh,
+    double inv_dt, const double *const *in, const double *k_axial,
+    const double *k_torsion, const double *k_bend, const double *c_seed,
+    double *link_last, double *const *out)
+{
+    const double *P0_ = in[0], *P1_ = in[1], *P2_ = in[2], *a1y_ = in[3], *a1z_ = in[4];
+    const double *a2x_ = in[5], *a2y_ = in[6], *a2z_ = in[7], *rw_ = in[8], *ry_ = in[9];
+    const double *rz_ = in[10], *sa_ = in[11], *chg_ = in[12], *neg2_ = in[13];
+    double *o0 = out[0], *o1 = out[1], *o2 = out[2], *o3 = out[3], *o4 = out[4];
+    double *o5 = out[5], *o6 = out[6], *o7 = out[7], *o8 = out[8], *o9 = out[9];
+    double *o10 = out[10], *o11 = out[11];
+    Py_ssize_t li;
+    SOFTGYM_IVDEP
+    for (li = lo; li < hi; li++) {
+        long long sa = sa_[li] != 0.0, changed = chg_[li] != 0.0, neg2 = neg2_[li] != 0.0;
+        double P0 = P0_[li], P1 = P1_[li], P2 = P2_[li];
+        double a1x = 0.0, a1y = a1y_[li], a1z = a1z_[li];
+        double a2x = a2x_[li], a2y = a2y_[li], a2z = a2z_[li];
+        double rw = rw_[li], ry = ry_[li], rz = rz_[li];
+        double ka = k_axial[li], kt = k_torsion[li], kb = k_bend[li];
+        double b2 = 0.5 * ka * L;
+        double f1x = ka * P0;
+        double f1y = ka * P1 - b2 * (a1z + a2z);
+        double f1z = ka * P2 + b2 * (a1y + a2y);
+        double m1x = kt * (a1x - a2x);
+        double m1y = b2 * P2 + kb * (2.0 * a1y + a2y);
+        double m1z = -b2 * P1 + kb * (2.0 * a1z + a2z);
+        double m2x = -m1x;
+        double f2x = -f1x, f2y = -f1y, f2z = -f1z;
+        double m2y = b2 * P2 + kb * (a1y + 2.0 * a2y);
+        double m2z = -b2 * P1 + kb * (a1z + 2.0 * a2z);
+        /* damping: rates from the memory of the last step */
+        double l0 = link_last[li], l1 = link_last[n + li], l2 = link_last[2 * n + li];
+        double l3 = link_last[3 * n + li], l4 = link_last[4 * n + li];
+        double l5 = link_last[5 * n + li], l6 = link_last[6 * n + li];
+        double l7 = link_last[7 * n + li], l8 = link_last[8 * n + li];
+        double vx = (P0 - l0) * inv_dt, vy = (P1 - l1) * inv_dt, vz = (P2 - l2) * inv_dt;
+        double ra1x = (a1x - l3) * inv_dt, ra1y = (a1y - l4) * inv_dt;
+        double ra1z = (a1z - l5) * inv_dt, ra2x = (a2x - l6) * inv_dt;
+        double ra2y = (a2y - l7) * inv_dt, ra2z = (a2z - l8) * inv_dt;
+        double ca = c_seed[li], cb2 = c_seed[n + li];
+        double ca2 = c_seed[2 * n + li], cb3 = c_seed[3 * n + li];
+        double d1x = f1x + bz * (ca * vx);
+        double d1y = f1y + bz * (ca * vy - cb2 * (ra1z + ra2z));
+        double d1z = f1z + bz * (ca * vz + cb2 * (ra1y + ra2y));
+        double e1x = m1x + bzh * (-ca2 * (ra2x - ra1x));
+        double e1y = m1y + bzh * (cb2 * vz + cb3 * (2.0 * ra1y + ra2y));
+        double e1z = m1z + bzh * (-cb2 * vy + cb3 * (2.0 * ra1z + ra2z));
+        ca = c_seed[4 * n + li];
+        cb2 = c_seed[5 * n + li];
+        ca2 = c_seed[6 * n + li];
+        cb3 = c_seed[7 * n + li];
+        double d2x = f2x + bz * (-ca * vx);
+        double d2y = f2y + bz * (-ca * vy + cb2 * (ra1z + ra2z));
+        double d2z = f2z + bz * (-ca * vz - cb2 * (ra1y + ra2y));
+        double e2x = m2x + bzh * (ca2 * (ra2x - ra1x));
+        double e2y = m2y + bzh * (cb2 * vz + cb3 * (ra1y + 2.0 * ra2y));
+        double e2z = m2z + bzh * (-cb2 * vy + cb3 * (ra1z + 2.0 * ra2z));
+        link_last[li] = softgym_pick(changed, l0, P0);
+        link_last[n + li] = softgym_pick(changed, l1, P1);
+        link_last[2 * n + li] = softgym_pick(changed, l2, P2);
+        link_last[3 * n + li] = softgym_pick(changed, l3, a1x);
+        link_last[4 * n + li] = softgym_pick(changed, l4, a1y);
+        link_last[5 * n + li] = softgym_pick(changed, l5, a1z);
+        link_last[6 * n + li] = softgym_pick(changed, l6, a2x);
+        link_last[7 * n + li] = softgym_pick(changed, l7, a2y);
+        link_last[8 * n + li] = softgym_pick(changed, l8, a2z);
+        /* (x, y, z) stays where c holds, else becomes (dx, dy, dz) */
+#define SOFTGYM_KEEP3(c, x, y, z, dx, dy, dz) do { \
+            x = softgym_pick(c, x, dx); \
+            y = softgym_pick(c, y, dy); \
+            z = softgym_pick(c, z, dz); \
+        } while (0)
+        SOFTGYM_KEEP3(changed, f1x, f1y, f1z, d1x, d1y, d1z);
+        SOFTGYM_KEEP3(changed, m1x, m1y, m1z, e1x, e1y, e1z);
+        SOFTGYM_KEEP3(neg2, f2x, f2y, f2z, d2x, d2y, d2z);
+        SOFTGYM_KEEP3(changed, m2x, m2y, m2z, e2x, e2y, e2z);
+        /* large angle: G = RQ^T v rotates by rq^-1 (RQ the matrix of rq,
+           normalised by |rq|^2: the small-ratio rq is not exactly unit) */
+        double n2q = rw * rw + ry * ry + rz * rz;
+        double r0 = n2q - 2.0 * (ry * ry + rz * rz);
+        double r1 = 2.0 * (rw * rz);
+        double r2 = 2.0 * (rw * ry);
+        double r4 = n2q - 2.0 * (rz * rz);
+        double r5 = 2.0 * (ry * rz);
+        double r8 = n2q - 2.0 * (ry * ry);
+#define SOFTGYM_UNTURN(x, y, z) do { \
+            double gx_ = r0 * x + r1 * y - r2 * z; \
+            double gy_ = -r1 * x + r4 * y + r5 * z; \
+            double gz_ = r2 * x + r5 * y + r8 * z; \
+            SOFTGYM_KEEP3(sa, x, y, z, gx_, gy_, gz_); \
+        } while (0)
+        SOFTGYM_UNTURN(f1x, f1y, f1z);
+        SOFTGYM_UNTURN(m1x, m1y, m1z);
+        SOFTGYM_UNTURN(m2x, m2y, m2z);
+        SOFTGYM_UNTURN(f2x, f2y, f2z);
+#undef SOFTGYM_UNTURN
+#undef SOFTGYM_KEEP3
+        o0[li] = f1x;
+        o1[li] = f1y;
+        o2[li] = f1z;
+        o3[li] = softgym_pick(neg2, -f1x, f2x);
+        o4[li] = softgym_pick(neg2, -f1y, f2y);
+        o5[li] = softgym_pick(neg2, -f1z, f2z);
+        o6[li] = -m1x;
+        o7[li] = -m1y;
+        o8[li] = -m1z;
+        o9[li] = -m2x;
+        o10[li] = -m2y;
+        o11[li] = -m2z;
+    }
+}
+
+/* The orientation step of _integrate_seed for voxels lo..hi, in C for the
+   vectorising pragma: q + (w dt / 2) x q (w the new angular velocity),
+   renormalised exactly (the seed's square root and division), snapped to
+   the identity at w >= 1, into the scratch rows q_out (4, n_voxels). The
+   same IEEE operations as the scalar seed code; the square root and the
+   division of one voxel no longer wait on the previous voxel's. */
+static void softgym_seed_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,
+                               const double *av, const double *quat, double *q_out)
+{
+    Py_ssize_t i;
+    SOFTGYM_IVDEP
+    for (i = lo; i < hi; i++) {
+        double wx = av[3 * i] * 0.5 * dt;
+        double wy = av[3 * i + 1] * 0.5 * dt;
+        double wz = av[3 * i + 2] * 0.5 * dt;
+        double q0 = quat[4 * i], q1 = quat[4 * i + 1], q2 = quat[4 * i + 2], q3 = quat[4 * i + 3];
+        double qw = q0 - wx * q1 - wy * q2 - wz * q3;
+        double qx = q1 + wx * q0 + wy * q3 - wz * q2;
+        double qy = q2 + wy * q0 + wz * q1 - wx * q3;
+        double qz = q3 + wz * q0 + wx * q2 - wy * q1;
+        double nq = sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
+        double inv = 1.0 / nq;
+        double nw = nq != 0.0 ? qw * inv : qw;
+        double nx = nq != 0.0 ? qx * inv : qx;
+        double ny = nq != 0.0 ? qy * inv : qy;
+        double nz = nq != 0.0 ? qz * inv : qz;
+        long long one = nw >= 1.0;
+        q_out[i] = one ? 1.0 : nw;
+        q_out[n + i] = one ? 0.0 : nx;
+        q_out[2 * n + i] = one ? 0.0 : ny;
+        q_out[3 * n + i] = one ? 0.0 : nz;
+    }
+}
+
+#endif  /* SOFTGYM_SEED_H */

@@ -1,0 +1,33 @@
+/* Portable helpers of the engine's vectorised C loops (included by the
+   seed kernels, softgym_seed.h). */
+#ifndef SOFTGYM_SIMD_H
+#define SOFTGYM_SIMD_H
+
+/* SOFTGYM_IVDEP before a loop: its iterations touch distinct elements,
+   vectorise without alias checks */
+#if defined(__clang__)
+#define SOFTGYM_IVDEP _Pragma("clang loop vectorize(assume_safety)")
+#elif defined(__GNUC__)
+#define SOFTGYM_IVDEP _Pragma("GCC ivdep")
+#else
+#define SOFTGYM_IVDEP
+#endif
+#include <string.h>
+/* c ? a : b on the bits: compilers keep it a blend (a select before a
+   store may otherwise become a masked store, slow on some cores) */
+static inline double softgym_pick(long long c, double a, double b)
+{
+    unsigned long long ua, ub, m = (unsigned long long)0 - (unsigned long long)(c != 0);
+    double r;
+    memcpy(&ua, &a, sizeof ua);
+    memcpy(&ub, &b, sizeof ub);
+    ua = (ua & m) | (ub & ~m);
+    memcpy(&r, &ua, sizeof r);
+    return r;
+}
+#if defined(_MSC_VER)
+#define SOFTGYM_ALWAYS_INLINE static __forceinline
+#else
+#define SOFTGYM_ALWAYS_INLINE static inline __attribute__((always_inline))
+#endif
+#endif  /* SOFTGYM_SIMD_H */
