@@ -22,6 +22,7 @@ SOFTGYM_PORTABLE=1
     speculative evaluation; floating-point traps are never enabled).
 """
 
+import glob
 import os
 import shutil
 import subprocess
@@ -133,6 +134,8 @@ ext_kwargs = dict(
 )
 
 core_kwargs = dict(ext_kwargs)
+# the headers' own includes are not tracked by cythonize: any header change rebuilds the kernel
+core_kwargs["depends"] = sorted(glob.glob(os.path.join(ENGINE_INCLUDE, "*.h")))
 # the kernel's `cdef inline` helpers take constant lattice axes: force inlining
 # so the compiler specialises them (Cython's guard lets us predefine the macro)
 if sys.platform != "win32":
