@@ -35,6 +35,7 @@ only allows speculative evaluation; floating-point traps are never enabled);
 ``tests/engine/test_kernel_variants.py`` checks it.
 """
 
+import glob
 import os
 import platform
 import shutil
@@ -179,6 +180,8 @@ ext_kwargs = dict(
 )
 
 core_kwargs = dict(ext_kwargs)
+# the headers' own includes are not tracked by cythonize: any header change rebuilds the kernel
+core_kwargs["depends"] = sorted(glob.glob(os.path.join(ENGINE_INCLUDE, "*.h")))
 # the kernel's `cdef inline` helpers take constant lattice axes: force inlining
 # so the compiler specialises them (Cython's guard lets us predefine the macro)
 if sys.platform != "win32":
