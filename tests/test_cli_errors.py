@@ -69,7 +69,7 @@ def test_evolve_out_in_a_read_only_folder(tmp_path, capsys):
 
 def test_compare_reads_config_through_read_json(tmp_path, capsys):
     line = _one_line_error(capsys, ["compare", str(tmp_path / "nonexistent")], "compare")
-    assert str(tmp_path / "nonexistent" / "config.json") in line and "not found" in line
+    assert str(tmp_path / "nonexistent" / "config.json") in line and "does not exist" in line
     run = tmp_path / "run"
     run.mkdir()
     (run / "config.json").write_text('{"experiment": ')

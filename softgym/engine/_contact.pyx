@@ -24,9 +24,11 @@ from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t
 # ---------------------------------------------------------------------------
 # The spatial hash (SpatialHash, _contact.pxd): points binned in cubic cells
 # of one edge, keyed by their packed cell coordinates, sorted by (key, index);
-# a query walks the 27 cells around a point's cell (_hash_cell, then
-# _hash_first of each neighbour's key), cells in (di, dj, dk) order, each
-# cell's points in index order. Used for the voxel pairs of both models and
+# a query walks the 27 cells around a point's cell in (di, dj, dk) order,
+# each cell's points in index order: as the key packs k in its lowest bits,
+# the three cells dk = -1, 0, +1 of one (di, dj) are one run of the sorted
+# points (_hash_first of the first key, then up to the last), so a query
+# makes 9 binary searches, not 27. Used for the voxel pairs of both models and
 # for the seed's voxel-obstacle pairs.
 
 cdef enum:
@@ -69,14 +71,17 @@ cdef inline bint _excluded(Batch* b, intp_t i, intp_t j) noexcept nogil:
 
 
 cdef inline intp_t _lower_bound(const KeyIndex* cells, intp_t n, int64_t key) noexcept nogil:
-    cdef intp_t lo = 0, hi = n, mid
-    while lo < hi:
-        mid = (lo + hi) >> 1
-        if cells[mid].key < key:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
+    # the first k with cells[k].key >= key (n if none); branch-free halving
+    # (the compiler makes the select a conditional move: the searched keys are
+    # unpredictable, the branchy search mispredicted half its steps)
+    cdef intp_t base = 0, half
+    if n == 0:
+        return 0
+    while n > 1:
+        half = n >> 1
+        base = base + half if cells[base + half].key < key else base
+        n -= half
+    return base + (cells[base].key < key)
 
 
 cdef inline int64_t _pack(int64_t ci, int64_t cj, int64_t ck) noexcept nogil:
@@ -155,7 +160,7 @@ cdef inline int _voxel_pairs(Batch* b, intp_t r, Contacts* c, const float64_t* P
         float64_t L = b.L
         float64_t h2 = horizon * horizon, x0, y0, z0, dx, dy, dz, d2, act
         intp_t first
-        int di, dj, dk
+        int di, dj
         int64_t key
         int64_t ijk[3]
         intp_t* grown
@@ -181,31 +186,31 @@ cdef inline int _voxel_pairs(Batch* b, intp_t r, Contacts* c, const float64_t* P
         _hash_cell(&h, P + stride * i, ijk)
         for di in range(-1, 2):
             for dj in range(-1, 2):
-                for dk in range(-1, 2):
-                    key = _pack(ijk[0] + di, ijk[1] + dj, ijk[2] + dk)
-                    k = _hash_first(&h, key)
-                    while k < h.n and h.cells[k].key == key:
-                        j = h.cells[k].index
-                        k += 1
-                        if j <= i:
+                # the cells dk = -1, 0, +1: one run of keys
+                key = _pack(ijk[0] + di, ijk[1] + dj, ijk[2] + 1)
+                k = _hash_first(&h, key - 2)
+                while k < h.n and h.cells[k].key <= key:
+                    j = h.cells[k].index
+                    k += 1
+                    if j <= i:
+                        continue
+                    dx = P[stride * j] - P[stride * i]
+                    dy = P[stride * j + 1] - P[stride * i + 1]
+                    dz = P[stride * j + 2] - P[stride * i + 2]
+                    d2 = dx * dx + dy * dy + dz * dz
+                    if seed_rule:
+                        if d2 >= 9.0 * L * L:
                             continue
-                        dx = P[stride * j] - P[stride * i]
-                        dy = P[stride * j + 1] - P[stride * i + 1]
-                        dz = P[stride * j + 2] - P[stride * i + 2]
-                        d2 = dx * dx + dy * dy + dz * dz
-                        if seed_rule:
-                            if d2 >= 9.0 * L * L:
-                                continue
-                            first = i if b.seed_rank[i] < b.seed_rank[j] else j
-                            act = 2.0 * P[stride * first + 3]
-                            if d2 >= act * act:
-                                continue
-                        elif d2 >= h2:
+                        first = i if b.seed_rank[i] < b.seed_rank[j] else j
+                        act = 2.0 * P[stride * first + 3]
+                        if d2 >= act * act:
                             continue
-                        if _excluded(b, i, j):
-                            continue
-                        c.row[n_row] = j
-                        n_row += 1
+                    elif d2 >= h2:
+                        continue
+                    if _excluded(b, i, j):
+                        continue
+                    c.row[n_row] = j
+                    n_row += 1
         if n_row == 0:
             continue
         qsort(c.row, n_row, sizeof(intp_t), _cmp_intp)
@@ -301,7 +306,7 @@ cdef int _obstacle_pairs(Batch* b, intp_t r, Contacts* c, float64_t horizon) noe
         intp_t o1 = b.obs_start[r + 1]
         intp_t n_o = o1 - o0
         intp_t i, m, k, n_row, mm
-        int di, dj, dk
+        int di, dj
         int64_t key
         int64_t ijk[3]
         float64_t L = b.L
@@ -325,33 +330,33 @@ cdef int _obstacle_pairs(Batch* b, intp_t r, Contacts* c, float64_t horizon) noe
         _hash_cell(&h, R + 4 * i, ijk)
         for di in range(-1, 2):
             for dj in range(-1, 2):
-                for dk in range(-1, 2):
-                    key = _pack(ijk[0] + di, ijk[1] + dj, ijk[2] + dk)
-                    k = _hash_first(&h, key)
-                    while k < h.n and h.cells[k].key == key:
-                        m = h.cells[k].index
-                        k += 1
-                        dx = b.obs[4 * m] - R[4 * i]
-                        dy = b.obs[4 * m + 1] - R[4 * i + 1]
-                        dz = b.obs[4 * m + 2] - R[4 * i + 2]
-                        d2 = dx * dx + dy * dy + dz * dz
-                        if d2 >= 9.0 * L * L:
-                            continue
-                        s_first = R[4 * i + 3] if b.seed_rank[i] < b.obs_rank[m] else L
-                        act = 2.0 * s_first
-                        if d2 >= act * act:
-                            continue
-                        if c.n_opairs + 1 > c.ocapacity:
-                            mm = 2 * (c.n_opairs + 1) + 64
-                            grown = <intp_t*> realloc(c.opairs, 2 * mm * sizeof(intp_t))
-                            if grown == NULL:
-                                return STATUS_MEMORY
-                            c.opairs = grown
-                            c.ocapacity = mm
-                        c.opairs[2 * c.n_opairs] = i
-                        c.opairs[2 * c.n_opairs + 1] = m
-                        c.n_opairs += 1
-                        n_row += 1
+                # the cells dk = -1, 0, +1: one run of keys
+                key = _pack(ijk[0] + di, ijk[1] + dj, ijk[2] + 1)
+                k = _hash_first(&h, key - 2)
+                while k < h.n and h.cells[k].key <= key:
+                    m = h.cells[k].index
+                    k += 1
+                    dx = b.obs[4 * m] - R[4 * i]
+                    dy = b.obs[4 * m + 1] - R[4 * i + 1]
+                    dz = b.obs[4 * m + 2] - R[4 * i + 2]
+                    d2 = dx * dx + dy * dy + dz * dz
+                    if d2 >= 9.0 * L * L:
+                        continue
+                    s_first = R[4 * i + 3] if b.seed_rank[i] < b.obs_rank[m] else L
+                    act = 2.0 * s_first
+                    if d2 >= act * act:
+                        continue
+                    if c.n_opairs + 1 > c.ocapacity:
+                        mm = 2 * (c.n_opairs + 1) + 64
+                        grown = <intp_t*> realloc(c.opairs, 2 * mm * sizeof(intp_t))
+                        if grown == NULL:
+                            return STATUS_MEMORY
+                        c.opairs = grown
+                        c.ocapacity = mm
+                    c.opairs[2 * c.n_opairs] = i
+                    c.opairs[2 * c.n_opairs + 1] = m
+                    c.n_opairs += 1
+                    n_row += 1
         if n_row > 1:
             # the row's obstacles in index order (results independent of the hash)
             qsort(c.opairs + 2 * (c.n_opairs - n_row), n_row, 2 * sizeof(intp_t), _cmp_intp2)
