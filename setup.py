@@ -130,21 +130,24 @@ def _kernel_levels():
 
 
 class BuildExt(build_ext):
-    """build_ext that compiles each kernel variant in a temporary folder of its own.
+    """build_ext that compiles the extensions in parallel (one job per CPU) by default."""
 
-    A variant (``softgym.engine._x86_64_v3._core``...) is its module's
-    generated C compiled with other flags: the same source file, so its
-    objects must not land on (or be mistaken for) the baseline's.
-    """
+    def finalize_options(self):
+        super().finalize_options()
+        if self.parallel is None:
+            self.parallel = os.cpu_count() or 1
 
-    def build_extension(self, ext):
-        temp = self.build_temp
-        if getattr(ext, "variant_dir", None):
-            self.build_temp = os.path.join(temp, ext.variant_dir)
-        try:
-            super().build_extension(ext)
-        finally:
-            self.build_temp = temp
+
+def _variant_copy(source, folder):
+    """A copy of the generated C file ``source`` under ``build/<folder>/`` (its own objects)."""
+    target = os.path.join("build", folder, source)
+    os.makedirs(os.path.dirname(target), exist_ok=True)
+    with open(source, "rb") as fh:
+        data = fh.read()
+    if not os.path.exists(target) or open(target, "rb").read() != data:
+        with open(target, "wb") as fh:  # rewritten only when changed: no needless rebuild
+            fh.write(data)
+    return target
 
 
 debug = bool(os.environ.get("SOFTGYM_DEBUG"))
@@ -223,22 +226,22 @@ extensions = cythonize(extensions, compiler_directives=directives)
 # calls into one another resolve within one build: softgym/engine/_dispatch.py)
 base = [e for e in extensions if e.name in {f"softgym.engine.{m}" for m in ENGINE_MODULES}]
 for level in _kernel_levels():
+    folder = f"_x86_64_{level}"
     for ext in base:
         # softgym.engine._x86_64_v3._core: the generated C of softgym.engine._core
-        # compiled with the level's flags (softgym/engine/_dispatch.py loads it
-        # under its own name)
+        # (copied, so its objects are its own) compiled with the level's flags;
+        # softgym/engine/_dispatch.py loads it under the module's own name
         package, _, module = ext.name.rpartition(".")
-        variant = Extension(
-            f"{package}._x86_64_{level}.{module}",
-            list(ext.sources),
+        extensions.append(Extension(
+            f"{package}.{folder}.{module}",
+            [_variant_copy(src, folder) for src in ext.sources],
             include_dirs=list(ext.include_dirs),
             define_macros=list(ext.define_macros),
             extra_compile_args=[*ext.extra_compile_args, f"-march=x86-64-{level}"],
             extra_link_args=list(ext.extra_link_args),
-        )
-        variant.variant_dir = f"_x86_64_{level}"
-        extensions.append(variant)
+            depends=list(ext.depends),
+        ))  # fmt: skip
         # an in-place (editable) build copies the library there: the folder must exist
-        os.makedirs(os.path.join(*package.split("."), variant.variant_dir), exist_ok=True)
+        os.makedirs(os.path.join(*package.split("."), folder), exist_ok=True)
 
 setup(ext_modules=extensions, cmdclass={"build_ext": BuildExt})
