@@ -563,7 +563,8 @@ class RunRecorder:
             self._bar.refresh()
 
     def interrupted(self, generation: int, resume: str) -> RunInterrupted:
-        """Close the bar, log where the run stopped and return the :class:`RunInterrupted` to raise.
+        """Close the bar, log where the run stopped (INFO: the exception says it to the user,
+        the CLI in one message) and return the :class:`RunInterrupted` to raise.
 
         Parameters
         ----------
@@ -575,7 +576,7 @@ class RunRecorder:
         self.close_progress()
         ckpt = latest_checkpoint(self.checkpoint_dir) if self.checkpoint_dir.exists() else None
         exc = RunInterrupted(self.out, generation, ckpt, resume)
-        log.warning("%s: %s", self.out, exc)
+        log.info("%s: %s", self.out, exc)
         return exc
 
     # ------------------------------------------------------------------ records

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from softgym.cli import main
+from softgym_cli import main
 
 TINY = ["--pop", "4", "--seconds", "1.5", "--shape", "4", "4", "4", "--quiet"]
 
@@ -64,7 +64,7 @@ def test_kill_9_then_resume_equals_uninterrupted(tmp_path):
     killed = tmp_path / "killed"
     env = {**os.environ, "SOFTGYM_NUM_THREADS": "1"}
     proc = subprocess.Popen(
-        [sys.executable, "-m", "softgym.cli", *args, "--out", str(killed)],
+        [sys.executable, "-m", "softgym_cli", *args, "--out", str(killed)],
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
         env=env,

@@ -11,7 +11,7 @@ import time
 
 import pytest
 
-from softgym.cli import main
+from softgym_cli import main
 
 TINY = ["--pop", "4", "--seconds", "1.5", "--shape", "4", "4", "4", "--quiet", "--no-gif"]
 
@@ -38,7 +38,7 @@ def test_resume_reads_the_settings_from_the_run_folder(runs, capsys):
 
 
 def test_help_shows_every_default(capsys):
-    from softgym import cli
+    import softgym_cli as cli
 
     parser_holder = {}
     real = argparse.ArgumentParser.parse_args
@@ -113,7 +113,7 @@ def test_convert_both_ways_and_view(runs, tmp_path, capsys):
 @pytest.mark.skipif(os.name != "posix", reason="needs POSIX signals")
 def test_ctrl_c_stops_fast_and_prints_the_resume_command(tmp_path):
     out = tmp_path / "run"
-    cmd = [sys.executable, "-m", "softgym.cli", "evolve", "--out", str(out), "--generations",
+    cmd = [sys.executable, "-m", "softgym_cli", "evolve", "--out", str(out), "--generations",
            "50", "--pop", "6", "--seconds", "3", "--shape", "4", "4", "4", "--no-gif",
            "--no-figures"]  # fmt: skip
     p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -134,3 +134,4 @@ def test_ctrl_c_stops_fast_and_prints_the_resume_command(tmp_path):
     assert "Traceback" not in err
     assert f"resume with: softgym evolve --out {out} --resume" in err
     assert "checkpointed in" in err
+    assert err.count("interrupted") == 1, err  # one message, not the log's and the CLI's

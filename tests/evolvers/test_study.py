@@ -20,8 +20,8 @@ from evolvers.study import (
     time_to_go,
 )
 from evolvers.study_report import a12, load_runs, permutation_pvalue
-from softgym.cli import main
 from softgym.exceptions import InvalidParameterError
+from softgym_cli import main
 
 TINY = ["--pop", "4", "--seconds", "1.5", "--shape", "4", "4", "4", "--quiet"]
 VERDICTS = {"holds", "partly", "does not hold", "not run"}

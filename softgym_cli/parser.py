@@ -1,0 +1,107 @@
+"""The ``softgym`` parser and entry point: global flags, one help format, one error line."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+from importlib.metadata import PackageNotFoundError, version
+from typing import Any
+
+from softgym.exceptions import SoftGymError
+from softgym_cli.commands import add_tool_parsers
+from softgym_cli.runs import add_evolve_parser, add_poet_parser, add_qd_parser, explicit_flags
+from softgym_cli.study import add_study_parser
+
+__all__ = ["main"]
+
+
+class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """``--help`` shows every default as ``(default: X)``; options without one say theirs in words."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        if action.default is None or isinstance(action, argparse._StoreTrueAction):
+            return action.help or ""
+        return super()._get_help_string(action)
+
+
+def _installed_version() -> str:
+    """The version pyproject.toml gives the installed distribution."""
+    try:
+        return version("softgym")
+    except PackageNotFoundError:  # pragma: no cover - run from a bare source tree
+        return "unknown (not installed)"
+
+
+def _global_flags(p: argparse.ArgumentParser, default: Any) -> None:
+    """``-v`` and ``-q``, on the main parser (``default``: their defaults) and on every
+    subcommand (``argparse.SUPPRESS``: typed after the subcommand, they still count).
+    """
+    p.add_argument("-v", "--verbose", action="count",
+                   default=0 if default is None else default,
+                   help="log lines (-v: each generation and Dask's; -vv: debug)")  # fmt: skip
+    p.add_argument("-q", "--quiet", action="store_true",
+                   default=False if default is None else default,
+                   help="no progress bar (study: no line per finished run)")  # fmt: skip
+
+
+def _subcommands(parser: argparse.ArgumentParser, dest: str, required: bool = True) -> Any:
+    """A subparsers action whose parsers show their defaults and take the global flags."""
+    sub = parser.add_subparsers(dest=dest, required=required)
+    add = sub.add_parser
+
+    def add_parser(name: str, **kw: Any) -> argparse.ArgumentParser:
+        p = add(name, formatter_class=_HelpFormatter, allow_abbrev=False, **kw)
+        _global_flags(p, argparse.SUPPRESS)
+        return p
+
+    sub.add_parser = add_parser
+    return sub
+
+
+def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
+    """The ``softgym`` parser and its ``evolve`` subparser."""
+    import softgym_cli
+
+    parser = argparse.ArgumentParser(
+        prog="softgym", description=softgym_cli.__doc__.split("\n")[0],
+        formatter_class=_HelpFormatter,
+    )  # fmt: skip
+    parser.add_argument("--version", action="version", version=f"softgym {_installed_version()}")
+    _global_flags(parser, None)
+    parser.add_argument(
+        "--debug", action="store_true", help="show the traceback of an error (before the command)"
+    )
+    sub = _subcommands(parser, "command")
+    add_tool_parsers(sub)
+    evolve = add_evolve_parser(sub)
+    add_study_parser(sub)
+    add_qd_parser(sub)
+    add_poet_parser(sub)
+    return parser, evolve
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``softgym`` command.
+
+    A :class:`~softgym.exceptions.SoftGymError` or :class:`OSError` from a
+    subcommand prints one line, ``softgym <command>: <message>``, to stderr and
+    returns 2; ``softgym --debug <command> ...`` raises it instead (traceback).
+    """
+    parser, evolve_parser = _parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = parser.parse_args(argv)
+    if args.command == "evolve":
+        args.explicit = explicit_flags(evolve_parser, argv)
+    level = (logging.WARNING, logging.INFO, logging.DEBUG)[min(args.verbose, 2)]
+    logging.basicConfig(level=level, format="%(message)s")
+    for name in ("softgym", "evolvers"):
+        logging.getLogger(name).setLevel(level)
+    try:
+        return int(args.func(args))
+    except (SoftGymError, OSError) as exc:  # bad input or a file problem: one line, exit 2
+        if args.debug:
+            raise
+        message = " ".join(str(exc).split()) or type(exc).__name__
+        print(f"softgym {args.command}: {message}", file=sys.stderr)
+        return 2
