@@ -32,7 +32,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
-from evolvers.selection import Objective
+from evolvers.selection import SELECTORS, Objective
 from softgym.design import MATERIAL_TREE_4, MATERIAL_TREE_8, CompositionRules
 from softgym.exceptions import InvalidParameterError
 from softgym.metrics import WALK_METRICS
@@ -42,7 +42,7 @@ from softgym.terrain import Terrain
 __all__ = ["EXPERIMENTS", "SELECTIONS", "Experiment", "get_experiment", "list_experiments"]
 
 #: Selection schemes an experiment may name.
-SELECTIONS: tuple[str, ...] = ("pareto", "tournament", "novelty", "novelty-archive", "nsga2")
+SELECTIONS: tuple[str, ...] = tuple(SELECTORS)
 
 
 @dataclass(frozen=True)

@@ -58,7 +58,6 @@ from softgym.io import (
 __all__ = [
     "HALL_OF_FAME_SIZE",
     "RUN_SCHEMA",
-    "RecordedRun",
     "RunRecorder",
     "add_run_note",
     "config_difference",
@@ -346,46 +345,6 @@ def log_row(
             row[f"novelty_{k}"] = v
     row.update(study_columns(exp, population, stats))
     return row
-
-
-class RecordedRun:
-    """What every runner shows of its record: a mixin over its :attr:`recorder`.
-
-    The runners (:class:`~evolvers.runner.EvolutionRun`, ``PymooRun``, ``QDRun``)
-    keep their log, hall of fame, totals and checkpoints in a :class:`RunRecorder`
-    at ``self.recorder``; these read-only views are the same for all of them.
-    """
-
-    recorder: RunRecorder
-
-    @property
-    def rows(self) -> list[dict[str, Any]]:
-        """The log rows so far (one per generation)."""
-        return self.recorder.rows
-
-    @property
-    def hall_of_fame(self) -> list[dict[str, Any]]:
-        """The best individuals so far (plain data, best first)."""
-        return self.recorder.hall_of_fame
-
-    @property
-    def evaluations_total(self) -> int:
-        """Simulations run so far."""
-        return self.recorder.evaluations_total
-
-    @property
-    def wall_total(self) -> float:
-        """Wall time (s) of the generations so far."""
-        return self.recorder.wall_total
-
-    @property
-    def checkpoint_dir(self) -> Path:
-        """Folder of the checkpoints."""
-        return self.recorder.checkpoint_dir
-
-    def best(self) -> Individual:
-        """The best individual found so far (by the first objective)."""
-        return self.recorder.best()
 
 
 class RunRecorder:

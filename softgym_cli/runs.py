@@ -83,16 +83,14 @@ def recorded_config(args: argparse.Namespace) -> dict[str, Any] | None:
     return read_run_config(args.out)
 
 
-def build_run(args: argparse.Namespace, stack: contextlib.ExitStack, make: Maker,
-              dask_fn: str = "batch_fn") -> Any:  # fmt: skip
+def build_run(args: argparse.Namespace, stack: contextlib.ExitStack, make: Maker) -> Any:
     """The run a command's flags describe.
 
     ``make(args, cfg)`` names the run class, its experiment and its own
     keywords (``cfg``: the recorded config under ``--resume``, else None);
     the rest is the same for every command: the Dask client (kept open in
-    ``stack``) passed as ``dask_fn`` (``DaskBatchFn``; POET's ``DaskJobsFn``
-    as ``jobs_fn``), threads, figures, GIF, progress, and the shell command
-    that resumes.
+    ``stack``) as a ``DaskBatchFn``, threads, figures, GIF, progress, and the
+    shell command that resumes.
     """
     run_cls, experiment, kw = make(args, recorded_config(args))
     if args.dask:
@@ -101,9 +99,7 @@ def build_run(args: argparse.Namespace, stack: contextlib.ExitStack, make: Maker
         quiet_dask(args.verbose)
         client = stack.enter_context(dask_client(args.dask, n_workers=args.workers))
         quiet_dask(args.verbose)
-        if dask_fn == "jobs_fn":
-            from evolvers.poet import DaskJobsFn as DaskBatchFn
-        kw[dask_fn] = DaskBatchFn(client)
+        kw["batch_fn"] = DaskBatchFn(client)
     if hasattr(args, "no_gif"):
         kw["gif"] = not args.no_gif
     run = run_cls(experiment, args.out, n_threads=args.threads, figures=not args.no_figures,
@@ -117,7 +113,7 @@ def _raise_keyboard_interrupt(signum, frame):  # SIGTERM: stop like Ctrl-C, chec
 
 
 def run_command(args: argparse.Namespace, unit: str, make: Maker,
-                summary: Callable[[Any, Any], dict[str, Any]], dask_fn: str = "batch_fn") -> int:  # fmt: skip
+                summary: Callable[[Any, Any], dict[str, Any]]) -> int:  # fmt: skip
     """Build the run of the flags (:func:`build_run`), run it, print its JSON summary.
 
     Every long command runs this way: SIGTERM acts as Ctrl-C, log lines go
@@ -134,7 +130,7 @@ def run_command(args: argparse.Namespace, unit: str, make: Maker,
     try:
         with contextlib.ExitStack() as stack:
             stack.enter_context(logging_redirect_tqdm())
-            run = build_run(args, stack, make, dask_fn)
+            run = build_run(args, stack, make)
             result = run.run(resume=args.resume)
     except RunInterrupted as exc:
         where = (f"{unit} {exc.generation} is checkpointed in {exc.checkpoint}"
@@ -422,7 +418,7 @@ def cmd_poet(args: argparse.Namespace) -> int:
     """``softgym poet [run]`` and ``softgym poet compare``."""
     if getattr(args, "poet_command", None) == "compare":
         return _cmd_poet_compare(args)
-    return run_command(args, "iteration", _poet_run, _poet_summary, "jobs_fn")
+    return run_command(args, "iteration", _poet_run, _poet_summary)
 
 
 def _cmd_poet_compare(args: argparse.Namespace) -> int:
