@@ -30,7 +30,6 @@ accepted wherever a task name is: ``softgym.evaluate(d, task=Terrain.stairs())``
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, fields, replace
@@ -43,6 +42,7 @@ from softgym.exceptions import InvalidParameterError, InvalidTerrainError
 from softgym.metrics import TASK_MEASURES, WALK_METRICS, dilute, task_measure, walk_metrics
 from softgym.tasks.suite import KINDS
 from softgym.terrain import Terrain
+from softgym.validate import positive
 
 if TYPE_CHECKING:  # annotations only: softgym.engine's __init__ loads compiled code
     from softgym.engine import Rollout, SimConfig
@@ -109,16 +109,6 @@ LAYOUTS: dict[str, Callable[..., Terrain]] = {
 
 #: Other names users know a task by (the seed's reports call the wall a fence).
 ALIASES: dict[str, str] = {"fence": "wall"}
-
-
-def _positive(name: str, value: Any) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(f"{name} must be a number, got {value!r}") from None
-    if not (math.isfinite(v) and v > 0):
-        raise InvalidParameterError(f"{name} must be finite and > 0, got {value!r}")
-    return v
 
 
 @dataclass(frozen=True)
@@ -190,8 +180,8 @@ class Task:
                 f"terrain must be a layout name or a Terrain, got {type(terrain).__name__}"
             )
         object.__setattr__(self, "terrain", terrain)
-        object.__setattr__(self, "seconds", _positive("seconds", self.seconds))
-        object.__setattr__(self, "trace_interval", _positive("trace_interval", self.trace_interval))
+        object.__setattr__(self, "seconds", positive("seconds", self.seconds))
+        object.__setattr__(self, "trace_interval", positive("trace_interval", self.trace_interval))
         if not isinstance(self.options, Mapping):
             raise InvalidParameterError(f"options must be a dict, got {type(self.options).__name__}")
         kind = KINDS.get(terrain) if isinstance(terrain, str) else None
