@@ -100,6 +100,7 @@ from evolvers.selection import sel_fitness_tournament
 from softgym.design import CONTROLLER_BOUNDS, Controller
 from softgym.exceptions import InvalidParameterError
 from softgym.io import rng_from_state, rng_state
+from softgym.render.figures import pyplot
 from softgym.tasks import Task
 from softgym.tasks.terrain_genome import TerrainGenome
 
@@ -1004,15 +1005,6 @@ def _matrix_log(robots: Sequence[Pair], terrains: Sequence[Pair], m: np.ndarray)
 
 
 # ---------------------------------------------------------------------- figures
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def plot_annecs(
     groups: Mapping[str, Sequence[Sequence[Mapping[str, Any]]]], path: str | Path
 ) -> Path:
@@ -1025,7 +1017,7 @@ def plot_annecs(
     path : path
         PNG file.
     """
-    plt = _plt()
+    plt = pyplot()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig, ax = plt.subplots(figsize=(6.4, 3.8))
@@ -1065,7 +1057,7 @@ def transfer_counts(rows: Sequence[Mapping[str, Any]]) -> tuple[list[int], np.nd
 
 def plot_transfers(rows: Sequence[Mapping[str, Any]], path: str | Path) -> Path:
     """Heatmap of the transfers of a run (rows: the robot's pair, columns: the adopting pair)."""
-    plt = _plt()
+    plt = pyplot()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     ids, counts = transfer_counts(rows)
@@ -1088,7 +1080,7 @@ def plot_gallery(run: PoetRun, hardest: Sequence[tuple[Pair, float]], path: str 
     from softgym.engine import Simulation
     from softgym.render.frames import VoxelRenderer, render_rollout
 
-    plt = _plt()
+    plt = pyplot()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     n = len(hardest)

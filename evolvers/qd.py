@@ -72,6 +72,7 @@ from softgym.io import (
     rng_from_state,
     rng_state,
 )
+from softgym.render.figures import pyplot
 
 try:
     from ribs.archives import CVTArchive, GridArchive, k_means_centroids
@@ -537,10 +538,7 @@ def plot_archive_heatmap(
     -------
     Path
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     from ribs.visualize import cvt_archive_heatmap, grid_archive_heatmap
 
     path = Path(path)
@@ -579,10 +577,7 @@ def _axis_label(name: str) -> str:
 
 def plot_qd_progress(rows: Sequence[Mapping[str, Any]], path: str | Path) -> Path:
     """QD-score and coverage against simulations, from a QD run's log rows."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)

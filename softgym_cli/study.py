@@ -108,7 +108,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
 
 
 def _cmd_study_report(args: argparse.Namespace) -> int:
-    from evolvers.study_report import claims, load_runs, write_report
+    from evolvers.study import claims, load_runs, write_report
 
     root = Path(args.runs)
     if not root.is_dir() or not load_runs(root):
