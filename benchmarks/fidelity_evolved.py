@@ -41,7 +41,7 @@ sys.path.insert(0, str(HERE))
 import fidelity_cases as fc  # noqa: E402
 from fidelity_seed import METRIC, SOFTGYM_METRIC, agreement, fence_terrain  # noqa: E402
 
-from evolvers.study import a12, permutation_pvalue  # noqa: E402
+from evolvers.study.stats import a12, permutation_pvalue  # noqa: E402
 from softgym.design.robot import RobotDesign  # noqa: E402
 from softgym.engine import SimConfig, Simulation  # noqa: E402
 from softgym.metrics import dilute, walk_metrics  # noqa: E402

@@ -43,7 +43,7 @@ from pymoo.core.problem import Problem
 from pymoo.core.sampling import Sampling
 
 from evolvers.driver import Checkpoint, Driver, IdCounter
-from evolvers.evaluation import BatchFn, EvalStats, Evaluator, PhenotypeCache, pack_traces
+from evolvers.evaluation import EvalStats, Evaluator, PhenotypeCache, pack_traces
 from evolvers.experiments import Experiment
 from evolvers.genome import Individual
 from evolvers.operators import mut_controller, mut_cppn, mut_materials, set_counterphase
@@ -341,8 +341,9 @@ class PymooRun(Driver):
 
     Parameters
     ----------
-    experiment, out, seed, generations, batch_fn, n_threads, on_generation, figures, gif, progress
-        As for :class:`~evolvers.runner.EvolutionRun` (Ctrl-C raises
+    experiment, out, seed, generations, **driver
+        As for :class:`~evolvers.driver.Driver` (``batch_fn``, ``n_threads``,
+        ``on_generation``, ``figures``, ``gif``, ``progress``; Ctrl-C raises
         :class:`~evolvers.recorder.RunInterrupted` the same way).
     algorithm : str or callable
         ``"nsga2"`` (default), ``"nsga3"``, ``"sms-emoa"``, ``"ga"``
@@ -357,22 +358,11 @@ class PymooRun(Driver):
 
     backend = "pymoo"
 
-    def __init__(
-        self,
-        experiment: Experiment,
-        out: str | Path,
-        seed: int = 0,
-        generations: int | None = None,
-        batch_fn: BatchFn | None = None,
-        n_threads: int | None = None,
-        on_generation: Callable[[PymooRun, dict[str, Any]], None] | None = None,
-        figures: bool = True,
-        gif: bool = True,
-        algorithm: str | Callable[..., Algorithm] = "nsga2",
-        algorithm_kwargs: dict[str, Any] | None = None,
-        single_objective: bool | None = None,
-        progress: bool = True,
-    ) -> None:
+    def __init__(self, experiment: Experiment, out: str | Path, seed: int = 0,
+                 generations: int | None = None, *,
+                 algorithm: str | Callable[..., Algorithm] = "nsga2",
+                 algorithm_kwargs: dict[str, Any] | None = None,
+                 single_objective: bool | None = None, **driver: Any) -> None:  # fmt: skip
         if isinstance(algorithm, str) and algorithm not in ALGORITHMS:
             raise InvalidParameterError(
                 f"unknown algorithm {algorithm!r}; expected one of {ALGORITHMS}"
@@ -382,10 +372,8 @@ class PymooRun(Driver):
         self.single_objective = (
             (algorithm == "ga") if single_objective is None else single_objective
         )
-        super().__init__(
-            experiment, out, seed, generations, batch_fn, n_threads, on_generation, figures,
-            gif, progress, extra_config={"algorithm": _algorithm_label(algorithm)},
-        )  # fmt: skip
+        super().__init__(experiment, out, seed, generations,
+                         extra_config={"algorithm": _algorithm_label(algorithm)}, **driver)  # fmt: skip
 
     # ------------------------------------------------------------------ the loop
     def _fresh(self) -> None:

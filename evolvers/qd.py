@@ -54,7 +54,6 @@ from evolvers.descriptors import MOURET_CLUNE_2015, check_descriptors, descripto
 from evolvers.distributed import MissingExtraError
 from evolvers.driver import Checkpoint, Driver, IdCounter
 from evolvers.evaluation import (
-    BatchFn,
     EvalStats,
     PhenotypeCache,
     pack_traces,
@@ -357,33 +356,21 @@ class QDRun(Driver):
         Default: the experiment's.
     config : QDConfig, optional
         The archive (default: Mouret and Clune's 128 x 128 grid).
-    batch_fn, n_threads, on_generation, figures, gif, progress
-        As for :class:`~evolvers.runner.EvolutionRun` (Ctrl-C raises
+    **driver
+        ``batch_fn``, ``n_threads``, ``on_generation``, ``figures``, ``gif``,
+        ``progress``: as for :class:`~evolvers.driver.Driver` (Ctrl-C raises
         :class:`~evolvers.recorder.RunInterrupted` the same way).
     """
 
     backend = "qd"
 
-    def __init__(
-        self,
-        experiment: Experiment,
-        out: str | Path,
-        seed: int = 0,
-        generations: int | None = None,
-        config: QDConfig | None = None,
-        batch_fn: BatchFn | None = None,
-        n_threads: int | None = None,
-        on_generation: Callable[[QDRun, dict[str, Any]], None] | None = None,
-        figures: bool = True,
-        gif: bool = True,
-        progress: bool = True,
-    ) -> None:
+    def __init__(self, experiment: Experiment, out: str | Path, seed: int = 0,
+                 generations: int | None = None, *, config: QDConfig | None = None,
+                 **driver: Any) -> None:  # fmt: skip
         self.config = QDConfig() if config is None else config
         self.objective = self.config.objective_for(experiment)
-        super().__init__(
-            experiment, out, seed, generations, batch_fn, n_threads, on_generation, figures,
-            gif, progress, extra_config={"qd": self.config.to_dict()},
-        )  # fmt: skip
+        super().__init__(experiment, out, seed, generations,
+                         extra_config={"qd": self.config.to_dict()}, **driver)  # fmt: skip
 
     def _fresh(self, centroids: np.ndarray | None = None) -> None:
         super()._fresh()

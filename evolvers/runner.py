@@ -44,38 +44,8 @@ __all__ = ["RUN_SCHEMA", "EvolutionRun", "RunInterrupted", "population_summary"]
 class EvolutionRun(Driver):
     """A resumable evolutionary run of an :class:`~evolvers.experiments.Experiment` (native backend).
 
-    Parameters
-    ----------
-    experiment : Experiment
-    out : path
-        Run folder.
-    seed : int
-        Seed of the run's single ``numpy.random.Generator`` (every random
-        choice: genomes, variation, selection).
-    generations : int, optional
-        Generations after generation 0 (default the experiment's).
-    batch_fn : callable, optional
-        Batch evaluation (default: one local Simulation; see
-        :class:`evolvers.distributed.DaskBatchFn`).
-    n_threads : int, optional
-        OpenMP threads of local simulations.
-    on_generation : callable, optional
-        ``on_generation(run, row)`` after each generation's checkpoint
-        (progress bars; raising here interrupts the run like a crash).
-    figures : bool
-        Write figures (and the GIF) at the end.
-    gif : bool
-        Also render the best robot's GIF.
-    progress : bool
-        Show a tqdm bar over the generations (each generation is also logged
-        to the ``evolvers`` logger at INFO).
-
-    Raises
-    ------
-    RunInterrupted
-        From :meth:`run` on Ctrl-C (a ``KeyboardInterrupt``; the simulations
-        stop within a fraction of a second): it names the last checkpoint
-        and :attr:`resume_command`.
+    Parameters: those of :class:`~evolvers.driver.Driver` (``seed`` seeds the run's single
+    ``numpy.random.Generator``: every random choice, genomes, variation, selection).
     """
 
     backend = "native"

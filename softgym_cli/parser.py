@@ -5,58 +5,14 @@ from __future__ import annotations
 import argparse
 import logging
 import sys
-from importlib.metadata import PackageNotFoundError, version
-from typing import Any
 
 from softgym.exceptions import SoftGymError
 from softgym_cli.commands import add_tool_parsers
+from softgym_cli.flags import HelpFormatter, global_flags, installed_version, subcommands
 from softgym_cli.runs import add_evolve_parser, add_poet_parser, add_qd_parser, explicit_flags
 from softgym_cli.study import add_study_parser
 
 __all__ = ["main"]
-
-
-class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
-    """``--help`` shows every default as ``(default: X)``; options without one say theirs in words."""
-
-    def _get_help_string(self, action: argparse.Action) -> str:
-        if action.default is None or isinstance(action, argparse._StoreTrueAction):
-            return action.help or ""
-        return super()._get_help_string(action)
-
-
-def _installed_version() -> str:
-    """The version pyproject.toml gives the installed distribution."""
-    try:
-        return version("softgym")
-    except PackageNotFoundError:  # pragma: no cover - run from a bare source tree
-        return "unknown (not installed)"
-
-
-def _global_flags(p: argparse.ArgumentParser, default: Any) -> None:
-    """``-v`` and ``-q``, on the main parser (``default``: their defaults) and on every
-    subcommand (``argparse.SUPPRESS``: typed after the subcommand, they still count).
-    """
-    p.add_argument("-v", "--verbose", action="count",
-                   default=0 if default is None else default,
-                   help="log lines (-v: each generation and Dask's; -vv: debug)")  # fmt: skip
-    p.add_argument("-q", "--quiet", action="store_true",
-                   default=False if default is None else default,
-                   help="no progress bar (study: no line per finished run)")  # fmt: skip
-
-
-def _subcommands(parser: argparse.ArgumentParser, dest: str, required: bool = True) -> Any:
-    """A subparsers action whose parsers show their defaults and take the global flags."""
-    sub = parser.add_subparsers(dest=dest, required=required)
-    add = sub.add_parser
-
-    def add_parser(name: str, **kw: Any) -> argparse.ArgumentParser:
-        p = add(name, formatter_class=_HelpFormatter, allow_abbrev=False, **kw)
-        _global_flags(p, argparse.SUPPRESS)
-        return p
-
-    sub.add_parser = add_parser
-    return sub
 
 
 def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
@@ -65,14 +21,14 @@ def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
 
     parser = argparse.ArgumentParser(
         prog="softgym", description=softgym_cli.__doc__.split("\n")[0],
-        formatter_class=_HelpFormatter,
+        formatter_class=HelpFormatter,
     )  # fmt: skip
-    parser.add_argument("--version", action="version", version=f"softgym {_installed_version()}")
-    _global_flags(parser, None)
+    parser.add_argument("--version", action="version", version=f"softgym {installed_version()}")
+    global_flags(parser, None)
     parser.add_argument(
         "--debug", action="store_true", help="show the traceback of an error (before the command)"
     )
-    sub = _subcommands(parser, "command")
+    sub = subcommands(parser, "command")
     add_tool_parsers(sub)
     evolve = add_evolve_parser(sub)
     add_study_parser(sub)

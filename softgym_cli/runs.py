@@ -24,6 +24,7 @@ from typing import Any
 from evolvers.experiments import Experiment, get_experiment
 from evolvers.recorder import RunInterrupted, read_run_config
 from softgym.exceptions import CheckpointError
+from softgym_cli.flags import subcommands
 
 __all__ = [
     "add_evolve_parser",
@@ -368,9 +369,7 @@ def add_qd_parser(sub: Any) -> None:
     p.add_argument("--seconds", type=float, help="simulated seconds per evaluation (default: 5)")
     p.add_argument("--shape", type=int, nargs=3, metavar=("NX", "NY", "NZ"),
                    help="robot grid (default: 6 6 6)")  # fmt: skip
-    ss = p.add_subparsers(dest="qd_command", required=False)
-    r = ss.add_parser("run", help="run (the default)")
-    r.set_defaults(qd_command="run")
+    ss = subcommands(p, "qd_command", default="run")
     r = ss.add_parser("export", help="write a QD run's elites as design files (.json, .vxa)")
     r.add_argument("run", help="a softgym qd run folder")
     r.add_argument("--out", dest="export_out", help="folder (default: RUN/elites)")
@@ -478,9 +477,7 @@ def add_poet_parser(sub: Any) -> None:
     p.add_argument("--seconds", type=float, help="simulated seconds per evaluation (default: 3)")
     p.add_argument("--shape", type=int, nargs=3, metavar=("NX", "NY", "NZ"),
                    help="robot grid (default: 4 4 4)")  # fmt: skip
-    ss = p.add_subparsers(dest="poet_command", required=False)
-    r = ss.add_parser("run", help="run (the default)")
-    r.set_defaults(poet_command="run")
+    ss = subcommands(p, "poet_command", default="run")
     r = ss.add_parser("compare", help="ANNECS over iterations of POET runs and controls, one figure")
     r.add_argument("runs", nargs="+", metavar="RUN", help="softgym poet run folders")
     r.add_argument("--out", dest="compare_out", default="runs/poet_annecs.png", help="figure file")

@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from softgym_cli.flags import subcommands
 from softgym_cli.runs import quiet_dask
 
 __all__ = ["add_study_parser"]
@@ -18,15 +19,7 @@ __all__ = ["add_study_parser"]
 def _cmd_study(args: argparse.Namespace) -> int:
     if getattr(args, "study_command", None) == "report":
         return _cmd_study_report(args)
-    from evolvers.study import (
-        get_study,
-        plan,
-        run_order,
-        run_status,
-        run_study,
-        settings_difference,
-        time_to_go,
-    )
+    from evolvers.study import runs as study_runs
     from softgym.exceptions import SoftGymError
 
     overrides = {}
@@ -38,8 +31,8 @@ def _cmd_study(args: argparse.Namespace) -> int:
         overrides["shape"] = tuple(args.shape)
     names = [n for item in (args.scenarios or []) for n in item.split(",") if n]
     try:
-        study = get_study(args.study)
-        specs = plan(
+        study = study_runs.get_study(args.study)
+        specs = study_runs.plan(
             args.out, study, scenarios=names or None, seeds=args.seeds,
             generations=args.generations, first_seed=args.first_seed, n_threads=args.threads,
             **overrides,
@@ -48,15 +41,15 @@ def _cmd_study(args: argparse.Namespace) -> int:
         print(f"softgym study: {exc}", file=sys.stderr)
         return 2
     if args.plan:
-        ordered = run_order(specs)  # the order the runs start in
-        other = {id(s): d for s in ordered if (d := settings_difference(s)) is not None}
+        ordered = study_runs.run_order(specs)  # the order the runs start in
+        other = {id(s): d for s in ordered if (d := study_runs.settings_difference(s)) is not None}
         ok = [s for s in ordered if id(s) not in other]  # the study refuses the others
-        togo = dict(zip(map(id, ok), time_to_go(ok)))
+        togo = dict(zip(map(id, ok), study_runs.time_to_go(ok)))
         for s in ordered:
             if id(s) in other:
                 status, left_text = "other", f"run with other settings: {other[id(s)]}"
             else:
-                status = run_status(s.out, s.generations)
+                status = study_runs.run_status(s.out, s.generations)
                 left, source = togo[id(s)]
                 left_text = "" if status == "complete" else f"~{left / 3600:5.2f} CPU h to go ({source})"
             print(f"{s.scenario:24s} seed {s.seed:<4d} {s.generations:4d} generations  "
@@ -84,7 +77,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
         quiet_dask(args.verbose)
     t0 = time.perf_counter()
     try:
-        results = run_study(specs, workers=args.workers, scheduler=args.dask,
+        results = study_runs.run_study(specs, workers=args.workers, scheduler=args.dask,
                             study=study.name, on_result=report)  # fmt: skip
     except SoftGymError as exc:
         print(f"softgym study: {exc}", file=sys.stderr)
@@ -151,9 +144,7 @@ def add_study_parser(sub: Any) -> None:
     p.add_argument(
         "--plan", action="store_true", help="list the runs and their status; run nothing"
     )
-    ss = p.add_subparsers(dest="study_command", required=False)
-    r = ss.add_parser("run", help="run the study (the default)")
-    r.set_defaults(study_command="run")
+    ss = subcommands(p, "study_command", default="run", default_help="run the study (the default)")
     r = ss.add_parser("report", help="write README.md and figures from a study's run folders")
     r.add_argument("runs", help="the study's root folder (softgym study --out)")
     r.add_argument("--out", dest="report_out", default="docs/study",

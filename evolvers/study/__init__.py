@@ -13,47 +13,9 @@ never import it:
   :mod:`~evolvers.study.report` (``README.md``, ``claims.json``).
 """
 
-from evolvers.study.claims import Claim, claims
-from evolvers.study.data import RunData, load_runs
+from evolvers.study.claims import claims
+from evolvers.study.data import load_runs
 from evolvers.study.report import write_report
-from evolvers.study.runs import (
-    SEED_REPORT,
-    STUDIES,
-    STUDY_SCHEMA,
-    RunSpec,
-    Scenario,
-    Study,
-    get_study,
-    plan,
-    run_one,
-    run_order,
-    run_status,
-    run_study,
-    settings_difference,
-    time_to_go,
-)
-from evolvers.study.stats import a12, permutation_pvalue
+from evolvers.study.runs import Study, get_study, plan, run_status, run_study
 
-__all__ = [
-    "SEED_REPORT",
-    "STUDIES",
-    "STUDY_SCHEMA",
-    "Claim",
-    "RunData",
-    "RunSpec",
-    "Scenario",
-    "Study",
-    "a12",
-    "claims",
-    "get_study",
-    "load_runs",
-    "permutation_pvalue",
-    "plan",
-    "run_one",
-    "run_order",
-    "run_status",
-    "run_study",
-    "settings_difference",
-    "time_to_go",
-    "write_report",
-]
+__all__ = ["Study", "claims", "get_study", "load_runs", "plan", "run_status", "run_study", "write_report"]

@@ -10,11 +10,9 @@ from evolver_helpers import tiny
 from evolvers.evaluation import EvalStats
 from evolvers.genome import Individual
 from evolvers.recorder import add_run_note, read_run_notes, study_columns
-from evolvers.study import (
+from evolvers.study.data import load_runs
+from evolvers.study.runs import (
     SEED_REPORT,
-    a12,
-    load_runs,
-    permutation_pvalue,
     plan,
     run_order,
     run_status,
@@ -22,6 +20,7 @@ from evolvers.study import (
     settings_difference,
     time_to_go,
 )
+from evolvers.study.stats import a12, permutation_pvalue
 from softgym.exceptions import InvalidParameterError
 from softgym.metrics import obstacle_footprint
 from softgym_cli import main
@@ -245,7 +244,7 @@ def _fake_run(scenario, seed, voxels, target, best=1.0, repeats=0):
     ``best + g``; each generation >= 1 has 10 new robots of which ``repeats`` were seen before."""
     from pathlib import Path
 
-    from evolvers.study import RunData
+    from evolvers.study.data import RunData
 
     rows = [{"generation": g, "top_n_voxels": v, "norm_final_dist_best": best + g,
              "new_individuals": 10, "repeated_phenotypes": repeats}
@@ -259,7 +258,7 @@ def _fake_run(scenario, seed, voxels, target, best=1.0, repeats=0):
 def test_fixed_generation_claim_counts_unfinished_runs_past_it():
     # T2-voxels reads T1 at T2's last generation (3 here): T1 seeds that passed it count,
     # complete or not; a seed short of it is left out and named
-    from evolvers.study import claims
+    from evolvers.study.claims import claims
 
     t2 = [_fake_run("materials-t2", s, [200, 150, 100, 50 + s], 3) for s in range(4)]
     t1 = [
@@ -305,7 +304,7 @@ def test_t1_final_names_the_flying_winners():
 def test_novelty_claims_compare_with_the_reports_baselines():
     # novelty-fitness: the report compares novelty with "the other two evolution techniques"
     # (materials and controller evolution); basic evolution with the same generations is context
-    from evolvers.study import claims
+    from evolvers.study.claims import claims
 
     def runs(name, best, repeats=0, n=5):
         return [_fake_run(name, k, [100] * 4, 3, best=best + k, repeats=repeats) for k in range(n)]
@@ -343,7 +342,7 @@ def test_novelty_claims_compare_with_the_reports_baselines():
 def test_obstacle_claims_wait_for_seeds_that_have_not_decided():
     # a seed that has neither crossed nor run 80 generations says nothing yet about crossing
     # "in 80 generations": it is left out (named), not counted as a failure
-    from evolvers.study import claims
+    from evolvers.study.claims import claims
 
     def run(seed, generations, crossed_at=None):
         r = _fake_run("obstacles", seed, [100] * (generations + 1), 120)
