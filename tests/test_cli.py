@@ -112,3 +112,24 @@ def test_dask_without_the_extra_names_it(tmp_path, capsys, monkeypatch):
     args = ["evolve", "--dask", "local", "--generations", "0", "--out", str(tmp_path / "d")]
     assert main([*args, *TINY]) == 2
     assert 'pip install "softgym[distributed]"' in capsys.readouterr().err
+
+
+def test_a_task_string_is_read_once_per_command(tmp_path, monkeypatch, capsys):
+    import importlib
+
+    import evolvers.experiments
+    from softgym.tasks import get_task
+
+    strings = []
+
+    def spy(spec, **kw):
+        if isinstance(spec, str):
+            strings.append(spec)
+        return get_task(spec, **kw)
+
+    evaluate_module = importlib.import_module("softgym.evaluate")  # not the function
+    for module in (evolvers.experiments, evaluate_module):
+        monkeypatch.setattr(module, "get_task", spy)
+    args = ["evolve", "--task", "stairs", "--generations", "1", "--no-figures", "--no-gif"]
+    assert main([*args, "--out", str(tmp_path / "r"), *TINY]) == 0
+    assert strings == ["stairs"]  # the experiment holds the Task from there to the kernel

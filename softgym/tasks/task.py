@@ -31,7 +31,7 @@ accepted wherever a task name is: ``softgym.evaluate(d, task=Terrain.stairs())``
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -49,18 +49,14 @@ if TYPE_CHECKING:  # annotations only: softgym.engine's __init__ loads compiled 
 
 __all__ = [
     "ALIASES",
-    "LAYOUTS",
     "REWARDS",
     "TASKS",
     "Task",
     "TaskLike",
-    "flat_layout",
     "get_task",
     "measure_params",
     "register_task",
-    "stairs_layout",
     "task_names",
-    "wall_layout",
 ]
 
 #: Schema tag of :meth:`Task.to_dict`.
@@ -70,42 +66,6 @@ SCHEMA = "softgym.task"
 #: the final position and the suite's measures (:data:`softgym.metrics.TASK_MEASURES`).
 REWARDS: tuple[str, ...] = ("norm_final_dist", "max_xy_dist", *TASK_MEASURES)
 
-
-def _around(shape: Sequence[int]) -> tuple[float, tuple[float, float]]:
-    """Interior side and centre of an obstacle ring around a robot grid of ``shape`` at the origin.
-
-    The seed's fence has a 10-voxel interior around its 6x6 workspace (a
-    2-voxel gap on every side); a wider grid keeps the 2-voxel gap.
-    """
-    nx, ny = int(shape[0]), int(shape[1])
-    return max(10.0, max(nx, ny) + 4.0), (nx / 2.0, ny / 2.0)
-
-
-def flat_layout(shape: Sequence[int]) -> Terrain:
-    """The floor alone (``shape`` is unused)."""
-    return Terrain.flat()
-
-
-def wall_layout(shape: Sequence[int]) -> Terrain:
-    """The seed's fence (1 voxel high and thick) centred on a robot grid of ``shape``."""
-    inner, center = _around(shape)
-    return Terrain.fence(inner=inner, center=center)
-
-
-def stairs_layout(shape: Sequence[int]) -> Terrain:
-    """Three rings, each 2 voxels wide and 1 voxel higher than the one inside it, around the grid."""
-    inner, center = _around(shape)
-    return Terrain.stairs(inner=inner, center=center)
-
-
-#: Terrains placed around each robot's grid (its corner at the origin): name -> builder(shape,
-#: **options) (the suite's kinds take their arguments, :mod:`softgym.tasks.suite`).
-LAYOUTS: dict[str, Callable[..., Terrain]] = {
-    "flat": flat_layout,
-    "wall": wall_layout,
-    "stairs": stairs_layout,
-    **{name: kind.layout for name, kind in KINDS.items()},
-}
 
 #: Other names users know a task by (the seed's reports call the wall a fence).
 ALIASES: dict[str, str] = {"fence": "wall"}
@@ -170,10 +130,10 @@ class Task:
         terrain = self.terrain
         if isinstance(terrain, str):
             terrain = ALIASES.get(terrain, terrain)
-            if terrain not in LAYOUTS:
+            if terrain not in KINDS:
                 raise InvalidParameterError(
                     f"unknown terrain layout {self.terrain!r}; expected one of "
-                    f"{sorted(LAYOUTS)}, a Terrain, or a registered task name through get_task()"
+                    f"{sorted(KINDS)}, a Terrain, or a registered task name through get_task()"
                 )
         elif not isinstance(terrain, Terrain):
             raise InvalidParameterError(
@@ -185,7 +145,7 @@ class Task:
         if not isinstance(self.options, Mapping):
             raise InvalidParameterError(f"options must be a dict, got {type(self.options).__name__}")
         kind = KINDS.get(terrain) if isinstance(terrain, str) else None
-        if kind is None:
+        if kind is None or not kind.options:
             if self.options:
                 raise InvalidParameterError(
                     f"task {self.name!r} takes no options, got {sorted(self.options)}"
@@ -236,7 +196,7 @@ class Task:
         """The terrain of a robot whose grid of ``shape`` has its corner at the origin."""
         if isinstance(self.terrain, Terrain):
             return self.terrain
-        return LAYOUTS[self.terrain](shape, **self.options)
+        return KINDS[self.terrain].layout(shape, **self.options)
 
     def config(self, base: SimConfig | None = None) -> SimConfig:
         """The engine settings: ``base`` (default the seed's) with ``sim`` and ``trace_interval``."""
@@ -327,7 +287,7 @@ def measure_params(terrains: Sequence[Terrain]) -> dict[str, np.ndarray]:
 
 
 #: The named tasks: one name each (``"fence"`` is read as ``"wall"``, see :data:`ALIASES`).
-TASKS: dict[str, Task] = {name: Task(terrain=name) for name in LAYOUTS}
+TASKS: dict[str, Task] = {name: Task(terrain=name) for name in KINDS}
 
 #: What :func:`get_task` accepts: a name, a JSON file, a Terrain, a Task or its dict.
 TaskLike = str | os.PathLike | Terrain | Task | Mapping[str, Any]
