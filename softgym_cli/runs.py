@@ -37,7 +37,7 @@ __all__ = [
 ]
 
 #: What builds a run: ``make(args, cfg) -> (run class, experiment, keywords)``.
-Maker = Callable[[argparse.Namespace, "dict[str, Any] | None"], "tuple[type, Experiment, dict]"]
+Maker = Callable[[argparse.Namespace, dict[str, Any] | None], tuple[type, Experiment, dict[str, Any]]]
 
 _DASK_HELP = ('evaluate on Dask: a LocalCluster or an existing scheduler '
               '(pip install ".[distributed]"; default: local simulations, no Dask)')  # fmt: skip
