@@ -147,6 +147,7 @@ def add_study_parser(sub: Any) -> None:
     ss = subcommands(p, "study_command", default="run", default_help="run the study (the default)")
     r = ss.add_parser("report", help="write README.md and figures from a study's run folders")
     r.add_argument("runs", help="the study's root folder (softgym study --out)")
-    r.add_argument("--out", dest="report_out", default="docs/study",
-                   help="where README.md and figures/ go")  # fmt: skip
+    r.add_argument("--out", dest="report_out",
+                   help="where README.md and figures/ go (default: RUNS/report; the "
+                   "committed report is --out docs/study)")  # fmt: skip
     p.set_defaults(func=_cmd_study)

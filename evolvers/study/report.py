@@ -67,7 +67,7 @@ def _settings(rs: Sequence[RunData]) -> str:
 
 def write_report(
     root: str | os.PathLike[str],
-    out: str | os.PathLike[str] = "docs/study",
+    out: str | os.PathLike[str] | None = None,
     command: str | None = None,
 ) -> Path:
     """Write ``out/README.md`` and ``out/figures/*.png`` from the run folders under ``root``.
@@ -76,8 +76,9 @@ def write_report(
     ----------
     root : path
         A study's root folder (or any folder holding run folders).
-    out : path
-        Where the README and its figures go.
+    out : path, optional
+        Where the README and its figures go (default ``root/report``: a
+        report never lands on the committed ``docs/study`` unless asked).
     command : str, optional
         The command that made the runs (quoted in the README).
 
@@ -87,7 +88,7 @@ def write_report(
         The README.
     """
     runs = load_runs(root)
-    out = Path(out)
+    out = Path(root) / "report" if out is None else Path(out)
     figs = out / "figures"
     figs.mkdir(parents=True, exist_ok=True)
     rows = claims(runs)

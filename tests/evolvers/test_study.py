@@ -63,8 +63,8 @@ def test_study_runs_resumes_skips_and_reports(tmp_path, capsys):
     # a note in a run folder (e.g. left by a repair) is quoted by the report
     add_run_note(root / "controller-pareto" / "seed-1", "repaired after a bad resume", generation=1)
     assert read_run_notes(root / "controller-pareto" / "seed-1")[0]["generation"] == 1
-    out = tmp_path / "report"
-    assert main(["study", "report", str(root), "--out", str(out)]) == 0
+    out = root / "report"  # by default the report goes beside the runs, not over docs/study
+    assert main(["study", "report", str(root)]) == 0
     text = (out / "README.md").read_text()
     assert "controller-pareto seed 1 (" in text and "repaired after a bad resume" in text
     claims = json.loads((out / "claims.json").read_text())
