@@ -166,11 +166,23 @@ def _cmd_view(args: argparse.Namespace) -> int:
         from evolvers.recorder import read_run_config
         from softgym.design import RobotDesign
 
-        exp = Experiment.from_dict(read_run_config(src)["experiment"])
-        design = RobotDesign.load(src / "best_design.json")
+        cfg = read_run_config(src)
+        exp = Experiment.from_dict(cfg["experiment"])
         task = args.task or exp.make_task()
         seconds = exp.seconds if seconds is None else seconds
         name = f"{src.name}: best robot ({exp.name})"
+        if "poet" in cfg:  # POET: the best robot of its pairs, on its own terrain
+            from softgym.io import read_json
+            from softgym.tasks.terrain_genome import TerrainGenome
+
+            pair = max(read_json(src / "pairs.json")["pairs"], key=lambda p: (p["score"], -p["id"]))
+            design = RobotDesign.from_dict(pair["design"])
+            if args.task is None:
+                terrain = TerrainGenome.from_dict(pair["terrain"]).terrain(exp.shape)
+                task = task.replace(terrain=terrain)
+            name = f"{src.name}: best robot (POET pair {pair['id']}, {pair['describe']})"
+        else:  # the other drivers (native, DEAP, pymoo, QD) write best_design.json
+            design = RobotDesign.load(src / "best_design.json")
         out = Path(args.out) if args.out else src / "view.html"
     else:
         design = _load_design(src)
@@ -250,7 +262,8 @@ def add_tool_parsers(sub: Any) -> None:
         "view", help="write an interactive 3D viewer (self-contained HTML) of a robot's rollout"
     )
     p.add_argument("source", metavar="RUN_OR_DESIGN",
-                   help="a run folder (its best robot, in its task) or a design .json / .vxa")  # fmt: skip
+                   help="a run folder (its best robot, in its task; POET: on its terrain) "
+                   "or a design .json / .vxa")  # fmt: skip
     p.add_argument("--out",
                    help="HTML file (default: RUN/view.html, or the design's name with .html)")  # fmt: skip
     p.add_argument("--seconds", type=float, help="simulated seconds (default: the run's, or 5)")
