@@ -127,9 +127,15 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     if metric is None:
         first = configs[next(iter(configs))]["experiment"]["objectives"][0]["name"]
         metric = first if first != "age" else "norm_final_dist"
-    column = f"{metric}_{args.stat}"
+    column, top = f"{metric}_{args.stat}", f"top_{metric}"
     for d, rows in logs.items():
-        if not rows or column not in rows[0]:
+        if rows and column not in rows[0] and args.stat == "best" and top in rows[0]:
+            # e.g. an obstacle run (fitness max_xy_dist) beside flat runs: its log holds the
+            # fittest robot's NormFinalDist, which stands in for the best
+            logs[d] = [{**r, column: r[top]} for r in rows]
+            print(f"softgym compare: {d} logs no {column}; its fittest robot's {metric} "
+                  f"({top}) stands in", file=sys.stderr)  # fmt: skip
+        elif not rows or column not in rows[0]:
             have = sorted({k.rsplit("_", 1)[0] for k in (rows[0] if rows else {})
                            if k.endswith("_best")})  # fmt: skip
             print(f"softgym compare: {d} did not record {metric!r} (it has: {', '.join(have) or 'no generation yet'}); "
@@ -252,7 +258,9 @@ def add_tool_parsers(sub: Any) -> None:
         "median + interquartile band (Fig. 4)",
     )
     p.add_argument("run_dirs", nargs="+", metavar="RUN", help="run folders (any mix)")
-    p.add_argument("--metric", help="metric to compare (default: the first run's fitness)")
+    p.add_argument("--metric", help="metric to compare (default: the first run's fitness; with "
+                   "--stat best, a run that logs only its fittest robot's value, top_METRIC, "
+                   "compares that)")
     p.add_argument("--stat", choices=["best", "median", "mean", "worst"], default="best",
                    help="per-generation statistic of each run")  # fmt: skip
     p.add_argument("--out", default="runs/compare.png", help="figure file")

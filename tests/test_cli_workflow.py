@@ -74,7 +74,11 @@ def test_compare_groups_seeds_and_explains_a_missing_metric(runs, tmp_path, caps
     assert main(["compare", str(runs / "a0"), str(runs / "a1"), "--out", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "2 run(s)" in printed and out.stat().st_size > 5000
-    assert main(["compare", str(runs / "a0"), str(runs / "o"), "--out", str(out)]) == 2
+    # a flat run and an obstacle run on one axis: the obstacle run's fittest robot's distance
+    assert main(["compare", str(runs / "a0"), str(runs / "o"), "--out", str(out)]) == 0
+    assert "(top_norm_final_dist) stands in" in capsys.readouterr().err
+    assert main(["compare", str(runs / "a0"), str(runs / "o"), "--stat", "median",
+                 "--out", str(out)]) == 2  # fmt: skip
     err = capsys.readouterr().err
     assert "did not record 'norm_final_dist'" in err and "--metric" in err
     # a mix of experiments compares on a metric both record
