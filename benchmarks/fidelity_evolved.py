@@ -12,7 +12,7 @@ A against the oracle's draws B, and the oracle's draws A against its draws B
 Chaotic bodies (the flying winners of materials treatment 1 change by up to 7x
 between draws in either engine) are compared as pooled distributions over
 designs and draws: median and quartiles per engine, A12 and a two-sided
-permutation test (``evolvers.study_report``).
+permutation test (``evolvers.study.stats``).
 
     python benchmarks/fidelity_evolved.py            # every design (minutes to an hour: light
                                                      # evolved materials shrink dt up to 30x)
@@ -41,7 +41,7 @@ sys.path.insert(0, str(HERE))
 import fidelity_cases as fc  # noqa: E402
 from fidelity_seed import METRIC, SOFTGYM_METRIC, agreement, fence_terrain  # noqa: E402
 
-from evolvers.study_report import a12, permutation_pvalue  # noqa: E402
+from evolvers.study.stats import a12, permutation_pvalue  # noqa: E402
 from softgym.design.robot import RobotDesign  # noqa: E402
 from softgym.engine import SimConfig, Simulation  # noqa: E402
 from softgym.metrics import dilute, walk_metrics  # noqa: E402

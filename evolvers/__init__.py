@@ -5,9 +5,10 @@
 * :mod:`evolvers.selection`: the seed's Pareto (with age), NSGA-II, fitness tournament, AMSS novelty.
 * :class:`Evaluator` (:mod:`evolvers.evaluation`): batched, phenotype-cached evaluation.
 * :data:`EXPERIMENTS` (:mod:`evolvers.experiments`): the seed's scenarios by name.
-* Drivers with exact resume, all writing their run folder through one
-  :class:`RunRecorder` (config, log, hall of fame, atomic checkpoints, figures):
-  :class:`EvolutionRun` (the seed's loop), :class:`~evolvers.deap_runner.DeapRun`
+* Drivers with exact resume, each a :class:`~evolvers.driver.Driver` (the one run
+  skeleton: construction, generation loop, progress, Ctrl-C, checkpoint, resume) writing
+  its run folder through one :class:`RunRecorder` (config, log, hall of fame, atomic
+  checkpoints, figures): :class:`EvolutionRun` (the seed's loop), :class:`~evolvers.deap_runner.DeapRun`
   (the same loop on a DEAP toolbox), :class:`~evolvers.pymoo_runner.PymooRun`
   (any pymoo algorithm through ask and tell: NSGA-II, NSGA-III, SMS-EMOA, GA...);
   Dask evaluation in :mod:`evolvers.distributed` (``pip install "softgym[distributed]"``).
@@ -17,6 +18,7 @@
 The DEAP, pymoo and Dask modules are imported on demand (``from evolvers.deap_runner import DeapRun``).
 """
 
+from evolvers.driver import Driver, IdCounter
 from evolvers.evaluation import Evaluator, PhenotypeCache
 from evolvers.experiments import EXPERIMENTS, Experiment, get_experiment, list_experiments
 from evolvers.genome import Individual
@@ -33,9 +35,11 @@ from evolvers.selection import (
 
 __all__ = [
     "EXPERIMENTS",
+    "Driver",
     "EvolutionRun",
     "Evaluator",
     "Experiment",
+    "IdCounter",
     "Individual",
     "Objective",
     "PhenotypeCache",

@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 
+from evolvers.driver import IdCounter
 from evolvers.evaluation import BatchFn, EvalStats, Evaluator
 from evolvers.experiments import Experiment
 from evolvers.genome import Individual
@@ -139,8 +140,7 @@ def make_toolbox(
     _, Softbot = softbot_classes(experiment)
     exp = experiment
     if next_id is None:
-        counter = iter(range(2**62))
-        next_id = partial(next, counter)
+        next_id = IdCounter()
     evaluator = evaluator or Evaluator(exp, batch_fn=batch_fn, n_threads=n_threads)
 
     def individual() -> Individual:

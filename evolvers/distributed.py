@@ -114,12 +114,17 @@ class DaskBatchFn:
     def __call__(self, designs: list[dict[str, Any]], task: Task) -> dict[str, Any]:
         """``(design dicts, task) -> metrics``, like :func:`evolvers.evaluation.local_batch_fn`."""
         slices = split_batches(len(designs), self.n_batches or self._default_batches())
+        return _merge(self.jobs([(designs[a:b], task) for a, b in slices]))
+
+    def jobs(self, jobs: list[tuple[list[dict[str, Any]], Task]]) -> list[dict[str, Any]]:
+        """``[(design dicts, task), ...] -> [metrics, ...]``: one Dask task per batch, all at
+        once (POET's terrains; :class:`~evolvers.poet.PoetRun` uses it when given this
+        ``batch_fn``).
+        """
         # one engine thread per batch: workers already run batches in parallel
-        task_dict = {**task.to_dict(), "n_threads": 1}
-        payloads = [{"designs": designs[a:b], "task": task_dict} for a, b in slices]
+        payloads = [{"designs": d, "task": {**t.to_dict(), "n_threads": 1}} for d, t in jobs]
         futures = self.client.map(self.payload_fn, payloads, pure=False, retries=self.retries)
-        parts = self.client.gather(futures)
-        return _merge(parts)
+        return list(self.client.gather(futures))
 
 
 @contextlib.contextmanager

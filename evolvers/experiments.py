@@ -32,7 +32,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
-from evolvers.selection import Objective
+from evolvers.selection import SELECTORS, Objective
 from softgym.design import MATERIAL_TREE_4, MATERIAL_TREE_8, CompositionRules
 from softgym.exceptions import InvalidParameterError
 from softgym.metrics import WALK_METRICS
@@ -42,7 +42,7 @@ from softgym.terrain import Terrain
 __all__ = ["EXPERIMENTS", "SELECTIONS", "Experiment", "get_experiment", "list_experiments"]
 
 #: Selection schemes an experiment may name.
-SELECTIONS: tuple[str, ...] = ("pareto", "tournament", "novelty", "novelty-archive", "nsga2")
+SELECTIONS: tuple[str, ...] = tuple(SELECTORS)
 
 
 @dataclass(frozen=True)
@@ -65,11 +65,14 @@ class Experiment:
         CPPN outputs: the 4-output tree, or the 8-output tree of materials evolution.
     rules : CompositionRules
         Validity of a body (enforced by generation and mutation; pymoo's G).
-    task : str or Terrain
+    task : Task, str or Terrain
         The world: a task name of :mod:`softgym.tasks` (``"flat"``, ``"wall"``,
-        ``"stairs"``; ``"fence"`` is read as ``"wall"``) or a custom
-        :class:`~softgym.terrain.Terrain` (a terrain JSON file's path is read
-        into one, so the run folder's config.json holds the whole world).
+        ``"stairs"``, ``"gap:width=3"``; ``"fence"`` is read as ``"wall"``), a
+        custom :class:`~softgym.terrain.Terrain` (a terrain JSON file's path is
+        read into one, so the run folder's config.json holds the whole world) or
+        a Task. Read once, here: the experiment holds it as a
+        :class:`~softgym.tasks.Task` of the world alone (terrain and arguments);
+        :meth:`make_task` adds the duration and sampling.
     seconds : float
         Simulated seconds per evaluation (5).
     trace_interval : float
@@ -102,7 +105,7 @@ class Experiment:
     evolve_materials: bool = False
     cppn_outputs: tuple[str, ...] = MATERIAL_TREE_4
     rules: CompositionRules = field(default_factory=CompositionRules.seed)
-    task: str | Terrain = "flat"
+    task: Task | str | Terrain = "flat"
     seconds: float = 5.0
     trace_interval: float = 0.1
     pop_size: int = 15
@@ -123,8 +126,10 @@ class Experiment:
         if not self.objectives:
             raise InvalidParameterError("an experiment needs at least one objective")
         object.__setattr__(self, "shape", tuple(int(s) for s in self.shape))
-        task = get_task(self.task)  # a name, alias, Terrain, or JSON file; raises if unknown
-        object.__setattr__(self, "task", task.spec)
+        task = get_task(self.task)  # a name, alias, Terrain, JSON file or Task; raises if unknown
+        # the world alone (what config.json records, Task.spec): the experiment sets the rest
+        task = Task(terrain=task.terrain, options=dict(task.options))
+        object.__setattr__(self, "task", task)
         if task.reward not in WALK_METRICS:
             # a suite task that is not about walking: its score replaces the walking distances
             objectives, seen = [], set()
@@ -148,9 +153,8 @@ class Experiment:
         return tuple(dict.fromkeys(names))
 
     def make_task(self, n_threads: int | None = None) -> Task:
-        """The :class:`softgym.tasks.Task` evaluations run (the named task with this duration and sampling)."""
-        return get_task(
-            self.task,
+        """The :class:`softgym.tasks.Task` evaluations run (the task with this duration and sampling)."""
+        return self.task.replace(
             seconds=self.seconds,
             trace_interval=self.trace_interval,
             sim=dict(self.sim),
@@ -169,8 +173,8 @@ class Experiment:
             v = getattr(self, f.name)
             if f.name == "objectives":
                 v = [o.to_dict() for o in v]
-            elif isinstance(v, Terrain):
-                v = v.to_dict()
+            elif f.name == "task":  # as get_task reads it: "name", "name:arg=value", a terrain
+                v = v.spec.to_dict() if isinstance(v.spec, Terrain) else v.spec
             elif f.name == "rules":
                 v = v.to_dict()
             elif isinstance(v, tuple):

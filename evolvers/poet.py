@@ -29,7 +29,7 @@ One :class:`PoetRun` iteration:
    varies them, ``n_random`` random newcomers join; elitist fitness
    tournament back to ``pop_size``). The new robots of all pairs are
    evaluated together: one batched Simulation per terrain, or all terrains at
-   once on Dask (:class:`DaskJobsFn`).
+   once on Dask (:meth:`evolvers.distributed.DaskBatchFn.jobs`).
 3. **Transfers** (every ``transfer_every`` iterations, T): the best robot of
    every active pair is scored on every active terrain; a pair adopts another
    pair's robot that beats its own best there (replacing its worst robot).
@@ -77,7 +77,6 @@ from __future__ import annotations
 import hashlib
 import logging
 import math
-import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, fields
 from pathlib import Path
@@ -85,6 +84,7 @@ from typing import Any
 
 import numpy as np
 
+from evolvers.driver import Checkpoint, Driver, IdCounter
 from evolvers.evaluation import (
     STORED_METRICS,
     BatchFn,
@@ -93,23 +93,20 @@ from evolvers.evaluation import (
     local_batch_fn,
     worst_objectives,
 )
-from evolvers.experiments import Experiment, get_experiment, smoke_sizes
+from evolvers.experiments import Experiment, get_experiment
 from evolvers.genome import Individual
 from evolvers.operators import make_children
-from evolvers.pymoo_runner import IdCounter
-from evolvers.recorder import RunRecorder
 from evolvers.selection import sel_fitness_tournament
 from softgym.design import CONTROLLER_BOUNDS, Controller
-from softgym.evaluate import evaluate_payload
-from softgym.exceptions import CheckpointError, InvalidParameterError
+from softgym.exceptions import InvalidParameterError
 from softgym.io import rng_from_state, rng_state
+from softgym.render.figures import pyplot
 from softgym.tasks import Task
 from softgym.tasks.terrain_genome import TerrainGenome
 
 __all__ = [
     "GENERATORS",
     "POET_REWARDS",
-    "DaskJobsFn",
     "JobsFn",
     "Pair",
     "PoetConfig",
@@ -372,27 +369,6 @@ def local_jobs_fn(batch_fn: BatchFn | None = None) -> JobsFn:
     return jobs_fn
 
 
-class DaskJobsFn:
-    """Evaluate the batches of several terrains at once on a Dask client (one task per terrain).
-
-    Parameters
-    ----------
-    client : distributed.Client
-    retries : int
-        Times a failed batch is resubmitted.
-    """
-
-    def __init__(self, client: Any, retries: int = 3) -> None:
-        self.client = client
-        self.retries = int(retries)
-
-    def __call__(self, jobs: list[tuple[list[dict[str, Any]], Task]]) -> list[dict[str, Any]]:
-        """``[(design dicts, task), ...] -> [metrics, ...]``, like :func:`local_jobs_fn`."""
-        payloads = [{"designs": d, "task": {**t.to_dict(), "n_threads": 1}} for d, t in jobs]
-        futures = self.client.map(evaluate_payload, payloads, pure=False, retries=self.retries)
-        return list(self.client.gather(futures))
-
-
 # ---------------------------------------------------------------------- pairs
 @dataclass
 class Pair:
@@ -491,7 +467,7 @@ def _score(objectives: Mapping[str, float], metric: str, cap: float | None = Non
 
 
 # ---------------------------------------------------------------------- the run
-class PoetRun:
+class PoetRun(Driver):
     """A resumable POET run (see the module docstring).
 
     ``iterations`` counts the iterations after iteration 0 (the first pair's
@@ -511,9 +487,10 @@ class PoetRun:
     config : PoetConfig, optional
     batch_fn : callable, optional
         ``(design dicts, task) -> metrics`` of one terrain (default: one local
-        Simulation); tests pass a fake.
+        Simulation); tests pass a fake. A :class:`~evolvers.distributed.DaskBatchFn`
+        evaluates all terrains at once (its ``jobs``).
     jobs_fn : callable, optional
-        Several terrains' batches at once (:class:`DaskJobsFn`); overrides ``batch_fn``.
+        Several terrains' batches at once; overrides ``batch_fn``.
     n_threads : int, optional
         OpenMP threads of local simulations.
     on_iteration : callable, optional
@@ -526,6 +503,8 @@ class PoetRun:
     """
 
     backend = "poet"
+    unit = "iteration"
+    recorder_figures = False  # POET draws its own (write_figures)
 
     def __init__(
         self,
@@ -541,51 +520,53 @@ class PoetRun:
         figures: bool = True,
         progress: bool = True,
     ) -> None:
-        experiment = poet_experiment() if experiment is None else experiment
-        experiment, iters = smoke_sizes(experiment, int(iterations))
-        if iters < 0:
-            raise InvalidParameterError(f"iterations must be >= 0, got {iters}")
-        self.experiment = experiment
-        self.out = Path(out)
-        self.seed = int(seed)
-        self.iterations = iters
         self.config = PoetConfig() if config is None else config
         self.metric = "max_xy_dist"
-        self.jobs_fn = jobs_fn or local_jobs_fn(batch_fn)
-        self.base_task = experiment.make_task(n_threads)
-        self.on_iteration = on_iteration
-        self.figures = figures
-        self.recorder = RunRecorder(
-            out, experiment, self.seed, self.backend, figures=False, gif=False,
-            extra_config={"poet": self.config.to_dict()}, progress=progress,
+        self.jobs_fn = jobs_fn or getattr(batch_fn, "jobs", None) or local_jobs_fn(batch_fn)
+        super().__init__(
+            poet_experiment() if experiment is None else experiment, out, seed, int(iterations),
+            None, n_threads, on_iteration, figures, False, progress,
+            extra_config={"poet": self.config.to_dict()},
         )  # fmt: skip
-        #: What :class:`~evolvers.recorder.RunInterrupted` tells the user to type.
-        self.resume_command = (
-            f"PoetRun(experiment, {str(self.out)!r}, seed={self.seed}).run(resume=True)"
-        )
-        self._fresh()
+        self.base_task = self.experiment.make_task(n_threads)
+
+    def _evaluator(self, batch_fn: BatchFn | None, n_threads: int | None, progress: bool) -> None:
+        """None: POET scores robots per terrain (:meth:`evaluate`, its own cache)."""
+        return None
 
     def _fresh(self) -> None:
+        super()._fresh()
         self.rng = np.random.default_rng(self.seed)
-        self.ids = IdCounter()
         self.pair_ids = IdCounter()
         self.pairs: list[Pair] = []
         self.cache = PhenotypeCache()
-        self.iteration = -1
         self.annecs = 0
         self.annecs_archive = 0
         self.n_simulated = 0
 
     # ------------------------------------------------------------------ views
     @property
-    def rows(self) -> list[dict[str, Any]]:
-        """The log rows so far (one per iteration)."""
-        return self.recorder.rows
+    def iteration(self) -> int:
+        """The last finished iteration (the driver's :attr:`generation`), -1 before the first."""
+        return self.generation
+
+    @iteration.setter
+    def iteration(self, value: int) -> None:
+        self.generation = value
 
     @property
-    def evaluations_total(self) -> int:
-        """Simulations run so far."""
-        return self.recorder.evaluations_total
+    def iterations(self) -> int:
+        """Iterations after iteration 0 (the driver's :attr:`generations`)."""
+        return self.generations
+
+    @property
+    def label(self) -> str:
+        """The progress bar's description."""
+        return f"poet [{self.config.generator}]"
+
+    def result(self) -> list[Pair]:
+        """Every pair, active and archived, in order of creation (what :meth:`run` returns)."""
+        return list(self.pairs)
 
     def active(self) -> list[Pair]:
         """Active pairs, oldest first."""
@@ -915,35 +896,11 @@ class PoetRun:
         return total, events
 
     # ------------------------------------------------------------------ the loop
-    def run(self, resume: bool = False) -> list[Pair]:
-        """Run (or continue from the last checkpoint) until ``iterations``.
+    def _step(self) -> EvalStats:
+        stats, self._events = self._iterate()
+        return stats
 
-        Returns
-        -------
-        list of Pair
-            Every pair, active and archived, in order of creation.
-        """
-        loaded = self.recorder.resume(self.iterations) if resume else None
-        if loaded is None:
-            self.recorder.start(self.iterations)
-            self._fresh()
-        else:
-            self._restore(*loaded)
-        desc = f"poet [{self.config.generator}]"
-        self.recorder.open_progress(self.iteration, self.iterations, desc)
-        try:
-            while self.iteration < self.iterations:
-                t0 = time.perf_counter()
-                stats, events = self._iterate()
-                self._end_iteration(stats, events, time.perf_counter() - t0)
-        except KeyboardInterrupt as exc:
-            raise self.recorder.interrupted(self.iteration, self.resume_command) from exc
-        finally:
-            self.recorder.close_progress()
-        self.finish()
-        return list(self.pairs)
-
-    def _end_iteration(self, stats: EvalStats, events: dict[str, Any], wall: float) -> None:
+    def _checkpoint_state(self) -> Checkpoint:
         active = self.active()
         columns = {
             "iteration": self.iteration,
@@ -962,7 +919,7 @@ class PoetRun:
                 }  # fmt: skip
                 for p in self.pairs
             ],
-            **events,
+            **self._events,
         }
         state = {
             "rng": rng_state(self.rng),
@@ -973,30 +930,20 @@ class PoetRun:
             "n_simulated": self.n_simulated,
             "pairs": [p.to_dict() for p in self.pairs],
         }
-        row = self.recorder.end_generation(
-            self.iteration, [p.best for p in active], stats, wall, state,
-            self.cache.to_arrays(), columns=columns,
-        )  # fmt: skip
-        if self.on_iteration is not None:
-            self.on_iteration(self, row)
+        return state, self.cache.to_arrays(), columns, [p.best for p in active]
 
     def _restore(self, state: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
-        where = self.recorder.checkpoint_dir
-        try:
-            self._fresh()
-            self.rng = rng_from_state(state["rng"])
-            self.ids.value = int(state["next_id"])
-            self.pair_ids.value = int(state["next_pair"])
-            self.annecs = int(state["annecs"])
-            self.annecs_archive = int(state["annecs_archive"])
-            self.n_simulated = int(state["n_simulated"])
-            self.pairs = [
-                Pair.from_dict(d, self.metric, self.config.score_cap) for d in state["pairs"]
-            ]
-            self.iteration = int(state["generation"])
-            self.cache = PhenotypeCache.from_arrays(arrays)
-        except (KeyError, TypeError, ValueError) as exc:
-            raise CheckpointError(f"{where}: checkpoint content is invalid ({exc!r})") from None
+        self.rng = rng_from_state(state["rng"])
+        self.ids.value = int(state["next_id"])
+        self.pair_ids.value = int(state["next_pair"])
+        self.annecs = int(state["annecs"])
+        self.annecs_archive = int(state["annecs_archive"])
+        self.n_simulated = int(state["n_simulated"])
+        self.pairs = [
+            Pair.from_dict(d, self.metric, self.config.score_cap) for d in state["pairs"]
+        ]
+        self.iteration = int(state["generation"])
+        self.cache = PhenotypeCache.from_arrays(arrays)
 
     # ------------------------------------------------------------------ outputs
     def finish(self) -> None:
@@ -1058,15 +1005,6 @@ def _matrix_log(robots: Sequence[Pair], terrains: Sequence[Pair], m: np.ndarray)
 
 
 # ---------------------------------------------------------------------- figures
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def plot_annecs(
     groups: Mapping[str, Sequence[Sequence[Mapping[str, Any]]]], path: str | Path
 ) -> Path:
@@ -1079,7 +1017,7 @@ def plot_annecs(
     path : path
         PNG file.
     """
-    plt = _plt()
+    plt = pyplot()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig, ax = plt.subplots(figsize=(6.4, 3.8))
@@ -1119,7 +1057,7 @@ def transfer_counts(rows: Sequence[Mapping[str, Any]]) -> tuple[list[int], np.nd
 
 def plot_transfers(rows: Sequence[Mapping[str, Any]], path: str | Path) -> Path:
     """Heatmap of the transfers of a run (rows: the robot's pair, columns: the adopting pair)."""
-    plt = _plt()
+    plt = pyplot()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     ids, counts = transfer_counts(rows)
@@ -1142,7 +1080,7 @@ def plot_gallery(run: PoetRun, hardest: Sequence[tuple[Pair, float]], path: str 
     from softgym.engine import Simulation
     from softgym.render.frames import VoxelRenderer, render_rollout
 
-    plt = _plt()
+    plt = pyplot()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     n = len(hardest)

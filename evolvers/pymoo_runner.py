@@ -30,7 +30,6 @@ past behaviours.
 from __future__ import annotations
 
 import math
-import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -43,11 +42,12 @@ from pymoo.core.mutation import Mutation
 from pymoo.core.problem import Problem
 from pymoo.core.sampling import Sampling
 
-from evolvers.evaluation import BatchFn, EvalStats, Evaluator, PhenotypeCache, pack_traces
-from evolvers.experiments import Experiment, smoke_sizes
+from evolvers.driver import Checkpoint, Driver, IdCounter
+from evolvers.evaluation import EvalStats, Evaluator, PhenotypeCache, pack_traces
+from evolvers.experiments import Experiment
 from evolvers.genome import Individual
 from evolvers.operators import mut_controller, mut_cppn, mut_materials, set_counterphase
-from evolvers.recorder import RecordedRun, RunRecorder, population_summary
+from evolvers.recorder import population_summary
 from evolvers.selection import Objective, minimised_matrix
 from softgym.design import CompositionRules, Controller
 from softgym.exceptions import CheckpointError, InvalidParameterError
@@ -56,7 +56,6 @@ from softgym.metrics import NoveltyArchive
 
 __all__ = [
     "ALGORITHMS",
-    "IdCounter",
     "PymooRun",
     "SoftbotCrossover",
     "SoftbotDuplicateElimination",
@@ -107,19 +106,6 @@ def constraint_values(grid: np.ndarray, rules: CompositionRules) -> np.ndarray:
         g.append(rules.min_bone_voxels - n_bone)
     g.append(0 if filled else 1)  # non-empty
     return np.asarray(g, dtype=np.float64)
-
-
-class IdCounter:
-    """A shared id counter: ``ids()`` gives the next individual id (part of the checkpointed state)."""
-
-    def __init__(self, start: int = 0) -> None:
-        self.value = int(start)
-
-    def __call__(self) -> int:
-        """The next id."""
-        v = self.value
-        self.value += 1
-        return v
 
 
 class SoftbotProblem(Problem):
@@ -346,7 +332,7 @@ def _algorithm_label(algorithm: Any) -> str:
     return getattr(algorithm, "__name__", type(algorithm).__name__)
 
 
-class PymooRun(RecordedRun):
+class PymooRun(Driver):
     """An experiment run with a pymoo algorithm through ask and tell (see the module docstring).
 
     Same run folder, log, figures and checkpoints as every driver
@@ -355,8 +341,9 @@ class PymooRun(RecordedRun):
 
     Parameters
     ----------
-    experiment, out, seed, generations, batch_fn, n_threads, on_generation, figures, gif, progress
-        As for :class:`~evolvers.runner.EvolutionRun` (Ctrl-C raises
+    experiment, out, seed, generations, **driver
+        As for :class:`~evolvers.driver.Driver` (``batch_fn``, ``n_threads``,
+        ``on_generation``, ``figures``, ``gif``, ``progress``; Ctrl-C raises
         :class:`~evolvers.recorder.RunInterrupted` the same way).
     algorithm : str or callable
         ``"nsga2"`` (default), ``"nsga3"``, ``"sms-emoa"``, ``"ga"``
@@ -371,31 +358,11 @@ class PymooRun(RecordedRun):
 
     backend = "pymoo"
 
-    def __init__(
-        self,
-        experiment: Experiment,
-        out: str | Path,
-        seed: int = 0,
-        generations: int | None = None,
-        batch_fn: BatchFn | None = None,
-        n_threads: int | None = None,
-        on_generation: Callable[[PymooRun, dict[str, Any]], None] | None = None,
-        figures: bool = True,
-        gif: bool = True,
-        algorithm: str | Callable[..., Algorithm] = "nsga2",
-        algorithm_kwargs: dict[str, Any] | None = None,
-        single_objective: bool | None = None,
-        progress: bool = True,
-    ) -> None:
-        experiment, gens = smoke_sizes(
-            experiment, experiment.generations if generations is None else int(generations)
-        )
-        self.experiment = experiment
-        self.out = Path(out)
-        self.seed = int(seed)
-        self.generations = gens
-        if self.generations < 0:
-            raise InvalidParameterError(f"generations must be >= 0, got {self.generations}")
+    def __init__(self, experiment: Experiment, out: str | Path, seed: int = 0,
+                 generations: int | None = None, *,
+                 algorithm: str | Callable[..., Algorithm] = "nsga2",
+                 algorithm_kwargs: dict[str, Any] | None = None,
+                 single_objective: bool | None = None, **driver: Any) -> None:  # fmt: skip
         if isinstance(algorithm, str) and algorithm not in ALGORITHMS:
             raise InvalidParameterError(
                 f"unknown algorithm {algorithm!r}; expected one of {ALGORITHMS}"
@@ -405,40 +372,31 @@ class PymooRun(RecordedRun):
         self.single_objective = (
             (algorithm == "ga") if single_objective is None else single_objective
         )
-        self.on_generation = on_generation
-        self.evaluator = Evaluator(experiment, batch_fn=batch_fn, n_threads=n_threads, progress=progress)
-        self.recorder = RunRecorder(
-            out, experiment, self.seed, self.backend, figures, gif,
-            extra_config={"algorithm": _algorithm_label(algorithm)}, progress=progress,
-        )  # fmt: skip
-        #: What :class:`~evolvers.recorder.RunInterrupted` tells the user to type.
-        self.resume_command = (
-            f"PymooRun(experiment, {str(self.out)!r}, seed={self.seed}).run(resume=True)"
-        )
-        self.ids = IdCounter()
-        self.archive: NoveltyArchive | None = None
-        self.algorithm: Algorithm | None = None
-        self.generation = -1
-        self.population: list[Individual] = []
+        super().__init__(experiment, out, seed, generations,
+                         extra_config={"algorithm": _algorithm_label(algorithm)}, **driver)  # fmt: skip
 
     # ------------------------------------------------------------------ the loop
-    def _fresh(self) -> tuple[SoftbotProblem, Algorithm]:
+    def _fresh(self) -> None:
+        super()._fresh()
         exp = self.experiment
-        self.ids = IdCounter()
         novelty = exp.selection.startswith("novelty")
-        self.archive = (
+        self.archive: NoveltyArchive | None = (
             NoveltyArchive(k=exp.pop_size, n_add=2, variant="normalized") if novelty else None
         )
         objectives = exp.objectives[:1] if self.single_objective else exp.objectives
-        problem = SoftbotProblem(exp, self.evaluator, self.archive, objectives)
-        algorithm = make_algorithm(
-            self.algorithm_spec, exp, self.ids, problem.n_obj, **self.algorithm_kwargs
+        self.problem = SoftbotProblem(exp, self.evaluator, self.archive, objectives)
+        self.algorithm: Algorithm = make_algorithm(
+            self.algorithm_spec, exp, self.ids, self.problem.n_obj, **self.algorithm_kwargs
         )
-        algorithm.setup(
-            problem, termination=("n_gen", self.generations + 1), seed=self.seed, verbose=False
-        )
-        self.generation = -1
-        return problem, algorithm
+        self.algorithm.setup(
+            self.problem, termination=("n_gen", self.generations + 1), seed=self.seed,
+            verbose=False,
+        )  # fmt: skip
+
+    @property
+    def label(self) -> str:
+        """The progress bar's description."""
+        return f"{self.experiment.name} [pymoo {_algorithm_label(self.algorithm_spec)}]"
 
     def _generation(self, problem: SoftbotProblem, algorithm: Algorithm) -> list[Individual]:
         """One ask / evaluate / tell round; returns the evaluated infills."""
@@ -464,49 +422,18 @@ class PymooRun(RecordedRun):
                 "reach the checkpointed population (another softgym, pymoo or algorithm?)"
             )
 
-    def run(self, resume: bool = False) -> list[Individual]:
-        """Run the algorithm (or continue it from the last checkpoint).
+    def _step(self) -> EvalStats:
+        infills = self._generation(self.problem, self.algorithm)
+        self.recorder.update_hall_of_fame(infills, self.generation)
+        return self.problem.last_stats
 
-        Returns
-        -------
-        list of Individual
-            The final population.
-        """
-        loaded = self.recorder.resume(self.generations) if resume else None
-        if loaded is None:
-            self.recorder.start(self.generations)
-        problem, algorithm = self._fresh()
-        self.algorithm = algorithm
-        if loaded is not None:
-            state, arrays = loaded
-            try:
-                self.evaluator.cache = PhenotypeCache.from_arrays(arrays)
-                self.evaluator.n_evaluations = int(state.get("evaluations_counter", 0))
-                self._replay(problem, algorithm, state)
-            except (KeyError, TypeError, ValueError) as exc:
-                raise CheckpointError(
-                    f"{self.recorder.checkpoint_dir}: checkpoint content is invalid ({exc!r})"
-                ) from exc
-        self.recorder.open_progress(
-            self.generation,
-            self.generations,
-            f"{self.experiment.name} [pymoo {_algorithm_label(self.algorithm_spec)}]",
-        )
-        try:
-            while self.generation < self.generations:
-                t0 = time.perf_counter()
-                infills = self._generation(problem, algorithm)
-                self.recorder.update_hall_of_fame(infills, self.generation)
-                self._end_generation(algorithm, problem.last_stats, time.perf_counter() - t0)
-        except KeyboardInterrupt as exc:
-            done = len(self.recorder.rows) - 1
-            raise self.recorder.interrupted(done, self.resume_command) from exc
-        finally:
-            self.recorder.close_progress()
-        self.recorder.finish(self.generation, self.population)
-        return self.population
+    def _restore(self, state: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
+        self.evaluator.cache = PhenotypeCache.from_arrays(arrays)
+        self.evaluator.n_evaluations = int(state.get("evaluations_counter", 0))
+        self._replay(self.problem, self.algorithm, state)
 
-    def _end_generation(self, algorithm: Algorithm, stats: EvalStats, wall: float) -> None:
+    def _checkpoint_state(self) -> Checkpoint:
+        algorithm = self.algorithm
         pop = algorithm.pop
         data, lengths = pack_traces([ind.trace for ind in self.population])
         arrays = {
@@ -521,8 +448,4 @@ class PymooRun(RecordedRun):
             "n_eval": int(algorithm.evaluator.n_eval),
             "evaluations_counter": self.evaluator.n_evaluations,
         }
-        row = self.recorder.end_generation(
-            self.generation, self.population, stats, wall, state, arrays
-        )
-        if self.on_generation is not None:
-            self.on_generation(self, row)
+        return state, arrays, None, self.population

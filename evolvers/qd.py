@@ -43,7 +43,6 @@ from __future__ import annotations
 
 import logging
 import math
-import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, fields
 from pathlib import Path
@@ -53,19 +52,16 @@ import numpy as np
 
 from evolvers.descriptors import MOURET_CLUNE_2015, check_descriptors, descriptor_values
 from evolvers.distributed import MissingExtraError
+from evolvers.driver import Checkpoint, Driver, IdCounter
 from evolvers.evaluation import (
-    BatchFn,
     EvalStats,
-    Evaluator,
     PhenotypeCache,
     pack_traces,
     unpack_traces,
 )
-from evolvers.experiments import Experiment, smoke_sizes
+from evolvers.experiments import Experiment
 from evolvers.genome import Individual
 from evolvers.operators import make_children
-from evolvers.pymoo_runner import IdCounter
-from evolvers.recorder import RecordedRun, RunRecorder
 from softgym.exceptions import CheckpointError, InvalidParameterError
 from softgym.io import (
     atomic_write_json,
@@ -75,6 +71,7 @@ from softgym.io import (
     rng_from_state,
     rng_state,
 )
+from softgym.render.figures import pyplot
 
 try:
     from ribs.archives import CVTArchive, GridArchive, k_means_centroids
@@ -340,7 +337,7 @@ class SoftbotEmitter(EmitterBase):
         self.improved_cells = len(np.unique(cells[status == 1]))
 
 
-class QDRun(RecordedRun):
+class QDRun(Driver):
     """A resumable MAP-Elites run of an experiment's robots (see the module docstring).
 
     ``generations`` counts the batches after generation 0 (the first, random
@@ -359,61 +356,39 @@ class QDRun(RecordedRun):
         Default: the experiment's.
     config : QDConfig, optional
         The archive (default: Mouret and Clune's 128 x 128 grid).
-    batch_fn, n_threads, on_generation, figures, gif, progress
-        As for :class:`~evolvers.runner.EvolutionRun` (Ctrl-C raises
+    **driver
+        ``batch_fn``, ``n_threads``, ``on_generation``, ``figures``, ``gif``,
+        ``progress``: as for :class:`~evolvers.driver.Driver` (Ctrl-C raises
         :class:`~evolvers.recorder.RunInterrupted` the same way).
     """
 
     backend = "qd"
 
-    def __init__(
-        self,
-        experiment: Experiment,
-        out: str | Path,
-        seed: int = 0,
-        generations: int | None = None,
-        config: QDConfig | None = None,
-        batch_fn: BatchFn | None = None,
-        n_threads: int | None = None,
-        on_generation: Callable[[QDRun, dict[str, Any]], None] | None = None,
-        figures: bool = True,
-        gif: bool = True,
-        progress: bool = True,
-    ) -> None:
-        experiment, gens = smoke_sizes(
-            experiment, experiment.generations if generations is None else int(generations)
-        )
-        if gens < 0:
-            raise InvalidParameterError(f"generations must be >= 0, got {gens}")
-        self.experiment = experiment
-        self.out = Path(out)
-        self.seed = int(seed)
-        self.generations = gens
+    def __init__(self, experiment: Experiment, out: str | Path, seed: int = 0,
+                 generations: int | None = None, *, config: QDConfig | None = None,
+                 **driver: Any) -> None:  # fmt: skip
         self.config = QDConfig() if config is None else config
         self.objective = self.config.objective_for(experiment)
-        self.on_generation = on_generation
-        self.figures = figures
-        self.evaluator = Evaluator(experiment, batch_fn=batch_fn, n_threads=n_threads, progress=progress)
-        self.recorder = RunRecorder(
-            out, experiment, self.seed, self.backend, figures, gif,
-            extra_config={"qd": self.config.to_dict()}, progress=progress,
-        )  # fmt: skip
-        #: What :class:`~evolvers.recorder.RunInterrupted` tells the user to type.
-        self.resume_command = (
-            f"QDRun(experiment, {str(self.out)!r}, seed={self.seed}).run(resume=True)"
-        )
-        self.generation = -1
-        self._fresh()
+        super().__init__(experiment, out, seed, generations,
+                         extra_config={"qd": self.config.to_dict()}, **driver)  # fmt: skip
 
     def _fresh(self, centroids: np.ndarray | None = None) -> None:
-        self.ids = IdCounter()
+        super()._fresh()
         self.archive = make_archive(self.config, self.seed, centroids)
         self.emitter = SoftbotEmitter(
             self.archive, self.experiment, self.experiment.pop_size,
             np.random.default_rng(self.seed), self.ids,
         )  # fmt: skip
         self.scheduler = Scheduler(self.archive, [self.emitter], add_mode="batch")
-        self.generation = -1
+
+    @property
+    def label(self) -> str:
+        """The progress bar's description."""
+        return f"{self.experiment.name} [qd {self.config.archive}]"
+
+    def result(self) -> list[Individual]:
+        """The elites, in cell-index order (what :meth:`run` returns)."""
+        return self.elites()
 
     # ------------------------------------------------------------------ the record
     def elites(self) -> list[Individual]:
@@ -442,7 +417,7 @@ class QDRun(RecordedRun):
         shape = self.experiment.shape
         return descriptor_values([ind.grid(shape) for ind in individuals], self.config.descriptors)
 
-    def _generation(self) -> EvalStats:
+    def _step(self) -> EvalStats:
         """One ask / evaluate / tell round."""
         solutions = self.scheduler.ask()
         batch = list(solutions)
@@ -452,42 +427,9 @@ class QDRun(RecordedRun):
         self.recorder.update_hall_of_fame(batch, self.generation)
         return stats
 
-    def run(self, resume: bool = False) -> list[Individual]:
-        """Run (or continue from the last checkpoint) until ``generations``.
-
-        Returns
-        -------
-        list of Individual
-            The elites, in cell-index order.
-        """
-        loaded = self.recorder.resume(self.generations) if resume else None
-        if loaded is None:
-            self.recorder.start(self.generations)
-            if self.generation >= 0 or not self.archive.empty:
-                self._fresh()
-        else:
-            self._restore(*loaded)
-        self.recorder.open_progress(
-            self.generation, self.generations, f"{self.experiment.name} [qd {self.config.archive}]"
-        )
-        try:
-            while self.generation < self.generations:
-                t0 = time.perf_counter()
-                stats = self._generation()
-                self._end_generation(stats, time.perf_counter() - t0)
-        except KeyboardInterrupt as exc:
-            raise self.recorder.interrupted(
-                len(self.recorder.rows) - 1, self.resume_command
-            ) from exc
-        finally:
-            self.recorder.close_progress()
-        self.finish()
-        return self.elites()
-
     def finish(self) -> None:
         """Final population (the elites), best designs, the run's figures and the archive's."""
-        elites = self.elites()
-        self.recorder.finish(self.generation, elites)
+        self.recorder.finish(self.generation, self.elites())
         if self.figures:
             try:
                 self.write_figures()
@@ -505,7 +447,7 @@ class QDRun(RecordedRun):
             )  # fmt: skip
         return out
 
-    def _end_generation(self, stats: EvalStats, wall: float) -> None:
+    def _checkpoint_state(self) -> Checkpoint:
         data = _elite_data(self.archive)
         elites = list(data["solution"])
         traces, lengths = pack_traces([ind.trace for ind in elites])
@@ -530,41 +472,31 @@ class QDRun(RecordedRun):
             "new_cells": self.emitter.new_cells,
             "improved_cells": self.emitter.improved_cells,
         }
-        row = self.recorder.end_generation(
-            self.generation, elites, stats, wall, state, arrays, columns=columns
-        )
-        if self.on_generation is not None:
-            self.on_generation(self, row)
+        return state, arrays, columns, elites
 
     def _restore(self, state: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
-        where = self.recorder.checkpoint_dir
-        try:
-            self._fresh(arrays.get("archive_centroids"))
-            elites = [Individual.from_dict(d) for d in state["population"]]
-            for ind, tr in zip(
-                elites, unpack_traces(arrays["pop_traces"], arrays["pop_trace_len"])
-            ):
-                ind.trace = tr
-            if elites:
-                self.archive.add(
-                    _object_array(elites), arrays["archive_objective"], arrays["archive_measures"]
-                )
-            data = _elite_data(self.archive)
-            if not (
-                np.array_equal(data["index"], arrays["archive_index"])
-                and np.array_equal(data["threshold"], arrays["archive_threshold"])
-            ):
-                raise CheckpointError(
-                    f"{where}: the checkpointed elites do not rebuild the archive "
-                    "(another archive configuration or pyribs version?)"
-                )
-            self.generation = int(state["generation"])
-            self.ids.value = int(state["next_id"])
-            self.emitter.rng = rng_from_state(state["rng"])
-            self.evaluator.cache = PhenotypeCache.from_arrays(arrays)
-            self.evaluator.n_evaluations = int(state.get("evaluations_counter", 0))
-        except (KeyError, TypeError, ValueError) as exc:
-            raise CheckpointError(f"{where}: checkpoint content is invalid ({exc!r})") from exc
+        self._fresh(arrays.get("archive_centroids"))
+        elites = [Individual.from_dict(d) for d in state["population"]]
+        for ind, tr in zip(elites, unpack_traces(arrays["pop_traces"], arrays["pop_trace_len"])):
+            ind.trace = tr
+        if elites:
+            self.archive.add(
+                _object_array(elites), arrays["archive_objective"], arrays["archive_measures"]
+            )
+        data = _elite_data(self.archive)
+        if not (
+            np.array_equal(data["index"], arrays["archive_index"])
+            and np.array_equal(data["threshold"], arrays["archive_threshold"])
+        ):
+            raise CheckpointError(
+                f"{self.checkpoint_dir}: the checkpointed elites do not rebuild the archive "
+                "(another archive configuration or pyribs version?)"
+            )
+        self.generation = int(state["generation"])
+        self.ids.value = int(state["next_id"])
+        self.emitter.rng = rng_from_state(state["rng"])
+        self.evaluator.cache = PhenotypeCache.from_arrays(arrays)
+        self.evaluator.n_evaluations = int(state.get("evaluations_counter", 0))
 
 
 # ---------------------------------------------------------------------- figures
@@ -593,10 +525,7 @@ def plot_archive_heatmap(
     -------
     Path
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
     from ribs.visualize import cvt_archive_heatmap, grid_archive_heatmap
 
     path = Path(path)
@@ -635,10 +564,7 @@ def _axis_label(name: str) -> str:
 
 def plot_qd_progress(rows: Sequence[Mapping[str, Any]], path: str | Path) -> Path:
     """QD-score and coverage against simulations, from a QD run's log rows."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -54,16 +54,15 @@ from softgym.io import (
     read_json,
     save_checkpoint,
 )
+from softgym.metrics import crossed_obstacles, final_xy, obstacle_footprint
 
 __all__ = [
     "HALL_OF_FAME_SIZE",
     "RUN_SCHEMA",
-    "RecordedRun",
     "RunRecorder",
     "add_run_note",
     "config_difference",
     "log_row",
-    "obstacle_footprint",
     "population_summary",
     "read_run_notes",
     "study_columns",
@@ -211,39 +210,6 @@ def _stats_of(values: np.ndarray, maximize: bool) -> dict[str, float]:
 _TOP_COUNTS = ("n_voxels", "n_muscle", "n_bone", "n_tissue", "n_old_materials")
 
 
-def obstacle_footprint(experiment: Experiment) -> tuple[float, float, float, float] | None:
-    """The xy extent ``(x0, x1, y0, y1)`` (voxel lengths) of the experiment's obstacles, or None.
-
-    A robot whose final centre of mass lies outside it has crossed every obstacle
-    (for the ``wall`` task: it is past the fence's outer face).
-    """
-    terrain = experiment.make_task().terrain_for(experiment.shape)
-    if not terrain.boxes:
-        return None
-    lo = np.array([b.lo for b in terrain.boxes], dtype=np.float64)
-    hi = np.array([b.hi for b in terrain.boxes], dtype=np.float64)
-    return (
-        float(lo[:, 0].min()),
-        float(hi[:, 0].max()),
-        float(lo[:, 1].min()),
-        float(hi[:, 1].max()),
-    )
-
-
-def _final_xy(ind: Individual, voxel_size: float) -> tuple[float, float]:
-    """Final centre-of-mass (x, y) in voxel lengths from the individual's trace (NaN without one)."""
-    tr = ind.trace
-    if tr is None or len(tr) == 0:
-        return (float("nan"), float("nan"))
-    return (float(tr[-1, 0]) / voxel_size, float(tr[-1, 1]) / voxel_size)
-
-
-def _crossed(xy: tuple[float, float], footprint: tuple[float, float, float, float]) -> bool:
-    x, y = xy
-    x0, x1, y0, y1 = footprint
-    return bool(x < x0 or x > x1 or y < y0 or y > y1)
-
-
 def _individual_columns(
     prefix: str, ind: Individual | None, metrics: Sequence[str]
 ) -> dict[str, Any]:
@@ -268,7 +234,7 @@ def study_columns(
     generation, and how many of them had a phenotype already simulated in the
     run (:class:`~evolvers.evaluation.EvalStats`). On a task with obstacles:
     ``crossed`` (individuals whose final centre of mass is outside the
-    obstacles' footprint, :func:`obstacle_footprint`), ``top_crossed``, and
+    obstacles' footprint, :func:`softgym.metrics.obstacle_footprint`), ``top_crossed``, and
     ``crosser_*`` (the best of those, or id -1 and NaN).
     """
     exp = experiment
@@ -293,14 +259,15 @@ def study_columns(
     row.update(_individual_columns("top", top, metrics))
     if top is not None:
         row.update({f"top_{k}": v for k, v in top.genes().items()})
-    voxel_size = exp.make_task().config().voxel_size
-    xy = _final_xy(top, voxel_size) if top is not None else (float("nan"), float("nan"))
+    task = exp.make_task()
+    voxel_size = task.config().voxel_size
+    xy = final_xy(None if top is None else top.trace, voxel_size)
     row["top_final_x"], row["top_final_y"] = xy
-    footprint = obstacle_footprint(exp)
+    footprint = obstacle_footprint(task.terrain_for(exp.shape))
     if footprint is not None:
-        crossers = [ind for ind in pop if _crossed(_final_xy(ind, voxel_size), footprint)]
+        crossers = [ind for ind in pop if crossed_obstacles(final_xy(ind.trace, voxel_size), footprint)]
         row["crossed"] = len(crossers)
-        row["top_crossed"] = int(top is not None and _crossed(xy, footprint))
+        row["top_crossed"] = int(top is not None and crossed_obstacles(xy, footprint))
         best = None
         if crossers:
             cv = np.array([ind.value(name) for ind in crossers], dtype=np.float64)
@@ -346,46 +313,6 @@ def log_row(
             row[f"novelty_{k}"] = v
     row.update(study_columns(exp, population, stats))
     return row
-
-
-class RecordedRun:
-    """What every runner shows of its record: a mixin over its :attr:`recorder`.
-
-    The runners (:class:`~evolvers.runner.EvolutionRun`, ``PymooRun``, ``QDRun``)
-    keep their log, hall of fame, totals and checkpoints in a :class:`RunRecorder`
-    at ``self.recorder``; these read-only views are the same for all of them.
-    """
-
-    recorder: RunRecorder
-
-    @property
-    def rows(self) -> list[dict[str, Any]]:
-        """The log rows so far (one per generation)."""
-        return self.recorder.rows
-
-    @property
-    def hall_of_fame(self) -> list[dict[str, Any]]:
-        """The best individuals so far (plain data, best first)."""
-        return self.recorder.hall_of_fame
-
-    @property
-    def evaluations_total(self) -> int:
-        """Simulations run so far."""
-        return self.recorder.evaluations_total
-
-    @property
-    def wall_total(self) -> float:
-        """Wall time (s) of the generations so far."""
-        return self.recorder.wall_total
-
-    @property
-    def checkpoint_dir(self) -> Path:
-        """Folder of the checkpoints."""
-        return self.recorder.checkpoint_dir
-
-    def best(self) -> Individual:
-        """The best individual found so far (by the first objective)."""
-        return self.recorder.best()
 
 
 class RunRecorder:
@@ -563,7 +490,8 @@ class RunRecorder:
             self._bar.refresh()
 
     def interrupted(self, generation: int, resume: str) -> RunInterrupted:
-        """Close the bar, log where the run stopped and return the :class:`RunInterrupted` to raise.
+        """Close the bar, log where the run stopped (INFO: the exception says it to the user,
+        the CLI in one message) and return the :class:`RunInterrupted` to raise.
 
         Parameters
         ----------
@@ -575,7 +503,7 @@ class RunRecorder:
         self.close_progress()
         ckpt = latest_checkpoint(self.checkpoint_dir) if self.checkpoint_dir.exists() else None
         exc = RunInterrupted(self.out, generation, ckpt, resume)
-        log.warning("%s: %s", self.out, exc)
+        log.info("%s: %s", self.out, exc)
         return exc
 
     # ------------------------------------------------------------------ records

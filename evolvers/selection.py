@@ -9,19 +9,22 @@ Objectives are :class:`Objective` (a metric name and a direction); the name
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from evolvers.genome import Individual
+from softgym.exceptions import InvalidParameterError
 from softgym.metrics import WORST_FITNESS, NoveltyArchive, novelty_scores
 
 __all__ = [
+    "SELECTORS",
     "Objective",
     "minimised_matrix",
     "pareto_levels",
+    "select",
     "sel_fitness_tournament",
     "sel_nsga2",
     "sel_novelty",
@@ -231,3 +234,50 @@ def sel_nsga2(
 
     wrapped = [_Wrap(ind) for ind in individuals]
     return [w.ind for w in tools.selNSGA2(wrapped, min(int(k), len(wrapped)))]
+
+
+def _by_name() -> dict[str, Callable[..., list[Individual]]]:
+    def pareto(inds, k, objectives, rng, archive):
+        return sel_pareto(inds, k, objectives, rng)
+
+    def tournament(inds, k, objectives, rng, archive):
+        return sel_fitness_tournament(inds, k, objectives[0].name, rng)
+
+    def novelty(inds, k, objectives, rng, archive):
+        return sel_novelty(inds, k)
+
+    def novelty_archive(inds, k, objectives, rng, archive):
+        return sel_novelty(inds, k, archive=archive)
+
+    def nsga2(inds, k, objectives, rng, archive):
+        return sel_nsga2(inds, k, objectives)
+
+    return {"pareto": pareto, "tournament": tournament, "novelty": novelty,
+            "novelty-archive": novelty_archive, "nsga2": nsga2}  # fmt: skip
+
+
+#: The selections an experiment names (``Experiment.selection``), each as
+#: ``sel(individuals, k, objectives, rng, archive)`` (the tournament reads the first
+#: objective; ``novelty-archive`` scores against ``archive``). One registry: the
+#: native driver selects through it and experiments validate against it.
+SELECTORS: dict[str, Callable[..., list[Individual]]] = _by_name()
+
+
+def select(
+    name: str,
+    individuals: list[Individual],
+    k: int,
+    objectives: Sequence[Objective],
+    rng: np.random.Generator | int | None = None,
+    archive: NoveltyArchive | None = None,
+) -> list[Individual]:
+    """Select ``k`` of ``individuals`` with the selection called ``name`` (:data:`SELECTORS`).
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``name`` is not a selection.
+    """
+    if name not in SELECTORS:
+        raise InvalidParameterError(f"unknown selection {name!r}; expected one of {tuple(SELECTORS)}")
+    return SELECTORS[name](individuals, k, objectives, rng, archive)

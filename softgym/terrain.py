@@ -26,15 +26,15 @@ measures that read them).
 from __future__ import annotations
 
 import json
-import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
-from numbers import Real
+from functools import partial
 from typing import Any
 
 import numpy as np
 
 from softgym.exceptions import InvalidTerrainError
+from softgym.validate import number, positive
 
 __all__ = [
     "BOX_CONTACTS",
@@ -67,17 +67,8 @@ MAX_BLOCK_DIM = 32
 BOX_CONTACTS: tuple[str, ...] = ("auto", "surface")
 
 
-def _number(name: str, value: Any) -> float:
-    """A finite real number (int, float, numpy scalar); bools and strings are refused."""
-    if isinstance(value, (bool, str, bytes)) or not isinstance(value, Real):
-        raise InvalidTerrainError(f"{name} must be a number, got {value!r:.80}")
-    try:
-        v = float(value)
-    except (TypeError, ValueError, OverflowError):
-        raise InvalidTerrainError(f"{name} must be a finite number, got {value!r:.80}") from None
-    if not math.isfinite(v):
-        raise InvalidTerrainError(f"{name} must be finite, got {v}")
-    return v
+_number = partial(number, error=InvalidTerrainError)
+_positive = partial(positive, error=InvalidTerrainError)
 
 
 def _point(name: str, value: Any, n: int = 3) -> tuple[float, ...]:
@@ -126,13 +117,6 @@ class Box:
     def overlaps(self, lo: Sequence[float], hi: Sequence[float]) -> bool:
         """True when the open interiors of this box and the box [lo, hi] intersect."""
         return all(self.lo[k] < hi[k] and lo[k] < self.hi[k] for k in range(3))
-
-
-def _positive(name: str, value: Any) -> float:
-    v = _number(name, value)
-    if not v > 0:
-        raise InvalidTerrainError(f"{name} must be > 0, got {v}")
-    return v
 
 
 @dataclass(frozen=True, eq=False)

@@ -19,7 +19,7 @@ FUZZ_EXAMPLES = int(os.environ.get("SOFTGYM_FUZZ_EXAMPLES", "150"))
 FUZZ = settings(
     max_examples=FUZZ_EXAMPLES,
     deadline=None,
-    suppress_health_check=[HealthCheck.too_slow],
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
     database=None,
 )
 
@@ -27,15 +27,21 @@ FUZZ = settings(
 OUTCOMES: Counter = Counter()
 
 
-def outcome(kind, fn, *args, **kwargs):
-    """Call ``fn``; count and return "valid" or the SoftGymError's class name; fail on anything else."""
+def outcome_and_result(kind, fn, *args, **kwargs):
+    """Call ``fn``; count and return ("valid" or the SoftGymError's class name, its result or
+    None); fail on anything else."""
     try:
-        fn(*args, **kwargs)
+        result = fn(*args, **kwargs)
     except SoftGymError as exc:
-        label = type(exc).__name__
+        label, result = type(exc).__name__, None
     except Exception as exc:  # noqa: BLE001 - the property under test
         pytest.fail(f"{kind}: {type(exc).__name__} escaped: {exc!s:.300}")
     else:
         label = "valid"
     OUTCOMES[(kind, label)] += 1
-    return label
+    return label, result
+
+
+def outcome(kind, fn, *args, **kwargs):
+    """Call ``fn``; count and return "valid" or the SoftGymError's class name; fail on anything else."""
+    return outcome_and_result(kind, fn, *args, **kwargs)[0]

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from softgym.cli import main
+from softgym_cli import main
 
 TINY = ["--pop", "4", "--seconds", "1.5", "--shape", "4", "4", "4", "--quiet"]
 
@@ -64,7 +64,7 @@ def test_kill_9_then_resume_equals_uninterrupted(tmp_path):
     killed = tmp_path / "killed"
     env = {**os.environ, "SOFTGYM_NUM_THREADS": "1"}
     proc = subprocess.Popen(
-        [sys.executable, "-m", "softgym.cli", *args, "--out", str(killed)],
+        [sys.executable, "-m", "softgym_cli", *args, "--out", str(killed)],
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
         env=env,
@@ -112,3 +112,24 @@ def test_dask_without_the_extra_names_it(tmp_path, capsys, monkeypatch):
     args = ["evolve", "--dask", "local", "--generations", "0", "--out", str(tmp_path / "d")]
     assert main([*args, *TINY]) == 2
     assert 'pip install "softgym[distributed]"' in capsys.readouterr().err
+
+
+def test_a_task_string_is_read_once_per_command(tmp_path, monkeypatch, capsys):
+    import importlib
+
+    import evolvers.experiments
+    from softgym.tasks import get_task
+
+    strings = []
+
+    def spy(spec, **kw):
+        if isinstance(spec, str):
+            strings.append(spec)
+        return get_task(spec, **kw)
+
+    evaluate_module = importlib.import_module("softgym.evaluate")  # not the function
+    for module in (evolvers.experiments, evaluate_module):
+        monkeypatch.setattr(module, "get_task", spy)
+    args = ["evolve", "--task", "stairs", "--generations", "1", "--no-figures", "--no-gif"]
+    assert main([*args, "--out", str(tmp_path / "r"), *TINY]) == 0
+    assert strings == ["stairs"]  # the experiment holds the Task from there to the kernel

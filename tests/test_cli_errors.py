@@ -5,8 +5,8 @@ import sys
 
 import pytest
 
-from softgym.cli import main
 from softgym.exceptions import CheckpointError, InvalidDesignError, SoftGymError
+from softgym_cli import main
 
 TINY = ["--pop", "4", "--seconds", "0.5", "--shape", "4", "4", "4", "--quiet", "--no-figures"]
 
@@ -85,3 +85,44 @@ def test_debug_flag_leaves_success_alone(capsys):
     assert main(["--debug", "experiments"]) == 0
     assert "controller-tournament" in capsys.readouterr().out
     assert issubclass(CheckpointError, SoftGymError)
+
+
+def test_resume_of_a_folder_without_a_run_refuses(tmp_path, capsys):
+    for command in ("evolve", "qd", "poet"):
+        out = tmp_path / command
+        line = _one_line_error(capsys, [command, "--out", str(out), "--resume", "-q"], command)
+        assert str(out) in line and "no run to resume" in line
+        assert not out.exists()  # nothing was started
+    with pytest.raises(CheckpointError):
+        main(["--debug", "evolve", "--out", str(tmp_path / "x"), "--resume"])
+
+
+def test_version_and_global_flags_on_either_side(capsys):
+    from importlib.metadata import version
+
+    with pytest.raises(SystemExit) as exit_:
+        main(["--version"])
+    assert exit_.value.code == 0
+    assert capsys.readouterr().out.strip() == f"softgym {version('softgym')}"
+    import softgym
+
+    assert softgym.__version__ == version("softgym")  # one source: pyproject.toml
+    for argv in (["-v", "-q", "experiments"], ["experiments", "-v", "--quiet"]):
+        assert main(argv) == 0
+        assert "controller-tournament" in capsys.readouterr().out
+
+
+def test_the_library_does_not_import_the_cli_or_the_evolvers():
+    import ast
+    from pathlib import Path
+
+    import softgym
+
+    root = Path(softgym.__file__).parent
+    for path in root.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = ([a.name for a in node.names] if isinstance(node, ast.Import)
+                     else [node.module or ""] if isinstance(node, ast.ImportFrom) else [])  # fmt: skip
+            for name in names:
+                top = name.split(".")[0]
+                assert top not in ("evolvers", "softgym_cli"), f"{path} imports {name}"

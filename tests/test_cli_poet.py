@@ -1,8 +1,8 @@
-"""softgym poet: a tiny run, its resume (a differing flag is named), compare, bad input."""
+"""softgym poet: a tiny run, its resume (a differing flag is named), compare, view, bad input."""
 
 import json
 
-from softgym.cli import main
+from softgym_cli import main
 
 _TINY = ["--pop", "3", "--seconds", "1", "--shape", "3", "3", "3", "--reproduce-every", "1",
          "--transfer-every", "1", "--no-figures", "--quiet"]  # fmt: skip
@@ -26,6 +26,9 @@ def test_poet_runs_resumes_and_compares(tmp_path, capsys):
     fig = tmp_path / "annecs.png"
     assert main(["poet", "compare", out, "--out", str(fig)]) == 0
     assert fig.is_file() and "POET: 1 run(s)" in capsys.readouterr().out
+    # softgym view shows the best robot of the pairs, on its own terrain
+    assert main(["view", out, "--seconds", "0.3", "--fps", "2"]) == 0
+    assert "best robot (POET pair" in (tmp_path / "p" / "view.html").read_text()
 
 
 def test_poet_bad_input_is_one_line_and_exit_2(tmp_path, capsys):

@@ -6,7 +6,7 @@ import pytest
 
 pytest.importorskip("ribs")
 
-from softgym.cli import main  # noqa: E402
+from softgym_cli import main  # noqa: E402
 
 _TINY = ["--batch", "4", "--shape", "4", "4", "4", "--seconds", "1", "--cells", "8",
          "--no-figures", "--quiet"]  # fmt: skip

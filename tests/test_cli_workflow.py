@@ -11,7 +11,7 @@ import time
 
 import pytest
 
-from softgym.cli import main
+from softgym_cli import main
 
 TINY = ["--pop", "4", "--seconds", "1.5", "--shape", "4", "4", "4", "--quiet", "--no-gif"]
 
@@ -38,7 +38,7 @@ def test_resume_reads_the_settings_from_the_run_folder(runs, capsys):
 
 
 def test_help_shows_every_default(capsys):
-    from softgym import cli
+    import softgym_cli as cli
 
     parser_holder = {}
     real = argparse.ArgumentParser.parse_args
@@ -74,7 +74,11 @@ def test_compare_groups_seeds_and_explains_a_missing_metric(runs, tmp_path, caps
     assert main(["compare", str(runs / "a0"), str(runs / "a1"), "--out", str(out)]) == 0
     printed = capsys.readouterr().out
     assert "2 run(s)" in printed and out.stat().st_size > 5000
-    assert main(["compare", str(runs / "a0"), str(runs / "o"), "--out", str(out)]) == 2
+    # a flat run and an obstacle run on one axis: the obstacle run's fittest robot's distance
+    assert main(["compare", str(runs / "a0"), str(runs / "o"), "--out", str(out)]) == 0
+    assert "(top_norm_final_dist) stands in" in capsys.readouterr().err
+    assert main(["compare", str(runs / "a0"), str(runs / "o"), "--stat", "median",
+                 "--out", str(out)]) == 2  # fmt: skip
     err = capsys.readouterr().err
     assert "did not record 'norm_final_dist'" in err and "--metric" in err
     # a mix of experiments compares on a metric both record
@@ -113,7 +117,7 @@ def test_convert_both_ways_and_view(runs, tmp_path, capsys):
 @pytest.mark.skipif(os.name != "posix", reason="needs POSIX signals")
 def test_ctrl_c_stops_fast_and_prints_the_resume_command(tmp_path):
     out = tmp_path / "run"
-    cmd = [sys.executable, "-m", "softgym.cli", "evolve", "--out", str(out), "--generations",
+    cmd = [sys.executable, "-m", "softgym_cli", "evolve", "--out", str(out), "--generations",
            "50", "--pop", "6", "--seconds", "3", "--shape", "4", "4", "4", "--no-gif",
            "--no-figures"]  # fmt: skip
     p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -134,3 +138,4 @@ def test_ctrl_c_stops_fast_and_prints_the_resume_command(tmp_path):
     assert "Traceback" not in err
     assert f"resume with: softgym evolve --out {out} --resume" in err
     assert "checkpointed in" in err
+    assert err.count("interrupted") == 1, err  # one message, not the log's and the CLI's

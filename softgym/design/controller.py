@@ -11,10 +11,10 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
-from numbers import Real
 from typing import Any, ClassVar
 
 from softgym.exceptions import InvalidDesignError, InvalidParameterError
+from softgym.validate import number
 
 __all__ = ["CONTROLLER_BOUNDS", "Controller"]
 
@@ -24,16 +24,6 @@ CONTROLLER_BOUNDS: dict[str, tuple[float, float, str]] = {
     "period": (0.01, 0.75, "s"),
     "muscle_cte": (0.001, 0.04, "1/degC"),
 }
-
-
-def _number(name: str, raw: Any) -> float:
-    # a real number (int, float, numpy scalar); bools and strings are refused, not coerced
-    if isinstance(raw, (bool, str, bytes)) or not isinstance(raw, Real):
-        raise InvalidParameterError(f"controller {name} must be a number, got {raw!r}")
-    try:
-        return float(raw)
-    except (TypeError, ValueError, OverflowError):
-        raise InvalidParameterError(f"controller {name} must be a number, got {raw!r}") from None
 
 
 @dataclass(frozen=True)
@@ -64,7 +54,7 @@ class Controller:
 
     def __post_init__(self) -> None:
         for name, (lo, hi, unit) in CONTROLLER_BOUNDS.items():
-            value = _number(name, getattr(self, name))
+            value = number(f"controller {name}", getattr(self, name), finite=False)
             if not (math.isfinite(value) and lo <= value <= hi):
                 raise InvalidParameterError(
                     f"controller {name} = {value} {unit} is outside the seed's bounds [{lo}, {hi}]"
@@ -88,7 +78,7 @@ class Controller:
         out = {}
         for name, raw in values.items():
             lo, hi, _ = CONTROLLER_BOUNDS[name]
-            v = _number(name, raw)
+            v = number(f"controller {name}", raw, finite=False)
             if not math.isfinite(v):
                 raise InvalidParameterError(f"controller {name} must be finite, got {v}")
             out[name] = min(max(v, lo), hi)

@@ -31,13 +31,13 @@ import math
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, fields, replace
 from functools import lru_cache
-from numbers import Real
 from typing import Any
 
 import numpy as np
 
 from softgym.engine.config import DENSITY_RANGE, YOUNGS_MODULUS_RANGE
 from softgym.exceptions import InvalidDesignError, InvalidParameterError
+from softgym.validate import is_int, number
 
 __all__ = [
     "BONE_IDS",
@@ -73,24 +73,6 @@ BONE_IDS: tuple[int, ...] = (2,)
 OLD_MATERIAL_IDS: tuple[int, ...] = (1, 2, 3, 4)
 #: Ids that are environment, not robot (not counted as robot voxels).
 OBSTACLE_IDS: tuple[int, ...] = (5,)
-
-
-def _is_int(value: Any) -> bool:
-    """Whether ``value`` is an integer (Python or numpy), not a bool."""
-    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
-
-
-def _finite(name: str, value: Any) -> float:
-    # a real number: int, float or a numpy scalar; never a bool, a string or a container
-    if isinstance(value, (bool, str, bytes)) or not isinstance(value, Real):
-        raise InvalidParameterError(f"{name} must be a number, got {value!r}")
-    try:
-        v = float(value)
-    except (TypeError, ValueError, OverflowError):
-        raise InvalidParameterError(f"{name} must be a finite number, got {value!r}") from None
-    if not math.isfinite(v):
-        raise InvalidParameterError(f"{name} must be finite, got {v}")
-    return v
 
 
 @dataclass(frozen=True)
@@ -137,12 +119,12 @@ class Material:
         if not isinstance(self.name, str):
             raise InvalidParameterError(f"material name must be a str, got {self.name!r}")
         label = f"material {self.name!r}"
-        E = _finite(f"{label}: youngs_modulus", self.youngs_modulus)
-        rho = _finite(f"{label}: density", self.density)
-        nu = _finite(f"{label}: poisson", self.poisson)
-        cte = _finite(f"{label}: cte", self.cte)
-        mus = _finite(f"{label}: mu_static", self.mu_static)
-        muk = _finite(f"{label}: mu_kinetic", self.mu_kinetic)
+        E = number(f"{label}: youngs_modulus", self.youngs_modulus)
+        rho = number(f"{label}: density", self.density)
+        nu = number(f"{label}: poisson", self.poisson)
+        cte = number(f"{label}: cte", self.cte)
+        mus = number(f"{label}: mu_static", self.mu_static)
+        muk = number(f"{label}: mu_kinetic", self.mu_kinetic)
         lo, hi = YOUNGS_MODULUS_RANGE
         if not lo <= E <= hi:
             raise InvalidParameterError(
@@ -174,7 +156,7 @@ class Material:
             raise InvalidParameterError(
                 f"{label}: color must be 3 or 4 numbers in [0, 1], got {len(raw_color)} values"
             )
-        color = tuple(_finite(f"{label}: color channel", c) for c in raw_color)
+        color = tuple(number(f"{label}: color channel", c) for c in raw_color)
         if len(color) == 3:
             color = (*color, 1.0)
         if len(color) != 4 or not all(math.isfinite(c) and 0.0 <= c <= 1.0 for c in color):
@@ -330,7 +312,7 @@ class Palette(Mapping[int, Material]):
             raise InvalidDesignError("a palette needs at least one material")
         table: dict[int, Material] = {}
         for key, mat in items:
-            if not _is_int(key) or not 1 <= key <= MAX_MATERIAL_ID:
+            if not is_int(key) or not 1 <= key <= MAX_MATERIAL_ID:
                 raise InvalidDesignError(
                     f"material ids must be integers in 1..{MAX_MATERIAL_ID} (0 is empty), got {key!r}"
                 )
@@ -423,7 +405,7 @@ class Palette(Mapping[int, Material]):
                 raise InvalidDesignError(f"palette entry {i} has no 'id'")
             data = dict(item)
             key = data.pop("id")
-            if not _is_int(key) or not 1 <= key <= MAX_MATERIAL_ID:
+            if not is_int(key) or not 1 <= key <= MAX_MATERIAL_ID:
                 raise InvalidDesignError(
                     f"palette entry {i}: 'id' must be an integer in 1..{MAX_MATERIAL_ID} "
                     f"(0 is empty), got {key!r}"

@@ -42,6 +42,7 @@ from softgym.exceptions import (
     SoftGymError,
 )
 from softgym.io import atomic_write_text, read_capped
+from softgym.validate import is_int, show
 
 if TYPE_CHECKING:  # importing softgym.engine.* runs softgym/engine/__init__ (compiled code)
     from softgym.engine.body import Body
@@ -83,25 +84,6 @@ _MIGRATIONS: dict[int, Any] = {}
 # --------------------------------------------------------------------------------------------
 
 
-def _is_int(value: Any) -> bool:
-    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
-
-
-def _shown(value: Any) -> str:
-    # repr for an error message, short even for what repr cannot print (a
-    # 5000-digit int exceeds Python's int-to-str limit) or prints at length
-    if isinstance(value, int) and value.bit_length() > 64:
-        return f"<a {value.bit_length()}-bit integer>"
-    if isinstance(value, (list, tuple)) and len(value) <= 8:
-        inner = ", ".join(_shown(v) for v in value)
-        return f"({inner}{',' if len(value) == 1 else ''})" if isinstance(value, tuple) else f"[{inner}]"
-    try:
-        text = repr(value)
-    except ValueError:
-        return f"<{type(value).__name__}>"
-    return text if len(text) <= 80 else text[:77] + "..."
-
-
 def check_grid_shape(shape: Any, name: str = "grid shape") -> tuple[int, int, int]:
     """Validate a grid shape before anything of that shape is allocated.
 
@@ -124,14 +106,14 @@ def check_grid_shape(shape: Any, name: str = "grid shape") -> tuple[int, int, in
         product is at most :data:`MAX_GRID_VOXELS`.
     """
     if isinstance(shape, (str, bytes)) or not isinstance(shape, (Sequence, np.ndarray)):
-        raise InvalidDesignError(f"{name} must be 3 integers (nx, ny, nz), got {_shown(shape)}")
+        raise InvalidDesignError(f"{name} must be 3 integers (nx, ny, nz), got {show(shape)}")
     dims = list(shape)
-    if len(dims) != 3 or not all(_is_int(v) for v in dims):
-        raise InvalidDesignError(f"{name} must be 3 integers (nx, ny, nz), got {_shown(shape)}")
+    if len(dims) != 3 or not all(is_int(v) for v in dims):
+        raise InvalidDesignError(f"{name} must be 3 integers (nx, ny, nz), got {show(shape)}")
     dims = [int(v) for v in dims]
     if not all(1 <= v <= MAX_GRID_DIM for v in dims):
         raise InvalidDesignError(
-            f"{name} {_shown(tuple(dims))}: each side must lie in 1..{MAX_GRID_DIM} cells"
+            f"{name} {show(tuple(dims))}: each side must lie in 1..{MAX_GRID_DIM} cells"
         )
     if dims[0] * dims[1] * dims[2] > MAX_GRID_VOXELS:
         raise InvalidDesignError(
@@ -337,7 +319,7 @@ class CompositionRules:
                     )
                 object.__setattr__(self, f.name, float(value))
             elif f.name == "min_bone_voxels":
-                if not _is_int(value) or not 0 <= value <= MAX_GRID_VOXELS:
+                if not is_int(value) or not 0 <= value <= MAX_GRID_VOXELS:
                     raise InvalidParameterError(
                         f"composition rule min_bone_voxels must be an integer in "
                         f"0..{MAX_GRID_VOXELS}, got {value!r}"
@@ -355,7 +337,7 @@ class CompositionRules:
                         f"composition rule {f.name} must be a sequence of material ids, got {value!r}"
                     )
                 ids = tuple(value)
-                if not all(_is_int(v) and 1 <= v <= MAX_MATERIAL_ID for v in ids):
+                if not all(is_int(v) and 1 <= v <= MAX_MATERIAL_ID for v in ids):
                     raise InvalidParameterError(
                         f"composition rule {f.name} must hold material ids in 1..{MAX_MATERIAL_ID}, "
                         f"got {value!r}"

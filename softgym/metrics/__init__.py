@@ -35,6 +35,7 @@ from softgym.metrics.novelty import (
     traces_from_rollout,
     trajectory_vectors,
 )
+from softgym.metrics.obstacles import crossed_obstacles, final_xy, obstacle_footprint
 from softgym.metrics.task_measures import TASK_MEASURES, task_measure, task_measure_from_arrays
 
 __all__ = [
@@ -50,7 +51,9 @@ __all__ = [
     "amss",
     "amss_matrix",
     "composition_counts",
+    "crossed_obstacles",
     "dilute",
+    "final_xy",
     "l_coefficient",
     "l_coefficient_details",
     "l_coefficient_from_arrays",
@@ -58,6 +61,7 @@ __all__ = [
     "max_xy_dist",
     "max_xy_dist_from_arrays",
     "norm_final_dist",
+    "obstacle_footprint",
     "norm_final_dist_from_arrays",
     "novelty_scores",
     "similarity_matrix",

@@ -20,6 +20,7 @@ import numpy as np
 from softgym.design.material import BONE_IDS, MUSCLE_IDS, OBSTACLE_IDS, OLD_MATERIAL_IDS, TISSUE_IDS
 from softgym.design.robot import RobotDesign
 from softgym.exceptions import InvalidParameterError
+from softgym.validate import positive
 
 if TYPE_CHECKING:  # only for annotations: softgym.engine's __init__ loads compiled code
     from softgym.engine.rollout import Rollout
@@ -55,13 +56,6 @@ L_TOLERANCE = 0.1
 WALK_METRICS: tuple[str, ...] = ("norm_final_dist", "max_xy_dist", "l_coefficient")
 
 
-def _positive(name: str, value: float) -> float:
-    v = float(value)
-    if not (np.isfinite(v) and v > 0):
-        raise InvalidParameterError(f"{name} must be a finite value > 0, got {value!r}")
-    return v
-
-
 def _xy_offset(cm_init, cm_final, voxel_size: float) -> np.ndarray:
     a = np.asarray(cm_init, dtype=np.float64)
     b = np.asarray(cm_final, dtype=np.float64)
@@ -69,7 +63,7 @@ def _xy_offset(cm_init, cm_final, voxel_size: float) -> np.ndarray:
         raise InvalidParameterError(
             f"cm_init and cm_final must have the same shape (..., 3), got {a.shape} and {b.shape}"
         )
-    return (b[..., :2] - a[..., :2]) / _positive("voxel_size", voxel_size)
+    return (b[..., :2] - a[..., :2]) / positive("voxel_size", voxel_size)
 
 
 def norm_final_dist_from_arrays(cm_init, cm_final, voxel_size: float) -> np.ndarray | float:
@@ -178,7 +172,7 @@ def l_coefficients_from_arrays(
     time_max_xy_dist : ndarray of shape (n,), float64
         ``timeMaxReached`` (s).
     """
-    L = _positive("voxel_size", voxel_size)
+    L = positive("voxel_size", voxel_size)
     x0 = np.asarray(cm_init, dtype=np.float64).reshape(-1, 3)
     n = x0.shape[0]
     m = np.asarray(max_xy_dist_from_arrays(x0, np.reshape(cm_final, (-1, 3)), L)).reshape(n)
@@ -231,8 +225,8 @@ def l_coefficient_from_arrays(
     -------
     LCoefficient
     """
-    L = _positive("voxel_size", voxel_size)
-    end_time = _positive("end_time", end_time)
+    L = positive("voxel_size", voxel_size)
+    end_time = positive("end_time", end_time)
     m = float(max_xy_dist_from_arrays(cm_init, cm_final, L))
     tr = np.asarray(trace, dtype=np.float64).reshape(-1, 4) if np.size(trace) else np.zeros((0, 4))
     lc, t_max = l_coefficients_from_arrays(

@@ -37,6 +37,7 @@ __all__ = [
     "plot_pareto_front",
     "plot_robot",
     "plot_trajectory",
+    "pyplot",
     "read_log",
     "run_figures",
     "save_robot_gif",
@@ -75,7 +76,8 @@ def trace_interval_for(design: Any, default: float = 0.01) -> float:
     return float(min(default, period / 20.0))
 
 
-def _plt():
+def pyplot():
+    """``matplotlib.pyplot`` on the headless Agg backend (unless one was chosen already)."""
     import matplotlib
 
     matplotlib.use("Agg", force=False)
@@ -89,7 +91,7 @@ def _save(fig: Any, path: str | os.PathLike[str]) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110, bbox_inches="tight", pad_inches=0.1)  # no clipped labels
-    _plt().close(fig)
+    pyplot().close(fig)
     return path
 
 
@@ -142,7 +144,7 @@ def plot_fitness_trend(
     path : path
         Output image.
     """
-    plt = _plt()
+    plt = pyplot()
     gens = [r["generation"] for r in rows]
     fig, ax = plt.subplots(figsize=(6.4, 4.8))
     for stat, label in (
@@ -175,7 +177,7 @@ def plot_best_fitness(
     metric : str
     path : path
     """
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6.4, 4.8))
     for label, rows in curves.items():
         ax.plot([r["generation"] for r in rows], [r[f"{metric}_best"] for r in rows], label=label)
@@ -212,7 +214,7 @@ def plot_compare(
     Runs of a group may have different lengths: each generation's median and
     quartiles use the runs that reached it (the legend gives the count).
     """
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7.0, 4.8))
     key = f"{metric}_{stat}"
     for i, (label, runs) in enumerate(groups.items()):
@@ -279,7 +281,7 @@ def plot_pareto_front(
 
     With two objectives one panel; with more, one panel per pair.
     """
-    plt = _plt()
+    plt = pyplot()
     F = np.asarray(objectives, dtype=np.float64)
     if F.ndim != 2 or F.shape[1] != len(names) or len(names) < 2:
         raise ValueError(f"need (n, >= 2) objectives matching names, got {F.shape} and {names}")
@@ -319,7 +321,7 @@ def plot_robot(design: Any, path: str | os.PathLike[str], title: str | None = No
     Colours are the palette's (the seed's: soft tissue cyan, bone blue,
     muscles red / green, evolved materials brown / dark red / yellow / orange).
     """
-    plt = _plt()
+    plt = pyplot()
     grid = np.asarray(design.grid)
     colors = design_colors(design)
     fig = plt.figure(figsize=(5, 5))
@@ -366,7 +368,7 @@ def plot_trajectory(
     terrain : Terrain, optional
         Boxes drawn (outlined) in the top view.
     """
-    plt = _plt()
+    plt = pyplot()
     L = float(voxel_size)
     tr = np.asarray(trace, dtype=np.float64)
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))

@@ -21,27 +21,22 @@ from softgym.tasks.episode import (
     EpisodeBatch,
     observation_size,
 )
-from softgym.tasks.suite import KINDS, Option, TaskKind
+from softgym.tasks.suite import KINDS, Option, TaskKind, flat_layout, stairs_layout, wall_layout
 from softgym.tasks.task import (
     ALIASES,
-    LAYOUTS,
     REWARDS,
     TASKS,
     Task,
     TaskLike,
-    flat_layout,
     get_task,
     measure_params,
     register_task,
-    stairs_layout,
     task_names,
-    wall_layout,
 )
 
 __all__ = [
     "ALIASES",
     "DRIVES",
-    "LAYOUTS",
     "OBS_POSITION_BOUND",
     "OBS_VELOCITY_BOUND",
     "REWARDS",

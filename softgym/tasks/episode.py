@@ -11,7 +11,6 @@ same numbers for a robot. Nothing here knows Gymnasium.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from typing import Any
 
@@ -29,6 +28,7 @@ from softgym.metrics import (
 )
 from softgym.tasks.task import Task, measure_params
 from softgym.terrain import Terrain
+from softgym.validate import positive, show
 
 __all__ = [
     "DRIVES",
@@ -61,32 +61,6 @@ def observation_size(grid_shape: Sequence[int]) -> int:
     return 6 * int(np.prod(grid_shape)) + 5
 
 
-def _show(value: Any) -> str:
-    # repr for an error message: short, and safe for ints beyond repr's 4300 digits
-    try:
-        text = repr(value)
-    except ValueError:
-        text = f"<{type(value).__name__} too large to print>"
-    return text if len(text) <= 80 else text[:77] + "..."
-
-
-def _is_real(value: Any) -> bool:
-    # int or float (Python or NumPy); bools, strings and complex numbers are not numbers here
-    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
-        value, (bool, np.bool_)
-    )
-
-
-def _positive(name: str, value: Any) -> float:
-    try:
-        v = float(value) if _is_real(value) else math.nan
-    except OverflowError:  # an int beyond float64
-        v = math.inf
-    if not (math.isfinite(v) and v > 0):
-        raise InvalidParameterError(f"{name} must be a finite number > 0 (s), got {_show(value)}")
-    return v
-
-
 def _check_max_episode_steps(value: Any) -> int | None:
     """``max_episode_steps`` as an int in 1..MAX_STEPS_PER_EPISODE, or None (no extra cap).
 
@@ -102,7 +76,7 @@ def _check_max_episode_steps(value: Any) -> int | None:
     if not ok or not 1 <= value <= MAX_STEPS_PER_EPISODE:
         raise InvalidParameterError(
             f"max_episode_steps must be None or an integer in 1..{MAX_STEPS_PER_EPISODE}, "
-            f"got {_show(value)}"
+            f"got {show(value)}"
         )
     return int(value)
 
@@ -163,7 +137,7 @@ class EpisodeBatch:
         if not isinstance(task, Task):
             raise InvalidParameterError(f"task must be a Task, got {type(task).__name__}")
         if not isinstance(drive, str) or drive not in DRIVES:
-            raise InvalidParameterError(f"drive must be one of {DRIVES}, got {_show(drive)}")
+            raise InvalidParameterError(f"drive must be one of {DRIVES}, got {show(drive)}")
         self.task = task
         self.drive = drive
         self.metric = task.reward
@@ -176,13 +150,13 @@ class EpisodeBatch:
                 f"grid_shape must be 3 integers (nx, ny, nz), each in 1..{MAX_GRID_DIM}"
             ) from None
         self.n_cells = int(np.prod(self.grid_shape))
-        self.control_dt = _positive("control_dt", control_dt)
+        self.control_dt = positive("control_dt", control_dt, unit=" (s)")
         if self.control_dt > MAX_CONTROL_DT:
             raise InvalidParameterError(
                 f"control_dt must be at most MAX_CONTROL_DT = {MAX_CONTROL_DT} s "
                 f"(the time one step simulates), got {control_dt!r}"
             )
-        self.episode_seconds = _positive("episode_seconds", episode_seconds)
+        self.episode_seconds = positive("episode_seconds", episode_seconds, unit=" (s)")
         cap = _check_max_episode_steps(max_episode_steps)
         ratio = self.episode_seconds / self.control_dt  # finite or inf, never NaN
         if cap is None and not ratio < MAX_STEPS_PER_EPISODE + 0.5:

@@ -25,7 +25,7 @@ import numpy as np
 from softgym.exceptions import InvalidParameterError
 from softgym.terrain import Block, Box, Terrain
 
-__all__ = ["KINDS", "Option", "TaskKind"]
+__all__ = ["KINDS", "Option", "TaskKind", "flat_layout", "stairs_layout", "wall_layout"]
 
 
 @dataclass(frozen=True)
@@ -259,13 +259,47 @@ def _swim(shape: Sequence[int], **_: Any) -> Terrain:
     return Terrain((), False, "swim", {"builder": "swim"})
 
 
+# ----------------------------------------------------------------------- the seed's
+def _seed_ring(shape: Sequence[int]) -> tuple[float, tuple[float, float]]:
+    """Interior side and centre of an obstacle ring around a robot grid of ``shape`` at the origin.
+
+    The seed's fence has a 10-voxel interior around its 6x6 workspace (a
+    2-voxel gap on every side); a wider grid keeps the 2-voxel gap.
+    """
+    nx, ny = int(shape[0]), int(shape[1])
+    return max(10.0, max(nx, ny) + 4.0), (nx / 2.0, ny / 2.0)
+
+
+def flat_layout(shape: Sequence[int]) -> Terrain:
+    """The floor alone (``shape`` is unused)."""
+    return Terrain.flat()
+
+
+def wall_layout(shape: Sequence[int]) -> Terrain:
+    """The seed's fence (1 voxel high and thick) centred on a robot grid of ``shape``."""
+    inner, center = _seed_ring(shape)
+    return Terrain.fence(inner=inner, center=center)
+
+
+def stairs_layout(shape: Sequence[int]) -> Terrain:
+    """Three rings, each 2 voxels wide and 1 voxel higher than the one inside it, around the grid."""
+    inner, center = _seed_ring(shape)
+    return Terrain.stairs(inner=inner, center=center)
+
+
 # ----------------------------------------------------------------------- suite
 _SEED = Option(0, 0, 2**31 - 1, "seed of the random heights", integer=True)
 
-#: The suite's new tasks by name (``flat``, ``wall`` and ``stairs`` are the seed's, in task.py).
+#: Every kind of task by name, the one registry: the seed's three (``flat``, ``wall``,
+#: ``stairs``: no arguments) and the suite's.
 KINDS: dict[str, TaskKind] = {
     k.name: k
     for k in (
+        TaskKind("flat", "walk on flat ground (the seed's)", flat_layout, "norm_final_dist"),
+        TaskKind("wall", "get past a fence around the start (the seed's obstacle)", wall_layout,
+                 "max_xy_dist"),  # fmt: skip
+        TaskKind("stairs", "climb three rings of steps around the start", stairs_layout,
+                 "max_xy_dist"),  # fmt: skip
         TaskKind(
             "stairs_down", "walk down a stepped pyramid from its top", stairs_down_layout,
             "max_xy_dist",

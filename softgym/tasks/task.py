@@ -30,9 +30,8 @@ accepted wherever a task name is: ``softgym.evaluate(d, task=Terrain.stairs())``
 
 from __future__ import annotations
 
-import math
 import os
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -43,24 +42,21 @@ from softgym.exceptions import InvalidParameterError, InvalidTerrainError
 from softgym.metrics import TASK_MEASURES, WALK_METRICS, dilute, task_measure, walk_metrics
 from softgym.tasks.suite import KINDS
 from softgym.terrain import Terrain
+from softgym.validate import positive
 
 if TYPE_CHECKING:  # annotations only: softgym.engine's __init__ loads compiled code
     from softgym.engine import Rollout, SimConfig
 
 __all__ = [
     "ALIASES",
-    "LAYOUTS",
     "REWARDS",
     "TASKS",
     "Task",
     "TaskLike",
-    "flat_layout",
     "get_task",
     "measure_params",
     "register_task",
-    "stairs_layout",
     "task_names",
-    "wall_layout",
 ]
 
 #: Schema tag of :meth:`Task.to_dict`.
@@ -71,54 +67,8 @@ SCHEMA = "softgym.task"
 REWARDS: tuple[str, ...] = ("norm_final_dist", "max_xy_dist", *TASK_MEASURES)
 
 
-def _around(shape: Sequence[int]) -> tuple[float, tuple[float, float]]:
-    """Interior side and centre of an obstacle ring around a robot grid of ``shape`` at the origin.
-
-    The seed's fence has a 10-voxel interior around its 6x6 workspace (a
-    2-voxel gap on every side); a wider grid keeps the 2-voxel gap.
-    """
-    nx, ny = int(shape[0]), int(shape[1])
-    return max(10.0, max(nx, ny) + 4.0), (nx / 2.0, ny / 2.0)
-
-
-def flat_layout(shape: Sequence[int]) -> Terrain:
-    """The floor alone (``shape`` is unused)."""
-    return Terrain.flat()
-
-
-def wall_layout(shape: Sequence[int]) -> Terrain:
-    """The seed's fence (1 voxel high and thick) centred on a robot grid of ``shape``."""
-    inner, center = _around(shape)
-    return Terrain.fence(inner=inner, center=center)
-
-
-def stairs_layout(shape: Sequence[int]) -> Terrain:
-    """Three rings, each 2 voxels wide and 1 voxel higher than the one inside it, around the grid."""
-    inner, center = _around(shape)
-    return Terrain.stairs(inner=inner, center=center)
-
-
-#: Terrains placed around each robot's grid (its corner at the origin): name -> builder(shape,
-#: **options) (the suite's kinds take their arguments, :mod:`softgym.tasks.suite`).
-LAYOUTS: dict[str, Callable[..., Terrain]] = {
-    "flat": flat_layout,
-    "wall": wall_layout,
-    "stairs": stairs_layout,
-    **{name: kind.layout for name, kind in KINDS.items()},
-}
-
 #: Other names users know a task by (the seed's reports call the wall a fence).
 ALIASES: dict[str, str] = {"fence": "wall"}
-
-
-def _positive(name: str, value: Any) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(f"{name} must be a number, got {value!r}") from None
-    if not (math.isfinite(v) and v > 0):
-        raise InvalidParameterError(f"{name} must be finite and > 0, got {value!r}")
-    return v
 
 
 @dataclass(frozen=True)
@@ -180,22 +130,22 @@ class Task:
         terrain = self.terrain
         if isinstance(terrain, str):
             terrain = ALIASES.get(terrain, terrain)
-            if terrain not in LAYOUTS:
+            if terrain not in KINDS:
                 raise InvalidParameterError(
                     f"unknown terrain layout {self.terrain!r}; expected one of "
-                    f"{sorted(LAYOUTS)}, a Terrain, or a registered task name through get_task()"
+                    f"{sorted(KINDS)}, a Terrain, or a registered task name through get_task()"
                 )
         elif not isinstance(terrain, Terrain):
             raise InvalidParameterError(
                 f"terrain must be a layout name or a Terrain, got {type(terrain).__name__}"
             )
         object.__setattr__(self, "terrain", terrain)
-        object.__setattr__(self, "seconds", _positive("seconds", self.seconds))
-        object.__setattr__(self, "trace_interval", _positive("trace_interval", self.trace_interval))
+        object.__setattr__(self, "seconds", positive("seconds", self.seconds))
+        object.__setattr__(self, "trace_interval", positive("trace_interval", self.trace_interval))
         if not isinstance(self.options, Mapping):
             raise InvalidParameterError(f"options must be a dict, got {type(self.options).__name__}")
         kind = KINDS.get(terrain) if isinstance(terrain, str) else None
-        if kind is None:
+        if kind is None or not kind.options:
             if self.options:
                 raise InvalidParameterError(
                     f"task {self.name!r} takes no options, got {sorted(self.options)}"
@@ -246,7 +196,7 @@ class Task:
         """The terrain of a robot whose grid of ``shape`` has its corner at the origin."""
         if isinstance(self.terrain, Terrain):
             return self.terrain
-        return LAYOUTS[self.terrain](shape, **self.options)
+        return KINDS[self.terrain].layout(shape, **self.options)
 
     def config(self, base: SimConfig | None = None) -> SimConfig:
         """The engine settings: ``base`` (default the seed's) with ``sim`` and ``trace_interval``."""
@@ -337,7 +287,7 @@ def measure_params(terrains: Sequence[Terrain]) -> dict[str, np.ndarray]:
 
 
 #: The named tasks: one name each (``"fence"`` is read as ``"wall"``, see :data:`ALIASES`).
-TASKS: dict[str, Task] = {name: Task(terrain=name) for name in LAYOUTS}
+TASKS: dict[str, Task] = {name: Task(terrain=name) for name in KINDS}
 
 #: What :func:`get_task` accepts: a name, a JSON file, a Terrain, a Task or its dict.
 TaskLike = str | os.PathLike | Terrain | Task | Mapping[str, Any]

@@ -3,52 +3,28 @@
 Hypothesis properties over the keyword arguments of :class:`SoftWalkerEnv` and
 :class:`SoftWalkerVectorEnv` (each one valid, out of range, or of another type) and over
 the actions given to ``step`` (dtypes, shapes, values). An env that builds is reset and
-stepped once; a refused action leaves the state untouched. ``OUTCOMES`` counts what each
+stepped once; a refused action leaves the state untouched. ``fuzzing.OUTCOMES`` counts what each
 property saw (used for the issue's tally). ``gym.make``'s own ``max_episode_steps`` is
 Gymnasium's (its TimeLimit) and is not fuzzed here.
 """
 
-import os
-from collections import Counter
-
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from fuzzing import FUZZ, FUZZ_EXAMPLES  # tests/fuzzing.py
+from fuzzing import outcome_and_result as outcome
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 from softgym.design import RobotDesign, default_walker
 from softgym.engine import SimConfig
 from softgym.envs import SoftWalkerEnv, SoftWalkerVectorEnv
-from softgym.exceptions import SoftGymError
 from softgym.terrain import Terrain
 
 pytestmark = pytest.mark.filterwarnings("ignore:.*ends episodes after:UserWarning")
 
-OUTCOMES: Counter = Counter()
-# SOFTGYM_FUZZ_EXAMPLES raises the count for a deeper run (the default keeps the suite fast)
-N_EXAMPLES = int(os.environ.get("SOFTGYM_FUZZ_EXAMPLES", "150"))
-FUZZ = settings(
-    max_examples=N_EXAMPLES,
-    deadline=None,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
-    database=None,
-)
 # building an env that works means settling it (about 0.1 s): fewer of those by default
-FUZZ_KWARGS = settings(FUZZ, max_examples=max(1, N_EXAMPLES * 2 // 3))
-
-
-def outcome(kind, fn, *args, **kwargs):
-    """Call ``fn``; count and return (label, result); fail on anything but a SoftGymError."""
-    try:
-        result = fn(*args, **kwargs)
-    except SoftGymError as exc:
-        OUTCOMES[(kind, type(exc).__name__)] += 1
-        return type(exc).__name__, None
-    except Exception as exc:  # noqa: BLE001 - the property under test
-        pytest.fail(f"{kind}: {type(exc).__name__} escaped: {exc!s:.300}")
-    OUTCOMES[(kind, "valid")] += 1
-    return "valid", result
+FUZZ_KWARGS = settings(FUZZ, max_examples=max(1, FUZZ_EXAMPLES * 2 // 3))
 
 
 JUNK = (

@@ -26,7 +26,7 @@ def test_ctrl_c_names_the_checkpoint_and_resumes_exactly(tmp_path, Run, caplog):
     ref = Run(exp, tmp_path / "ref", seed=3, generations=2, figures=False, progress=False).run()
     run = Run(exp, tmp_path / "r", seed=3, generations=2, figures=False, progress=False,
               on_generation=_ctrl_c_after(1))  # fmt: skip
-    with caplog.at_level(logging.WARNING, logger="evolvers"), pytest.raises(RunInterrupted) as info:
+    with caplog.at_level(logging.INFO, logger="evolvers"), pytest.raises(RunInterrupted) as info:
         run.run()
     exc = info.value
     assert isinstance(exc, KeyboardInterrupt)

@@ -202,8 +202,7 @@ def test_simulated_run_writes_pairs_and_figures(tmp_path):
 
 def test_pairs_on_dask_equal_local(tmp_path):
     pytest.importorskip("distributed")
-    from evolvers.distributed import dask_client
-    from evolvers.poet import DaskJobsFn
+    from evolvers.distributed import DaskBatchFn, dask_client
 
     exp = tiny("obstacles-attempt2", seconds=1.0, pop_size=3)
     cfg = PoetConfig(reproduce_every=1, transfer_every=1, mc_low=0.0, mc_high=50.0,
@@ -212,7 +211,7 @@ def test_pairs_on_dask_equal_local(tmp_path):
     local = PoetRun(exp, tmp_path / "local", **common)
     local.run()
     with dask_client("local", n_workers=2, processes=False) as client:
-        remote = PoetRun(exp, tmp_path / "dask", jobs_fn=DaskJobsFn(client), **common)
+        remote = PoetRun(exp, tmp_path / "dask", batch_fn=DaskBatchFn(client), **common)
         remote.run()
     assert len(local.pairs) > 1  # a terrain was admitted: several terrains were evaluated at once
     assert _rows(remote.rows) == _rows(local.rows)

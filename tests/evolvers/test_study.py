@@ -9,8 +9,9 @@ from evolver_helpers import tiny
 
 from evolvers.evaluation import EvalStats
 from evolvers.genome import Individual
-from evolvers.recorder import add_run_note, obstacle_footprint, read_run_notes, study_columns
-from evolvers.study import (
+from evolvers.recorder import add_run_note, read_run_notes, study_columns
+from evolvers.study.data import load_runs
+from evolvers.study.runs import (
     SEED_REPORT,
     plan,
     run_order,
@@ -19,9 +20,10 @@ from evolvers.study import (
     settings_difference,
     time_to_go,
 )
-from evolvers.study_report import a12, load_runs, permutation_pvalue
-from softgym.cli import main
+from evolvers.study.stats import a12, permutation_pvalue
 from softgym.exceptions import InvalidParameterError
+from softgym.metrics import obstacle_footprint
+from softgym_cli import main
 
 TINY = ["--pop", "4", "--seconds", "1.5", "--shape", "4", "4", "4", "--quiet"]
 VERDICTS = {"holds", "partly", "does not hold", "not run"}
@@ -61,8 +63,8 @@ def test_study_runs_resumes_skips_and_reports(tmp_path, capsys):
     # a note in a run folder (e.g. left by a repair) is quoted by the report
     add_run_note(root / "controller-pareto" / "seed-1", "repaired after a bad resume", generation=1)
     assert read_run_notes(root / "controller-pareto" / "seed-1")[0]["generation"] == 1
-    out = tmp_path / "report"
-    assert main(["study", "report", str(root), "--out", str(out)]) == 0
+    out = root / "report"  # by default the report goes beside the runs, not over docs/study
+    assert main(["study", "report", str(root)]) == 0
     text = (out / "README.md").read_text()
     assert "controller-pareto seed 1 (" in text and "repaired after a bad resume" in text
     claims = json.loads((out / "claims.json").read_text())
@@ -171,7 +173,7 @@ def test_statistics():
 
 def test_study_columns_count_wall_crossings():
     exp = tiny("obstacles-attempt2")
-    x0, x1, y0, y1 = obstacle_footprint(exp)
+    x0, x1, y0, y1 = obstacle_footprint(exp.make_task().terrain_for(exp.shape))
     assert (x0, x1) == (-4.0, 8.0)  # the fence around a 4x4 grid: 10-voxel interior, 1 thick
     rng = np.random.default_rng(0)
     inds = []
@@ -242,7 +244,7 @@ def _fake_run(scenario, seed, voxels, target, best=1.0, repeats=0):
     ``best + g``; each generation >= 1 has 10 new robots of which ``repeats`` were seen before."""
     from pathlib import Path
 
-    from evolvers.study_report import RunData
+    from evolvers.study.data import RunData
 
     rows = [{"generation": g, "top_n_voxels": v, "norm_final_dist_best": best + g,
              "new_individuals": 10, "repeated_phenotypes": repeats}
@@ -256,7 +258,7 @@ def _fake_run(scenario, seed, voxels, target, best=1.0, repeats=0):
 def test_fixed_generation_claim_counts_unfinished_runs_past_it():
     # T2-voxels reads T1 at T2's last generation (3 here): T1 seeds that passed it count,
     # complete or not; a seed short of it is left out and named
-    from evolvers.study_report import claims
+    from evolvers.study.claims import claims
 
     t2 = [_fake_run("materials-t2", s, [200, 150, 100, 50 + s], 3) for s in range(4)]
     t1 = [
@@ -280,7 +282,7 @@ def test_t1_final_names_the_flying_winners():
     # flies (thousands of body lengths); the claim says so and which seeds
     from pathlib import Path
 
-    from evolvers.study_report import LIGHT_MUSCLE, claims, winner_of
+    from evolvers.study.claims import LIGHT_MUSCLE, claims, winner_of
 
     root = Path(__file__).resolve().parents[2] / "benchmarks" / "data" / "study" / "runs"
     runs = load_runs(root / "materials-t1")
@@ -302,7 +304,7 @@ def test_t1_final_names_the_flying_winners():
 def test_novelty_claims_compare_with_the_reports_baselines():
     # novelty-fitness: the report compares novelty with "the other two evolution techniques"
     # (materials and controller evolution); basic evolution with the same generations is context
-    from evolvers.study_report import claims
+    from evolvers.study.claims import claims
 
     def runs(name, best, repeats=0, n=5):
         return [_fake_run(name, k, [100] * 4, 3, best=best + k, repeats=repeats) for k in range(n)]
@@ -340,7 +342,7 @@ def test_novelty_claims_compare_with_the_reports_baselines():
 def test_obstacle_claims_wait_for_seeds_that_have_not_decided():
     # a seed that has neither crossed nor run 80 generations says nothing yet about crossing
     # "in 80 generations": it is left out (named), not counted as a failure
-    from evolvers.study_report import claims
+    from evolvers.study.claims import claims
 
     def run(seed, generations, crossed_at=None):
         r = _fake_run("obstacles", seed, [100] * (generations + 1), 120)

@@ -4,7 +4,7 @@ import importlib.util
 import json
 from pathlib import Path
 
-from softgym.cli import main
+from softgym_cli import main
 
 ROOT = Path(__file__).resolve().parents[2]
 _spec = importlib.util.spec_from_file_location("study_state", ROOT / "scripts" / "study_state.py")

@@ -153,7 +153,7 @@ def test_evaluate_and_the_controller_env_agree_on_a_suite_measure():
 
 def test_evolution_on_a_suite_task_selects_on_its_score():
     exp = get_experiment("basic", task="jump")
-    assert exp.fitness.name == "score" and exp.task == "jump"
+    assert exp.fitness.name == "score" and exp.task.spec == "jump"
     assert get_experiment("basic", task="gap:width=3").make_task().options["width"] == 3.0
     assert get_experiment("basic", task="swim").make_task().config().fluid_drag > 0
     assert get_experiment("basic").fitness.name == "norm_final_dist"

@@ -118,7 +118,7 @@ def test_same_design_same_task_same_metrics_through_evaluate_and_an_env_episode(
 
 def test_experiments_and_old_run_configs_go_through_the_registry(tmp_path):
     exp = get_experiment("obstacles")
-    assert exp.task == "wall" and exp.make_task().name == "wall"
+    assert exp.task.spec == "wall" and exp.make_task().name == "wall"
     old = {**exp.to_dict()}
     old["terrain"] = "fence"  # a config.json written before the task layer
     del old["task"]
@@ -126,6 +126,6 @@ def test_experiments_and_old_run_configs_go_through_the_registry(tmp_path):
     path = tmp_path / "boxes.json"
     path.write_text(Terrain.stairs(n_rings=2).to_json())
     custom = get_experiment("basic", task=str(path))
-    assert isinstance(custom.task, Terrain)
+    assert isinstance(custom.task.terrain, Terrain)
     assert Experiment.from_dict(json.loads(json.dumps(custom.to_dict()))) == custom
     assert get_experiment("basic", task="stairs").make_task(n_threads=1).n_threads == 1

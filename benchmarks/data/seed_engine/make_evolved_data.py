@@ -55,10 +55,10 @@ def run_designs(run: Path, population: int) -> dict[str, dict[str, Any]]:
     """``{name: {"design", "terrain", "source"}}`` of a run folder's chosen individuals."""
     config = read_json(run / "config.json")
     exp = Experiment.from_dict(config["experiment"])
-    terrain = "fence" if exp.task in ("wall", "fence") else "flat"
-    if exp.task not in ("flat", "wall", "fence"):
+    terrain = "fence" if exp.task.name == "wall" else "flat"
+    if exp.task.spec not in ("flat", "wall"):
         raise SystemExit(
-            f"{run}: task {exp.task!r}: only flat and wall runs can be written for the seed"
+            f"{run}: task {exp.task.spec!r}: only flat and wall runs can be written for the seed"
         )
     stem = f"{exp.name}-s{config['seed']}"
     out: dict[str, dict[str, Any]] = {}

@@ -20,7 +20,7 @@ worker (a LocalCluster of ``workers`` processes, or an existing scheduler's
 workers: ``pip install "softgym[distributed]"``); a run lost with its worker is
 resubmitted and resumes from its checkpoint.
 
-The report (:mod:`evolvers.study_report`, ``softgym study report RUNS``) is
+The report (:mod:`evolvers.study.report`, ``softgym study report RUNS``) is
 written from the run folders alone.
 
 ================================  ======================  =====  =====  ==============================

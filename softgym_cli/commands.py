@@ -1,0 +1,289 @@
+"""The commands that read or render what exists: ``simulate``, ``replay``, ``compare``,
+``view``, ``convert`` and ``experiments``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+__all__ = ["add_tool_parsers"]
+
+
+def _cmd_simulate(args: argparse.Namespace) -> int:
+    from softgym.design import RobotDesign, default_walker
+    from softgym.engine import SimConfig, Simulation
+    from softgym.metrics import norm_final_dist
+    from softgym.render.figures import plot_trajectory
+
+    robot = RobotDesign.load(args.design) if args.design else default_walker()
+    cfg = SimConfig(actuation=args.actuation, trace_interval=0.05)
+    sim = Simulation([robot], cfg)
+    t0 = time.perf_counter()
+    rollout = sim.run(args.seconds)
+    wall = time.perf_counter() - t0
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    summary = {
+        "seconds": args.seconds,
+        "wall_seconds": wall,
+        "steps": int(rollout.steps[0]),
+        "dt": float(rollout.dt[0]),
+        "n_voxels": int(rollout.voxel_offsets[1]),
+        "voxel_steps_per_s": float(rollout.voxel_offsets[1] * rollout.steps[0] / wall),
+        "norm_final_dist": float(norm_final_dist(rollout)[0]),
+        "diverged": bool(rollout.diverged[0]),
+    }
+    (out / "summary.json").write_text(json.dumps(summary, indent=2))
+    plot_trajectory(rollout.trace(0), out / "trajectory.png", voxel_size=rollout.voxel_size,
+                    init_time=rollout.init_time)  # fmt: skip
+    print(json.dumps(summary, indent=2))
+    print(f"wrote {out / 'trajectory.png'} and {out / 'summary.json'}")
+    return 0
+
+def _cmd_replay(args: argparse.Namespace) -> int:
+    from evolvers.experiments import Experiment
+    from softgym.design import RobotDesign
+    from softgym.evaluate import evaluate
+    from softgym.exceptions import SoftGymError
+    from softgym.render.figures import (
+        plot_robot,
+        plot_trajectory,
+        save_robot_gif,
+        trace_interval_for,
+    )
+
+    run_dir = Path(args.run_dir)
+    try:
+        cfg = json.loads((run_dir / "config.json").read_text())
+        design = RobotDesign.load(run_dir / "best_design.json")
+        best = json.loads((run_dir / "best_designs.json").read_text())["best"][0]
+        experiment = Experiment.from_dict(cfg["experiment"])
+    except (OSError, ValueError, KeyError, TypeError, SoftGymError) as exc:
+        print(f"softgym replay: {run_dir} is not a finished run folder ({exc})", file=sys.stderr)
+        return 2
+    exp = cfg["experiment"]
+    seconds = float(exp["seconds"] if args.seconds is None else args.seconds)
+    task = experiment.make_task().replace(seconds=seconds)
+    m = evaluate([design], task=task, traces=True)
+    out = Path(args.out) if args.out else run_dir / "replay"
+    terrain = task.terrain_for(design.shape)
+    fine = evaluate([design], task=task.replace(trace_interval=trace_interval_for(design)),
+                    traces=True)  # fmt: skip
+    paths = [
+        plot_robot(design, out / "best_robot.png", title=f"best robot ({exp['name']})"),
+        plot_trajectory(
+            fine["traces"][0], out / "best_trajectory.png", init_time=1.0, terrain=terrain
+        ),
+    ]
+    if not args.no_gif:
+        paths.append(
+            save_robot_gif(design, out / "best_robot.gif", terrain, seconds, config=task.config())
+        )
+    if args.video:
+        paths.append(
+            save_robot_gif(design, out / "best_robot.mp4", terrain, seconds, fps=20.0,
+                           config=task.config())  # fmt: skip
+        )
+    metrics = {
+        k: (v[0].item() if hasattr(v[0], "item") else v[0]) for k, v in m.items() if k != "traces"
+    }
+    summary = {"experiment": exp["name"], "seconds": seconds, "metrics": metrics,
+               "recorded": best["objectives"], "files": [str(p) for p in paths]}  # fmt: skip
+    print(json.dumps(summary, indent=2))
+    return 0
+
+
+def _config_key(cfg: dict) -> str:
+    """What makes two runs the same configuration: everything but the seed."""
+    from evolvers.experiments import Experiment
+
+    exp = Experiment.from_dict(cfg["experiment"]).to_dict()
+    exp.pop("generations", None)
+    rest = {k: v for k, v in cfg.items() if k not in ("seed", "experiment", "generations")}
+    return json.dumps({"experiment": exp, **rest}, sort_keys=True, default=str)
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    import statistics
+
+    from evolvers.recorder import config_difference, read_run_config
+    from softgym.render.figures import plot_compare, read_log
+
+    groups: dict[str, list] = {}
+    configs: dict[str, dict] = {}
+    logs = {}
+    for d in args.run_dirs:
+        cfg = read_run_config(d)  # CheckpointError naming the folder if it is not a run
+        key = _config_key(cfg)
+        groups.setdefault(key, []).append(d)
+        configs.setdefault(key, cfg)
+        logs[d] = read_log(d)
+    metric = args.metric
+    if metric is None:
+        first = configs[next(iter(configs))]["experiment"]["objectives"][0]["name"]
+        metric = first if first != "age" else "norm_final_dist"
+    column, top = f"{metric}_{args.stat}", f"top_{metric}"
+    for d, rows in logs.items():
+        if rows and column not in rows[0] and args.stat == "best" and top in rows[0]:
+            # e.g. an obstacle run (fitness max_xy_dist) beside flat runs: its log holds the
+            # fittest robot's NormFinalDist, which stands in for the best
+            logs[d] = [{**r, column: r[top]} for r in rows]
+            print(f"softgym compare: {d} logs no {column}; its fittest robot's {metric} "
+                  f"({top}) stands in", file=sys.stderr)  # fmt: skip
+        elif not rows or column not in rows[0]:
+            have = sorted({k.rsplit("_", 1)[0] for k in (rows[0] if rows else {})
+                           if k.endswith("_best")})  # fmt: skip
+            print(f"softgym compare: {d} did not record {metric!r} (it has: {', '.join(have) or 'no generation yet'}); "
+                  f"pick a metric every run has with --metric", file=sys.stderr)  # fmt: skip
+            return 2
+    labelled: dict[str, list] = {}
+    base = configs[next(iter(configs))]
+    for key, dirs in groups.items():
+        cfg = configs[key]
+        label = f"{cfg['experiment']['name']} ({cfg['backend']}"
+        label += f", {cfg['algorithm']})" if cfg.get("algorithm") else ")"
+        if label in labelled or any(k != key and configs[k]["experiment"]["name"] == cfg["experiment"]["name"]
+                                    and configs[k]["backend"] == cfg["backend"] for k in groups):  # fmt: skip
+            diff = config_difference(base, cfg)
+            if diff:
+                label += f" [{diff.split(':')[0]}={diff.split('!=')[-1].strip()}]"
+        labelled[label] = [logs[d] for d in dirs]
+    path = plot_compare(labelled, metric, args.out, stat=args.stat)
+    for label, runs in labelled.items():
+        finals = [rows[-1][column] for rows in runs]
+        print(f"{label}: {len(runs)} run(s), final {args.stat} {metric} median "
+              f"{statistics.median(finals):.4g}")  # fmt: skip
+    print(path)
+    return 0
+
+
+def _cmd_view(args: argparse.Namespace) -> int:
+    from softgym.render.viewer import write_viewer
+
+    src = Path(args.source)
+    task, seconds, name = args.task or "flat", args.seconds, src.stem
+    if src.is_dir():
+        from evolvers.experiments import Experiment
+        from evolvers.recorder import read_run_config
+        from softgym.design import RobotDesign
+
+        cfg = read_run_config(src)
+        exp = Experiment.from_dict(cfg["experiment"])
+        task = args.task or exp.make_task()
+        seconds = exp.seconds if seconds is None else seconds
+        name = f"{src.name}: best robot ({exp.name})"
+        if "poet" in cfg:  # POET: the best robot of its pairs, on its own terrain
+            from softgym.io import read_json
+            from softgym.tasks.terrain_genome import TerrainGenome
+
+            pair = max(read_json(src / "pairs.json")["pairs"], key=lambda p: (p["score"], -p["id"]))
+            design = RobotDesign.from_dict(pair["design"])
+            if args.task is None:
+                terrain = TerrainGenome.from_dict(pair["terrain"]).terrain(exp.shape)
+                task = task.replace(terrain=terrain)
+            name = f"{src.name}: best robot (POET pair {pair['id']}, {pair['describe']})"
+        else:  # the other drivers (native, DEAP, pymoo, QD) write best_design.json
+            design = RobotDesign.load(src / "best_design.json")
+        out = Path(args.out) if args.out else src / "view.html"
+    else:
+        design = _load_design(src)
+        out = Path(args.out) if args.out else src.with_suffix(".html")
+    path = write_viewer(design, out, seconds=5.0 if seconds is None else seconds, fps=args.fps,
+                        task=task, name=name)  # fmt: skip
+    print(path)
+    return 0
+
+
+def _load_design(path: Path):
+    from softgym.design import RobotDesign, load_vxa
+
+    if path.suffix.lower() in (".vxa", ".vxd", ".xml"):
+        return load_vxa(path)
+    return RobotDesign.load(path)
+
+
+def _cmd_convert(args: argparse.Namespace) -> int:
+    from softgym.design import save_vxa
+
+    src, dst = Path(args.source), Path(args.dest)
+    design = _load_design(src)
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    if dst.suffix.lower() == ".vxa":
+        save_vxa(design, dst)
+    elif dst.suffix.lower() == ".json":
+        design.save(dst)
+    else:
+        print(f"softgym convert: {dst} must end in .json or .vxa", file=sys.stderr)
+        return 2
+    print(f"{src} -> {dst} ({design.n_voxels} voxels, {design.shape[0]}x{design.shape[1]}x{design.shape[2]})")
+    return 0
+
+
+def _cmd_experiments(args: argparse.Namespace) -> int:
+    from evolvers.experiments import EXPERIMENTS
+
+    for name, exp in EXPERIMENTS.items():
+        objs = ", ".join(f"{o.name} ({'max' if o.maximize else 'min'})" for o in exp.objectives)
+        print(f"{name:24s} {exp.selection:16s} {objs}\n{'':24s} {exp.description}")
+    return 0
+
+
+
+def add_tool_parsers(sub: Any) -> None:
+    """``simulate``, ``replay``, ``compare``, ``view``, ``convert`` and ``experiments``."""
+    p = sub.add_parser("simulate", help="simulate one robot and plot its trajectory")
+    p.add_argument("--design", help="a RobotDesign JSON file (default: the embedded walker)")
+    p.add_argument("--seconds", type=float, default=5.0, help="simulated seconds")
+    p.add_argument("--actuation", choices=["seed", "symmetric"], default="seed",
+                   help="muscle law: the seed's contraction-only, or symmetric")  # fmt: skip
+    p.add_argument("--out", default="runs/simulate", help="output folder")
+    p.set_defaults(func=_cmd_simulate)
+
+    p = sub.add_parser("replay", help="re-simulate and render the best robot of a run folder")
+    p.add_argument("run_dir")
+    p.add_argument("--seconds", type=float, help="simulated seconds (default: the run's)")
+    p.add_argument("--out", help="output folder (default: RUN_DIR/replay)")
+    p.add_argument("--no-gif", action="store_true", help="no GIF")
+    p.add_argument("--video", action="store_true", help='also an MP4 (pip install ".[video]")')
+    p.set_defaults(func=_cmd_replay)
+
+    p = sub.add_parser(
+        "compare",
+        help="best fitness per generation of several runs; seeds of one configuration as "
+        "median + interquartile band (Fig. 4)",
+    )
+    p.add_argument("run_dirs", nargs="+", metavar="RUN", help="run folders (any mix)")
+    p.add_argument("--metric", help="metric to compare (default: the first run's fitness; with "
+                   "--stat best, a run that logs only its fittest robot's value, top_METRIC, "
+                   "compares that)")
+    p.add_argument("--stat", choices=["best", "median", "mean", "worst"], default="best",
+                   help="per-generation statistic of each run")  # fmt: skip
+    p.add_argument("--out", default="runs/compare.png", help="figure file")
+    p.set_defaults(func=_cmd_compare)
+
+    p = sub.add_parser(
+        "view", help="write an interactive 3D viewer (self-contained HTML) of a robot's rollout"
+    )
+    p.add_argument("source", metavar="RUN_OR_DESIGN",
+                   help="a run folder (its best robot, in its task; POET: on its terrain) "
+                   "or a design .json / .vxa")  # fmt: skip
+    p.add_argument("--out",
+                   help="HTML file (default: RUN/view.html, or the design's name with .html)")  # fmt: skip
+    p.add_argument("--seconds", type=float, help="simulated seconds (default: the run's, or 5)")
+    p.add_argument("--fps", type=float, default=10.0, help="frames per simulated second")
+    p.add_argument("--task", metavar="TASK[:ARG=V,...]|FILE.json",
+                   help="the world (default: the run's task, or flat)")  # fmt: skip
+    p.set_defaults(func=_cmd_view)
+
+    p = sub.add_parser("convert", help="convert a design between JSON and .vxa (both ways)")
+    p.add_argument("source", metavar="A", help="a design .json or .vxa file")
+    p.add_argument("dest", metavar="B", help="the output .json or .vxa file")
+    p.set_defaults(func=_cmd_convert)
+
+    p = sub.add_parser("experiments", help="list the named experiments")
+    p.set_defaults(func=_cmd_experiments)

@@ -1,0 +1,63 @@
+"""The ``softgym`` parser and entry point: global flags, one help format, one error line."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import sys
+
+from softgym.exceptions import SoftGymError
+from softgym_cli.commands import add_tool_parsers
+from softgym_cli.flags import HelpFormatter, global_flags, installed_version, subcommands
+from softgym_cli.runs import add_evolve_parser, add_poet_parser, add_qd_parser, explicit_flags
+from softgym_cli.study import add_study_parser
+
+__all__ = ["main"]
+
+
+def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
+    """The ``softgym`` parser and its ``evolve`` subparser."""
+    import softgym_cli
+
+    parser = argparse.ArgumentParser(
+        prog="softgym", description=softgym_cli.__doc__.split("\n")[0],
+        formatter_class=HelpFormatter,
+    )  # fmt: skip
+    parser.add_argument("--version", action="version", version=f"softgym {installed_version()}")
+    global_flags(parser, None)
+    parser.add_argument(
+        "--debug", action="store_true", help="show the traceback of an error (before the command)"
+    )
+    sub = subcommands(parser, "command")
+    add_tool_parsers(sub)
+    evolve = add_evolve_parser(sub)
+    add_study_parser(sub)
+    add_qd_parser(sub)
+    add_poet_parser(sub)
+    return parser, evolve
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the ``softgym`` command.
+
+    A :class:`~softgym.exceptions.SoftGymError` or :class:`OSError` from a
+    subcommand prints one line, ``softgym <command>: <message>``, to stderr and
+    returns 2; ``softgym --debug <command> ...`` raises it instead (traceback).
+    """
+    parser, evolve_parser = _parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = parser.parse_args(argv)
+    if args.command == "evolve":
+        args.explicit = explicit_flags(evolve_parser, argv)
+    level = (logging.WARNING, logging.INFO, logging.DEBUG)[min(args.verbose, 2)]
+    logging.basicConfig(level=level, format="%(message)s")
+    for name in ("softgym", "evolvers"):
+        logging.getLogger(name).setLevel(level)
+    try:
+        return int(args.func(args))
+    except (SoftGymError, OSError) as exc:  # bad input or a file problem: one line, exit 2
+        if args.debug:
+            raise
+        message = " ".join(str(exc).split()) or type(exc).__name__
+        print(f"softgym {args.command}: {message}", file=sys.stderr)
+        return 2
