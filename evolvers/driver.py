@@ -35,6 +35,7 @@ from evolvers.experiments import Experiment, smoke_sizes
 from evolvers.genome import Individual
 from evolvers.recorder import RunRecorder
 from softgym.exceptions import CheckpointError, InvalidParameterError
+from softgym.io import RunLock
 
 __all__ = ["Checkpoint", "Driver", "IdCounter"]
 
@@ -88,6 +89,8 @@ class Driver:
 
     Raises
     ------
+    RunFolderLockedError
+        From :meth:`run` when another process is writing the run folder.
     RunInterrupted
         From :meth:`run` on Ctrl-C (a ``KeyboardInterrupt``; the simulations
         stop within a fraction of a second): it names the last checkpoint
@@ -212,20 +215,22 @@ class Driver:
         -------
         :meth:`result`: the final population (QD: the elites; POET: the pairs).
         """
-        if not (resume and self.resume()):
-            self.start()
-        self.recorder.open_progress(self.generation, self.generations, self.label)
-        try:
-            while self.generation < self.generations:
-                t0 = time.perf_counter()
-                stats = self._step()
-                self._end_generation(stats, time.perf_counter() - t0)
-        except KeyboardInterrupt as exc:
-            done = len(self.recorder.rows) - 1  # the last checkpointed generation
-            raise self.recorder.interrupted(done, self.resume_command) from exc
-        finally:
-            self.recorder.close_progress()
-        self.finish()
+        # one writer per run folder: a second run into it is refused, naming the first
+        with RunLock(self.out):
+            if not (resume and self.resume()):
+                self.start()
+            self.recorder.open_progress(self.generation, self.generations, self.label)
+            try:
+                while self.generation < self.generations:
+                    t0 = time.perf_counter()
+                    stats = self._step()
+                    self._end_generation(stats, time.perf_counter() - t0)
+            except KeyboardInterrupt as exc:
+                done = len(self.recorder.rows) - 1  # the last checkpointed generation
+                raise self.recorder.interrupted(done, self.resume_command) from exc
+            finally:
+                self.recorder.close_progress()
+            self.finish()
         return self.result()
 
     def _end_generation(self, stats: EvalStats, wall: float) -> None:

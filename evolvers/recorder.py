@@ -31,11 +31,13 @@ from __future__ import annotations
 
 import csv
 import datetime as _dt
+import hashlib
 import io
 import json
 import logging
 import math
 import os
+import uuid
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -360,6 +362,10 @@ class RunRecorder:
             "backend": backend,
             **dict(extra_config or {}),
         }
+        #: The run's identity, recorded in config.json when it starts and in every
+        #: checkpoint (``run_id``: random per run; ``config_sha256``: its settings):
+        #: a checkpoint of another run copied into this folder is never resumed.
+        self.identity: dict[str, str] | None = None
         self.rows: list[dict[str, Any]] = []
         self.hall_of_fame: list[dict[str, Any]] = []
         self.evaluations_total = 0
@@ -383,7 +389,16 @@ class RunRecorder:
                 f"{self.out}: the folder already holds a run; use resume (--resume) or another --out"
             )
         self.generations = generations
-        atomic_write_json(self.out / "config.json", {**self.config, "generations": generations})
+        self.identity = self._new_identity()
+        self._write_config()
+
+    def _new_identity(self) -> dict[str, str]:
+        digest = hashlib.sha256(json.dumps(self.config, sort_keys=True).encode()).hexdigest()
+        return {"run_id": uuid.uuid4().hex, "config_sha256": digest}
+
+    def _write_config(self) -> None:
+        atomic_write_json(self.out / "config.json",
+                          {**self.config, "generations": self.generations, **(self.identity or {})})  # fmt: skip
 
     def _same(self, key: str, recorded: Any) -> bool:
         if key != "experiment":
@@ -438,9 +453,15 @@ class RunRecorder:
                     f"{self.out} was started with another {diff or key}; "
                     "resume with the run's own settings (softgym evolve --out DIR --resume)"
                 )
+        if isinstance(cfg.get("run_id"), str) and isinstance(cfg.get("config_sha256"), str):
+            self.identity = {"run_id": cfg["run_id"], "config_sha256": cfg["config_sha256"]}
+        else:  # a folder written before runs had an identity: it gets one from now on
+            self.identity = self._new_identity()
         if not self._has_checkpoint():
             return None
-        state, arrays, _, _ = load_latest_intact(self.checkpoint_dir)
+        # a checkpoint that records another run's identity (copied in, whatever its
+        # name) is skipped, and the run's own newest one resumed, or none: an error
+        state, arrays, _, _ = load_latest_intact(self.checkpoint_dir, identity=self.identity)
         try:
             self.rows = list(state["rows"])
             self.hall_of_fame = list(state["hall_of_fame"])
@@ -451,7 +472,7 @@ class RunRecorder:
                 f"{self.checkpoint_dir}: checkpoint content is invalid ({exc!r})"
             ) from exc
         self.generations = generations
-        atomic_write_json(cfg_path, {**self.config, "generations": generations})
+        self._write_config()
         return state, arrays
 
     # ------------------------------------------------------------------ progress
@@ -593,7 +614,8 @@ class RunRecorder:
             **{k: getattr(self, k) for k in _RECORDER_KEYS},
         }
         return save_checkpoint(
-            self.checkpoint_dir, generation, full, dict(arrays), keep=KEEP_CHECKPOINTS
+            self.checkpoint_dir, generation, full, dict(arrays), keep=KEEP_CHECKPOINTS,
+            identity=self.identity,
         )
 
     def write_log(self) -> None:

@@ -362,8 +362,9 @@ def load_checkpoint(
     path : path
         The checkpoint's JSON file (or a folder: its latest checkpoint).
     identity : mapping, optional
-        The run's identity: a checkpoint that records another identity (or
-        none) is refused, whatever its file name.
+        The run's identity: a checkpoint that records another identity is
+        refused, whatever its file name (one written before checkpoints
+        recorded identities, with none, is accepted).
 
     Returns
     -------
@@ -411,9 +412,12 @@ def load_checkpoint(
             f"{path}: its name says step {int(named.group(1))} but it records step {step}; "
             f"a renamed checkpoint is not resumed"
         )
-    if identity is not None and doc.get("identity") != _to_json(dict(identity)):
+    # a checkpoint written before checkpoints recorded identities carries none:
+    # it is taken on the strength of the run's other checks (its config.json)
+    recorded = doc.get("identity")
+    if identity is not None and recorded is not None and recorded != _to_json(dict(identity)):
         raise CheckpointError(
-            f"{path}: belongs to another run (it records {_describe(doc.get('identity'))}, "
+            f"{path}: belongs to another run (it records {_describe(recorded)}, "
             f"this run is {_describe(dict(identity))}); it is not resumed"
         )
     npz_name = doc.get("npz")

@@ -107,3 +107,38 @@ def test_resume_refuses_another_experiment(tmp_path):
         EvolutionRun(tiny(), tmp_path / "r", seed=2, generations=1, figures=False).run(resume=True)
     with pytest.raises(CheckpointError, match="already holds a run"):
         EvolutionRun(tiny(), tmp_path / "r", seed=1, generations=1, figures=False).run()
+
+
+def test_a_checkpoint_copied_in_from_another_run_is_never_resumed(tmp_path):
+    # issue 31: a checkpoint of another run (here: the same settings, another folder)
+    # copied into a run folder was resumed without a word, whatever its name
+    import shutil
+
+    a, b = tmp_path / "a", tmp_path / "b"
+    EvolutionRun(tiny(), a, seed=1, generations=1, figures=False).run()
+    EvolutionRun(tiny(), b, seed=1, generations=0, figures=False, gif=False).run()
+    ids = {json.loads((d / "config.json").read_text())["run_id"] for d in (a, b)}
+    assert len(ids) == 2  # each run has its own identity
+    newest_a = list_checkpoints(a / "checkpoints")[-1]
+    for suffix in (".json", ".npz"):
+        shutil.copy(newest_a.with_suffix(suffix), b / "checkpoints" / f"ckpt-000001{suffix}")
+    run = EvolutionRun(tiny(), b, seed=1, generations=1, figures=False, gif=False)
+    assert run.resume()
+    assert run.generation == 0  # b's own checkpoint, not a's generation 1
+    for p in (b / "checkpoints").glob("ckpt-0*"):
+        if not p.name.startswith("ckpt-000001"):
+            p.unlink()
+    with pytest.raises(CheckpointError, match="belongs to another run"):
+        EvolutionRun(tiny(), b, seed=1, generations=1, figures=False).run(resume=True)
+
+
+def test_a_second_writer_of_a_run_folder_is_refused_naming_the_first(tmp_path):
+    import os
+
+    from softgym.exceptions import RunFolderLockedError
+    from softgym.io import RunLock
+
+    with RunLock(tmp_path / "r"):  # another process's run, as far as the folder can tell
+        with pytest.raises(RunFolderLockedError, match=f"in use by pid {os.getpid()}"):
+            EvolutionRun(tiny(), tmp_path / "r", seed=4, generations=0, figures=False).run()
+    assert not (tmp_path / "r" / "config.json").exists()  # nothing was written
