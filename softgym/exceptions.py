@@ -12,6 +12,7 @@ __all__ = [
     "DesignFileError",
     "InvalidActionError",
     "InvalidDesignError",
+    "InvalidIndexError",
     "InvalidParameterError",
     "InvalidTerrainError",
     "RunFolderLockedError",
@@ -26,6 +27,10 @@ class SoftGymError(Exception):
 
 class InvalidParameterError(SoftGymError, ValueError):
     """A physical or numerical parameter is non-finite, non-physical or out of range."""
+
+
+class InvalidIndexError(SoftGymError, IndexError):
+    """An index (a robot of a batch...) is not an integer in its range."""
 
 
 class InvalidDesignError(SoftGymError, ValueError):

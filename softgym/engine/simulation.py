@@ -68,6 +68,7 @@ from softgym.engine.rollout import Rollout
 from softgym.exceptions import (
     InvalidActionError,
     InvalidDesignError,
+    InvalidIndexError,
     InvalidParameterError,
     InvalidTerrainError,
     SimulationDivergedError,
@@ -183,10 +184,35 @@ class Simulation:
                 "a terrain's movable objects touch the robot through self-collision: "
                 "SimConfig.self_collision must be True"
             )
+        self._check_memory()
         self._build()
         self._initial = {k: self._a[k].copy() for k in _STATE}
         self._contacts = _core.ContactCache(self.n_robots)
         self._t_target = 0.0
+
+    #: Memory budget (bytes) of one Simulation: its state, its layout's temporaries
+    #: and its traces. Checked before anything is allocated (construction, and each
+    #: :meth:`advance_to` for the traces), so a batch or a trace interval that would
+    #: exhaust the machine is refused with a typed error instead; raise it on the
+    #: class or an instance for a larger machine.
+    max_bytes: float = 8 * 2**30
+
+    #: Upper bound of the bytes one voxel takes while a Simulation is built and
+    #: run: ~75 float64 of state and scratch, and the layout's self-collision
+    #: exclusion lists (voxels within ``collision_exclusion`` bond hops, at most
+    #: 63 for 3 hops, built through temporaries of ~8 int64 each).
+    bytes_per_voxel: int = 75 * 8 + 63 * 8 * 8
+
+    def _check_memory(self) -> None:
+        n = sum(int(np.count_nonzero(b.grid)) for b in self.bodies)
+        n += sum(sum(int(np.prod(blk.shape)) for blk in t.objects) for t in self.terrains)
+        need = n * self.bytes_per_voxel
+        if need > self.max_bytes:
+            raise InvalidParameterError(
+                f"{self.n_robots} robots of {n} voxels in all need about {need / 2**30:.1f} GiB, "
+                f"over Simulation.max_bytes = {self.max_bytes / 2**30:.1f} GiB; simulate fewer "
+                f"or smaller robots per batch, or raise the budget"
+            )
 
     # ------------------------------------------------------------------ layout
     def _terrains(self, terrain: Any) -> list:
@@ -287,15 +313,23 @@ class Simulation:
         """Bytes held by the batch's arrays."""
         return int(sum(v.nbytes for v in self._a.values()))
 
+    def _robot(self, robot: Any) -> int:
+        # a robot index: an integer (not a bool) in [0, n_robots)
+        if isinstance(robot, (bool, np.bool_)) or not isinstance(robot, (int, np.integer)):
+            raise InvalidIndexError(f"robot must be an integer index, got {robot!r:.40}")
+        if not 0 <= robot < self.n_robots:
+            raise InvalidIndexError(
+                f"robot = {robot} is out of range: this batch holds robots 0..{self.n_robots - 1}"
+            )
+        return int(robot)
+
     def _slice(self, robot: int) -> slice:
         # the robot's own voxels in the kernel arrays (its objects follow them)
-        if not 0 <= robot < self.n_robots:
-            raise IndexError(f"robot index {robot} out of range for {self.n_robots} robots")
+        robot = self._robot(robot)
         return slice(int(self._a["vox_start"][robot]), int(self._a["body_end"][robot]))
 
     def _object_slice(self, robot: int) -> slice:
-        if not 0 <= robot < self.n_robots:
-            raise IndexError(f"robot index {robot} out of range for {self.n_robots} robots")
+        robot = self._robot(robot)
         return slice(int(self._a["body_end"][robot]), int(self._a["vox_start"][robot + 1]))
 
     def object_positions(self, robot: int) -> np.ndarray:
@@ -505,8 +539,21 @@ class Simulation:
         self._a["ext_force"][s] = arr
 
     # -------------------------------------------------------------------- run
+    def _trace_samples(self, t_end: float) -> int:
+        """Centre-of-mass samples per robot to reach ``t_end``, refused past :attr:`max_bytes`."""
+        need = t_end / self.config.trace_interval + 3
+        per_sample = 8 * (1 + 3 + len(_core.AUX_NAMES)) * self.n_robots
+        if need * per_sample > self.max_bytes - self.nbytes:
+            raise InvalidParameterError(
+                f"SimConfig.trace_interval = {self.config.trace_interval:g} s up to t = "
+                f"{t_end:g} s means {need:.3g} centre-of-mass samples per robot "
+                f"({need * per_sample / 2**30:.3g} GiB for {self.n_robots} robots), over "
+                f"Simulation.max_bytes = {self.max_bytes / 2**30:.1f} GiB; raise trace_interval"
+            )
+        return int(math.floor(t_end / self.config.trace_interval + 1e-9)) + 3
+
     def _ensure_trace_capacity(self, t_end: float) -> None:
-        need = int(math.floor(t_end / self.config.trace_interval + 1e-9)) + 3
+        need = self._trace_samples(t_end)
         cap = self._a["trace_t"].shape[1]
         if need <= cap:
             return
@@ -579,7 +626,7 @@ class Simulation:
                 f"(about {self.max_voxel_steps / 1e7 / 3600:.0f} h on one core); stiffer or lighter "
                 "materials shrink the time step: check the materials or raise the limit"
             )
-        self._ensure_trace_capacity(time + dt.max())
+        self._ensure_trace_capacity(time + dt.max())  # refused past max_bytes before it runs
         a = self._a
         before = a["diverged"].copy()
         # simulated seconds per chunk = work per chunk / voxel-steps per simulated second
@@ -736,7 +783,10 @@ class Simulation:
         if ids.size == 0:
             return
         if ids[0] < 0 or ids[-1] >= self.n_robots:
-            raise IndexError(f"robot indices {ids.tolist()} out of range for {self.n_robots} robots")
+            raise InvalidIndexError(
+                f"robot indices {ids.tolist()} out of range: this batch holds robots "
+                f"0..{self.n_robots - 1}"
+            )
         missing = [k for k in _STATE if k not in state]
         if missing:
             raise InvalidParameterError(f"state is missing arrays {missing}")

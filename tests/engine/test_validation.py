@@ -8,6 +8,7 @@ from softgym.engine import Body, SimConfig, Simulation
 from softgym.exceptions import (
     InvalidActionError,
     InvalidDesignError,
+    InvalidIndexError,
     InvalidParameterError,
     SoftGymError,
 )
@@ -84,6 +85,27 @@ def test_materials_beyond_physical_ranges_are_refused_naming_the_range(field, va
         Body.uniform(np.ones((2, 2, 2)), **{field: value})
 
 
+def test_a_batch_beyond_the_memory_budget_is_refused_before_anything_is_allocated():
+    # issue 31: 2 robots at the grid cap (100^3) died in the layout at 3.8 GB after 92 s
+    import time
+
+    bodies = [Body.uniform(np.ones((100, 100, 100)))] * 2
+    t0 = time.perf_counter()
+    with pytest.raises(InvalidParameterError, match="GiB, over Simulation.max_bytes"):
+        Simulation(bodies)
+    assert time.perf_counter() - t0 < 10.0
+
+
+def test_a_trace_interval_that_would_exhaust_memory_is_refused_before_the_run():
+    # issue 31: evaluate(..., trace_interval=1e-9) asked for 37 GiB
+    sim = Simulation(_body(), SimConfig(trace_interval=1e-9))
+    state = sim.get_state()
+    with pytest.raises(InvalidParameterError, match="SimConfig.trace_interval = 1e-09 s"):
+        sim.run(5.0)
+    after = sim.get_state()
+    assert all(np.array_equal(state[k], after[k]) for k in state)
+
+
 def test_config_dict_round_trip_and_unknown_keys():
     cfg = SimConfig(gravity=0.0, actuation="symmetric")
     assert SimConfig.from_dict(cfg.to_dict()) == cfg
@@ -103,8 +125,11 @@ def test_simulation_rejects_bad_arguments():
         sim.advance(-1.0)
     with pytest.raises(InvalidParameterError):
         sim.advance(float("nan"))
-    with pytest.raises(IndexError):
-        sim.positions(3)
+    with pytest.raises(InvalidIndexError, match="robot = 3 is out of range: .* robots 0..0"):
+        sim.positions(3)  # issue 31: was a bare IndexError
+    with pytest.raises(InvalidIndexError, match="integer index"):
+        sim.positions(True)
+    assert issubclass(InvalidIndexError, IndexError)
 
 
 def test_nan_temperatures_raise_and_leave_the_state_unchanged():
