@@ -19,13 +19,14 @@ each design's composition as arrays. The task is anything
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 import numpy as np
 
-from softgym.exceptions import InvalidParameterError
+from softgym.exceptions import InvalidDesignError, InvalidParameterError
 from softgym.tasks import Task, TaskLike, get_task
+from softgym.validate import is_int, positive, show
 
 __all__ = ["METRIC_KEYS", "Task", "estimated_cost", "evaluate", "evaluate_payload"]
 
@@ -132,17 +133,29 @@ def evaluate(
         fitness = m["max_xy_dist"]
     """
     from softgym.design import RobotDesign
+    from softgym.engine import SimConfig
 
     if isinstance(designs, (RobotDesign, Mapping)):
         designs = [designs]
+    if isinstance(designs, (str, bytes)) or not isinstance(designs, Iterable):
+        raise InvalidDesignError(
+            f"designs must be a RobotDesign, a design dict or a sequence of them, got {show(designs)}"
+        )
     designs = [_as_design(d) for d in designs]
+    # strict types: a bool, a string or a list is not a number (issue 31)
     changes: dict[str, Any] = {}
     if seconds is not None:
-        changes["seconds"] = float(seconds)
+        changes["seconds"] = positive("seconds", seconds, unit=" (s)")
     if trace_interval is not None:
-        changes["trace_interval"] = float(trace_interval)
+        changes["trace_interval"] = positive("trace_interval", trace_interval, unit=" (s)")
     if n_threads is not None:
+        if not is_int(n_threads) or n_threads < 1:
+            raise InvalidParameterError(f"n_threads must be an integer >= 1, got {show(n_threads)}")
         changes["n_threads"] = int(n_threads)
+    if config is not None and not isinstance(config, SimConfig):
+        raise InvalidParameterError(
+            f"config must be a softgym SimConfig (or None for the task's), got {show(config)}"
+        )
     task = get_task(task, **changes)
     n = len(designs)
     out: dict[str, Any] = {k: np.zeros(n) for k in METRIC_KEYS}
