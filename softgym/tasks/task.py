@@ -327,17 +327,13 @@ def register_task(name: str, task: Task | Terrain, *, overwrite: bool = False) -
 
 
 def _read_file(path: Path) -> Task:
-    try:
-        text = path.read_text()
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InvalidParameterError(f"cannot read the task file {str(path)!r}: {exc}") from None
-    import json
+    # a regular file within the terrain cap, read without blocking (a FIFO is
+    # refused), JSON of any depth a typed error
+    from softgym.io import loads_json, read_capped
+    from softgym.terrain import MAX_TERRAIN_JSON_BYTES
 
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise InvalidTerrainError(f"{path}: invalid JSON: {exc}") from None
-    return get_task(data)
+    data = read_capped(path, MAX_TERRAIN_JSON_BYTES, "task", InvalidParameterError)
+    return get_task(loads_json(data, f"task file {str(path)!r}", InvalidTerrainError))
 
 
 def _parse_options(spec: str, text: str) -> dict[str, float]:
@@ -348,12 +344,14 @@ def _parse_options(spec: str, text: str) -> dict[str, float]:
             if not eq:
                 raise ValueError
             v = float(value)
-            out[key.strip()] = int(v) if v.is_integer() and "." not in value else v
         except ValueError:
             raise InvalidParameterError(
                 f"task {spec!r}: arguments are name=number pairs separated by commas "
                 f"(e.g. 'gap:width=3,depth=5'), got {item!r}"
             ) from None
+        if key.strip() in out:
+            raise InvalidParameterError(f"task {spec!r}: argument {key.strip()!r} is given twice")
+        out[key.strip()] = int(v) if v.is_integer() and "." not in value else v
     return out
 
 

@@ -56,7 +56,7 @@ def test_a_terrain_its_json_file_and_a_task_dict_are_tasks(tmp_path):
     t = get_task(boxes, seconds=2.0, sim={"actuation": "symmetric"})
     back = Task.from_dict(json.loads(json.dumps(t.to_dict())))
     assert back == t and back.config().actuation == "symmetric"
-    with pytest.raises(InvalidParameterError, match="cannot read"):
+    with pytest.raises(InvalidParameterError, match="does not exist"):
         get_task(tmp_path / "missing.json")
 
 
@@ -129,3 +129,36 @@ def test_experiments_and_old_run_configs_go_through_the_registry(tmp_path):
     assert isinstance(custom.task.terrain, Terrain)
     assert Experiment.from_dict(json.loads(json.dumps(custom.to_dict()))) == custom
     assert get_experiment("basic", task="stairs").make_task(n_threads=1).n_threads == 1
+
+
+def test_task_strings_files_and_fifos_are_refused_with_typed_errors(tmp_path):
+    # issue 31: a repeated argument took the last; a FIFO blocked forever; a task
+    # JSON 100,000 deep gave a 48-line RecursionError; a 37 MB terrain file was read
+    import os
+    import subprocess
+    import sys
+
+    from softgym.exceptions import InvalidParameterError, InvalidTerrainError
+    from softgym.tasks import get_task
+    from softgym.terrain import MAX_TERRAIN_JSON_BYTES
+
+    with pytest.raises(InvalidParameterError, match="'width' is given twice"):
+        get_task("gap:width=2,width=3")
+    deep = tmp_path / "deep.json"
+    deep.write_text("[" * 100_000 + "]" * 100_000)
+    with pytest.raises(InvalidTerrainError, match="nested too deeply"):
+        get_task(str(deep))
+    big = tmp_path / "big.json"
+    big.write_bytes(b" " * (MAX_TERRAIN_JSON_BYTES + 1))
+    with pytest.raises(InvalidParameterError, match="more than the cap"):
+        get_task(str(big))
+    if hasattr(os, "mkfifo"):
+        fifo = tmp_path / "task.json"
+        os.mkfifo(fifo)
+        code = ("from softgym.tasks import get_task\n"
+                "from softgym.exceptions import InvalidParameterError\n"
+                f"try:\n    get_task({str(fifo)!r})\n"
+                "except InvalidParameterError as e:\n    print('REFUSED', e)\n")  # fmt: skip
+        res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                             timeout=60)  # fmt: skip
+        assert "REFUSED" in res.stdout and "not a regular file" in res.stdout, res.stderr
