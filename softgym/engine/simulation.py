@@ -236,6 +236,13 @@ class Simulation:
             filled = np.argwhere(body.grid > 0)
             lo = body.origin / L + filled.min(axis=0)
             hi = body.origin / L + filled.max(axis=0) + 1
+            if self.config.floor and lo[2] < -1e-9:
+                # deep in the floor, the penalty force launches the body (issue 31: 5 m
+                # below the floor it flew to z = 65 m without diverging)
+                raise InvalidDesignError(
+                    f"a body's lowest voxel starts at z = {lo[2]:g} voxel lengths, below the "
+                    f"floor (z = 0): its origin must put every voxel at or above the floor"
+                )
             t.validate(lo, hi)
         return terrains
 

@@ -261,3 +261,11 @@ def test_cm_init_is_public_and_equals_the_rollouts():
     sim = Simulation([default_walker()], SimConfig(init_time=0.2))
     sim.advance(0.5)
     np.testing.assert_array_equal(sim.cm_init, sim.rollout().cm_init)
+
+
+def test_a_body_placed_below_the_floor_is_refused():
+    # issue 31: 5 m below the floor, the penalty force flew it to z = 65 m, not diverged
+    with pytest.raises(InvalidDesignError, match="below the floor"):
+        Simulation([Body.uniform(np.ones((2, 2, 2)), origin=(0.0, 0.0, -5.0))])
+    Simulation([Body.uniform(np.ones((2, 2, 2)), origin=(0.0, 0.0, -5.0))],
+               SimConfig(floor=False))  # fmt: skip  (no floor: any height)
