@@ -26,8 +26,9 @@ from typing import Any
 import numpy as np
 
 from softgym.evaluate import evaluate_payload
-from softgym.exceptions import SoftGymError
+from softgym.exceptions import InvalidParameterError, SoftGymError
 from softgym.tasks import Task
+from softgym.validate import is_int, show
 
 __all__ = [
     "DaskBatchFn",
@@ -146,8 +147,15 @@ def dask_client(
     Raises
     ------
     MissingExtraError
-        If Dask is not installed (``pip install "softgym[distributed]"``).
+        If Dask is not installed (``pip install ".[distributed]"``).
+    InvalidParameterError
+        If ``n_workers`` is not an integer >= 1 (a cluster without workers
+        would wait for one forever).
     """
+    if address == "local" and (not is_int(n_workers) or n_workers < 1):
+        raise InvalidParameterError(
+            f"a local Dask cluster needs n_workers >= 1 (--workers), got {show(n_workers)}"
+        )
     distributed = require_distributed()
     Client, LocalCluster = distributed.Client, distributed.LocalCluster
 

@@ -38,8 +38,20 @@ from softgym.exceptions import InvalidParameterError
 from softgym.metrics import WALK_METRICS
 from softgym.tasks import Task, get_task
 from softgym.terrain import Terrain
+from softgym.validate import is_int, show
 
-__all__ = ["EXPERIMENTS", "SELECTIONS", "Experiment", "get_experiment", "list_experiments"]
+__all__ = [
+    "EXPERIMENTS",
+    "MAX_POP_SIZE",
+    "SELECTIONS",
+    "Experiment",
+    "get_experiment",
+    "list_experiments",
+]
+
+#: Largest population an experiment accepts (each individual is simulated every
+#: generation: 100,000 6x6x6 robots are ~10 CPU-hours a generation).
+MAX_POP_SIZE = 100_000
 
 #: Selection schemes an experiment may name.
 SELECTIONS: tuple[str, ...] = tuple(SELECTORS)
@@ -121,8 +133,10 @@ class Experiment:
             raise InvalidParameterError(
                 f"unknown selection {self.selection!r}; expected one of {SELECTIONS}"
             )
-        if self.pop_size < 2:
-            raise InvalidParameterError(f"pop_size must be >= 2, got {self.pop_size}")
+        if not is_int(self.pop_size) or not 2 <= self.pop_size <= MAX_POP_SIZE:
+            raise InvalidParameterError(
+                f"pop_size must be an integer in [2, {MAX_POP_SIZE}], got {show(self.pop_size)}"
+            )
         if not self.objectives:
             raise InvalidParameterError("an experiment needs at least one objective")
         object.__setattr__(self, "shape", tuple(int(s) for s in self.shape))

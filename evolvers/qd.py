@@ -93,7 +93,12 @@ __all__ = [
     "make_archive",
     "plot_archive_heatmap",
     "plot_qd_progress",
+    "MAX_CELLS",
 ]
+
+#: Most cells an archive may have (a grid of 1,000 x 1,000): each is an array
+#: slot of pyribs' archive and, once filled, an elite's design in the checkpoint.
+MAX_CELLS = 1_000_000
 
 log = logging.getLogger("evolvers")
 
@@ -146,6 +151,11 @@ class QDConfig:
             raise InvalidParameterError(
                 f"cells must be {want} positive int(s) for a {self.archive} archive over "
                 f"{d} descriptor(s), got {list(cells)}"
+            )
+        if int(np.prod(cells)) > MAX_CELLS:
+            raise InvalidParameterError(
+                f"cells {list(cells)} make {int(np.prod(cells))} archive cells, more than "
+                f"{MAX_CELLS}: fewer cells per descriptor (each holds an elite and its design)"
             )
         object.__setattr__(self, "cells", cells)
         if self.objective is not None and self.objective not in QD_OBJECTIVES:

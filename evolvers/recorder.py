@@ -60,6 +60,7 @@ from softgym.metrics import crossed_obstacles, final_xy, obstacle_footprint
 
 __all__ = [
     "HALL_OF_FAME_SIZE",
+    "IDENTITY_FILE",
     "RUN_SCHEMA",
     "RunRecorder",
     "add_run_note",
@@ -109,6 +110,8 @@ def read_run_notes(run_dir: str | os.PathLike[str]) -> list[dict[str, Any]]:
 
 #: ``"schema"`` of a run's config.json.
 RUN_SCHEMA = "softgym.run"
+#: The file of a run folder that names the run (:attr:`RunRecorder.identity`).
+IDENTITY_FILE = "identity.json"
 #: Best individuals kept in ``best_designs.json``.
 HALL_OF_FAME_SIZE = 5
 #: Checkpoints kept on disk (older ones are removed).
@@ -362,9 +365,10 @@ class RunRecorder:
             "backend": backend,
             **dict(extra_config or {}),
         }
-        #: The run's identity, recorded in config.json when it starts and in every
-        #: checkpoint (``run_id``: random per run; ``config_sha256``: its settings):
-        #: a checkpoint of another run copied into this folder is never resumed.
+        #: The run's identity, recorded in ``identity.json`` when it starts and in
+        #: every checkpoint (``run_id``: random per run; ``config_sha256``: its
+        #: settings): a checkpoint of another run copied into this folder is never
+        #: resumed. Not a setting: config.json (what runs are compared by) holds none.
         self.identity: dict[str, str] | None = None
         self.rows: list[dict[str, Any]] = []
         self.hall_of_fame: list[dict[str, Any]] = []
@@ -389,16 +393,16 @@ class RunRecorder:
                 f"{self.out}: the folder already holds a run; use resume (--resume) or another --out"
             )
         self.generations = generations
-        self.identity = self._new_identity()
+        self._new_identity()
         self._write_config()
 
-    def _new_identity(self) -> dict[str, str]:
+    def _new_identity(self) -> None:
         digest = hashlib.sha256(json.dumps(self.config, sort_keys=True).encode()).hexdigest()
-        return {"run_id": uuid.uuid4().hex, "config_sha256": digest}
+        self.identity = {"run_id": uuid.uuid4().hex, "config_sha256": digest}
+        atomic_write_json(self.out / IDENTITY_FILE, self.identity)
 
     def _write_config(self) -> None:
-        atomic_write_json(self.out / "config.json",
-                          {**self.config, "generations": self.generations, **(self.identity or {})})  # fmt: skip
+        atomic_write_json(self.out / "config.json", {**self.config, "generations": self.generations})
 
     def _same(self, key: str, recorded: Any) -> bool:
         if key != "experiment":
@@ -453,10 +457,12 @@ class RunRecorder:
                     f"{self.out} was started with another {diff or key}; "
                     "resume with the run's own settings (softgym evolve --out DIR --resume)"
                 )
-        if isinstance(cfg.get("run_id"), str) and isinstance(cfg.get("config_sha256"), str):
-            self.identity = {"run_id": cfg["run_id"], "config_sha256": cfg["config_sha256"]}
+        ident = read_json(self.out / IDENTITY_FILE) if (self.out / IDENTITY_FILE).exists() else None
+        if isinstance(ident, dict) and all(isinstance(ident.get(k), str)
+                                           for k in ("run_id", "config_sha256")):  # fmt: skip
+            self.identity = {"run_id": ident["run_id"], "config_sha256": ident["config_sha256"]}
         else:  # a folder written before runs had an identity: it gets one from now on
-            self.identity = self._new_identity()
+            self._new_identity()
         if not self._has_checkpoint():
             return None
         # a checkpoint that records another run's identity (copied in, whatever its

@@ -7,7 +7,8 @@ copies the part of each run folder that resuming and ``softgym study report``
 need into a folder that can be committed or copied (``save``), and puts it back
 into a run root (``restore``):
 
-* per run: ``config.json``, ``log.jsonl``, ``notes.jsonl``,
+* per run: ``config.json``, ``identity.json`` (the run's identity, which its
+  checkpoints record), ``log.jsonl``, ``notes.jsonl``,
   ``best_designs.json``, ``best_design.json``, ``final_population.json``;
 * for a run that is not complete (``evolvers.study.run_status`` against its
   scenario's generations), the newest *intact* checkpoint too (its ``.json``
@@ -42,12 +43,14 @@ import shutil
 import sys
 from pathlib import Path
 
+from evolvers.recorder import IDENTITY_FILE
 from evolvers.study import run_status
 from softgym.exceptions import CheckpointError
 from softgym.io import list_checkpoints, load_latest_intact, read_json
 
 RUN_FILES = (
     "config.json",
+    IDENTITY_FILE,
     "log.jsonl",
     "notes.jsonl",
     "best_designs.json",

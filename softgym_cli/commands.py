@@ -93,7 +93,7 @@ def _cmd_replay(args: argparse.Namespace) -> int:
         k: (v[0].item() if hasattr(v[0], "item") else v[0]) for k, v in m.items() if k != "traces"
     }
     summary = {"experiment": exp["name"], "seconds": seconds, "metrics": metrics,
-               "recorded": best["objectives"], "files": [str(p) for p in paths]}  # fmt: skip
+               "recorded": best.get("objectives"), "files": [str(p) for p in paths]}  # fmt: skip
     print(json.dumps(summary, indent=2))
     return 0
 
@@ -112,7 +112,9 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     import statistics
 
     from evolvers.recorder import config_difference, read_run_config
-    from softgym.render.figures import plot_compare, read_log
+    from softgym.render.figures import figure_path, plot_compare, read_log
+
+    figure_path(args.out)  # a format matplotlib writes, checked before the runs are read
 
     groups: dict[str, list] = {}
     configs: dict[str, dict] = {}

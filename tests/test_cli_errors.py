@@ -126,3 +126,24 @@ def test_the_library_does_not_import_the_cli_or_the_evolvers():
             for name in names:
                 top = name.split(".")[0]
                 assert top not in ("evolvers", "softgym_cli"), f"{path} imports {name}"
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        # issue 31: each of these hung, tracebacked or allocated gigabytes
+        (["evolve", "--pop", "100000000"], "pop_size must be an integer in [2, 100000]"),
+        (["qd", "--cells", "20000", "20000"], "more than 1000000"),
+        (["evolve", "--dask", "local", "--workers", "0"], "n_workers >= 1"),
+    ],
+)  # fmt: skip
+def test_sizes_that_would_hang_or_exhaust_memory_are_refused_in_one_line(tmp_path, capsys,
+                                                                         argv, needle):  # fmt: skip
+    line = _one_line_error(capsys, [*argv, "--out", str(tmp_path / "run")], argv[0])
+    assert needle in line
+
+
+def test_compare_into_a_format_matplotlib_cannot_write_is_one_line(tmp_path, capsys):
+    line = _one_line_error(capsys, ["compare", str(tmp_path), "--out", str(tmp_path / "c.xyz")],
+                           "compare")  # fmt: skip
+    assert "c.xyz" in line and "not a format matplotlib writes" in line

@@ -94,7 +94,7 @@ def test_compare_groups_seeds_and_explains_a_missing_metric(runs, tmp_path, caps
     capsys.readouterr()
     assert main(["compare", str(runs / "a0"), str(bad), "--out", str(out)]) == 2
     err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0 and "log.jsonl: line 2 is not JSON" in err
+    assert err.count("\n") == 0 and "log.jsonl: line 2: corrupt or truncated JSON" in err
 
 
 def test_convert_both_ways_and_view(runs, tmp_path, capsys):

@@ -30,6 +30,7 @@ import numpy as np
 __all__ = [
     "METRIC_LABELS",
     "design_colors",
+    "figure_path",
     "metric_label",
     "plot_best_fitness",
     "plot_compare",
@@ -86,9 +87,35 @@ def pyplot():
     return plt
 
 
+def figure_path(path: str | os.PathLike[str]) -> Path:
+    """``path`` if matplotlib writes its format (its suffix: .png, .pdf, .svg...).
+
+    Raises
+    ------
+    InvalidParameterError
+        Naming the file and the formats matplotlib writes.
+    """
+    from softgym.exceptions import InvalidParameterError
+
+    path = Path(path)
+    plt = pyplot()
+    fig = plt.figure()
+    try:
+        formats = fig.canvas.get_supported_filetypes()
+    finally:
+        plt.close(fig)
+    fmt = path.suffix.lstrip(".").lower()
+    if fmt not in formats:
+        raise InvalidParameterError(
+            f"figure file {str(path)!r}: {'.' + fmt if fmt else 'no suffix'} is not a format "
+            f"matplotlib writes ({', '.join(sorted(formats))})"
+        )
+    return path
+
+
 def _save(fig: Any, path: str | os.PathLike[str]) -> Path:
     """Write ``fig`` to ``path`` (folders created) and close it."""
-    path = Path(path)
+    path = figure_path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=110, bbox_inches="tight", pad_inches=0.1)  # no clipped labels
     pyplot().close(fig)

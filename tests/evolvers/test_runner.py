@@ -117,7 +117,7 @@ def test_a_checkpoint_copied_in_from_another_run_is_never_resumed(tmp_path):
     a, b = tmp_path / "a", tmp_path / "b"
     EvolutionRun(tiny(), a, seed=1, generations=1, figures=False).run()
     EvolutionRun(tiny(), b, seed=1, generations=0, figures=False, gif=False).run()
-    ids = {json.loads((d / "config.json").read_text())["run_id"] for d in (a, b)}
+    ids = {json.loads((d / "identity.json").read_text())["run_id"] for d in (a, b)}
     assert len(ids) == 2  # each run has its own identity
     newest_a = list_checkpoints(a / "checkpoints")[-1]
     for suffix in (".json", ".npz"):
