@@ -9,17 +9,24 @@ id, and the two numbers of the sinusoidal drive. Higher layers
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from softgym.engine.config import DENSITY_RANGE, YOUNGS_MODULUS_RANGE
 from softgym.exceptions import InvalidDesignError, InvalidParameterError
+from softgym.validate import number, show
 
 __all__ = ["Body"]
 
 
 def _as_table(name: str, values, n: int) -> np.ndarray:
-    arr = np.asarray(values, dtype=np.float64)
+    try:
+        arr = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError, OverflowError):
+        raise InvalidParameterError(
+            f"{name} must be numbers, one per material id (length {n}), got {show(values)}"
+        ) from None
     if arr.ndim != 1 or arr.shape[0] != n:
         raise InvalidParameterError(
             f"{name} must be a 1-D array with one entry per material id (length {n}), "
@@ -164,14 +171,17 @@ class Body:
     ) -> Body:
         """A body made of one material (id 1) wherever ``grid`` is non-zero."""
         g = (np.asarray(grid) != 0).astype(np.int32)
-        row = lambda v: np.array([0.0, v])  # noqa: E731
+
+        def row(name: str, v: Any) -> np.ndarray:
+            return np.array([0.0, number(name, v)])  # a number: not a bool, string or list
+
         return cls(
             grid=g,
-            youngs_modulus=row(youngs_modulus),
-            density=row(density),
-            poisson=row(poisson),
-            cte=row(cte),
-            mu_static=row(mu_static),
-            mu_kinetic=row(mu_kinetic),
+            youngs_modulus=row("youngs_modulus", youngs_modulus),
+            density=row("density", density),
+            poisson=row("poisson", poisson),
+            cte=row("cte", cte),
+            mu_static=row("mu_static", mu_static),
+            mu_kinetic=row("mu_kinetic", mu_kinetic),
             **kwargs,
         )

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, dataclass, fields, replace
 from typing import Any, Literal
 
 from softgym.exceptions import InvalidParameterError
+from softgym.validate import number
 
 __all__ = ["DENSITY_RANGE", "SimConfig", "VOXEL_SIZE_RANGE", "YOUNGS_MODULUS_RANGE"]
 
@@ -135,22 +135,12 @@ class SimConfig:
                 raise InvalidParameterError(f"SimConfig.{name} must be {what}, got {value!r}")
 
         def finite(name: str) -> float:
-            value = getattr(self, name)
-            # a real number: never a bool, a string ("9.81") or a container
-            if isinstance(value, (bool, str, bytes)):
-                raise InvalidParameterError(f"SimConfig.{name} must be a number, got {value!r}")
-            try:
-                v = float(value)
-            except (TypeError, ValueError, OverflowError):
-                raise InvalidParameterError(
-                    f"SimConfig.{name} must be a number, got {value!r}"
-                ) from None
-            check(name, math.isfinite(v), "finite")
-            return v
+            # a real number, finite: never a bool, a string ("9.81") or a container
+            return number(f"SimConfig.{name}", getattr(self, name))
 
         lo, hi = VOXEL_SIZE_RANGE
         check("voxel_size", lo <= finite("voxel_size") <= hi, f"in [{lo:g}, {hi:g}] m")
-        check("dt_frac", 0 < finite("dt_frac") <= 10, "in (0, 10]")
+        check("dt_frac", 1e-4 <= finite("dt_frac") <= 10, "in [1e-4, 10]")
         check("gravity", finite("gravity") >= 0, ">= 0 m/s^2 (it pulls along -z)")
         for name in ("bond_damping", "collision_damping", "global_damping"):
             check(name, finite(name) >= 0, ">= 0")

@@ -21,7 +21,7 @@ import numpy as np
 from softgym.engine import _core
 from softgym.engine.body import Body
 from softgym.engine.config import SimConfig
-from softgym.exceptions import InvalidDesignError
+from softgym.exceptions import InvalidDesignError, InvalidParameterError
 
 __all__ = [
     "MAX_OBSTACLE_VOXELS",
@@ -153,8 +153,17 @@ def _time_step(k_axial, m, E, v1, v2, cfg: SimConfig) -> float:
         w2 = float(np.max(E / m)) if cfg.model == "seed" else float(np.max(E * L / m))
     if cfg.model == "seed":
         # the seed's CalcMaxDt writes pi as 3.1415926 and its DtFrac is single precision
-        return float(np.float32(cfg.dt_frac)) / (2.0 * 3.1415926 * math.sqrt(w2))
-    return cfg.dt_frac / (2.0 * math.pi * math.sqrt(w2))
+        dt = float(np.float32(cfg.dt_frac)) / (2.0 * 3.1415926 * math.sqrt(w2))
+    else:
+        dt = cfg.dt_frac / (2.0 * math.pi * math.sqrt(w2))
+    if not (math.isfinite(dt) and dt > 0.0):
+        # the materials' and voxel size's ranges keep it a normal number; a step of 0
+        # would never advance, an infinite one never stop
+        raise InvalidParameterError(
+            f"the time step came out as {dt!r} s (max k_axial / m = {w2:g} 1/s^2): check "
+            f"the materials' Young's modulus and density and SimConfig.voxel_size"
+        )
+    return dt
 
 
 def time_step(body: Any, config: SimConfig | None = None) -> float:

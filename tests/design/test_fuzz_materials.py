@@ -108,6 +108,9 @@ SCALARS = (
     | st.floats(allow_nan=True, allow_infinity=True)
     | st.floats(-1, 1)
     | st.floats(0, 1e10)
+    # physical extremes (issue 31): time steps that round to 0, buffers that overflow
+    | st.sampled_from([1e-300, 1e300, -1e300, 5e-324, 1e-30, 1e30])
+    | st.floats(1e-300, 1e300)
     | st.text(max_size=6)
     | st.complex_numbers(max_magnitude=10)
     | st.lists(st.floats(-1, 2), max_size=5)
@@ -135,6 +138,13 @@ def test_materials_are_valid_or_refused(changes):
         assert all(type(v) is float and math.isfinite(v) for v in values)
         assert abs(m.cte) <= MAX_ABS_CTE and m.youngs_modulus > 0 and m.density > 0
         assert Material.from_dict(m.to_dict()) == m
+        # an accepted material gives a robot a usable time step
+        from softgym.design import Palette, RobotDesign
+        from softgym.engine import time_step
+
+        design = RobotDesign(np.ones((2, 1, 1), dtype=int), palette=Palette({1: m}))
+        dt = time_step(design)
+        assert math.isfinite(dt) and dt > 0
 
 
 @FUZZ
