@@ -45,3 +45,24 @@ def outcome_and_result(kind, fn, *args, **kwargs):
 def outcome(kind, fn, *args, **kwargs):
     """Call ``fn``; count and return "valid" or the SoftGymError's class name; fail on anything else."""
     return outcome_and_result(kind, fn, *args, **kwargs)[0]
+
+
+def refused_in_child(code: str, timeout: float = 60.0) -> str:
+    """Run ``code`` in a child Python (a hang fails the test by ``timeout``); return its stdout.
+
+    For inputs that could block a reader forever (a FIFO given as a path): the
+    code catches the expected error and prints ``REFUSED <message>``.
+    """
+    import subprocess
+    import sys
+
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=timeout)  # fmt: skip
+    assert "REFUSED" in res.stdout, res.stderr[-2000:]
+    return res.stdout
+
+
+def fifo_code(imports: str, call: str, path: str, error: str) -> str:
+    """The child code of :func:`refused_in_child` for ``call(path)`` raising ``error``."""
+    return (f"{imports}\nfrom softgym.exceptions import {error}\n"
+            f"try:\n    {call}({path!r})\nexcept {error} as e:\n    print('REFUSED', e)\n")

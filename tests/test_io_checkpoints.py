@@ -11,7 +11,7 @@ import zipfile
 
 import numpy as np
 import pytest
-from fuzzing import FUZZ, outcome  # tests/fuzzing.py
+from fuzzing import FUZZ, fifo_code, outcome, refused_in_child  # tests/fuzzing.py
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -149,16 +149,9 @@ def test_a_fifo_is_refused_at_once_not_waited_on(tmp_path):
     # regression fails instead of hanging the suite)
     fifo = tmp_path / "ckpt-000001.json"
     os.mkfifo(fifo)
-    code = (
-        "import sys; from softgym import io\n"
-        "try:\n"
-        f"    io.read_json({str(fifo)!r})\n"
-        "except io.CheckpointError as e:\n"
-        "    print('REFUSED', e)\n"
-    )
-    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         timeout=60)  # fmt: skip
-    assert "REFUSED" in res.stdout and "not a regular file" in res.stdout, res.stderr
+    out = refused_in_child(fifo_code("from softgym import io", "io.read_json", str(fifo),
+                                     "CheckpointError"))  # fmt: skip
+    assert "not a regular file" in out
 
 
 def test_a_renamed_checkpoint_is_refused_not_taken_as_newest(tmp_path):

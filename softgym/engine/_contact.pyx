@@ -131,6 +131,14 @@ cdef inline intp_t _hash_first(const SpatialHash* h, int64_t key) noexcept nogil
     return _lower_bound(h.cells, h.n, key)
 
 
+cdef inline intp_t _hash_column(const SpatialHash* h, const int64_t* ijk, int di, int dj,
+                                int64_t* last) noexcept nogil:
+    # the first point of the cells (i + di, j + dj, k - 1 .. k + 1) around the
+    # cell ijk: one run of keys, up to *last (OUT) inclusive
+    last[0] = _pack(ijk[0] + di, ijk[1] + dj, ijk[2] + 1)
+    return _hash_first(h, last[0] - 2)
+
+
 # ---------------------------------------------------------------------------
 # Candidate lists
 
@@ -186,9 +194,7 @@ cdef inline int _voxel_pairs(Batch* b, intp_t r, Contacts* c, const float64_t* P
         _hash_cell(&h, P + stride * i, ijk)
         for di in range(-1, 2):
             for dj in range(-1, 2):
-                # the cells dk = -1, 0, +1: one run of keys
-                key = _pack(ijk[0] + di, ijk[1] + dj, ijk[2] + 1)
-                k = _hash_first(&h, key - 2)
+                k = _hash_column(&h, ijk, di, dj, &key)
                 while k < h.n and h.cells[k].key <= key:
                     j = h.cells[k].index
                     k += 1
@@ -330,9 +336,7 @@ cdef int _obstacle_pairs(Batch* b, intp_t r, Contacts* c, float64_t horizon) noe
         _hash_cell(&h, R + 4 * i, ijk)
         for di in range(-1, 2):
             for dj in range(-1, 2):
-                # the cells dk = -1, 0, +1: one run of keys
-                key = _pack(ijk[0] + di, ijk[1] + dj, ijk[2] + 1)
-                k = _hash_first(&h, key - 2)
+                k = _hash_column(&h, ijk, di, dj, &key)
                 while k < h.n and h.cells[k].key <= key:
                     m = h.cells[k].index
                     k += 1

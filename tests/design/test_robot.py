@@ -1,10 +1,9 @@
 import json
 import os
-import subprocess
-import sys
 
 import numpy as np
 import pytest
+from fuzzing import fifo_code, refused_in_child
 
 from softgym.design.controller import Controller
 from softgym.design.material import Material, Palette, default_palette
@@ -262,17 +261,8 @@ def test_a_fifo_given_as_a_design_file_is_refused_at_once(tmp_path, load):
     fifo = tmp_path / "robot.json"
     os.mkfifo(fifo)
     imports, call = load.split("; ")
-    code = (
-        f"{imports}\n"
-        "from softgym.exceptions import DesignFileError\n"
-        "try:\n"
-        f"    {call}({str(fifo)!r})\n"
-        "except DesignFileError as e:\n"
-        "    print('REFUSED', e)\n"
-    )
-    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         timeout=60)  # fmt: skip
-    assert "REFUSED" in res.stdout and "not a regular file" in res.stdout, res.stderr
+    out = refused_in_child(fifo_code(imports, call, str(fifo), "DesignFileError"))
+    assert "not a regular file" in out
 
 
 def test_saving_onto_a_folder_raises_and_leaves_no_temporary_file(tmp_path):

@@ -5,6 +5,7 @@ import json
 import gymnasium as gym
 import numpy as np
 import pytest
+from fuzzing import fifo_code, refused_in_child
 
 import softgym
 from evolvers.experiments import Experiment, get_experiment
@@ -135,8 +136,6 @@ def test_task_strings_files_and_fifos_are_refused_with_typed_errors(tmp_path):
     # issue 31: a repeated argument took the last; a FIFO blocked forever; a task
     # JSON 100,000 deep gave a 48-line RecursionError; a 37 MB terrain file was read
     import os
-    import subprocess
-    import sys
 
     from softgym.exceptions import InvalidParameterError, InvalidTerrainError
     from softgym.tasks import get_task
@@ -155,10 +154,6 @@ def test_task_strings_files_and_fifos_are_refused_with_typed_errors(tmp_path):
     if hasattr(os, "mkfifo"):
         fifo = tmp_path / "task.json"
         os.mkfifo(fifo)
-        code = ("from softgym.tasks import get_task\n"
-                "from softgym.exceptions import InvalidParameterError\n"
-                f"try:\n    get_task({str(fifo)!r})\n"
-                "except InvalidParameterError as e:\n    print('REFUSED', e)\n")  # fmt: skip
-        res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                             timeout=60)  # fmt: skip
-        assert "REFUSED" in res.stdout and "not a regular file" in res.stdout, res.stderr
+        out = refused_in_child(fifo_code("from softgym.tasks import get_task", "get_task",
+                                         str(fifo), "InvalidParameterError"))  # fmt: skip
+        assert "not a regular file" in out
