@@ -26,7 +26,7 @@ Sets
   with ``evolvers.operators.mut_cppn``.
 * :func:`fence_cases`: 6x6x6 bodies on the seed's fence task (a 1-voxel-high,
   1-voxel-thick square wall with a 10x10 interior, 2 voxels from the robot on every
-  side; SEED_REFERENCE §3.5).
+  side; the seed study).
 
 Perturbation
 ------------
@@ -87,7 +87,7 @@ REGIMES: dict[str, dict[str, float]] = {
 }
 
 #: Simulation settings of every run (``softgym.design.vxa.to_vxa`` keyword arguments;
-#: these are its defaults and the seed's, SEED_REFERENCE §2.1). to_vxa also writes
+#: these are its defaults and the seed's, docs/PHYSICS.md). to_vxa also writes
 #: BondDampingZ 1, ColDampingZ 0.8, SlowDampingZ 0.01, ColSystem 3, CollisionHorizon 2,
 #: flat floor, gravity -9.81, Lattice_Dim 0.01 m.
 SIM_SETTINGS: dict[str, Any] = dict(
@@ -97,7 +97,7 @@ SIM_SETTINGS: dict[str, Any] = dict(
 #: Relative density change of the perturbed voxel.
 PERTURBATION = 1e-6
 
-#: The seed's fence task (SEED_REFERENCE §1.8, §3.5): a 50x50x6 workspace, the 6x6x6
+#: The seed's fence task (docs/PHYSICS.md): a 50x50x6 workspace, the 6x6x6
 #: robot box at voxel indices x, y in 22..27, z in 0..5, a square wall of material 5
 #: (Obstacle, E 5e9 Pa, 1 kg per voxel) 1 voxel thick and 1 high at x in {19, 30}
 #: (y 19..30) and y in {19, 30} (x 19..30): 44 fixed voxels. In softgym:

@@ -1,4 +1,4 @@
-"""The seed study's scenarios as named, runnable configurations (SEED_REFERENCE §3.8).
+"""The seed study's scenarios as named, runnable configurations.
 
 ==========================  =====================  ==============  ============================================
 name                        variation              selection       objectives

@@ -1,6 +1,6 @@
 """`Individual`: a CPPN genome, material genes, controller genes, age and lineage.
 
-The genome of the seed study (SEED_REFERENCE §2.4, §3.1, §3.2):
+The genome of the seed study (docs/PHYSICS.md):
 
 * a :class:`~softgym.design.CPPN` drawing the voxel grid and choosing materials;
 * material genes: Young's modulus (Pa), density (kg/m^3) and CTE (1/°C) of
@@ -34,7 +34,7 @@ __all__ = [
 
 #: Material ids whose properties are genes (rows of ``Individual.materials``).
 MATERIAL_GENE_IDS: tuple[int, ...] = (6, 7, 8, 9)
-#: Initial material genes (SEED_REFERENCE §3.1): rows ids 6-9, columns (E Pa, density kg/m^3, CTE 1/°C).
+#: Initial material genes (the seed study): rows ids 6-9, columns (E Pa, density kg/m^3, CTE 1/°C).
 INITIAL_MATERIAL_GENES = np.array(
     [
         [5e6, 1e6, 0.0],

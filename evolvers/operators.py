@@ -1,4 +1,4 @@
-"""Variation operators of the seed study (SEED_REFERENCE §2.5, §3.1, §3.2).
+"""Variation operators of the seed study (docs/PHYSICS.md).
 
 * :func:`mut_cppn`: one NEAT-style CPPN mutation, retried until the body
   changes and stays valid (up to 1500 attempts).

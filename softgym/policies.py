@@ -6,7 +6,7 @@ sinusoidal controller (run by the engine; ``drive="controller"`` in the envs).
 :class:`Sinusoid` is the seed's open-loop controller as an env policy: every
 cell gets ``amplitude * sin(2 pi t / period + phase)``, so each muscle voxel's
 temperature is ``dT sin(2 pi t / period)`` as in the engine's built-in drive
-(SEED_REFERENCE section 1.5; the counter-phase of the two muscle kinds comes
+(docs/PHYSICS.md; the counter-phase of the two muscle kinds comes
 from the sign of their CTE).
 """
 

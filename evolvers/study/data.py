@@ -37,7 +37,7 @@ __all__ = [
 log = logging.getLogger(__name__)
 
 #: The report's single-run best-fitness curves (generation, NormFinalDist in voxel lengths), read
-#: from its figures by eye (+-1; SEED_REFERENCE §3.9; the Fig. 1 step to 24 at generation 6 and
+#: from its figures by eye (+-1; the seed study; the Fig. 1 step to 24 at generation 6 and
 #: the intermediate Fig. 4 steps read from the PNGs in ``shared/seed``).
 REPORT_CURVES: dict[str, list[tuple[int, float]]] = {
     "materials-t1": [(0, 15.0), (1, 21.5), (6, 24.0), (45, 28.5), (68, 32.3), (125, 42.7),

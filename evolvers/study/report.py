@@ -11,7 +11,7 @@ writes ``README.md`` and figures:
   does not hold, and why;
 * per scenario, the best-of-generation fitness (median and IQR band over
   seeds) vs. generation, with the report's single-run curve where it has one
-  (Fig. 1, Fig. 4; values read from its plots, SEED_REFERENCE §3.9);
+  (Fig. 1, Fig. 4; values read from its plots, the seed study);
 * the materials and controller genes of the winners (one point per seed);
 * the generation at which a robot first crossed the wall (one point per seed).
 

@@ -171,7 +171,7 @@ class Study:
 
 
 #: The seed's obstacle runs scored MaxXYDist and the L coefficient on a centre of mass that
-#: counts the 44 one-kilogram wall voxels (SEED_REFERENCE §3.6); the study's obstacle scenarios
+#: counts the 44 one-kilogram wall voxels (the seed study); the study's obstacle scenarios
 #: do the same (:attr:`evolvers.experiments.Experiment.seed_centre_of_mass`).
 SEED_COM: Mapping[str, Any] = {"seed_centre_of_mass": True}
 
@@ -196,7 +196,7 @@ def _robot_com(s: Scenario, seeds: int) -> Scenario:
                    description=f"{s.description}; scored on the robot's own centre of mass")  # fmt: skip
 
 
-#: The seed report's claims (SEED_REFERENCE §3.9; issue 15): >= 10 seeds for the Fig. 4 trio,
+#: The seed report's claims (the seed study; issue 15): >= 10 seeds for the Fig. 4 trio,
 #: materials T2 and the obstacle final setup, >= 5 for the long runs and the obstacle attempts.
 #: ``cpu_per_generation``: CPU s of generations 1-4 of one seed (6x6x6, pop 15, 5 s, one thread,
 #: the corotational default physics), measured for issue 15; the whole study is ~40 CPU hours.

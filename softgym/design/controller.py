@@ -3,7 +3,7 @@
 Every muscle voxel sees ``T(t) = dT sin(2 pi t / period)``; a voxel of CTE
 ``c`` is driven by ``c * T(t)``. Materials 3 (Active_+) and 4 (Active_-) get
 ``cte = +muscle_cte`` and ``-muscle_cte``, so the two muscle kinds work in
-counter-phase (SEED_REFERENCE §1.5, §3.2).
+counter-phase (docs/PHYSICS.md).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from softgym.validate import number
 
 __all__ = ["CONTROLLER_BOUNDS", "Controller"]
 
-#: The seed's controller-evolution bounds (SEED_REFERENCE §3.2): name -> (low, high, unit).
+#: The seed's controller-evolution bounds (the seed study): name -> (low, high, unit).
 CONTROLLER_BOUNDS: dict[str, tuple[float, float, str]] = {
     "temp_amplitude": (1.0, 20.0, "degC"),
     "period": (0.01, 0.75, "s"),

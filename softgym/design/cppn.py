@@ -1,7 +1,7 @@
 """CPPN genomes: compositional pattern-producing networks that draw robots.
 
 A :class:`CPPN` is a small acyclic graph evaluated once per voxel of a grid
-(SEED_REFERENCE §2.4, §2.5, §3.1):
+(docs/PHYSICS.md):
 
 * **Inputs** ``x, y, z, d, b``: the voxel indices, each linearly mapped to
   [-1, 1] over the grid (an axis of size 1 maps to -1, as the seed's
@@ -566,7 +566,7 @@ class CPPN:
         is_valid: Validity = None,
         max_attempts: int = 1500,
     ) -> MutationResult:
-        """One NEAT-style mutation with validity retries (SEED_REFERENCE §2.5).
+        """One NEAT-style mutation with validity retries (docs/PHYSICS.md).
 
         Each attempt copies this genome, applies one operator drawn uniformly
         from :data:`MUTATIONS`, prunes dangling hidden nodes and expresses the

@@ -22,7 +22,7 @@ CPPN material trees and ``.vxa`` files carry over unchanged:
 ====  ==================  ===========  ==========  ============================
 
 All have density 1e6 kg/m^3, Poisson's ratio 0.35, static friction 1 and
-kinetic friction 0.5 (SEED_REFERENCE §2.2, §3.1).
+kinetic friction 0.5 (docs/PHYSICS.md).
 """
 
 from __future__ import annotations
@@ -67,7 +67,7 @@ MAX_ABS_CTE = 0.1
 MUSCLE_IDS: tuple[int, ...] = (3, 4, 8, 9)
 #: Ids of passive tissue (soft and hard, old and new).
 TISSUE_IDS: tuple[int, ...] = (1, 2, 6, 7)
-#: Ids counted as "bone" by the obstacle experiment's rule (SEED_REFERENCE §3.7): Passive_Hard only.
+#: Ids counted as "bone" by the obstacle experiment's rule (the seed study): Passive_Hard only.
 BONE_IDS: tuple[int, ...] = (2,)
 #: The seed's four original materials (the ``old_materials`` objective, §3.1).
 OLD_MATERIAL_IDS: tuple[int, ...] = (1, 2, 3, 4)
@@ -208,7 +208,7 @@ class Material:
 
 @dataclass(frozen=True)
 class MaterialBounds:
-    """Bounds of the materials GA (SEED_REFERENCE §3.1).
+    """Bounds of the materials GA (the seed study).
 
     Parameters
     ----------
@@ -266,7 +266,7 @@ def seed_materials() -> dict[int, Material]:
     Returns
     -------
     dict of int to Material
-        Ids 1-9 with the values of SEED_REFERENCE §2.2 and the initial values of §3.1.
+        Ids 1-9 with the values of docs/PHYSICS.md.
     """
     return {
         1: Material("Passive_Soft", 5e6, color=(0.0, 1.0, 1.0)),
@@ -364,7 +364,7 @@ class Palette(Mapping[int, Material]):
         return self.with_material(material_id, self[material_id].replace(**changes))
 
     def with_counterphase(self, source: int = 8, target: int = 9) -> Palette:
-        """Make ``target`` the counter-phase twin of ``source`` (SEED_REFERENCE §3.1).
+        """Make ``target`` the counter-phase twin of ``source`` (the seed study).
 
         The target keeps its name and colour and takes the source's Young's
         modulus, density, Poisson's ratio and friction, with ``cte = -source.cte``.

@@ -9,7 +9,7 @@ x = i, y = j, z = k (z up).
 The controller is the single source of the muscle CTE: a design's palette
 entries 3 (Active_+) and 4 (Active_-) always carry ``+controller.muscle_cte``
 and ``-controller.muscle_cte`` (set on construction), as in the seed's
-controller evolution (SEED_REFERENCE §3.2).
+controller evolution (the seed study).
 """
 
 from __future__ import annotations
@@ -271,7 +271,7 @@ def _at_least(fraction: float, total: int) -> int:
 
 @dataclass(frozen=True)
 class CompositionRules:
-    """Validity rules of a design (SEED_REFERENCE §2.8, §3.1, §3.7).
+    """Validity rules of a design (docs/PHYSICS.md).
 
     A design always needs at least one voxel. The default instance checks
     only that and 6-connectivity; use :meth:`seed` or :meth:`obstacles` for

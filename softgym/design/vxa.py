@@ -18,7 +18,7 @@ Conventions (those of evosoro's ``read_write_voxelyze.py``):
   ``<CTE>`` (1/°C), ``<uStatic>``, ``<uDynamic>``. Only ``<MatModel>`` 0
   (linear) is supported.
 * ``<Environment><Thermal>``: ``<TempAmp>``, ``<TempBase>``, ``<TempPeriod>``.
-  The engine drives ``dT = TempAmp - TempBase`` (SEED_REFERENCE §1.5).
+  The engine drives ``dT = TempAmp - TempBase`` (docs/PHYSICS.md).
 
 Import builds a :class:`~softgym.design.controller.Controller` with
 ``temp_amplitude = TempAmp - TempBase``, ``period = TempPeriod`` and

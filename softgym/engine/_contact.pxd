@@ -65,7 +65,7 @@ cdef inline void surface_contact(Batch* b, intp_t i, float64_t nx, float64_t ny,
     # Penalty contact of voxel i with a static surface of outward unit normal n,
     # penetration pen > 0: normal force 2 E L pen minus collision damping (never
     # pulling), then Coulomb friction in the tangent plane (the seed's floor law,
-    # SEED_REFERENCE 1.6, for any normal). IN/OUT: f (force on the voxel), and
+    # docs/PHYSICS.md, for any normal). IN/OUT: f (force on the voxel), and
     # the voxel's velocity when kinetic friction stops it.
     cdef:
         float64_t* v = b.vel + 3 * i
@@ -152,7 +152,7 @@ cdef inline float64_t box_penetration(const float64_t* B, const float64_t* p, fl
 
 
 cdef inline void seed_floor(Batch* b, intp_t i, float64_t dt, float64_t* f) noexcept nogil:
-    # The seed's floor (SEED_REFERENCE 1.6) on voxel i. IN/OUT: f, the voxel's
+    # The seed's floor (docs/PHYSICS.md) on voxel i. IN/OUT: f, the voxel's
     # force before the floor (its in-plane part decides static friction), and
     # its velocity when kinetic friction stops it.
     cdef:

@@ -1,4 +1,4 @@
-# Self-collision (SEED_REFERENCE 1.7): surface voxels more than
+# Self-collision (docs/PHYSICS.md): surface voxels more than
 # `collision_exclusion` bond hops apart repel when their spherical envelopes, of diameter
 # 1.5 x their actuated size, overlap: F = E_h L (0.75 (s1 + s2) - |d|) along d,
 # E_h the harmonic mean of their moduli; no damping, no friction. Candidate

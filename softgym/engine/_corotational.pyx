@@ -2,7 +2,7 @@
 # The link forces of one robot (links_corotational); the voxel update is in
 # _integrate.pyx, self-collision in _contact.pyx, the step loop in _core.pyx.
 #
-# Physics (see SEED_REFERENCE section 1 and softgym/engine/simulation.py):
+# Physics (see docs/PHYSICS.md):
 # - each voxel is a rigid cube (position, quaternion, velocity, angular velocity);
 # - each face-adjacent pair is joined by an Euler-Bernoulli beam measured in a
 #   frame that turns with the link (co-rotational), so large rigid rotations are

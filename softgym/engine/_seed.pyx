@@ -1,5 +1,5 @@
 # Model 0, "seed": the step of the seed study's engine (evosoro's bundled
-# VoxCAD-era Voxelyze, SEED_REFERENCE section 1), written anew from its
+# VoxCAD-era Voxelyze, docs/PHYSICS.md), written anew from its
 # documented behaviour and checked against that engine's output
 # (benchmarks/fidelity_seed.py):
 # - each link is a beam measured in the frame of its first voxel (the one on

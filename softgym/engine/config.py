@@ -28,7 +28,7 @@ class SimConfig:
     """Settings shared by every robot of a :class:`~softgym.engine.Simulation`.
 
     The defaults are the seed study's (evosoro's ``.vxa`` settings,
-    SEED_REFERENCE section 2.1): the ``"seed"`` preset.
+    docs/PHYSICS.md): the ``"seed"`` preset.
 
     Parameters
     ----------

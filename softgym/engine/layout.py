@@ -84,7 +84,7 @@ def _hop_neighbours(n: int, v1: np.ndarray, v2: np.ndarray, hops: int):
     return start, b
 
 
-#: The seed's obstacle voxels (its material 5, SEED_REFERENCE §2.2): E (Pa), density (kg/m^3).
+#: The seed's obstacle voxels (its material 5, docs/PHYSICS.md): E (Pa), density (kg/m^3).
 OBSTACLE_YOUNGS_MODULUS = 5e9
 OBSTACLE_DENSITY = 1e6
 #: Most lattice cells a terrain may turn into seed-model obstacle voxels.
@@ -129,9 +129,8 @@ def obstacle_cells(terrain: Any) -> np.ndarray | None:
 def obstacle_mass_and_center(terrain: Any, voxel_size: float) -> tuple[float, np.ndarray]:
     """Mass (kg) and centre of mass (m) of a terrain's boxes as the seed's obstacle voxels.
 
-    The seed's centre of mass counts its 44 fixed wall voxels (SEED_REFERENCE
-    §1.8); this is what dilutes its obstacle metrics
-    (:func:`softgym.metrics.dilute`).
+    The seed's centre of mass counts its 44 fixed wall voxels (docs/PHYSICS.md); this
+    is what dilutes its obstacle metrics (:func:`softgym.metrics.dilute`).
     """
     boxes = terrain.as_array(voxel_size)
     if len(boxes) == 0:

@@ -6,7 +6,7 @@ offsets, every constant of the lattice model computed once), and calls
 :func:`softgym.engine._core.advance`, which runs the robots in parallel without
 the GIL.
 
-The physics is the seed's engine (SEED_REFERENCE section 1), re-derived:
+The physics is the seed's engine (docs/PHYSICS.md), re-derived:
 
 * voxel: rigid cube, mass ``rho L^3``, inertia ``m L^2 / 6``;
 * link between face neighbours: Euler-Bernoulli beam with the harmonic-mean

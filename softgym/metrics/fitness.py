@@ -1,4 +1,4 @@
-"""The seed's fitness measures (SEED_REFERENCE §1.8, §2.3, §3.1, §3.6).
+"""The seed's fitness measures (docs/PHYSICS.md).
 
 Each measure comes twice: a ``*_from_arrays`` function on plain arrays, and
 a function on a :class:`~softgym.engine.rollout.Rollout` vectorised over its
@@ -317,7 +317,7 @@ def dilute(rollout: Rollout) -> Rollout:
     """The rollout with the seed's own centre of mass, which counts the obstacle voxels.
 
     The seed's engine averages over every voxel of its world, its 44 fixed wall
-    voxels included (SEED_REFERENCE §1.8), so each displacement in its obstacle
+    voxels included (docs/PHYSICS.md), so each displacement in its obstacle
     runs is the robot's times ``m_robot / (m_robot + m_walls)`` and its
     MaxXYDist and L coefficient are computed on that diluted path. Use this to
     compare a run with the report's numbers; softgym's own metrics stay

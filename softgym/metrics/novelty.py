@@ -1,4 +1,4 @@
-"""Trajectory similarity (AMSS) and novelty scores (SEED_REFERENCE §3.4, §4).
+"""Trajectory similarity (AMSS) and novelty scores (the seed study).
 
 A *trace* is a robot's centre-of-mass samples, an array of shape
 (n_points, 4) holding (x, y, z, t) in metres and seconds

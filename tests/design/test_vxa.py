@@ -232,7 +232,7 @@ def test_to_vxa_writes_a_terrain_as_the_seeds_fixed_obstacle_voxels():
 
 
 def test_the_seeds_own_obstacle_workspace_reads_as_robot_plus_fence():
-    # the seed's obstacle runs (SEED_REFERENCE 3.5): a 50x50x6 lattice, the robot at
+    # the seed's obstacle runs (the seed study): a 50x50x6 lattice, the robot at
     # voxel (22, 22, 0), 44 wall voxels of material 5 fixed by four regions
     import numpy as np
 

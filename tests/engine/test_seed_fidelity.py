@@ -1,4 +1,4 @@
-"""The engine against a measurement of the seed's own engine (SEED_REFERENCE 5.2).
+"""The engine against a measurement of the seed's own engine (the seed study).
 
 A 2x2x6 column of Active+ voxels (CTE +0.01, dT 14, period 0.25 s) run in the
 seed's engine: its centre of mass settles at 27.61 mm and stays there for

@@ -11,7 +11,7 @@ see its README). The cases, regimes and perturbations are defined in
 Every (case, regime, draw) is one oracle run of ``softgym.design.vxa.to_vxa`` of
 ``fidelity_cases.case_design(case, regime, draw)`` with ``fidelity_cases.SIM_SETTINGS``
 and centre-of-mass traces every 0.1 s. Fence cases are written the way the seed's
-obstacle code wrote them (SEED_REFERENCE §3.5; ``to_vxa`` cannot write obstacles): a
+obstacle code wrote them (the seed study; ``to_vxa`` cannot write obstacles): a
 50x50x6 workspace with the robot at voxel (22, 22, 0), the 44 wall voxels of material 5
 in the structure and four ``<FRegion>`` boundary conditions with ``DofFixed`` 63 that
 fix them.
@@ -76,7 +76,7 @@ def _py2str(v: float) -> str:
 
 
 def fence_vxa(design: RobotDesign) -> str:
-    """The .vxa of ``design`` (a <= 6x6x6 robot) inside the seed's fence (SEED_REFERENCE §3.5)."""
+    """The .vxa of ``design`` (a <= 6x6x6 robot) inside the seed's fence (the seed study)."""
     ex, ey, ez = fc.FENCE["env_size"]
     ox, oy, oz = fc.FENCE["robot_offset"]
     lo, hi, h, wall = (
@@ -212,7 +212,7 @@ def make_header(set_name: str, command: str, timeout: float) -> dict[str, Any]:
             "divergence); metrics and trace are then null",
             "wall_s": "oracle wall time (s)",
             "NormFinalDist": "XY distance of the CM from t = InitCmTime to the end, voxel lengths",
-            "MaxXYDist": "max(|dx|, |dy|) of the final CM, voxel lengths (SEED_REFERENCE 3.6)",
+            "MaxXYDist": "max(|dx|, |dy|) of the final CM, voxel lengths (the seed study)",
             "TimeMaxXYDist": "first trace time within 0.1 voxel of MaxXYDist (s)",
             "LCoefficient": "MaxXYDist^2 / TimeMaxXYDist",
             "trace": "CM samples [x, y, z (m, rounded to 1e-7; the engine prints 6 significant digits), "
@@ -230,7 +230,7 @@ def make_header(set_name: str, command: str, timeout: float) -> dict[str, Any]:
             "Fence cases: the oracle's frame is the 50x50x6 workspace; the robot grid's corner is at "
             "robot_offset * L = (0.22, 0.22, 0) m.",
             "The seed's CM (trace and every metric) includes the 44 fixed 1 kg wall voxels "
-            "(SEED_REFERENCE 1.8): robot-only displacement = diluted x (robot_mass_kg + 44) / "
+            "(docs/PHYSICS.md): robot-only displacement = diluted x (robot_mass_kg + 44) / "
             "robot_mass_kg; the walls' own CM is (0.25, 0.25, 0.005) m.",
             "The walls are written as the seed did: material 5 voxels plus four <FRegion> boundary "
             "conditions (DofFixed 63) in <Boundary_Conditions>; softgym's to_vxa cannot write them.",
