@@ -18,6 +18,7 @@
 #   M2 = -k_b (b1 + 2 b2), torsion +-k_t tau r, axial force -k_a e u on voxel 2
 #   and the shear force that balances the moments, r x (M1 + M2) / L.
 #   Damping uses the same forms with the deformation rates, so its power is
+#   never positive.
 #
 # The link forces come from a branch-free kernel over restrict pointers that
 # the compiler vectorises (gathers + SIMD), then are scattered in link order,

@@ -22,8 +22,11 @@
 # - orientations renormalised exactly and snapped to the identity when
 #   w >= 1; voxel sizes follow the drive at the end of the step (so the
 #   link forces of a step use the previous step's sizes);
-# - every voxel is a self-collision candidate (the seed's surface test is
-#   always true), the drive's 2 pi is the single-precision constant.
+# - the drive's 2 pi is the single-precision constant.
+# One departure: the seed's surface test is always true (every voxel is a
+# self-collision candidate there); here only surface voxels (missing a face
+# bond) are, as the seed intended: an interior voxel is shielded by its six
+# bonded neighbours, and fidelity_seed.py's targets hold.
 #
 # This module holds the seed's link forces (links_seed); its voxel update
 # (integrate_seed, the floor law) is in _integrate.pyx / _contact.pxd, its

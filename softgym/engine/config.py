@@ -54,8 +54,8 @@ class SimConfig:
         The step. ``"seed"``: the seed study's own engine (links measured in
         their first voxel's frame with its small-/large-angle switch,
         finite-difference link damping, its floor and friction, sizes that
-        follow the drive one step late, every voxel a self-collision
-        candidate), which its results came from; checked against that
+        follow the drive one step late, its self-collision schedule), which
+        its results came from; checked against that
         engine by ``benchmarks/fidelity_seed.py``. ``"corotational"``:
         softgym's symmetric co-rotational beam (links measured in the
         bisector frame of their two voxels, viscous damping on physical

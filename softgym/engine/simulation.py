@@ -6,7 +6,9 @@ offsets, every constant of the lattice model computed once), and calls
 :func:`softgym.engine._core.advance`, which runs the robots in parallel without
 the GIL.
 
-The physics is the seed's engine (docs/PHYSICS.md), re-derived:
+Two presets (``SimConfig.model``, formulas and sources in docs/PHYSICS.md): ``"seed"``
+(the default) is the seed study's engine step, reproduced with its quirks; ``"corotational"``
+is softgym's own symmetric beam, summarised here:
 
 * voxel: rigid cube, mass ``rho L^3``, inertia ``m L^2 / 6``;
 * link between face neighbours: Euler-Bernoulli beam with the harmonic-mean
@@ -18,8 +20,8 @@ The physics is the seed's engine (docs/PHYSICS.md), re-derived:
 * bond damping ``zeta_b sqrt(k m)`` (axial, the seed's ``0.5 zeta_b 2 sqrt(a1 m)``),
   ``zeta_b sqrt(k_bend I) / 2`` (bending moments, the seed's coefficient; the
   shear damping follows from the moments) and ``zeta_b sqrt(k_torsion I) / 2``
-  (torsion), with the reduced mass ``2 m1 m2 / (m1 + m2)`` (= m for equal
-  voxels) so mixed links are symmetric. Damping acts on deformation rates
+  (torsion), with the harmonic mean of the masses ``2 m1 m2 / (m1 + m2)``
+  (= m for equal voxels; twice the reduced mass) so mixed links are symmetric. Damping acts on deformation rates
   only, so its power is never positive and rigid motion is not damped;
 * global damping ``zeta_g 2 sqrt(m E L)`` on velocity and the seed's
   multiplicative factor on angular momentum;
