@@ -29,6 +29,7 @@ checkpoint and the command that resumes.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import datetime as _dt
 import hashlib
@@ -47,6 +48,7 @@ import numpy as np
 from evolvers.evaluation import FITNESS_METRICS, MAXIMIZED, EvalStats
 from evolvers.experiments import Experiment
 from evolvers.genome import Individual
+from softgym.evaluate import caller_shows_progress
 from softgym.exceptions import CheckpointError, InvalidParameterError
 from softgym.io import (
     atomic_write_json,
@@ -493,12 +495,16 @@ class RunRecorder:
             total=generations + 1, initial=generation + 1, desc=desc, unit="gen",
             dynamic_ncols=True, leave=True,
         )  # fmt: skip
+        # one bar at a time: the batches of the run show none of their own
+        self._bar_scope = contextlib.ExitStack()
+        self._bar_scope.enter_context(caller_shows_progress())
 
     def close_progress(self) -> None:
         """Close the progress bar (if any)."""
         if self._bar is not None:
             self._bar.close()
             self._bar = None
+            self._bar_scope.close()
 
     def _report(self, row: Mapping[str, Any], generations: int | None) -> None:
         fit = self.experiment.fitness

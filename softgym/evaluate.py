@@ -19,7 +19,10 @@ each design's composition as arrays. The task is anything
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+import contextlib
+import sys
+import threading
+from collections.abc import Iterable, Iterator, Mapping
 from typing import Any
 
 import numpy as np
@@ -28,7 +31,14 @@ from softgym.exceptions import InvalidDesignError, InvalidParameterError
 from softgym.tasks import Task, TaskLike, get_task
 from softgym.validate import is_int, positive, show
 
-__all__ = ["METRIC_KEYS", "Task", "estimated_cost", "evaluate", "evaluate_payload"]
+__all__ = [
+    "METRIC_KEYS",
+    "Task",
+    "caller_shows_progress",
+    "estimated_cost",
+    "evaluate",
+    "evaluate_payload",
+]
 
 #: Keys of the dict returned by :func:`evaluate` (traces come with ``traces=True``).
 METRIC_KEYS: tuple[str, ...] = (
@@ -74,6 +84,27 @@ def _as_design(obj: Any):
 
 #: A batch estimated to take longer than this (s) shows a progress bar by default.
 PROGRESS_AFTER_S = 5.0
+
+_caller_bars = 0  # progress bars callers show around evaluations (caller_shows_progress)
+_caller_lock = threading.Lock()
+
+
+@contextlib.contextmanager
+def caller_shows_progress() -> Iterator[None]:
+    """While active, :func:`evaluate` shows no progress bar of its own by default.
+
+    One bar at a time: a caller that shows its own (a run's bar over its
+    generations) wraps its loop in this, and the batches it evaluates stay
+    quiet unless a call asks for a bar (``progress=True``).
+    """
+    global _caller_bars
+    with _caller_lock:
+        _caller_bars += 1
+    try:
+        yield
+    finally:
+        with _caller_lock:
+            _caller_bars -= 1
 _VOXEL_STEPS_PER_S = 5e6  # per thread, for that estimate (the seed preset's order of magnitude)
 
 
@@ -111,7 +142,10 @@ def evaluate(
         Full engine settings; replaces the task's (its ``trace_interval`` wins).
     progress : bool, optional
         Show a tqdm bar over the simulated time; default: only for a batch
-        estimated to take more than :data:`PROGRESS_AFTER_S` seconds.
+        estimated to take more than :data:`PROGRESS_AFTER_S` seconds, on an
+        interactive terminal, when no caller shows a bar of its own
+        (:func:`caller_shows_progress`). The bar is removed when the batch is
+        done, so calls in a loop show one bar at a time.
 
     Returns
     -------
@@ -178,11 +212,12 @@ def evaluate(
     sim = Simulation(batch, config=cfg, n_threads=task.n_threads, terrain=terrains)
     if progress is None:
         work = sum(voxel_steps_per_second(d, cfg) for d in batch) * task.seconds
-        progress = work / (_VOXEL_STEPS_PER_S * sim.n_threads) > PROGRESS_AFTER_S
+        progress = (work / (_VOXEL_STEPS_PER_S * sim.n_threads) > PROGRESS_AFTER_S
+                    and _caller_bars == 0 and sys.stderr.isatty())  # fmt: skip
     if progress:
         from tqdm.auto import tqdm
 
-        with tqdm(total=task.seconds, unit="s", desc=f"simulating {n} robots",
+        with tqdm(total=task.seconds, unit="s", desc=f"simulating {n} robots", leave=False,
                   bar_format="{l_bar}{bar}| {n:.2f}/{total:.2f} s [{elapsed}<{remaining}]") as bar:
             sim.advance_to(task.seconds, progress=lambda t: bar.update(t - bar.n))
     else:

@@ -48,17 +48,28 @@ def test_progress_bar_and_log_lines(tmp_path, caplog, capsys):
     assert "[native]" not in capsys.readouterr().err
 
 
-def test_a_quiet_run_keeps_long_batches_quiet_too(tmp_path, capsys, monkeypatch):
-    # inside a study the runs show no bar: not even the evaluation's own bar,
-    # which a long batch shows by default
+def test_one_progress_bar_at_a_time(tmp_path, capsys, monkeypatch):
+    # a run shows its bar over the generations and its batches none of their own
+    # (issue 30: one bar at a time), even a long batch on a terminal; a quiet run none
     import importlib
 
     ev = importlib.import_module("softgym.evaluate")  # the module (the package exports the function)
     monkeypatch.setattr(ev, "PROGRESS_AFTER_S", 0.0)  # every batch counts as long
+    monkeypatch.setattr(ev.sys.stderr, "isatty", lambda: True, raising=False)
     EvolutionRun(tiny(), tmp_path / "loud", seed=0, generations=0, figures=False).run()
-    assert "simulating" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "[native]" in err and "simulating" not in err
     EvolutionRun(tiny(), tmp_path / "q", seed=0, generations=0, figures=False, progress=False).run()
     assert capsys.readouterr().err == ""
+    # outside a run, a long batch on a terminal shows its own bar, which it removes
+    ev.evaluate([_walker()], seconds=0.05)
+    assert "simulating 1 robots" in capsys.readouterr().err
+
+
+def _walker():
+    from softgym.design import default_walker
+
+    return default_walker()
 
 
 def test_resume_mismatch_names_the_one_setting(tmp_path):
