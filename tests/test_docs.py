@@ -24,7 +24,7 @@ def _toctree_pages(index: Path) -> list[Path]:
     pages = []
     for block in re.findall(r"```\{toctree\}\n(.*?)```", index.read_text(), re.S):
         for line in block.splitlines():
-            entry = line.strip()
+            entry = line.strip().replace("_IF_PRESENT", "")  # conf.py: PHYSICS.md where it exists
             if entry and not entry.startswith(":"):
                 page = index.parent / f"{entry}.md"
                 if page.exists():
