@@ -126,6 +126,12 @@ def _kernel_levels():
         return []
     if sys.platform == "win32" or platform.machine().lower() not in ("x86_64", "amd64"):
         return []
+    # the target, not the build machine: a cross build (cibuildwheel's arm64 wheels on an
+    # x86-64 Mac set _PYTHON_HOST_PLATFORM and ARCHFLAGS) gets the portable kernel only
+    target = sysconfig.get_platform().lower()
+    archflags = os.environ.get("ARCHFLAGS", "").split()[1::2]
+    if not target.endswith(("x86_64", "amd64")) or any(a != "x86_64" for a in archflags):
+        return []
     return [lvl for lvl in ("v3", "v4") if _compiler_takes(f"-march=x86-64-{lvl}")]
 
 

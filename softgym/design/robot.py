@@ -873,8 +873,8 @@ def default_walker() -> RobotDesign:
     """A hand-made 6x6x6 robot that walks under the seed's default sinusoid.
 
     A full 6x6x6 block: in the lower five layers the front two x-columns
-    (x < 2) are Active_+ (3) and the rear four (x >= 2) Active_- (4); the top
-    layer (z = 5) is Passive_Soft (1). The two muscle groups contract in
+    (x < 2) are ``Active_+`` (3) and the rear four (x >= 2) ``Active_-`` (4); the top
+    layer (z = 5) is ``Passive_Soft`` (1). The two muscle groups contract in
     counter-phase; the uneven 1/3 : 2/3 split breaks the front/back symmetry
     (a symmetric half/half split only rocks in place), so the block shuffles
     steadily towards -x.

@@ -1,0 +1,139 @@
+"""Sphinx extension: one page per task of the registry (``softgym.tasks.KINDS``).
+
+At ``builder-inited`` it writes ``docs/tasks/index.md`` and ``docs/tasks/<name>.md``
+(generated, git-ignored) from each task's registry entry: its summary, Gym id, score,
+arguments with their defaults and ranges, the engine settings it sets, the world it
+builds around the default 6x6x6 grid and the docstring of its layout function. Run it
+alone with ``python docs/_ext/softgym_tasks.py OUT_DIR``.
+"""
+
+import inspect
+import sys
+from pathlib import Path
+
+from softgym.envs import env_id
+from softgym.tasks import ALIASES, KINDS, get_task
+
+SHAPE = (6, 6, 6)
+
+
+def _fmt(v):
+    return f"{v:g}" if isinstance(v, float) else str(v)
+
+
+def task_page(name: str) -> str:
+    """The Markdown page of one task of the registry."""
+    kind = KINDS[name]
+    defaults = kind.resolve(None)
+    terrain = kind.layout(SHAPE, **defaults)
+    task = get_task(name)
+    aliases = sorted(a for a, t in ALIASES.items() if t == name)
+    lines = [
+        f"# {name}",
+        "",
+        f"{kind.summary[0].upper()}{kind.summary[1:]}.",
+        "",
+        "| | |",
+        "|---|---|",
+        f"| Gym id | `{env_id(name)}` |",
+        f"| score (`reward`) | `{kind.reward}` |",
+        f"| `softgym evolve` | `--task {name}` |",
+        f"| `softgym.evaluate` | `task=\"{name}\"` |",
+        f"| duration | {task.seconds:g} s simulated |",
+    ]
+    if aliases:
+        lines.append(f"| aliases | {', '.join(f'`{a}`' for a in aliases)} |")
+    lines += ["", "## Arguments", ""]
+    if kind.options:
+        lines += [
+            "Given after a colon (`\"{0}:{1}={2}\"`) or as `Task(\"{0}\", options={{...}})`; "
+            "a value outside its range raises `InvalidParameterError` naming it.".format(
+                name, *next(iter((k, _fmt(o.default)) for k, o in kind.options.items()))
+            ),
+            "",
+            "| argument | default | range | meaning |",
+            "|---|---|---|---|",
+        ]
+        for k, o in kind.options.items():
+            kind_ = "integer " if o.integer else ""
+            lines.append(
+                f"| `{k}` | {_fmt(o.default)} | {kind_}[{o.lo:g}, {o.hi:g}] | {o.doc} |"
+            )
+    else:
+        lines.append("None: the task is fixed.")
+    sim = kind.sim(defaults)
+    lines += ["", "## The world", ""]
+    if sim:
+        settings = ", ".join(f"`{k}={v!r}`" for k, v in sim.items())
+        lines += [f"Engine settings (`SimConfig` fields) at the defaults: {settings}.", ""]
+    lines.append(
+        f"Around a {'x'.join(map(str, SHAPE))} grid at the defaults: "
+        f"{len(terrain.boxes)} fixed box(es), {len(terrain.objects)} movable object(s), "
+        f"{'a floor' if terrain.floor else 'no floor'}."
+    )
+    doc = inspect.getdoc(kind.layout)
+    if doc:
+        lines += ["", "The layout function's docstring:", "", "```text", doc, "```"]
+    return "\n".join(lines) + "\n"
+
+
+def index_page() -> str:
+    """The tasks' index: a table of every task and the toctree of their pages."""
+    lines = [
+        "# Tasks",
+        "",
+        "Every task is defined once in `softgym.tasks` (the registry `softgym.tasks.KINDS`: "
+        "world, engine settings, measure, difficulty arguments) and runs the same way in "
+        "`softgym.evaluate`, its Gym id and `softgym evolve --task NAME`. These pages are "
+        "generated from the registry when the site is built.",
+        "",
+        "| task | Gym id | the world and the goal | score | arguments (default) |",
+        "|---|---|---|---|---|",
+    ]
+    for name, kind in KINDS.items():
+        args = ", ".join(f"{k} ({_fmt(o.default)})" for k, o in kind.options.items())
+        lines.append(
+            f"| [{name}]({name}.md) | `{env_id(name)}` | {kind.summary} | `{kind.reward}` | {args} |"
+        )
+    lines += [
+        "",
+        "![The task suite: each task's world around the default walker after settling]"
+        "(../figures/task_gallery.png)",
+        "",
+        "```{toctree}",
+        ":hidden:",
+        "",
+        *KINDS,
+        "```",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def write_pages(out: Path) -> list[Path]:
+    """Write the index and one page per task into ``out``; return the paths written."""
+    out.mkdir(parents=True, exist_ok=True)
+    pages = {"index": index_page(), **{n: task_page(n) for n in KINDS}}
+    written = []
+    for stem, text in pages.items():
+        path = out / f"{stem}.md"
+        if not path.exists() or path.read_text() != text:  # unchanged pages stay cached
+            path.write_text(text)
+        written.append(path)
+    for stale in set(out.glob("*.md")) - set(written):
+        stale.unlink()
+    return written
+
+
+def _on_builder_inited(app):
+    write_pages(Path(app.srcdir) / "tasks")
+
+
+def setup(app):
+    """Register the page generator with Sphinx."""
+    app.connect("builder-inited", _on_builder_inited)
+    return {"version": "1", "parallel_read_safe": True, "parallel_write_safe": True}
+
+
+if __name__ == "__main__":
+    for p in write_pages(Path(sys.argv[1] if len(sys.argv) > 1 else "docs/tasks")):
+        print(p)
