@@ -63,7 +63,6 @@ def _physics_in_toctree(app, docname, source):
 NOT_YET_RST = {
     "softgym.envs.walker.SoftWalkerEnv",
     "softgym.envs.vector.SoftWalkerVectorEnv",
-    "softgym.engine.simulation.Simulation.set_external_force",
 }
 
 

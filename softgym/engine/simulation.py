@@ -537,7 +537,7 @@ class Simulation:
         ----------
         robot : int
             Robot index.
-        force : array_like of shape (3,), (n_voxels_r, 3) or (*grid_shape, 3)
+        force : array_like of shape (3,), (n_voxels_r, 3) or ``grid_shape + (3,)``
             A shape (3,) force is applied to every voxel.
         """
         s = self._slice(robot)
