@@ -19,7 +19,10 @@ steps, actions setting each muscle's contraction level; the episode length is
 set in seconds, so another ``control_dt`` keeps 4 s);
 ``gym.make_vec(id, num_envs=N)`` a :class:`SoftWalkerVectorEnv` stepping all N
 robots in one engine call (``designs=[...]`` may differ). ``task=`` also takes
-a Task, a Terrain or a terrain JSON file.
+a Task, a Terrain or a terrain JSON file. ``action_mode="temperature"`` gives the
+seed's temperature signal as the action instead of contraction levels.
+:mod:`softgym.envs.sb3` (the ``rl`` extra, imported only on demand) adapts the
+vector env to Stable-Baselines3.
 """
 
 import gymnasium as gym
