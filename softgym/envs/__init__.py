@@ -15,12 +15,12 @@ id                         world                                       reward (p
 Every task of :data:`softgym.tasks.TASKS` gets an id (a task added with
 :func:`softgym.tasks.register_task` gets one at the next :func:`register_envs`).
 ``gym.make(id)`` gives a :class:`SoftWalkerEnv` (4 s episodes of 0.05 s control
-steps, actions setting each muscle's contraction level; the episode length is
+steps, actions setting the muscles' contractions; the episode length is
 set in seconds, so another ``control_dt`` keeps 4 s);
 ``gym.make_vec(id, num_envs=N)`` a :class:`SoftWalkerVectorEnv` stepping all N
 robots in one engine call (``designs=[...]`` may differ). ``task=`` also takes
 a Task, a Terrain or a terrain JSON file. ``action_mode="temperature"`` gives the
-seed's temperature signal as the action instead of contraction levels.
+seed's temperature signal as the action instead of contractions.
 :mod:`softgym.envs.sb3` (the ``rl`` extra, imported only on demand) adapts the
 vector env to Stable-Baselines3.
 """

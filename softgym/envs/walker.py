@@ -221,11 +221,14 @@ class ActionMap:
 
     ``"temperature"``: an entry ``a`` is the temperature ``a * dT`` (the seed's
     signal; under the seed's law a command that would expand a muscle keeps
-    its last size). ``"contraction"``: an entry is its muscle's contraction
-    level ``c = (a + 1) / 2`` in [0, 1] (-1: rest, +1: the full contraction
-    the seed's drive reaches), i.e. the temperature ``-sign(CTE) c dT``,
-    which the seed's contraction-only law always follows: every action sets
-    the muscle's size, none holds it.
+    its last size). ``"contraction"``: the temperature ``(a - s) dT / 2``,
+    ``s = sign(CTE)`` of the cell's muscle: the seed's signal halved and
+    shifted into the range the seed's contraction-only law always follows, so
+    every action sets the muscle's size and none holds it. The muscle
+    contracts by ``(1 - s a) / 2`` of its full range: ``a = -1`` fully
+    contracts the positive-CTE muscles and rests the negative ones, ``+1`` the
+    reverse, ``0`` half contracts both. As with temperatures, one signal on
+    every cell drives the two muscle kinds in counter-phase (the seed's gait).
 
     Parameters
     ----------
@@ -260,7 +263,7 @@ class ActionMap:
         """Temperatures in units of ``dT`` for checked actions of shape (n_robots, n_cells)."""
         if self.mode == "temperature":
             return actions
-        return -self.sign * (0.5 * (actions + 1.0))
+        return 0.5 * (actions - self.sign)  # (passive cells: ignored by EpisodeBatch.apply)
 
     def from_temperatures(self, fraction: Any) -> np.ndarray:
         """The actions that give each muscle the size the temperature ``fraction * dT`` gives it.
@@ -280,8 +283,8 @@ class ActionMap:
         f = np.clip(np.asarray(fraction, dtype=np.float64), -1.0, 1.0)
         if self.mode == "temperature":
             return f.astype(np.float32)
-        level = np.clip(-self.sign * f, 0.0, 1.0)
-        return (2.0 * level - 1.0).astype(np.float32)
+        level = np.clip(-self.sign * f, 0.0, 1.0)  # the contraction the seed's law gives
+        return (self.sign * (1.0 - 2.0 * level)).astype(np.float32)
 
 
 class SoftWalkerEnv(gym.Env):
@@ -342,11 +345,16 @@ class SoftWalkerEnv(gym.Env):
     an entry means is ``action_mode`` (:class:`ActionMap`):
 
     * ``"contraction"`` (the default under the seed's actuation law): the
-      muscle's contraction level ``c = (a + 1) / 2``: ``a = -1`` is rest,
-      ``a = +1`` the full contraction of the seed's drive. The muscle gets the
-      temperature ``-sign(CTE) c dT`` (``dT`` the design's controller
-      amplitude, 14 degC by default), so its size is ``L (1 - |CTE| c dT)``;
-      every action sets it, and lowering ``a`` relaxes it towards rest.
+      temperature ``T = (a - s) dT / 2``, ``s = sign(CTE)`` of the cell's
+      muscle, ``dT`` the design's controller amplitude (14 degC by default):
+      the seed's signal halved and shifted into the muscles' contracting
+      range, so the muscle contracts by ``(1 - s a) / 2`` of its full range
+      (size ``L (1 - |CTE| dT (1 - s a) / 2)``). ``a = -1`` fully contracts
+      the positive-CTE muscles and rests the negative ones, ``+1`` the
+      reverse, ``0`` half contracts both. Every action sets the size; none
+      holds it. One value on every cell drives the two muscle kinds in
+      counter-phase, as the seed's drive does (``sin(2 pi t / period)`` on
+      every cell walks 2.68 voxel lengths in 4 s at 0.05 s steps).
     * ``"temperature"`` (the default with ``actuation="symmetric"``): the
       temperature ``T = a dT``, the seed's signal; the size follows
       ``L (1 + CTE T)`` under the actuation law. Under the seed's law
@@ -358,10 +366,11 @@ class SoftWalkerEnv(gym.Env):
     actions PPO (SB3, 600k steps) walked 0.135 voxel lengths in 4 s on
     ``SoftWalker-Flat-v0``, below the seed's sinusoid (0.67): a policy that
     overshoots holds its muscles contracted, and the hold changes the seed's
-    own gait when sampled every 0.05 s (0.67 against the engine's 4.38). With
-    contraction levels the same sinusoid walks 2.91 at 0.05 s, and PPO
-    learns (``benchmarks/RESULTS.md``). The physics is the seed's either
-    way; ``action_mode="temperature"`` gives the seed's signal back.
+    own gait when sampled every 0.05 s (0.67 against the engine's 4.38).
+    Through contraction actions (:meth:`action_from_temperatures`) the
+    seed's sinusoid walks 2.91 at 0.05 s (``benchmarks/RESULTS.md``). The
+    physics is the seed's either way; ``action_mode="temperature"`` gives
+    the seed's signal back.
 
     :class:`softgym.policies.Sinusoid` returns the seed's temperature signal
     ``sin(2 pi t / period)`` on every cell; :meth:`action_from_temperatures`
@@ -482,7 +491,7 @@ class SoftWalkerEnv(gym.Env):
 
     ## Version History
 
-    * v0: initial version. Since issue 33: ``action_mode`` (contraction levels by default
+    * v0: initial version. Since issue 33: ``action_mode`` (contractions by default
       under the seed's law; ``action_mode="temperature"`` is the former action), and the ids
       register no ``max_episode_steps`` (the episode lasts ``episode_seconds`` at any
       ``control_dt``; it was 80 steps whatever the step). Since the task suite (issue 14): ``info["score"]``, 13 more ids,

@@ -48,14 +48,22 @@ def test_an_unknown_action_mode_is_refused(bad):
         SoftWalkerEnv(action_mode=bad, episode_seconds=0.1)
 
 
-def test_contraction_levels_set_every_muscle_and_relax_it(full):
+def test_contraction_actions_set_every_muscle_and_relax_it(full):
     env = gym.make("SoftWalker-Flat-v0", episode_seconds=1.0)
     env.reset(seed=0)
     muscle = env.unwrapped.muscle_mask
-    # +1: every muscle (both kinds) fully contracted; 0: half way; -1: back at rest
-    np.testing.assert_allclose(_step(env, 1.0)[muscle], full)
-    np.testing.assert_allclose(_step(env, 0.0)[muscle], 0.5 * (1.0 + full))
-    np.testing.assert_allclose(_step(env, -1.0)[muscle], 1.0)
+    plus, minus = _signs() > 0, _signs() < 0
+    # -1: the positive-CTE muscles fully contracted, the negative ones at rest; +1 the reverse
+    s = _step(env, -1.0)
+    np.testing.assert_allclose(s[plus], full)
+    np.testing.assert_allclose(s[minus], 1.0)
+    s = _step(env, 1.0)  # no hold: the contracted muscles relax at once
+    np.testing.assert_allclose(s[plus], 1.0)
+    np.testing.assert_allclose(s[minus], full)
+    np.testing.assert_allclose(_step(env, 0.0)[muscle], 0.5 * (1.0 + full))  # both half way
+    s = _step(env, 0.5)
+    np.testing.assert_allclose(s[plus], 1.0 - 0.25 * (1.0 - full))
+    np.testing.assert_allclose(s[minus], 1.0 - 0.75 * (1.0 - full))
     assert (_scales(env)[~muscle] == 1.0).all()  # passive voxels keep their size
 
 
