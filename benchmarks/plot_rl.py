@@ -1,15 +1,15 @@
-"""Plot PPO learning curves from ``rl_ppo.py --json`` outputs.
+"""Plot the PPO learning curves stored before issue 33 (``benchmarks/data/rl/*.json``).
 
 Each input is either a JSON file (the runs stored in ``benchmarks/data/rl/``)
-or a log whose last line is the JSON object ``rl_ppo.py --json`` prints;
-without inputs the stored runs are drawn. The figure shows the training
-return (mean of the last 100 episodes) against env steps for every run, with
-the run's sinusoid (dotted) and random-policy (dashed) baselines in the same
-colour.
+or a log whose last line is such a JSON object (the format ``rl_ppo.py --json``
+printed before issue 33: top-level ``curve``, ``ppo``, ``sinusoid``,
+``random``); without inputs the stored runs are drawn. The figure shows the
+training return (mean of the last 100 episodes) against env steps for every
+run, with the run's sinusoid (dotted) and random-policy (dashed) baselines in
+the same colour. Runs of the current ``rl_ppo.py --run-dir`` are drawn by
+``rl_table.py``.
 
     python benchmarks/plot_rl.py --out docs/figures/ppo_flat_600k.png
-    python benchmarks/rl_ppo.py --timesteps 600000 --actuation symmetric --json > sym.log
-    python benchmarks/plot_rl.py sym.log benchmarks/data/rl/ppo_flat_seed_600k.json --out ppo.png
 """
 
 from __future__ import annotations

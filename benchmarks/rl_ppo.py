@@ -1,387 +1,344 @@
-"""RL baseline: stable-baselines3 PPO on SoftWalker-Flat-v0 for a fixed budget.
+"""RL baseline: stable-baselines3 PPO on a SoftWalker task, checkpointed and resumable.
 
-Trains PPO (MLP policy, observation and reward normalisation) for
-``--timesteps`` env steps on the default walker, then prints the mean episode
-return (= NormFinalDist over the 4 s episode, in voxel lengths) of
+Trains PPO (MLP policy, observation and reward normalisation by SB3's
+``VecNormalize``) for ``--timesteps`` env steps on the default walker, on the
+batched vector env through :mod:`softgym.envs.sb3`, then reports the episode
+return (= the task's score at the end of the episode) of
 
-* the trained policy (deterministic actions),
-* a uniformly random policy,
-* :class:`softgym.controllers.Sinusoid` (the seed's open-loop drive sampled
-  every control step).
+* the trained policy (deterministic actions; the start state is
+  deterministic, so one episode tells it) and its sampled actions,
+* uniformly random actions,
+* the seed's sinusoid (:class:`softgym.policies.Sinusoid`, sampled every
+  control step, turned into the env's actions by ``action_from_temperatures``).
 
-Training runs on the batched vector env (all robots in one engine call, on
-every core) through :func:`sb3_vec_env`, an SB3 ``VecEnv`` adapter; ``--vec
-dummy`` uses SB3's DummyVecEnv of single envs instead. ``--json`` adds the
-training curve; ``plot_rl.py`` draws it.
+With ``--run-dir`` the run is stored and resumable: every
+``--checkpoint-every`` env steps (whole rollouts; a rollout is one episode of
+every robot, so a checkpoint falls between episodes) the directory gets a new
+``ckpt/`` holding the SB3 model (``model.zip``, SB3's own format: policy,
+optimizer, counters; its ``data`` entry holds cloudpickled objects, so load
+only checkpoints this script wrote), the ``VecNormalize`` statistics
+(``vecnormalize.npz``), the RNG states (torch, NumPy, Python: ``rng.npz``,
+``state.json``) and ``state.json`` (the run's record, with the SHA-256 of
+every file, checked before loading). It is written as ``ckpt.new/`` and
+swapped in by renames, so an interruption leaves the previous checkpoint.
+Running the same command again resumes from the last checkpoint and continues
+exactly as the uninterrupted run would have (``tests/test_rl_ppo.py`` checks
+that the weights match). ``run.json`` (a copy of the record: command,
+settings, learning curves, baselines, final evaluation) is what
+``rl_table.py`` reads. ``--pause-at N`` stops at the first checkpoint at or
+after N steps (e.g. to stop a run at a checkpoint).
 
 Needs the ``rl`` extra (``pip install -e ".[rl]"``: torch pinned to 2.13.0,
-a CPU build from local disk on this machine kind; stable-baselines3). CI does
-not run it. Measured on 2 cores (``benchmarks/RESULTS.md``): 600k steps,
-about 20 minutes, walk 26 voxel lengths with ``--actuation symmetric``
-(sinusoid 9.0, random 0.08) and 0.10 under the seed's contraction-only law
-(sinusoid 0.50, random 0.03).
+stable-baselines3). Runs with one torch thread.
 
     python benchmarks/rl_ppo.py --timesteps 20000
-    python benchmarks/rl_ppo.py --timesteps 600000 --actuation symmetric --json --gif ppo.gif
+    python benchmarks/rl_ppo.py --task flat --seed 0 --timesteps 500000 \\
+        --run-dir benchmarks/data/rl/ppo/flat-s0
+    python benchmarks/rl_ppo.py --timesteps 600000 --action-mode temperature --json  # the seed's signal
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
+import random
+import shutil
 import sys
 import time
+from pathlib import Path
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
 
-import softgym  # noqa: F401  (registers the ids)
-from softgym.controllers import Sinusoid
+import softgym
+from softgym.envs import env_id
+from softgym.policies import Sinusoid
+from softgym.tasks import task_names
 
-ENV_ID = "SoftWalker-Flat-v0"
-
-
-def evaluate(policy, episodes: int, seed: int, env_kwargs: dict) -> tuple[float, float]:
-    """Mean and std of the episode return of ``policy(obs) -> action``."""
-    env = gym.make(ENV_ID, **env_kwargs)
-    returns = []
-    for ep in range(episodes):
-        obs, _ = env.reset(seed=seed + ep)
-        env.action_space.seed(seed + ep)
-        total, done = 0.0, False
-        while not done:
-            obs, r, term, trunc, _ = env.step(policy(obs, env))
-            total += r
-            done = term or trunc
-        returns.append(total)
-    env.close()
-    return float(np.mean(returns)), float(np.std(returns))
+CKPT, CKPT_NEW, CKPT_OLD = "ckpt", "ckpt.new", "ckpt.old"
+# arguments that define a run (a resumed run must be given the same ones)
+RUN_ARGS = (
+    "task", "seed", "n_envs", "control_dt", "episode_seconds", "actuation", "action_mode",
+    "n_steps", "batch_size", "n_epochs", "lr", "gamma", "log_std_init", "net_arch",
+)  # fmt: skip
 
 
-def sb3_vec_env(env_id: str, n_envs: int, seed: int, **kwargs):
-    """A Stable-Baselines3 ``VecEnv`` over the batched ``gym.make_vec`` env.
-
-    SB3 has its own vector API and asks users to adapt others to it (its
-    docs' EnvPool/ProcGen examples). All ``n_envs`` robots advance in one
-    engine call (the engine's threads, no subprocesses); the env runs in
-    Gymnasium's ``SAME_STEP`` autoreset mode, which is SB3's convention: the
-    end observation goes to ``infos[i]["terminal_observation"]``.
-    """
-    from gymnasium.vector import AutoresetMode
-    from stable_baselines3.common.vec_env import VecEnv
-
-    class SoftgymVecEnv(VecEnv):
-        def __init__(self) -> None:
-            self.venv = gym.make_vec(
-                env_id, num_envs=n_envs, autoreset_mode=AutoresetMode.SAME_STEP, **kwargs
-            )
-            super().__init__(
-                n_envs, self.venv.single_observation_space, self.venv.single_action_space
-            )
-            self._actions: np.ndarray | None = None
-            self._next_seed: int | None = seed
-
-        def reset(self):
-            obs, _ = self.venv.reset(seed=self._next_seed)
-            self._next_seed = None
-            return obs
-
-        def step_async(self, actions: np.ndarray) -> None:
-            self._actions = actions
-
-        def step_wait(self):
-            obs, rew, term, trunc, info = self.venv.step(self._actions)
-            done = term | trunc
-            infos: list[dict] = [{} for _ in range(self.num_envs)]
-            for i in np.flatnonzero(done):
-                infos[i]["terminal_observation"] = info["final_obs"][i]
-                infos[i]["TimeLimit.truncated"] = bool(trunc[i] and not term[i])
-            return obs, rew.astype(np.float32), done, infos
-
-        def close(self) -> None:
-            self.venv.close()
-
-        def get_attr(self, attr_name, indices=None):
-            return [getattr(self.venv, attr_name)] * len(self._get_indices(indices))
-
-        def set_attr(self, attr_name, value, indices=None) -> None:
-            raise AttributeError("SoftgymVecEnv: attributes are shared by the batch and read-only")
-
-        def env_method(self, method_name, *args, indices=None, **kwargs):
-            raise AttributeError("SoftgymVecEnv: sub-environments are not separate objects")
-
-        def env_is_wrapped(self, wrapper_class, indices=None):
-            return [False] * len(self._get_indices(indices))
-
-    return SoftgymVecEnv()
-
-
-def lattice_policy(grid_shape: tuple[int, int, int], width: int = 32):
-    """An SB3 ``ActorCriticPolicy`` sharing one small network across the lattice's cells.
-
-    The usual controller of the voxel-robot literature (one neural
-    controller per voxel with shared weights, e.g. Medvet et al. 2020; Huang
-    et al. 2020): each cell's action mean comes from the same MLP applied to
-    that cell's observation (its 6 features) with the global entries (CM
-    velocity, phase) and the cell's normalised lattice coordinates. The
-    value is an MLP of the mean cell embedding and the globals. A few
-    thousand weights instead of ~400k, and the policy fits any body on the
-    grid.
-    """
-    import torch as th
-    from stable_baselines3.common.policies import ActorCriticPolicy
-    from torch import nn
-
-    n_cells = int(np.prod(grid_shape))
-    coords = np.stack(
-        np.meshgrid(*[np.linspace(-1.0, 1.0, g) for g in grid_shape], indexing="ij"), axis=-1
-    ).reshape(n_cells, 3)
-    n_in = 6 + 5 + 3
-
-    class CellExtractor(nn.Module):
-        def __init__(self) -> None:
-            super().__init__()
-            self.latent_dim_pi = n_cells * width
-            self.latent_dim_vf = width
-            self.register_buffer("coords", th.as_tensor(coords, dtype=th.float32))
-            self.pi = nn.Sequential(nn.Linear(n_in, width), nn.Tanh(), nn.Linear(width, width), nn.Tanh())
-            self.vf_cell = nn.Sequential(nn.Linear(n_in, width), nn.Tanh())
-            self.vf = nn.Sequential(nn.Linear(width + 5, width), nn.Tanh())
-
-        def _cells(self, obs: th.Tensor) -> tuple[th.Tensor, th.Tensor]:
-            b = obs.shape[0]
-            glob = obs[:, 6 * n_cells :]
-            cell = obs[:, : 6 * n_cells].reshape(b, n_cells, 6)
-            x = th.cat(
-                [cell, glob[:, None, :].expand(b, n_cells, 5), self.coords.expand(b, n_cells, 3)],
-                dim=-1,
-            )
-            return x, glob
-
-        def forward_actor(self, obs: th.Tensor) -> th.Tensor:
-            x, _ = self._cells(obs)
-            return self.pi(x).reshape(obs.shape[0], -1)
-
-        def forward_critic(self, obs: th.Tensor) -> th.Tensor:
-            x, glob = self._cells(obs)
-            return self.vf(th.cat([self.vf_cell(x).mean(dim=1), glob], dim=-1))
-
-        def forward(self, obs: th.Tensor) -> tuple[th.Tensor, th.Tensor]:
-            return self.forward_actor(obs), self.forward_critic(obs)
-
-    class CellHead(nn.Module):
-        """The shared last layer: one action mean per cell from its embedding."""
-
-        def __init__(self) -> None:
-            super().__init__()
-            self.linear = nn.Linear(width, 1)
-            nn.init.orthogonal_(self.linear.weight, gain=0.01)
-            nn.init.zeros_(self.linear.bias)
-
-        def forward(self, latent: th.Tensor) -> th.Tensor:
-            return self.linear(latent.reshape(latent.shape[0], n_cells, width)).squeeze(-1)
-
-    class LatticePolicy(ActorCriticPolicy):
-        def __init__(self, *args, **kwargs) -> None:
-            kwargs["features_extractor_kwargs"] = {}
-            kwargs.pop("net_arch", None)
-            super().__init__(*args, **kwargs)
-
-        def _build_mlp_extractor(self) -> None:
-            self.mlp_extractor = CellExtractor()
-
-        def _build(self, lr_schedule) -> None:
-            super()._build(lr_schedule)
-            if self.use_sde:
-                raise ValueError("the lattice policy does not support gSDE")
-            self.action_net = CellHead()
-            self.optimizer = self.optimizer_class(
-                self.parameters(), lr=lr_schedule(1), **self.optimizer_kwargs
-            )
-
-    return LatticePolicy
-
-
-def main(argv: list[str] | None = None) -> int:
+def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--task", default="flat", help=f"a task name ({', '.join(task_names())})")
+    ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--timesteps", type=int, default=20_000, help="PPO training budget (env steps)")
-    ap.add_argument("--n-envs", type=int, default=16, help="robots stepped in parallel")
-    ap.add_argument(
-        "--vec",
-        choices=["batched", "dummy"],
-        default="batched",
-        help="batched: one engine call for all robots; dummy: SB3's DummyVecEnv of single envs",
-    )
-    ap.add_argument("--episodes", type=int, default=5, help="evaluation episodes per policy")
-    ap.add_argument("--control-dt", type=float, default=0.05, help="seconds per action")
+    ap.add_argument("--n-envs", type=int, default=16, help="robots stepped together")
+    ap.add_argument("--control-dt", type=float, default=None, help="seconds per action (env default)")
+    ap.add_argument("--episode-seconds", type=float, default=None, help="(env default: 4 s)")
     ap.add_argument("--actuation", choices=["seed", "symmetric"], default=None)
-    ap.add_argument("--n-steps", type=int, default=128, help="rollout length per env per update")
-    ap.add_argument("--batch-size", type=int, default=512)
+    ap.add_argument("--action-mode", choices=["contraction", "temperature"], default=None)
+    ap.add_argument(
+        "--n-steps", type=int, default=None,
+        help="rollout length per env (default: one episode, so checkpoints fall between episodes)",
+    )  # fmt: skip
+    ap.add_argument("--batch-size", type=int, default=None, help="default: a quarter of a rollout")
     ap.add_argument("--n-epochs", type=int, default=10)
     ap.add_argument("--lr", type=float, default=3e-4)
     ap.add_argument("--gamma", type=float, default=0.99)
-    ap.add_argument(
-        "--log-std-init", type=float, default=-1.0, help="initial log std of the Gaussian policy"
-    )
-    ap.add_argument(
-        "--sde",
-        type=int,
-        default=None,
-        metavar="FREQ",
-        help="generalized state-dependent exploration, new noise every FREQ steps (-1: per rollout)",
-    )
-    ap.add_argument("--net-arch", type=int, nargs="+", default=[256, 256], help="MLP policy only")
-    ap.add_argument(
-        "--policy",
-        choices=["mlp", "lattice"],
-        default="mlp",
-        help="mlp: SB3's MlpPolicy; lattice: one small network shared by every cell",
-    )
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--save", default=None, help="save the trained model (zip) and VecNormalize")
-    ap.add_argument("--gif", default=None, help="write one episode of the trained policy to this GIF")
-    ap.add_argument("--json", action="store_true", help="print one JSON object as the last line")
+    ap.add_argument("--log-std-init", type=float, default=-1.0)
+    ap.add_argument("--net-arch", type=int, nargs="+", default=[256, 256])
+    ap.add_argument("--eval-episodes", type=int, default=4, help="for sampled/random actions")
+    ap.add_argument("--run-dir", default=None, help="store (and resume) the run here")
+    ap.add_argument("--checkpoint-every", type=int, default=25_000, help="env steps (with --run-dir)")
+    ap.add_argument("--pause-at", type=int, default=None, help="stop at the first checkpoint >= this")
+    ap.add_argument("--json", action="store_true", help="print the run's record as the last line")
     ap.add_argument("--verbose", action="store_true", help="SB3's training log every update")
-    args = ap.parse_args(argv)
-    command = "python benchmarks/rl_ppo.py " + " ".join(sys.argv[1:] if argv is None else argv)
-    t_start = time.perf_counter()
+    return ap.parse_args(argv)
+
+
+def env_kwargs(args: argparse.Namespace) -> dict[str, Any]:
+    """The env arguments of a run (only those given: the env's defaults otherwise)."""
+    kw: dict[str, Any] = {}
+    for name in ("control_dt", "episode_seconds", "actuation", "action_mode"):
+        if getattr(args, name) is not None:
+            kw[name] = getattr(args, name)
+    return kw
+
+
+# ------------------------------------------------------------------ evaluation
+def run_episodes(eid: str, kw: dict, n: int, policy) -> list[float]:
+    """Returns of one episode of each of ``n`` robots (one batch) under ``policy(obs, env) -> actions``."""
+    env = gym.make_vec(eid, num_envs=n, vectorization_mode="vector_entry_point", n_threads=1, **kw)
+    obs, _ = env.reset(seed=0)
+    total = np.zeros(n)
+    done = np.zeros(n, dtype=bool)
+    while not done.all():
+        obs, r, term, trunc, _ = env.step(policy(obs, env))
+        total += np.where(done, 0.0, r)
+        done |= term | trunc
+    env.close()
+    return total.tolist()
+
+
+def baselines(eid: str, kw: dict, episodes: int, seed: int) -> dict[str, list[float]]:
+    """Random actions (``episodes`` robots) and the seed's sinusoid (deterministic: one episode)."""
+    rng = np.random.default_rng(seed + 1000)
+    probe = gym.make_vec(eid, num_envs=1, vectorization_mode="vector_entry_point", **kw)
+    sinusoid = Sinusoid.from_env(probe)
+    probe.close()
+    return {
+        "random": run_episodes(
+            eid, kw, episodes, lambda o, e: rng.uniform(-1, 1, e.action_space.shape)
+        ),
+        "sinusoid": run_episodes(
+            eid, kw, 1, lambda o, e: e.unwrapped.action_from_temperatures(sinusoid(o))
+        ),
+    }
+
+
+def ppo_returns(model, venv, eid: str, kw: dict, episodes: int, deterministic: bool) -> list[float]:
+    """Returns of the trained policy (observations normalised with the training statistics)."""
+
+    def policy(obs, env):
+        return model.predict(venv.normalize_obs(obs), deterministic=deterministic)[0]
+
+    return run_episodes(eid, kw, 1 if deterministic else episodes, policy)
+
+
+# ------------------------------------------------------------------ checkpoints
+def _sha256(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()
+
+
+def save_checkpoint(run_dir: Path, model, venv, record: dict) -> None:
+    """Write ``ckpt.new/`` (model, VecNormalize, RNG states, record) and swap it in."""
+    import torch
+
+    new, cur, old = run_dir / CKPT_NEW, run_dir / CKPT, run_dir / CKPT_OLD
+    shutil.rmtree(new, ignore_errors=True)
+    new.mkdir(parents=True)
+    model.save(new / "model.zip")
+    np.savez(
+        new / "vecnormalize.npz",
+        obs_mean=venv.obs_rms.mean, obs_var=venv.obs_rms.var, obs_count=venv.obs_rms.count,
+        ret_mean=venv.ret_rms.mean, ret_var=venv.ret_rms.var, ret_count=venv.ret_rms.count,
+        returns=venv.returns,
+    )  # fmt: skip
+    # SB3 shuffles minibatches with the legacy global NumPy RNG: its state is part of the run
+    kind, keys, pos, has_gauss, cached = np.random.get_state()  # noqa: NPY002
+    np.savez(
+        new / "rng.npz",
+        torch=torch.get_rng_state().numpy(), np_keys=keys,
+        np_rest=np.array([pos, has_gauss, cached], dtype=np.float64),
+    )  # fmt: skip
+    state = dict(record)
+    state["python_random"] = [random.getstate()[0], list(random.getstate()[1]), random.getstate()[2]]
+    state["files"] = {f.name: _sha256(f) for f in sorted(new.iterdir())}
+    (new / "state.json").write_text(json.dumps(state))
+    if cur.exists():
+        shutil.rmtree(old, ignore_errors=True)
+        cur.rename(old)
+    new.rename(cur)
+    shutil.rmtree(old, ignore_errors=True)
+    tmp = run_dir / "run.json.new"
+    tmp.write_text(json.dumps(record, indent=1))
+    tmp.replace(run_dir / "run.json")
+
+
+def find_checkpoint(run_dir: Path) -> Path | None:
+    """The last complete checkpoint (``ckpt/``, or ``ckpt.old/`` if a swap was interrupted)."""
+    for name in (CKPT, CKPT_OLD):
+        if (run_dir / name / "state.json").exists():
+            return run_dir / name
+    return None
+
+
+def load_checkpoint(ckpt: Path, venv, model_cls) -> tuple[Any, dict]:
+    """The model (on ``venv``) and record of a checkpoint; restores VecNormalize and the RNGs."""
+    import torch
+
+    state = json.loads((ckpt / "state.json").read_text())
+    for name, digest in state["files"].items():
+        if _sha256(ckpt / name) != digest:
+            raise SystemExit(f"{ckpt / name}: checksum mismatch; not loading it")
+    model = model_cls.load(ckpt / "model.zip", env=venv, device="cpu", force_reset=False)
+    with np.load(ckpt / "vecnormalize.npz", allow_pickle=False) as z:
+        venv.obs_rms.mean, venv.obs_rms.var, venv.obs_rms.count = z["obs_mean"], z["obs_var"], float(z["obs_count"])
+        venv.ret_rms.mean, venv.ret_rms.var, venv.ret_rms.count = z["ret_mean"], z["ret_var"], float(z["ret_count"])
+        returns = z["returns"]
+    # the robots are between episodes: restart them without counting the start observation
+    # twice in the statistics (the uninterrupted run saw it once, as the last step's)
+    venv.training = False
+    venv.reset()
+    venv.training = True
+    venv.returns = returns
+    with np.load(ckpt / "rng.npz", allow_pickle=False) as z:
+        torch.set_rng_state(torch.from_numpy(z["torch"]))
+        pos, has_gauss, cached = z["np_rest"]
+        np.random.set_state(("MT19937", z["np_keys"], int(pos), int(has_gauss), float(cached)))  # noqa: NPY002
+    v, internal, gauss = state["python_random"]
+    random.setstate((v, tuple(internal), gauss))
+    # (the zip holds the model's counters, last observation and episode buffer)
+    return model, state
+
+
+# ------------------------------------------------------------------ main
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(argv)
+    raw = sys.argv[1:] if argv is None else list(argv)
+    shown = [a for i, a in enumerate(raw) if a != "--pause-at" and (i == 0 or raw[i - 1] != "--pause-at")]
+    command = "python benchmarks/rl_ppo.py " + " ".join(shown)
+    if args.task not in task_names():
+        raise SystemExit(f"--task must be one of {', '.join(task_names())}, got {args.task!r}")
     try:
+        import stable_baselines3
         import torch
         from stable_baselines3 import PPO
-        from stable_baselines3.common.callbacks import BaseCallback
-        from stable_baselines3.common.env_util import make_vec_env
         from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
+
+        from softgym.envs.sb3 import make_sb3_vec_env
     except ImportError:
         print("rl_ppo.py needs the rl extra: pip install -e '.[rl]'", file=sys.stderr)
         return 2
     torch.set_num_threads(1)
-    # the ids register an 80-step limit (4 s at 0.05 s): keep 4 s at any control_dt
-    kw: dict = {"control_dt": args.control_dt, "max_episode_steps": round(4.0 / args.control_dt)}
-    if args.actuation is not None:
-        kw["actuation"] = args.actuation
-    if args.vec == "batched":
-        base = VecMonitor(sb3_vec_env(ENV_ID, args.n_envs, args.seed, **kw))
-    else:
-        base = make_vec_env(ENV_ID, n_envs=args.n_envs, seed=args.seed, env_kwargs=kw)
-    venv = VecNormalize(base, gamma=args.gamma)
-    # one single env tells the grid (lattice policy) and the period (sinusoid baseline)
-    probe = gym.make(ENV_ID, **kw)
-    sinusoid = Sinusoid.from_env(probe)
-    grid_shape = probe.unwrapped.grid_shape
-    preset = probe.unwrapped.sim.config.model
+    eid = env_id(args.task)
+    kw = env_kwargs(args)
+    probe = gym.make(eid, **kw).unwrapped
+    episode_steps, action_mode, preset = probe.max_steps, probe.action_mode, probe.sim.config.model
+    control_dt = probe.control_dt
     probe.close()
-    policy_kwargs: dict = {"log_std_init": args.log_std_init}
-    if args.policy == "mlp":
-        policy: object = "MlpPolicy"
-        policy_kwargs["net_arch"] = list(args.net_arch)
-    else:
-        policy = lattice_policy(grid_shape)
-    model = PPO(
-        policy,
-        venv,
-        n_steps=args.n_steps,
-        batch_size=args.batch_size,
-        n_epochs=args.n_epochs,
-        learning_rate=args.lr,
+    if args.n_steps is None:
+        args.n_steps = episode_steps
+    if args.batch_size is None:
+        args.batch_size = max(1, args.n_steps * args.n_envs // 4)
+    settings = {k: getattr(args, k) for k in RUN_ARGS}
+    rollout = args.n_steps * args.n_envs
+    run_dir = Path(args.run_dir) if args.run_dir else None
+    ckpt = find_checkpoint(run_dir) if run_dir else None
+
+    venv = VecNormalize(
+        VecMonitor(make_sb3_vec_env(eid, n_envs=args.n_envs, seed=args.seed, n_threads=1, **kw)),
         gamma=args.gamma,
-        use_sde=args.sde is not None,
-        sde_sample_freq=-1 if args.sde is None else args.sde,
-        policy_kwargs=policy_kwargs,
-        seed=args.seed,
-        verbose=int(args.verbose),
     )
-    curve: list[tuple[int, float]] = []
-
-    class Curve(BaseCallback):
-        """Mean training-episode return (last 100 episodes) after every rollout."""
-
-        def _on_step(self) -> bool:
-            return True
-
-        def _on_rollout_end(self) -> None:
-            eps = self.model.ep_info_buffer
-            if eps:
-                curve.append((self.num_timesteps, float(np.mean([e["r"] for e in eps]))))
-
-    t0 = time.perf_counter()
-    model.learn(total_timesteps=args.timesteps, callback=Curve())
-    train_s = time.perf_counter() - t0
-    venv.training = False
-    if args.save:
-        model.save(args.save)
-        venv.save(args.save + ".vecnormalize.pkl")
-
-    def ppo_policy(obs, env):
-        norm = venv.normalize_obs(obs[None])
-        return model.predict(norm, deterministic=True)[0][0]
-
-    def ppo_sampled(obs, env):
-        norm = venv.normalize_obs(obs[None])
-        return model.predict(norm, deterministic=False)[0][0]
-
-    if args.gif:
-        from softgym.render import save_gif
-
-        env = gym.make(ENV_ID, render_mode="rgb_array", **kw)
-        obs, _ = env.reset(seed=args.seed)
-        frames, done = [env.render()], False
-        while not done:
-            obs, _, term, trunc, _ = env.step(ppo_policy(obs, env))
-            frames.append(env.render())
-            done = term or trunc
-        save_gif(frames, args.gif, fps=env.metadata["render_fps"])
-        env.close()
-        print(f"wrote {args.gif} ({len(frames)} frames)", file=sys.stderr)
-    results = {
-        "ppo": evaluate(ppo_policy, args.episodes, args.seed + 1000, kw),
-        "ppo_sampled": evaluate(ppo_sampled, args.episodes, args.seed + 1000, kw),
-        "random": evaluate(
-            lambda obs, env: env.action_space.sample(),
-            args.episodes,
-            args.seed + 1000,
-            kw,
-        ),
-        "sinusoid": evaluate(
-            lambda obs, env: sinusoid(obs), args.episodes, args.seed + 1000, kw
-        ),
-    }
-    print(
-        f"PPO on {ENV_ID} ({preset} preset): {args.timesteps} env steps ({args.n_envs} envs "
-        f"{args.vec}, control_dt {args.control_dt} s) in {train_s:.0f} s ({args.timesteps / train_s:.0f} steps/s incl. "
-        f"updates)",
-        file=sys.stderr,
-    )
-    if curve:
-        marks = curve[:: max(1, len(curve) // 10)] + [curve[-1]]
+    if ckpt is not None:
+        model, record = load_checkpoint(ckpt, venv, PPO)
+        if record["settings"] != settings:
+            diff = {k: (record["settings"].get(k), v) for k, v in settings.items() if record["settings"].get(k) != v}
+            raise SystemExit(f"{run_dir} holds a run with other settings (stored, given): {diff}")
+        for key in ("python_random", "files"):
+            record.pop(key, None)
+        record["timesteps"] = args.timesteps
+        record["command"] = command
+        print(f"resuming {run_dir} at {model.num_timesteps} env steps", file=sys.stderr)
+    else:
+        model = PPO(
+            "MlpPolicy", venv, n_steps=args.n_steps, batch_size=args.batch_size,
+            n_epochs=args.n_epochs, learning_rate=args.lr, gamma=args.gamma,
+            policy_kwargs={"log_std_init": args.log_std_init, "net_arch": list(args.net_arch)},
+            seed=args.seed, device="cpu", verbose=int(args.verbose),
+        )  # fmt: skip
+        record = {
+            "command": command,
+            "env": eid,
+            "task": args.task,
+            "env_kwargs": kw,
+            "action_mode": action_mode,
+            "control_dt": control_dt,
+            "preset": preset,
+            "settings": settings,
+            "timesteps": args.timesteps,
+            "num_timesteps": 0,
+            "train_seconds": 0.0,
+            "curve": [],
+            "eval_curve": [],
+            "baselines": baselines(eid, kw, args.eval_episodes, args.seed),
+            "versions": {
+                "softgym": softgym.__version__,
+                "stable_baselines3": stable_baselines3.__version__,
+                "torch": torch.__version__,
+            },
+            "finished": False,
+        }
+    target = args.timesteps if args.pause_at is None else min(args.timesteps, args.pause_at)
+    every = max(rollout, -(-args.checkpoint_every // rollout) * rollout) if run_dir else target
+    first = ckpt is None
+    while model.num_timesteps < target:
+        t0 = time.perf_counter()
+        chunk = min(every, -(-(target - model.num_timesteps) // rollout) * rollout)
+        start = model.num_timesteps
+        model.learn(total_timesteps=chunk, reset_num_timesteps=first, progress_bar=False)
+        first = False
+        record["train_seconds"] += time.perf_counter() - t0
+        record["num_timesteps"] = int(model.num_timesteps)
+        if model.ep_info_buffer:
+            record["curve"].append(
+                [int(model.num_timesteps), float(np.mean([e["r"] for e in model.ep_info_buffer]))]
+            )
+        det = ppo_returns(model, venv, eid, kw, 1, deterministic=True)[0]
+        record["eval_curve"].append([int(model.num_timesteps), det])
         print(
-            "training return (last 100 episodes): "
-            + ", ".join(f"{t // 1000}k {r:.3f}" for t, r in marks),
+            f"{eid} seed {args.seed}: {model.num_timesteps} steps ({model.num_timesteps - start} in "
+            f"{time.perf_counter() - t0:.0f} s), training return {record['curve'][-1][1] if record['curve'] else float('nan'):.3f}, "
+            f"deterministic {det:.3f}",
+            file=sys.stderr,
+            flush=True,
+        )
+        if model.num_timesteps >= args.timesteps:
+            record["final"] = {
+                "ppo": det,
+                "ppo_sampled": ppo_returns(model, venv, eid, kw, args.eval_episodes, False),
+            }
+            record["finished"] = True
+        if run_dir:
+            save_checkpoint(run_dir, model, venv, record)
+    if record.get("final"):
+        b = record["baselines"]
+        print(
+            f"{eid}: PPO {record['final']['ppo']:.3f} (sampled {np.mean(record['final']['ppo_sampled']):.3f}), "
+            f"random {np.mean(b['random']):.3f}, sinusoid {b['sinusoid'][0]:.3f} "
+            f"after {record['num_timesteps']} env steps, {record['train_seconds']:.0f} s",
             file=sys.stderr,
         )
-    print("mean episode return (NormFinalDist over 4 s, voxel lengths):", file=sys.stderr)
-    for name, (mean, std) in results.items():
-        print(f"  {name:<12} {mean:8.3f} +- {std:.3f}", file=sys.stderr)
     if args.json:
-        print(
-            json.dumps(
-                {
-                    "command": command,
-                    "env": ENV_ID,
-                    "preset": preset,
-                    "timesteps": args.timesteps,
-                    "train_seconds": train_s,
-                    "wall_seconds": time.perf_counter() - t_start,
-                    "actuation": args.actuation or "seed",
-                    "control_dt": args.control_dt,
-                    "n_envs": args.n_envs,
-                    "episodes": args.episodes,
-                    "seed": args.seed,
-                    "curve": curve,
-                    **{k: v[0] for k, v in results.items()},
-                    "std": {k: v[1] for k, v in results.items()},
-                }
-            )
-        )
+        print(json.dumps(record))
     return 0
 
 

@@ -14,10 +14,15 @@ id                         world                                       reward (p
 
 Every task of :data:`softgym.tasks.TASKS` gets an id (a task added with
 :func:`softgym.tasks.register_task` gets one at the next :func:`register_envs`).
-``gym.make(id)`` gives a :class:`SoftWalkerEnv` (80 steps of 0.05 s);
+``gym.make(id)`` gives a :class:`SoftWalkerEnv` (4 s episodes of 0.05 s control
+steps, actions setting the muscles' contractions; the episode length is
+set in seconds, so another ``control_dt`` keeps 4 s);
 ``gym.make_vec(id, num_envs=N)`` a :class:`SoftWalkerVectorEnv` stepping all N
 robots in one engine call (``designs=[...]`` may differ). ``task=`` also takes
-a Task, a Terrain or a terrain JSON file.
+a Task, a Terrain or a terrain JSON file. ``action_mode="temperature"`` gives the
+seed's temperature signal as the action instead of contractions.
+:mod:`softgym.envs.sb3` (the ``rl`` extra, imported only on demand) adapts the
+vector env to Stable-Baselines3.
 """
 
 import gymnasium as gym
@@ -31,8 +36,6 @@ __all__ = ["ENV_IDS", "TASKS", "SoftWalkerEnv", "SoftWalkerVectorEnv", "env_id",
 #: Registered ids -> task name (filled by :func:`register_envs`).
 ENV_IDS: dict[str, str] = {}
 
-#: Default episode: 4 s (the seed's fitness window) of 0.05 s control steps.
-MAX_EPISODE_STEPS = 80
 
 
 def env_id(task_name: str) -> str:
@@ -51,7 +54,9 @@ def register_envs() -> None:
             id=eid,
             entry_point="softgym.envs.walker:SoftWalkerEnv",
             vector_entry_point="softgym.envs.vector:SoftWalkerVectorEnv",
-            max_episode_steps=MAX_EPISODE_STEPS,
+            # no step limit: an episode lasts its task's seconds whatever control_dt
+            # (the env truncates itself; gym.make(..., max_episode_steps=k) still adds one)
+            max_episode_steps=None,
             kwargs={"task": task},
         )
 

@@ -23,6 +23,7 @@ from gymnasium.vector.utils import batch_space
 from softgym.design.robot import RobotDesign
 from softgym.engine import SimConfig, Simulation
 from softgym.envs.walker import (
+    ActionMap,
     action_space,
     check_render_options,
     load_design,
@@ -68,15 +69,14 @@ class SoftWalkerVectorEnv(VectorEnv):
         One design for every robot (default: the embedded walker). Give
         ``design`` or ``designs``, not both.
     task, episode_seconds, control_dt, actuation, self_collision, grid_shape,
-    sim_config, terrain, render_mode, width, height, drive
+    sim_config, terrain, render_mode, width, height, drive, action_mode
         As for :class:`~softgym.envs.walker.SoftWalkerEnv` (a ``terrain``
         is the same world for every robot).
     n_threads : int, optional
         Engine threads (default: :func:`softgym.engine.default_num_threads`).
     max_episode_steps : int, optional
-        Truncation in steps (``make_vec`` passes the id's registered 80): an
-        int >= 1, not a bool or float; episodes also end after
-        ``episode_seconds``.
+        An extra cap on the steps per episode: None (episodes end after
+        ``episode_seconds``, the ids' default) or an int >= 1, not a bool or float.
     autoreset_mode : AutoresetMode or str, optional
         ``NEXT_STEP`` (default) or ``SAME_STEP`` (the enum, its value or its
         name: ``"same_step"``); ``DISABLED`` is not
@@ -119,6 +119,7 @@ class SoftWalkerVectorEnv(VectorEnv):
         max_episode_steps: int | None = None,
         autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
         drive: str = "action",
+        action_mode: str | None = None,
     ) -> None:
         try:
             mode = AutoresetMode(autoreset_mode)
@@ -167,6 +168,8 @@ class SoftWalkerVectorEnv(VectorEnv):
             max_episode_steps=max_episode_steps, drive=drive,
         )  # fmt: skip
         b = self._batch
+        self._action_map = ActionMap(b, action_mode)
+        self.action_mode = self._action_map.mode
         self.num_envs = num_envs
         self.designs = robots
         self.task = b.task
@@ -204,6 +207,15 @@ class SoftWalkerVectorEnv(VectorEnv):
     def period(self) -> np.ndarray:
         """Ndarray of shape (num_envs,): each robot's controller period (s)."""
         return self._batch.period.copy()
+
+    def action_from_temperatures(self, fraction: Any) -> np.ndarray:
+        """The actions giving each muscle the size the temperature ``fraction * dT`` gives it.
+
+        As :meth:`SoftWalkerEnv.action_from_temperatures
+        <softgym.envs.walker.SoftWalkerEnv.action_from_temperatures>`, for
+        ``fraction`` of shape (num_envs, n_cells); returns float32 of that shape.
+        """
+        return self._action_map.from_temperatures(fraction)
 
     # ------------------------------------------------------------------- API
     def _infos(self, with_mask: bool = False) -> dict[str, Any]:
@@ -269,7 +281,7 @@ class SoftWalkerVectorEnv(VectorEnv):
         restart = self._prev_done.copy()
         live = ~restart
         if live.any():
-            b.apply(a, live)
+            b.apply(self._action_map(a), live)
             b.advance()
         b.reset_robots(np.flatnonzero(restart))
         reward, terminated, truncated, _ = b.update(live)

@@ -36,9 +36,11 @@ from softgym.tasks.episode import MAX_STEPS_PER_EPISODE
 from softgym.terrain import Terrain
 
 __all__ = [
+    "ACTION_MODES",
     "OBS_POSITION_BOUND",
     "OBS_VELOCITY_BOUND",
     "TASKS",
+    "ActionMap",
     "SoftWalkerEnv",
     "MAX_FRAME_SIDE",
     "action_space",
@@ -58,6 +60,8 @@ _NO_ENGINE_TRACE = 1.0e9
 #: Largest rendered frame side (pixels): a frame is width x height x 3 bytes.
 MAX_FRAME_SIDE = 4096
 RENDER_MODES: tuple[str, ...] = ("rgb_array",)
+#: How an action entry drives its muscle (``action_mode``; see :class:`SoftWalkerEnv`).
+ACTION_MODES: tuple[str, ...] = ("contraction", "temperature")
 # engine threads an env may ask for (the engine uses at most one per robot anyway)
 _MAX_THREADS = 1024
 
@@ -212,6 +216,77 @@ def make_batch(
     return batch
 
 
+class ActionMap:
+    """How the actions of a batch become the muscle temperatures :meth:`EpisodeBatch.apply` sets.
+
+    ``"temperature"``: an entry ``a`` is the temperature ``a * dT`` (the seed's
+    signal; under the seed's law a command that would expand a muscle keeps
+    its last size). ``"contraction"``: the temperature ``(a - s) dT / 2``,
+    ``s = sign(CTE)`` of the cell's muscle: the seed's signal halved and
+    shifted into the range the seed's contraction-only law always follows, so
+    every action sets the muscle's size and none holds it. The muscle
+    contracts by ``(1 - s a) / 2`` of its full range: ``a = -1`` fully
+    contracts the positive-CTE muscles and rests the negative ones, ``+1`` the
+    reverse, ``0`` half contracts both. As with temperatures, one signal on
+    every cell drives the two muscle kinds in counter-phase (the seed's gait).
+
+    Parameters
+    ----------
+    batch : EpisodeBatch
+        The robots (their designs, cells and engine settings).
+    mode : {"contraction", "temperature"} or None
+        None: ``"contraction"`` under the seed's actuation law, ``"temperature"``
+        under ``"symmetric"`` (whose muscles also expand): either way the
+        action's range covers every size the law reaches, once.
+
+    Raises
+    ------
+    InvalidParameterError
+        For another ``mode``.
+    """
+
+    def __init__(self, batch: EpisodeBatch, mode: str | None) -> None:
+        if mode is None:
+            mode = "contraction" if batch.config.actuation == "seed" else "temperature"
+        if not (isinstance(mode, str) and mode in ACTION_MODES):
+            raise InvalidParameterError(
+                f"action_mode must be None or one of {list(ACTION_MODES)}, got {_show(mode)}"
+            )
+        self.mode = mode
+        #: ndarray of shape (n_robots, n_cells): each cell's CTE sign (0: no muscle)
+        self.sign = np.zeros((batch.n_robots, batch.n_cells))
+        for r, d in enumerate(batch.designs):
+            gi = batch.sim.grid_index(r)
+            self.sign[r, batch.cells[r]] = np.sign(batch.sim.bodies[r].cte[d.grid[tuple(gi.T)]])
+
+    def __call__(self, actions: np.ndarray) -> np.ndarray:
+        """Temperatures in units of ``dT`` for checked actions of shape (n_robots, n_cells)."""
+        if self.mode == "temperature":
+            return actions
+        return 0.5 * (actions - self.sign)  # (passive cells: ignored by EpisodeBatch.apply)
+
+    def from_temperatures(self, fraction: Any) -> np.ndarray:
+        """The actions that give each muscle the size the temperature ``fraction * dT`` gives it.
+
+        Under the seed's law without its hold: a command that would expand a
+        muscle leaves it at rest. This runs a temperature signal, such as
+        :class:`softgym.policies.Sinusoid`'s (the seed's drive), in any mode.
+
+        Parameters
+        ----------
+        fraction : array_like of shape (n_robots, n_cells), values in [-1, 1]
+
+        Returns
+        -------
+        ndarray of shape (n_robots, n_cells), float32
+        """
+        f = np.clip(np.asarray(fraction, dtype=np.float64), -1.0, 1.0)
+        if self.mode == "temperature":
+            return f.astype(np.float32)
+        level = np.clip(-self.sign * f, 0.0, 1.0)  # the contraction the seed's law gives
+        return (self.sign * (1.0 - 2.0 * level)).astype(np.float32)
+
+
 class SoftWalkerEnv(gym.Env):
     """A 3-D voxel soft robot that must walk, on flat ground, out of a fence or up stairs.
 
@@ -221,7 +296,7 @@ class SoftWalkerEnv(gym.Env):
     is simulated by softgym's lattice engine with the seed study's settings
     (evosoro / Ev-SoftBots: 1 cm voxels, thermal muscles, floor friction,
     self-collision). Instead of the seed's global sinusoid, the agent sets
-    every muscle voxel's temperature at each control step. The ids:
+    every muscle voxel's contraction at each control step. The ids:
 
     * ``SoftWalker-Flat-v0``: flat floor; reward on the seed's ``NormFinalDist``.
     * ``SoftWalker-Wall-v0``: the seed's fence (a square wall 1 voxel high and
@@ -264,20 +339,45 @@ class SoftWalkerEnv(gym.Env):
 
     ``Box(-1, 1, (nx * ny * nz,), float32)``: one entry per grid cell, in
     C order (x slowest, z fastest: ``action.reshape(grid_shape)[i, j, k]``
-    drives voxel ``(i, j, k)``). A muscle voxel (a material with a non-zero
-    CTE) gets the temperature ``T = action * dT`` (degC), ``dT`` the design's
-    controller amplitude (14 degC by default), so its size follows
-    ``L (1 + CTE T)`` under the configured actuation law (``"seed"``: muscles
-    only contract, and a command that would expand one keeps its last size,
-    the seed's rule, so only commands back towards 0 relax a contracted
-    muscle; ``"symmetric"``: they also expand). Entries of empty and
-    passive cells are ignored (``env.muscle_mask`` and ``info["muscle_mask"]``
-    of :meth:`reset` tell which count). Each action is held for
-    ``control_dt`` seconds. ``action = sin(2 pi t / period)`` on every cell
-    is the seed's open-loop drive sampled every control step
-    (:class:`softgym.policies.Sinusoid`); with ``control_dt <= 0.005`` it
-    walks the engine's built-in sinusoid's distance to within 1 %, while the
-    default 0.05 s (5 samples per 0.25 s period) changes the seed's gait.
+    drives voxel ``(i, j, k)``). Entries of empty and passive cells are
+    ignored (``env.muscle_mask`` and ``info["muscle_mask"]`` of :meth:`reset`
+    tell which count). Each action is held for ``control_dt`` seconds. What
+    an entry means is ``action_mode`` (:class:`ActionMap`):
+
+    * ``"contraction"`` (the default under the seed's actuation law): the
+      temperature ``T = (a - s) dT / 2``, ``s = sign(CTE)`` of the cell's
+      muscle, ``dT`` the design's controller amplitude (14 degC by default):
+      the seed's signal halved and shifted into the muscles' contracting
+      range, so the muscle contracts by ``(1 - s a) / 2`` of its full range
+      (size ``L (1 - |CTE| dT (1 - s a) / 2)``). ``a = -1`` fully contracts
+      the positive-CTE muscles and rests the negative ones, ``+1`` the
+      reverse, ``0`` half contracts both. Every action sets the size; none
+      holds it. One value on every cell drives the two muscle kinds in
+      counter-phase, as the seed's drive does (``sin(2 pi t / period)`` on
+      every cell walks 2.68 voxel lengths in 4 s at 0.05 s steps).
+    * ``"temperature"`` (the default with ``actuation="symmetric"``): the
+      temperature ``T = a dT``, the seed's signal; the size follows
+      ``L (1 + CTE T)`` under the actuation law. Under the seed's law
+      (muscles only contract) a command that would expand a muscle keeps its
+      last size, so half of each entry's range means "hold" and only commands
+      back towards 0 relax a contracted muscle.
+
+    Why contraction is the default: under the seed's law with temperature
+    actions PPO (SB3, 600k steps) walked 0.135 voxel lengths in 4 s on
+    ``SoftWalker-Flat-v0``, below the seed's sinusoid (0.67): a policy that
+    overshoots holds its muscles contracted, and the hold changes the seed's
+    own gait when sampled every 0.05 s (0.67 against the engine's 4.38).
+    Through contraction actions (:meth:`action_from_temperatures`) the
+    seed's sinusoid walks 2.91 at 0.05 s (``benchmarks/RESULTS.md``). The
+    physics is the seed's either way; ``action_mode="temperature"`` gives
+    the seed's signal back.
+
+    :class:`softgym.policies.Sinusoid` returns the seed's temperature signal
+    ``sin(2 pi t / period)`` on every cell; :meth:`action_from_temperatures`
+    turns it into this env's action (identity in ``"temperature"`` mode).
+    Sampled every ``control_dt <= 0.005`` s in ``"temperature"`` mode it walks
+    the engine's built-in sinusoid's distance to within 1 %, while 0.05 s
+    (5 samples per 0.25 s period) changes the seed's gait.
 
     An action must be an array (or nested list) of real numbers of shape
     exactly ``(nx * ny * nz,)``: another shape of the same size (e.g. the grid
@@ -332,9 +432,9 @@ class SoftWalkerEnv(gym.Env):
       diverges while settling (an unstable design or ``sim_config``) starts
       with ``info["diverged"]`` True and terminates at its first step.
     * Truncation: after ``episode_seconds`` (``round(episode_seconds /
-      control_dt)`` steps, 80 by default); ``gym.make`` also wraps a
-      ``TimeLimit`` of the registered 80 steps, so pass
-      ``max_episode_steps=`` as well for longer episodes.
+      control_dt)`` steps, 80 by default). The ids register no step limit,
+      so the episode lasts its seconds whatever ``control_dt``
+      (``control_dt=0.005`` gives 800 steps of 4 s).
 
     ## Info
 
@@ -353,7 +453,8 @@ class SoftWalkerEnv(gym.Env):
 
     ```python
     gym.make("SoftWalker-Wall-v0", design=None, episode_seconds=4.0, control_dt=0.05,
-             actuation=None, self_collision=None, grid_shape=(6, 6, 6), render_mode=None)
+             actuation=None, self_collision=None, grid_shape=(6, 6, 6), render_mode=None,
+             action_mode=None)
     ```
 
     * ``design``: a :class:`~softgym.design.RobotDesign` or the path of its JSON file; None: the default walker.
@@ -378,10 +479,11 @@ class SoftWalkerEnv(gym.Env):
     * ``max_episode_steps``: an extra cap on the steps per episode: None or an int in
       1..:data:`softgym.tasks.episode.MAX_STEPS_PER_EPISODE` (not a bool or a float), checked
       by the env. ``gym.make(id, max_episode_steps=...)`` is different: Gymnasium consumes it
-      for its ``TimeLimit`` wrapper (``-1`` removes the wrapper; Gymnasium raises its own
-      TypeError or ValueError for other bad values) and the env never receives it; pass it as
-      ``gym.make(id, max_episode_steps=k)`` for the wrapper, and the env's own cap through
-      ``SoftWalkerEnv(max_episode_steps=k)`` or ``make_vec``.
+      for a ``TimeLimit`` wrapper (the ids register none; ``-1`` means none; Gymnasium
+      raises its own TypeError or ValueError for bad values) and the env never receives it;
+      the env's own cap goes through ``SoftWalkerEnv(max_episode_steps=k)`` or ``make_vec``.
+    * ``action_mode``: ``"contraction"``, ``"temperature"`` (see Action Space) or None: contraction
+      under the seed's actuation law, temperature under ``"symmetric"``.
     * ``drive``: ``"action"`` (default) or ``"controller"``: the design's own sinusoidal
       controller drives the muscles as in :func:`softgym.evaluate` and the seed, and actions
       are ignored (the open-loop baseline; with ``control_dt`` equal to the task's
@@ -389,7 +491,10 @@ class SoftWalkerEnv(gym.Env):
 
     ## Version History
 
-    * v0: initial version. Since the task suite (issue 14): ``info["score"]``, 13 more ids,
+    * v0: initial version. Since issue 33: ``action_mode`` (contractions by default
+      under the seed's law; ``action_mode="temperature"`` is the former action), and the ids
+      register no ``max_episode_steps`` (the episode lasts ``episode_seconds`` at any
+      ``control_dt``; it was 80 steps whatever the step). Since the task suite (issue 14): ``info["score"]``, 13 more ids,
       task arguments in ``task=``. Since the task layer (issue 11): ``task`` also takes a Task,
       Terrain or JSON file, ``episode_seconds`` defaults to the task's, the wall is centred on
       the design's grid (as in ``softgym.evaluate``; the default walker fills its grid, so
@@ -416,6 +521,7 @@ class SoftWalkerEnv(gym.Env):
         n_threads: int | None = 1,
         max_episode_steps: int | None = None,
         drive: str = "action",
+        action_mode: str | None = None,
     ) -> None:
         super().__init__()
         size = check_render_options(render_mode, width, height)
@@ -427,6 +533,8 @@ class SoftWalkerEnv(gym.Env):
             max_episode_steps=max_episode_steps, drive=drive,
         )  # fmt: skip
         b = self._batch
+        self._action_map = ActionMap(b, action_mode)
+        self.action_mode = self._action_map.mode
         self.task = b.task
         self.grid_shape = b.grid_shape
         self.control_dt = b.control_dt
@@ -460,6 +568,18 @@ class SoftWalkerEnv(gym.Env):
     def period(self) -> float:
         """Period (s) of the design's controller: the phase observation's period."""
         return float(self._batch.period[0])
+
+    def action_from_temperatures(self, fraction: Any) -> np.ndarray:
+        """The action giving each muscle the size the temperature ``fraction * dT`` gives it.
+
+        ``fraction`` has shape (n_cells,), values in [-1, 1] (a temperature
+        signal such as :class:`softgym.policies.Sinusoid`'s, the seed's
+        drive). In ``action_mode="temperature"`` it is the action itself; in
+        ``"contraction"`` a command that would expand a muscle leaves it at
+        rest (the seed's law without its hold). Returns float32 of shape (n_cells,).
+        """
+        f = np.asarray(fraction, dtype=np.float64)
+        return self._action_map.from_temperatures(f.reshape(1, -1))[0]
 
     @property
     def time(self) -> float:
@@ -521,7 +641,7 @@ class SoftWalkerEnv(gym.Env):
         a = b.validate_actions(action, single=True)
         if self._needs_reset:
             raise gym.error.ResetNeeded("call reset() before step()")
-        b.apply(a)
+        b.apply(self._action_map(a))
         b.advance()
         reward, terminated, truncated, _ = b.update(np.ones(1, dtype=bool))
         return (

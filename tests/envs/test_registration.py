@@ -28,7 +28,7 @@ def test_import_softgym_registers_every_id():
         spec = gym.spec(env_id)
         assert isinstance(spec.entry_point, str) and spec.entry_point.startswith("softgym.envs")
         assert spec.vector_entry_point == "softgym.envs.vector:SoftWalkerVectorEnv"
-        assert spec.max_episode_steps == 80
+        assert spec.max_episode_steps is None  # the episode is set in seconds, not steps
 
 
 @pytest.mark.parametrize("env_id", IDS)
@@ -46,6 +46,7 @@ def test_make_without_arguments_gives_the_default_walker():
     assert isinstance(base, SoftWalkerEnv)
     assert base.design == default_walker()
     assert base.max_steps == 80 and base.control_dt == 0.05
+    assert base.action_mode == "contraction" and base.sim.config.actuation == "seed"
     assert env.action_space.shape == (216,) and env.observation_space.shape == (1301,)
     assert env.action_space.dtype == np.float32 and env.observation_space.dtype == np.float32
     env.close()

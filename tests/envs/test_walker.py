@@ -74,7 +74,7 @@ def test_returns_sum_to_the_task_metric_and_observations_stay_in_the_space():
         total = 0.0
         done = False
         while not done:
-            obs, r, term, trunc, info = env.step(policy(obs))
+            obs, r, term, trunc, info = env.step(env.unwrapped.action_from_temperatures(policy(obs)))
             assert obs in env.observation_space
             total += r
             done = term or trunc
@@ -105,7 +105,7 @@ def test_sinusoid_policy_matches_the_engines_sinusoid():
     cfg = SimConfig.corotational()
     ref = norm_final_dist(Simulation([default_walker()], cfg, n_threads=1).run(5.0))[0]
     assert ref > 1.0  # the walker does walk
-    env = gym.make("SoftWalker-Flat-v0", control_dt=0.005, max_episode_steps=10_000, sim_config=cfg)
+    env = gym.make("SoftWalker-Flat-v0", control_dt=0.005, sim_config=cfg, action_mode="temperature")
     policy = Sinusoid.from_env(env)
     obs, _ = env.reset(seed=0)
     done = False
@@ -139,7 +139,7 @@ def test_a_step_limit_that_cuts_the_episode_short_warns():
     import warnings
 
     with pytest.warns(UserWarning, match="max_episode_steps=400"):
-        gym.make_vec("SoftWalker-Flat-v0", num_envs=2, control_dt=0.01)
+        gym.make_vec("SoftWalker-Flat-v0", num_envs=2, control_dt=0.01, max_episode_steps=100)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         env = gym.make("SoftWalker-Flat-v0", control_dt=0.01, max_episode_steps=400)
@@ -147,3 +147,18 @@ def test_a_step_limit_that_cuts_the_episode_short_warns():
         assert env.unwrapped.max_steps == 400
         gym.make_vec("SoftWalker-Flat-v0", num_envs=2, control_dt=0.01, max_episode_steps=400)
         gym.make("SoftWalker-Flat-v0").reset(seed=0)
+
+
+@pytest.mark.parametrize("control_dt", [0.05, 0.025, 0.005])
+def test_an_episode_lasts_its_seconds_whatever_the_control_step(control_dt):
+    # the ids register no step limit: gym.make and make_vec both run the whole 4 s
+    env = gym.make("SoftWalker-Flat-v0", control_dt=control_dt)
+    env.reset(seed=0)
+    steps, done = 0, False
+    while not done:
+        *_, term, trunc, info = env.step(np.full(216, -1.0, dtype=np.float32))
+        steps += 1
+        done = term or trunc
+    assert trunc and steps == round(4.0 / control_dt) and info["time"] == pytest.approx(5.0)
+    venv = gym.make_vec("SoftWalker-Flat-v0", num_envs=2, control_dt=control_dt)
+    assert venv.max_steps == steps
