@@ -640,10 +640,16 @@ class SoftWalkerEnv(gym.Env):
         b = self._batch
         a = b.validate_actions(action, single=True)
         if self._needs_reset:
-            raise gym.error.ResetNeeded("call reset() before step()")
+            raise gym.error.ResetNeeded(
+                "call reset() before step(): the episode has not started or has ended "
+                "(terminated or truncated)"
+            )
         b.apply(self._action_map(a))
         b.advance()
         reward, terminated, truncated, _ = b.update(np.ones(1, dtype=bool))
+        # Gymnasium's convention: an episode that ended needs reset() (issue 31: the env
+        # went on stepping after truncation)
+        self._needs_reset = bool(terminated[0] or truncated[0])
         return (
             b.observations()[0],
             float(reward[0]),

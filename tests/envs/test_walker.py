@@ -162,3 +162,19 @@ def test_an_episode_lasts_its_seconds_whatever_the_control_step(control_dt):
     assert trunc and steps == round(4.0 / control_dt) and info["time"] == pytest.approx(5.0)
     venv = gym.make_vec("SoftWalker-Flat-v0", num_envs=2, control_dt=control_dt)
     assert venv.max_steps == steps
+
+
+def test_an_ended_episode_needs_reset_before_the_next_step():
+    # issue 31: the env kept stepping after truncation; Gymnasium's convention is reset()
+    env = gym.make("SoftWalker-Flat-v0", control_dt=0.05, episode_seconds=0.2).unwrapped
+    with pytest.raises(gym.error.ResetNeeded):
+        env.step(np.zeros(216, dtype=np.float32))  # before the first reset
+    env.reset(seed=0)
+    done = False
+    while not done:
+        *_, term, trunc, _ = env.step(np.zeros(216, dtype=np.float32))
+        done = term or trunc
+    with pytest.raises(gym.error.ResetNeeded, match="terminated or truncated"):
+        env.step(np.zeros(216, dtype=np.float32))
+    env.reset(seed=1)
+    env.step(np.zeros(216, dtype=np.float32))  # a new episode steps again
