@@ -69,6 +69,32 @@ cdef void clear_robot(Batch* b, intp_t r) noexcept nogil:
     memset(b.moment + 3 * vs, 0, 3 * (ve - vs) * sizeof(float64_t))
 
 
+cdef inline float64_t _drift2(const float64_t* pos, const float64_t* ref, intp_t i, intp_t vs,
+                               float64_t* c) noexcept nogil:
+    # squared displacement of voxel i since the contact list's rebuild (ref), less
+    # the robot's first voxel's (c, set when i == vs): a common translation does not
+    # bring voxels closer, so walking costs no rebuild
+    cdef intp_t k = 3 * (i - vs)
+    if i == vs:
+        c[0] = pos[3 * i] - ref[k]
+        c[1] = pos[3 * i + 1] - ref[k + 1]
+        c[2] = pos[3 * i + 2] - ref[k + 2]
+    return ((pos[3 * i] - ref[k] - c[0]) ** 2 + (pos[3 * i + 1] - ref[k + 1] - c[1]) ** 2
+            + (pos[3 * i + 2] - ref[k + 2] - c[2]) ** 2)
+
+
+cdef inline void _spin(Batch* b, intp_t i, float64_t dt, float64_t mx, float64_t my,
+                       float64_t mz) noexcept nogil:
+    # angular velocity: w += M dt / I, then the global damping factor
+    cdef:
+        float64_t h = dt * b.inv_inertia[i]
+        float64_t rd = b.rot_damp[i]
+        float64_t* av = b.angvel
+    av[3 * i] = (av[3 * i] + mx * h) * rd
+    av[3 * i + 1] = (av[3 * i + 1] + my * h) * rd
+    av[3 * i + 2] = (av[3 * i + 2] + mz * h) * rd
+
+
 cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
                                 float64_t* dmax2) noexcept nogil:
     # IN: force, moment. OUT: pos, vel, quat, angvel, rot (symplectic Euler).
@@ -79,8 +105,8 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
     cdef:
         intp_t i, k
         float64_t dt = b.dt[r]
-        float64_t m, h, pen, cg, rd, d2, mx, my, mz
-        float64_t c0 = 0.0, c1 = 0.0, c2 = 0.0
+        float64_t m, h, pen, cg, d2, mx, my, mz
+        float64_t c[3]
         float64_t wx, wy, wz, qw, qx, qy, qz, nq
         float64_t f[3]
         float64_t n[3]
@@ -95,6 +121,9 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
         intp_t k1 = b.box_start[r + 1]
         intp_t vs = b.vox_start[r]
     dmax2[0] = 0.0
+    c[0] = 0.0
+    c[1] = 0.0
+    c[2] = 0.0
     for i in range(b.vox_start[r], b.vox_start[r + 1]):
         if b.fixed[i]:
             vel[3 * i] = 0.0
@@ -135,23 +164,11 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
             clear_robot(b, r)
             return STATUS_NONFINITE
         if ref != NULL:
-            # displacement since the rebuild, less the first voxel's: a common
-            # translation does not bring voxels closer, so walking costs no rebuild
-            k = 3 * (i - vs)
-            if i == vs:
-                c0 = pos[3 * i] - ref[k]
-                c1 = pos[3 * i + 1] - ref[k + 1]
-                c2 = pos[3 * i + 2] - ref[k + 2]
-            d2 = ((pos[3 * i] - ref[k] - c0) ** 2 + (pos[3 * i + 1] - ref[k + 1] - c1) ** 2
-                  + (pos[3 * i + 2] - ref[k + 2] - c2) ** 2)
+            d2 = _drift2(pos, ref, i, vs, c)
             if d2 > dmax2[0]:
                 dmax2[0] = d2
         # rotation: w += M dt / I, global damping, q += 0.5 dt (0, w) q
-        h = dt * b.inv_inertia[i]
-        rd = b.rot_damp[i]
-        av[3 * i] = (av[3 * i] + mx * h) * rd
-        av[3 * i + 1] = (av[3 * i + 1] + my * h) * rd
-        av[3 * i + 2] = (av[3 * i + 2] + mz * h) * rd
+        _spin(b, i, dt, mx, my, mz)
         wx = av[3 * i] * 0.5 * dt
         wy = av[3 * i + 1] * 0.5 * dt
         wz = av[3 * i + 2] * 0.5 * dt
@@ -207,8 +224,8 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
     cdef:
         intp_t i, k
         float64_t dt = b.dt[r]
-        float64_t h, pen, cg, rd, d2, mx, my, mz
-        float64_t c0 = 0.0, c1 = 0.0, c2 = 0.0
+        float64_t h, pen, cg, d2, mx, my, mz
+        float64_t c[3]
         float64_t f[3]
         float64_t n[3]
         float64_t* pos = b.pos
@@ -220,6 +237,9 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
         intp_t k1 = b.box_start[r + 1]
         intp_t vs = b.vox_start[r]
     dmax2[0] = 0.0
+    c[0] = 0.0
+    c[1] = 0.0
+    c[2] = 0.0
     for i in range(b.vox_start[r], b.vox_start[r + 1]):
         if b.fixed[i]:
             for k in range(3):
@@ -255,20 +275,10 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
             clear_robot(b, r)
             return STATUS_NONFINITE
         if ref != NULL:
-            k = 3 * (i - vs)
-            if i == vs:
-                c0 = pos[3 * i] - ref[k]
-                c1 = pos[3 * i + 1] - ref[k + 1]
-                c2 = pos[3 * i + 2] - ref[k + 2]
-            d2 = ((pos[3 * i] - ref[k] - c0) ** 2 + (pos[3 * i + 1] - ref[k + 1] - c1) ** 2
-                  + (pos[3 * i + 2] - ref[k + 2] - c2) ** 2)
+            d2 = _drift2(pos, ref, i, vs, c)
             if d2 > dmax2[0]:
                 dmax2[0] = d2
-        h = dt * b.inv_inertia[i]
-        rd = b.rot_damp[i]
-        av[3 * i] = (av[3 * i] + mx * h) * rd
-        av[3 * i + 1] = (av[3 * i + 1] + my * h) * rd
-        av[3 * i + 2] = (av[3 * i + 2] + mz * h) * rd
+        _spin(b, i, dt, mx, my, mz)
     _seed_orient(b, vs, b.vox_start[r + 1], dt)
     return STATUS_OK
 
