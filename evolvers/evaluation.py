@@ -24,6 +24,7 @@ import numpy as np
 
 from evolvers.experiments import Experiment
 from evolvers.genome import Individual
+from softgym.design import RobotDesign
 from softgym.evaluate import METRIC_KEYS, evaluate
 from softgym.exceptions import CheckpointError
 from softgym.metrics import WORST_FITNESS, WORST_MINIMIZED
@@ -50,10 +51,12 @@ FITNESS_METRICS: tuple[str, ...] = ("norm_final_dist", "max_xy_dist", "l_coeffic
 #: Every maximised metric: the fitness measures and a task's ``score`` (its own measure).
 MAXIMIZED: tuple[str, ...] = (*FITNESS_METRICS, "score")
 
-#: ``(designs as dicts, task) -> softgym.evaluate output with traces``.
-BatchFn = Callable[[list[dict[str, Any]], Task], dict[str, Any]]
-#: ``[(design dicts, task), ...] -> [softgym.evaluate output, ...]``: several tasks' batches at once.
-JobsFn = Callable[[list[tuple[list[dict[str, Any]], Task]]], list[dict[str, Any]]]
+#: ``(designs, task) -> softgym.evaluate output with traces``. The designs are
+#: :class:`~softgym.design.RobotDesign` objects (plain dicts only across Dask, where
+#: :class:`evolvers.distributed.DaskBatchFn` turns them into ``to_dict()``).
+BatchFn = Callable[[list[RobotDesign], Task], dict[str, Any]]
+#: ``[(designs, task), ...] -> [softgym.evaluate output, ...]``: several tasks' batches at once.
+JobsFn = Callable[[list[tuple[list[RobotDesign], Task]]], list[dict[str, Any]]]
 #: Robots to score on one task, :meth:`Evaluator.evaluate_jobs`: ``(task key, task, individuals)``.
 Job = tuple[str | None, Task, Sequence[Individual]]
 
@@ -69,7 +72,7 @@ _UNNAMED_CACHE_COLUMNS: tuple[str, ...] = (
 
 
 def local_batch_fn(
-    designs: list[dict[str, Any]], task: Task, progress: bool | None = None
+    designs: list[RobotDesign] | list[dict[str, Any]], task: Task, progress: bool | None = None
 ) -> dict[str, Any]:
     """Evaluate every design in one local Simulation (:func:`softgym.evaluate`;
     ``progress`` as there: None shows a bar for a batch that takes long).
@@ -223,7 +226,7 @@ class Evaluator:
     experiment : Experiment
         Gives the task (:meth:`Experiment.make_task`), the grid shape and the rules.
     batch_fn : callable, optional
-        ``(design dicts, task) -> metrics`` (default :func:`local_batch_fn`:
+        ``(designs, task) -> metrics`` (default :func:`local_batch_fn`:
         one local Simulation). :class:`evolvers.distributed.DaskBatchFn` spreads
         the batch over Dask workers.
     n_threads : int, optional
@@ -263,7 +266,7 @@ class Evaluator:
         self.cache = PhenotypeCache() if cache is None else cache
         self.n_evaluations = 0
 
-    def _each_batch(self, jobs: list[tuple[list[dict[str, Any]], Task]]) -> list[dict[str, Any]]:
+    def _each_batch(self, jobs: list[tuple[list[RobotDesign], Task]]) -> list[dict[str, Any]]:
         return [self.batch_fn(designs, task) for designs, task in jobs]
 
     def evaluate(self, individuals: Sequence[Individual]) -> EvalStats:
@@ -336,8 +339,9 @@ class Evaluator:
             rows.append(row)
         if pending:
             groups = list(batches.values())
+            # the designs as objects: dicts only where they cross to Dask workers
             outs = self.jobs_fn(
-                [([pending[k].design(exp.shape).to_dict() for k in keys], task) for task, keys in groups]
+                [([pending[k].design(exp.shape) for k in keys], task) for task, keys in groups]
             )
             for (_, keys), res in zip(groups, outs):
                 for i, key in enumerate(keys):
