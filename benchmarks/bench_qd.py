@@ -42,7 +42,6 @@ from evolvers.experiments import get_experiment
 from evolvers.pymoo_runner import PymooRun
 from evolvers.qd import QDConfig, QDRun, archive_stats, make_archive
 from evolvers.runner import EvolutionRun
-from softgym.design import RobotDesign
 from softgym.io import atomic_write_text
 
 METHODS = ("map-elites", "nsga2", "novelty")
@@ -64,7 +63,7 @@ class RecordingBatchFn:
     def __call__(self, designs, task):
         res = local_batch_fn(designs, task, progress=False)  # the script prints one line a run
         for d, dist, div in zip(designs, res["norm_final_dist"], res["diverged"]):
-            self.grids.append(np.asarray(RobotDesign.from_dict(d).grid))
+            self.grids.append(np.asarray(d.grid))  # the evaluator passes RobotDesigns
             self.distances.append(0.0 if div else max(float(dist), 0.0))
         return res
 

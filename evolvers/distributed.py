@@ -20,7 +20,7 @@ Dask is an optional extra: ``pip install "softgym[distributed]"``. Without it,
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from typing import Any
 
 import numpy as np
@@ -112,18 +112,21 @@ class DaskBatchFn:
         except Exception:  # pragma: no cover - scheduler without the call
             return 1
 
-    def __call__(self, designs: list[dict[str, Any]], task: Task) -> dict[str, Any]:
-        """``(design dicts, task) -> metrics``, like :func:`evolvers.evaluation.local_batch_fn`."""
+    def __call__(self, designs: list[Any], task: Task) -> dict[str, Any]:
+        """``(designs, task) -> metrics``, like :func:`evolvers.evaluation.local_batch_fn`
+        (RobotDesigns or their dicts).
+        """
         slices = split_batches(len(designs), self.n_batches or self._default_batches())
         return _merge(self.jobs([(designs[a:b], task) for a, b in slices]))
 
-    def jobs(self, jobs: list[tuple[list[dict[str, Any]], Task]]) -> list[dict[str, Any]]:
-        """``[(design dicts, task), ...] -> [metrics, ...]``: one Dask task per batch, all at
+    def jobs(self, jobs: list[tuple[list[Any], Task]]) -> list[dict[str, Any]]:
+        """``[(designs, task), ...] -> [metrics, ...]``: one Dask task per batch, all at
         once (POET's terrains; :class:`~evolvers.poet.PoetRun` uses it when given this
-        ``batch_fn``).
+        ``batch_fn``). Designs travel as plain dicts (``RobotDesign.to_dict()``).
         """
         # one engine thread per batch: workers already run batches in parallel
-        payloads = [{"designs": d, "task": {**t.to_dict(), "n_threads": 1}} for d, t in jobs]
+        payloads = [{"designs": [x if isinstance(x, Mapping) else x.to_dict() for x in d],
+                     "task": {**t.to_dict(), "n_threads": 1}} for d, t in jobs]  # fmt: skip
         futures = self.client.map(self.payload_fn, payloads, pure=False, retries=self.retries)
         return list(self.client.gather(futures))
 

@@ -1,15 +1,20 @@
-"""Batched population evaluation with a phenotype cache.
+"""Batched population evaluation with a (task, phenotype) cache: the one evaluator of every driver.
 
 An :class:`Evaluator` turns individuals into designs, skips those whose
 phenotype (grid + used materials + controller, :meth:`Individual.phenotype_key`)
-was already simulated, and simulates all the others **in one batched
-Simulation** (locally) or in a few batches spread over Dask workers
-(:mod:`evolvers.distributed`). A robot's result does not depend on its batch,
-so local and distributed runs, cached and fresh evaluations, agree bit for bit.
+was already simulated on the same task, and simulates all the others **in one
+batched Simulation per task** (locally) or in a few batches spread over Dask
+workers (:mod:`evolvers.distributed`). The ordinary drivers evaluate on their
+experiment's task (:meth:`Evaluator.evaluate`); POET scores robots on many
+terrains at once (:meth:`Evaluator.evaluate_jobs`, the cache keyed by terrain
+and phenotype, :meth:`PhenotypeCache.key`). A robot's result does not depend on
+its batch, so local and distributed runs, cached and fresh evaluations, agree
+bit for bit.
 """
 
 from __future__ import annotations
 
+import hashlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import partial
@@ -19,6 +24,7 @@ import numpy as np
 
 from evolvers.experiments import Experiment
 from evolvers.genome import Individual
+from softgym.design import RobotDesign
 from softgym.evaluate import METRIC_KEYS, evaluate
 from softgym.exceptions import CheckpointError
 from softgym.metrics import WORST_FITNESS, WORST_MINIMIZED
@@ -30,6 +36,8 @@ __all__ = [
     "BatchFn",
     "EvalStats",
     "Evaluator",
+    "Job",
+    "JobsFn",
     "PhenotypeCache",
     "STORED_METRICS",
     "local_batch_fn",
@@ -43,8 +51,14 @@ FITNESS_METRICS: tuple[str, ...] = ("norm_final_dist", "max_xy_dist", "l_coeffic
 #: Every maximised metric: the fitness measures and a task's ``score`` (its own measure).
 MAXIMIZED: tuple[str, ...] = (*FITNESS_METRICS, "score")
 
-#: ``(designs as dicts, task) -> softgym.evaluate output with traces``.
-BatchFn = Callable[[list[dict[str, Any]], Task], dict[str, Any]]
+#: ``(designs, task) -> softgym.evaluate output with traces``. The designs are
+#: :class:`~softgym.design.RobotDesign` objects (plain dicts only across Dask, where
+#: :class:`evolvers.distributed.DaskBatchFn` turns them into ``to_dict()``).
+BatchFn = Callable[[list[RobotDesign], Task], dict[str, Any]]
+#: ``[(designs, task), ...] -> [softgym.evaluate output, ...]``: several tasks' batches at once.
+JobsFn = Callable[[list[tuple[list[RobotDesign], Task]]], list[dict[str, Any]]]
+#: Robots to score on one task, :meth:`Evaluator.evaluate_jobs`: ``(task key, task, individuals)``.
+Job = tuple[str | None, Task, Sequence[Individual]]
 
 #: The metrics kept per evaluated phenotype (on individuals and in the cache).
 STORED_METRICS: tuple[str, ...] = tuple(k for k in METRIC_KEYS if k != "time_max_xy_dist")
@@ -58,7 +72,7 @@ _UNNAMED_CACHE_COLUMNS: tuple[str, ...] = (
 
 
 def local_batch_fn(
-    designs: list[dict[str, Any]], task: Task, progress: bool | None = None
+    designs: list[RobotDesign] | list[dict[str, Any]], task: Task, progress: bool | None = None
 ) -> dict[str, Any]:
     """Evaluate every design in one local Simulation (:func:`softgym.evaluate`;
     ``progress`` as there: None shows a bar for a batch that takes long).
@@ -91,7 +105,7 @@ def unpack_traces(data: np.ndarray, lengths: np.ndarray) -> list[np.ndarray | No
 
 
 class PhenotypeCache:
-    """Results by phenotype key: metric values and the centre-of-mass trace."""
+    """Results by (task, phenotype) key (:meth:`key`): metric values and the centre-of-mass trace."""
 
     def __init__(self) -> None:
         self._data: dict[str, tuple[dict[str, float], np.ndarray | None]] = {}
@@ -101,6 +115,18 @@ class PhenotypeCache:
 
     def __contains__(self, key: str) -> bool:
         return key in self._data
+
+    @staticmethod
+    def key(phenotype: str, task: str | None = None) -> str:
+        """The cache key of a phenotype (:meth:`Individual.phenotype_key`) on a task.
+
+        ``task`` None (a run's own task): the phenotype key itself; else the
+        SHA-256 (hex) of the task's key and the phenotype key, e.g. POET's
+        ``TerrainGenome.key()``. Both keys are what checkpoints have always stored.
+        """
+        if task is None:
+            return phenotype
+        return hashlib.sha256((task + phenotype).encode()).hexdigest()
 
     def get(self, key: str) -> tuple[dict[str, float], np.ndarray | None]:
         """The stored ``(objectives, trace)`` of ``key``."""
@@ -189,14 +215,18 @@ def worst_objectives() -> dict[str, float]:
 
 
 class Evaluator:
-    """Evaluate individuals of an experiment, batched and cached.
+    """Evaluate individuals of an experiment, batched and cached by (task, phenotype).
+
+    Every driver evaluates through one: the ordinary runs on the experiment's
+    task (:meth:`evaluate`), POET on each pair's terrain (:meth:`evaluate_jobs`,
+    several tasks' batches at once).
 
     Parameters
     ----------
     experiment : Experiment
         Gives the task (:meth:`Experiment.make_task`), the grid shape and the rules.
     batch_fn : callable, optional
-        ``(design dicts, task) -> metrics`` (default :func:`local_batch_fn`:
+        ``(designs, task) -> metrics`` (default :func:`local_batch_fn`:
         one local Simulation). :class:`evolvers.distributed.DaskBatchFn` spreads
         the batch over Dask workers.
     n_threads : int, optional
@@ -206,6 +236,13 @@ class Evaluator:
     progress : bool
         False keeps the default batch function's progress bar off (a run
         that shows none of its own, e.g. inside a study).
+    jobs_fn : callable, optional
+        Several tasks' batches at once (:data:`JobsFn`, e.g.
+        :meth:`evolvers.distributed.DaskBatchFn.jobs`); default ``batch_fn``
+        on each batch in turn.
+    traces : bool
+        Keep each robot's centre-of-mass trace (in the cache and on the
+        individuals); False stores None (POET, which scores distances only).
     """
 
     def __init__(
@@ -215,6 +252,8 @@ class Evaluator:
         n_threads: int | None = None,
         cache: PhenotypeCache | None = None,
         progress: bool = True,
+        jobs_fn: JobsFn | None = None,
+        traces: bool = True,
     ) -> None:
         self.experiment = experiment
         self.task = experiment.make_task(n_threads)
@@ -222,55 +261,109 @@ class Evaluator:
         self.batch_fn = batch_fn or (
             local_batch_fn if progress else partial(local_batch_fn, progress=False)
         )
+        self.jobs_fn: JobsFn = jobs_fn or self._each_batch
+        self.traces = bool(traces)
         self.cache = PhenotypeCache() if cache is None else cache
         self.n_evaluations = 0
 
+    def _each_batch(self, jobs: list[tuple[list[RobotDesign], Task]]) -> list[dict[str, Any]]:
+        return [self.batch_fn(designs, task) for designs, task in jobs]
+
     def evaluate(self, individuals: Sequence[Individual]) -> EvalStats:
-        """Fill ``objectives`` and ``trace`` of every individual (in place).
+        """Fill ``objectives`` and ``trace`` of every individual (in place), on the experiment's task.
 
         All metrics of :func:`softgym.evaluate` are stored (``diverged`` as
         0/1). Invalid bodies (breaking the experiment's rules) are not
         simulated and get the worst values; identical phenotypes are
         simulated once.
         """
+        return self.evaluate_jobs([(None, self.task, individuals)])[1]
+
+    def evaluate_jobs(
+        self, jobs: Sequence[Job], assign: bool = True
+    ) -> tuple[list[list[dict[str, float]]], EvalStats]:
+        """Results of robots on tasks: every uncached (task, phenotype) simulated once, batched.
+
+        Parameters
+        ----------
+        jobs : sequence of (task key, Task, sequence of Individual)
+            The key names the task in the cache (:meth:`PhenotypeCache.key`;
+            None: the experiment's own task). The uncached robots of one key
+            are one batch (the task of its first job), all batches one
+            :attr:`jobs_fn` call.
+        assign : bool
+            Store each robot's results on it (``objectives``, ``trace``); False
+            only reads them (robots scored on another pair's terrain).
+
+        Returns
+        -------
+        results : list of list of dict
+            The objectives of each robot of each job (read only).
+        stats : EvalStats
+        """
         exp = self.experiment
-        stats = EvalStats(n_individuals=len(individuals))
-        todo: dict[str, list[Individual]] = {}
-        for ind in individuals:
-            new = not ind.objectives  # parents carry their results; children and newcomers do not
-            stats.n_new += int(new)
-            grid = ind.grid(exp.shape)
-            if exp.rules.violations(grid):
-                ind.objectives = worst_objectives()
-                ind.trace = None
-                stats.n_invalid += 1
-                continue
-            if (grid == 2).any():
-                stats.n_bone += 1
-            key = ind.phenotype_key(exp.shape)
-            stats.n_repeated += int(new and (key in self.cache or key in todo))
-            if key in self.cache:
-                obj, tr = self.cache.get(key)
-                ind.objectives = dict(obj)
-                ind.trace = tr
-                stats.n_cached += 1
-            else:
-                todo.setdefault(key, []).append(ind)
-        if todo:
-            keys = list(todo)
-            designs = [todo[k][0].design(exp.shape).to_dict() for k in keys]
-            res = self.batch_fn(designs, self.task)
-            for i, key in enumerate(keys):
-                # (a batch function of an older softgym may not report "score")
-                obj = {m: float(res[m][i]) for m in STORED_METRICS if m in res}
-                tr = res["traces"][i]
-                tr = None if tr is None else np.asarray(tr, dtype=np.float64)
-                self.cache.put(key, obj, tr)
-                stats.n_diverged += int(obj["diverged"])
-                for ind in todo[key]:
+        stats = EvalStats()
+        # cache key -> the robot simulated for it; task key -> (task, its keys to simulate)
+        pending: dict[str, Individual] = {}
+        batches: dict[str | None, tuple[Task, list[str]]] = {}
+        rows: list[list[dict[str, float] | str]] = []
+        for task_key, task, inds in jobs:
+            row: list[dict[str, float] | str] = []
+            for ind in inds:
+                stats.n_individuals += 1
+                new = not ind.objectives  # parents carry their results; children and newcomers do not
+                stats.n_new += int(new)
+                grid = ind.grid(exp.shape)
+                if exp.rules.violations(grid):
+                    row.append(worst_objectives())
+                    if assign:
+                        ind.objectives = worst_objectives()
+                        ind.trace = None
+                    stats.n_invalid += 1
+                    continue
+                if (grid == 2).any():
+                    stats.n_bone += 1
+                key = PhenotypeCache.key(ind.phenotype_key(exp.shape), task_key)
+                seen = key in self.cache or key in pending
+                stats.n_repeated += int(new and seen)
+                stats.n_cached += int(seen)
+                row.append(key)
+                if key in self.cache:
+                    if assign:
+                        obj, tr = self.cache.get(key)
+                        ind.objectives = dict(obj)
+                        ind.trace = tr
+                elif key not in pending:
+                    pending[key] = ind
+                    batches.setdefault(task_key, (task, []))[1].append(key)
+            rows.append(row)
+        if pending:
+            groups = list(batches.values())
+            # the designs as objects: dicts only where they cross to Dask workers
+            outs = self.jobs_fn(
+                [([pending[k].design(exp.shape) for k in keys], task) for task, keys in groups]
+            )
+            for (_, keys), res in zip(groups, outs):
+                for i, key in enumerate(keys):
+                    # (a batch function of an older softgym, or a fake, may not report "score")
+                    obj = {m: float(res[m][i]) for m in STORED_METRICS if m in res}
+                    tr = res["traces"][i] if self.traces else None
+                    tr = None if tr is None else np.asarray(tr, dtype=np.float64)
+                    self.cache.put(key, obj, tr)
+                    stats.n_diverged += int(obj["diverged"])
+            stats.n_simulated = len(pending)
+        self.n_evaluations += stats.n_simulated
+        results = []
+        for (_, _, inds), row in zip(jobs, rows):
+            out = []
+            for ind, entry in zip(inds, row):
+                if isinstance(entry, dict):
+                    out.append(entry)
+                    continue
+                obj, tr = self.cache.get(entry)
+                out.append(obj)
+                if assign and entry in pending:
                     ind.objectives = dict(obj)
                     ind.trace = tr
-            stats.n_simulated = len(keys)
-            stats.n_cached += sum(len(v) - 1 for v in todo.values())
-        self.n_evaluations += stats.n_simulated
-        return stats
+            results.append(out)
+        return results, stats

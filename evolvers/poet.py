@@ -74,7 +74,6 @@ with their robots (:meth:`PoetRun.write_figures`, :func:`plot_annecs`).
 
 from __future__ import annotations
 
-import hashlib
 import logging
 import math
 from collections.abc import Callable, Mapping, Sequence
@@ -85,14 +84,7 @@ from typing import Any
 import numpy as np
 
 from evolvers.driver import Checkpoint, Driver, IdCounter
-from evolvers.evaluation import (
-    STORED_METRICS,
-    BatchFn,
-    EvalStats,
-    PhenotypeCache,
-    local_batch_fn,
-    worst_objectives,
-)
+from evolvers.evaluation import BatchFn, EvalStats, Evaluator, JobsFn, PhenotypeCache
 from evolvers.experiments import Experiment, get_experiment
 from evolvers.genome import Individual
 from evolvers.operators import make_children
@@ -112,7 +104,6 @@ __all__ = [
     "PoetConfig",
     "PoetRun",
     "centered_ranks",
-    "local_jobs_fn",
     "novelty",
     "pata_ec",
     "plot_annecs",
@@ -135,8 +126,6 @@ GENERATORS: tuple[str, ...] = ("mutate", "random")
 #: Draws of a candidate terrain before it counts as a duplicate of a known one.
 _MUTATION_TRIES = 10
 
-#: ``[(design dicts, task), ...] -> [softgym.evaluate output, ...]``: one batch per terrain.
-JobsFn = Callable[[list[tuple[list[dict[str, Any]], Task]]], list[dict[str, Any]]]
 
 
 def poet_thresholds(trapped: float = 3.0, solved: float = 10.0) -> dict[str, float]:
@@ -358,17 +347,6 @@ def novelty(vector: np.ndarray, others: np.ndarray, k: int = 5) -> float:
     return float(d[: max(1, int(k))].mean())
 
 
-# ---------------------------------------------------------------------- evaluation
-def local_jobs_fn(batch_fn: BatchFn | None = None) -> JobsFn:
-    """Evaluate each terrain's batch locally, one after the other (each one batched Simulation)."""
-    fn = batch_fn or local_batch_fn
-
-    def jobs_fn(jobs: list[tuple[list[dict[str, Any]], Task]]) -> list[dict[str, Any]]:
-        return [fn(designs, task) for designs, task in jobs]
-
-    return jobs_fn
-
-
 # ---------------------------------------------------------------------- pairs
 @dataclass
 class Pair:
@@ -490,7 +468,8 @@ class PoetRun(Driver):
         Simulation); tests pass a fake. A :class:`~evolvers.distributed.DaskBatchFn`
         evaluates all terrains at once (its ``jobs``).
     jobs_fn : callable, optional
-        Several terrains' batches at once; overrides ``batch_fn``.
+        Several terrains' batches at once (:data:`~evolvers.evaluation.JobsFn`);
+        overrides ``batch_fn``.
     n_threads : int, optional
         OpenMP threads of local simulations.
     on_iteration : callable, optional
@@ -522,29 +501,34 @@ class PoetRun(Driver):
     ) -> None:
         self.config = PoetConfig() if config is None else config
         self.metric = "max_xy_dist"
-        self.jobs_fn = jobs_fn or getattr(batch_fn, "jobs", None) or local_jobs_fn(batch_fn)
+        self._jobs_fn = jobs_fn or getattr(batch_fn, "jobs", None)
         super().__init__(
             poet_experiment() if experiment is None else experiment, out, seed, int(iterations),
-            None, n_threads, on_iteration, figures, False, progress,
+            batch_fn, n_threads, on_iteration, figures, False, progress,
             extra_config={"poet": self.config.to_dict()},
         )  # fmt: skip
-        self.base_task = self.experiment.make_task(n_threads)
 
-    def _evaluator(self, batch_fn: BatchFn | None, n_threads: int | None, progress: bool) -> None:
-        """None: POET scores robots per terrain (:meth:`evaluate`, its own cache)."""
-        return None
+    def _evaluator(self, batch_fn: BatchFn | None, n_threads: int | None, progress: bool) -> Evaluator:
+        """The drivers' evaluator, keyed by (terrain, phenotype) (:meth:`evaluate`); no traces kept."""
+        return Evaluator(self.experiment, batch_fn, n_threads, progress=progress,
+                         jobs_fn=self._jobs_fn, traces=False)  # fmt: skip
 
     def _fresh(self) -> None:
         super()._fresh()
         self.rng = np.random.default_rng(self.seed)
         self.pair_ids = IdCounter()
         self.pairs: list[Pair] = []
-        self.cache = PhenotypeCache()
+        self.evaluator.cache = PhenotypeCache()
+        self.evaluator.n_evaluations = 0
         self.annecs = 0
         self.annecs_archive = 0
-        self.n_simulated = 0
 
     # ------------------------------------------------------------------ views
+    @property
+    def n_simulated(self) -> int:
+        """Simulations run so far (the evaluator's count)."""
+        return self.evaluator.n_evaluations
+
     @property
     def iteration(self) -> int:
         """The last finished iteration (the driver's :attr:`generation`), -1 before the first."""
@@ -586,17 +570,13 @@ class PoetRun(Driver):
     # ------------------------------------------------------------------ evaluation
     def task_for(self, terrain: TerrainGenome) -> Task:
         """The task a robot runs on ``terrain``: the experiment's duration and sampling."""
-        return self.base_task.replace(terrain=terrain.terrain(self.experiment.shape))
-
-    def _key(self, terrain: TerrainGenome, ind: Individual) -> str:
-        h = hashlib.sha256(terrain.key().encode())
-        h.update(ind.phenotype_key(self.experiment.shape).encode())
-        return h.hexdigest()
+        return self.evaluator.task.replace(terrain=terrain.terrain(self.experiment.shape))
 
     def evaluate(
         self, jobs: Sequence[tuple[TerrainGenome, Sequence[Individual]]], assign: bool = False
     ) -> tuple[list[np.ndarray], EvalStats]:
-        """Score robots on terrains: every uncached (terrain, phenotype) simulated once, batched.
+        """Score robots on terrains: every uncached (terrain, phenotype) simulated once, batched
+        (:meth:`Evaluator.evaluate_jobs`, the task keyed by :meth:`TerrainGenome.key`).
 
         Parameters
         ----------
@@ -610,58 +590,12 @@ class PoetRun(Driver):
         scores : list of ndarray of shape (n_robots of the job,), float64
         stats : EvalStats
         """
-        exp = self.experiment
-        stats = EvalStats()
-        todo: dict[str, dict[str, Any]] = {}  # terrain key -> {"terrain", "keys": {key: ind}}
-        results: list[list[tuple[str, dict[str, float] | None]]] = []
-        for terrain, inds in jobs:
-            row = []
-            for ind in inds:
-                stats.n_individuals += 1
-                if exp.rules.violations(ind.grid(exp.shape)):
-                    stats.n_invalid += 1
-                    row.append(("", worst_objectives()))
-                    continue
-                key = self._key(terrain, ind)
-                if key in self.cache:
-                    stats.n_cached += 1
-                else:
-                    entry = todo.setdefault(terrain.key(), {"terrain": terrain, "keys": {}})
-                    if key in entry["keys"]:
-                        stats.n_cached += 1
-                    entry["keys"].setdefault(key, ind)
-                row.append((key, None))
-            results.append(row)
-        if todo:
-            batches = list(todo.values())
-            payload = [
-                (
-                    [ind.design(exp.shape).to_dict() for ind in b["keys"].values()],
-                    self.task_for(b["terrain"]),
-                )
-                for b in batches
-            ]
-            outs = self.jobs_fn(payload)
-            for b, res in zip(batches, outs):
-                for i, key in enumerate(b["keys"]):
-                    obj = {
-                        m: float(res[m][i]) for m in STORED_METRICS if m in res
-                    }  # (a fake or older batch may lack "score")
-                    self.cache.put(key, obj, None)
-                    stats.n_diverged += int(obj["diverged"])
-                    stats.n_simulated += 1
-        self.n_simulated += stats.n_simulated
-        scores = []
-        for (_, inds), row in zip(jobs, results):
-            s = np.empty(len(inds))
-            for i, (ind, (key, obj)) in enumerate(zip(inds, row)):
-                if obj is None:
-                    obj = self.cache.get(key)[0]
-                s[i] = _score(obj, self.metric, self.config.score_cap)
-                if assign:
-                    ind.objectives = dict(obj)
-                    ind.trace = None
-            scores.append(s)
+        results, stats = self.evaluator.evaluate_jobs(
+            [(terrain.key(), self.task_for(terrain), inds) for terrain, inds in jobs], assign=assign
+        )
+        cap = self.config.score_cap
+        scores = [np.array([_score(obj, self.metric, cap) for obj in row], dtype=np.float64)
+                  for row in results]  # fmt: skip
         return scores, stats
 
     def score_matrix(
@@ -930,7 +864,7 @@ class PoetRun(Driver):
             "n_simulated": self.n_simulated,
             "pairs": [p.to_dict() for p in self.pairs],
         }
-        return state, self.cache.to_arrays(), columns, [p.best for p in active]
+        return state, self.evaluator.cache.to_arrays(), columns, [p.best for p in active]
 
     def _restore(self, state: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
         self.rng = rng_from_state(state["rng"])
@@ -938,12 +872,12 @@ class PoetRun(Driver):
         self.pair_ids.value = int(state["next_pair"])
         self.annecs = int(state["annecs"])
         self.annecs_archive = int(state["annecs_archive"])
-        self.n_simulated = int(state["n_simulated"])
+        self.evaluator.n_evaluations = int(state["n_simulated"])
         self.pairs = [
             Pair.from_dict(d, self.metric, self.config.score_cap) for d in state["pairs"]
         ]
         self.iteration = int(state["generation"])
-        self.cache = PhenotypeCache.from_arrays(arrays)
+        self.evaluator.cache = PhenotypeCache.from_arrays(arrays)
 
     # ------------------------------------------------------------------ outputs
     def finish(self) -> None:

@@ -203,7 +203,7 @@ def evaluate(
     from softgym.engine import Simulation, voxel_steps_per_second
     from softgym.metrics import composition_counts
 
-    cfg = task.config() if config is None else config.replace(trace_interval=task.trace_interval)
+    cfg = task.config(config, settings=config is None)  # a full config replaces the task's
     # longest first: the kernel's dynamic schedule then balances the threads (results do not
     # depend on a robot's place in the batch, so the order is free)
     order = sorted(range(n), key=lambda i: -estimated_cost(designs[i], cfg.voxel_size))

@@ -142,6 +142,9 @@ def make_config(
 ) -> SimConfig:
     """The env's engine settings: ``sim_config`` (the seed's by default), the task's ``sim``, overrides.
 
+    The arguments are checked here and assembled by :meth:`Task.config
+    <softgym.tasks.Task.config>` (no task: ``sim_config`` and the overrides
+    alone); the engine's own trace is off (the episode samples the robots).
     ``self_collision`` must be None or a bool (``"yes"`` or ``1`` is refused with
     :class:`~softgym.exceptions.InvalidParameterError`, not read as true).
     """
@@ -157,15 +160,11 @@ def make_config(
         raise InvalidParameterError(
             f"sim_config must be a SimConfig, got {type(sim_config).__name__}"
         )
-    cfg = SimConfig() if sim_config is None else sim_config
-    if task is not None:
-        cfg = task.config(cfg)
-    changes: dict[str, Any] = {"trace_interval": _NO_ENGINE_TRACE}
-    if actuation is not None:
-        changes["actuation"] = actuation
-    if self_collision is not None:
-        changes["self_collision"] = bool(self_collision)
-    return cfg.replace(**changes)
+    return (Task() if task is None else task).config(
+        SimConfig() if sim_config is None else sim_config, settings=task is not None,
+        trace_interval=_NO_ENGINE_TRACE, actuation=actuation,
+        self_collision=None if self_collision is None else bool(self_collision),
+    )  # fmt: skip
 
 
 def make_batch(

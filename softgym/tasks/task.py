@@ -198,13 +198,44 @@ class Task:
             return self.terrain
         return KINDS[self.terrain].layout(shape, **self.options)
 
-    def config(self, base: SimConfig | None = None) -> SimConfig:
-        """The engine settings: ``base`` (default the seed's) with ``sim`` and ``trace_interval``."""
+    def config(
+        self,
+        base: SimConfig | None = None,
+        *,
+        settings: bool = True,
+        trace_interval: float | None = None,
+        **overrides: Any,
+    ) -> SimConfig:
+        """The engine settings of a run of the task: the one place they are assembled.
+
+        ``softgym.evaluate``, the Gymnasium envs (:func:`softgym.envs.walker.make_config`)
+        and every caller that simulates a task build their :class:`~softgym.engine.SimConfig` here.
+
+        Parameters
+        ----------
+        base : SimConfig, optional
+            The settings to start from (default the seed's).
+        settings : bool
+            Apply the task's own settings (:attr:`engine_settings`: its kind's,
+            then ``sim``); False keeps a full ``base`` as it is
+            (``softgym.evaluate(config=...)``).
+        trace_interval : float, optional
+            Seconds between the engine's centre-of-mass samples (default the task's).
+        **overrides
+            :class:`~softgym.engine.SimConfig` fields set last (e.g. an env's
+            ``actuation``, ``self_collision``); a None value leaves the field as it is.
+
+        Returns
+        -------
+        SimConfig
+        """
         from softgym.engine import SimConfig
 
-        sim = self.engine_settings
+        sim = self.engine_settings if settings else {}
         cfg = SimConfig(**sim) if base is None else base.replace(**sim)
-        return cfg.replace(trace_interval=float(self.trace_interval))
+        changes = {k: v for k, v in overrides.items() if v is not None}
+        interval = self.trace_interval if trace_interval is None else trace_interval
+        return cfg.replace(trace_interval=float(interval), **changes)
 
     @property
     def engine_settings(self) -> dict[str, Any]:

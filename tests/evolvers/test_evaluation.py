@@ -148,3 +148,37 @@ def test_seed_centre_of_mass_scores_obstacle_runs_as_the_seed_did():
     assert twin.objectives["max_xy_dist"] == pytest.approx(
         f * ind.objectives["max_xy_dist"], rel=1e-6
     )
+
+
+def test_one_evaluator_keys_results_by_task_and_phenotype():
+    # the ordinary drivers' task (key None) and any other task (POET's terrains) share one
+    # cache: a phenotype is simulated once per task, batched per task in one jobs_fn call
+    from poet_helpers import fake_batch_fn
+
+    exp = tiny()
+    calls = []
+
+    def jobs_fn(jobs):
+        calls.append([(len(designs), task.name) for designs, task in jobs])
+        return [fake_batch_fn(designs, task) for designs, task in jobs]
+
+    ev = Evaluator(exp, jobs_fn=jobs_fn)
+    rng = np.random.default_rng(0)
+    a = Individual.random(rng, 0, exp.shape)
+    c = Individual.random(rng, 2, exp.shape)
+    wall = ev.task.replace(terrain="wall")
+    res, st = ev.evaluate_jobs(
+        [(None, ev.task, [a, c]), ("wall", wall, [a, c, c.child(3)])], assign=False
+    )
+    assert calls == [[(2, ev.task.name), (2, "wall")]]
+    assert (st.n_individuals, st.n_simulated, st.n_cached) == (5, 4, 1)
+    assert not a.objectives and res[1][2] == res[1][1]  # assign=False only reads
+    shape = exp.shape
+    assert PhenotypeCache.key(a.phenotype_key(shape)) == a.phenotype_key(shape)
+    for key in (None, "wall"):
+        assert PhenotypeCache.key(a.phenotype_key(shape), key) in ev.cache
+    assert len(PhenotypeCache.key(a.phenotype_key(shape), "wall")) == 64  # the stored <U64 keys
+    st = ev.evaluate([a])  # the run's own task: cached by phenotype alone
+    assert st.n_cached == 1 and st.n_simulated == 0 and a.objectives == res[0][0]
+    _, st = ev.evaluate_jobs([("wall", wall, [c.child(4)])])
+    assert st.n_cached == 1 and len(calls) == 1 and ev.n_evaluations == 4

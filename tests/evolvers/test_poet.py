@@ -186,6 +186,28 @@ def test_kill9_then_corrupt_latest_resumes_identically(tmp_path):
     assert _rows(logged) == _rows(ref.rows)
 
 
+def test_poet_evaluates_through_the_drivers_evaluator_keyed_by_terrain(tmp_path):
+    from evolvers.evaluation import Evaluator, PhenotypeCache
+    from evolvers.runner import EvolutionRun
+
+    run = _run(tmp_path / "r", iterations=4)
+    ordinary = EvolutionRun(tiny(), tmp_path / "o", figures=False, progress=False)
+    assert type(run.evaluator) is type(ordinary.evaluator) is Evaluator
+    run.run()
+    assert run.n_simulated == run.evaluator.n_evaluations == run.evaluations_total > 0
+    pair = run.pairs[0]
+    best = pair.best
+    key = PhenotypeCache.key(best.phenotype_key(run.experiment.shape), pair.terrain.key())
+    assert run.evaluator.cache.get(key)[0]["max_xy_dist"] == best.objectives["max_xy_dist"]
+    n = run.n_simulated
+    (score,), st = run.evaluate([(pair.terrain, [best])])  # the same terrain: cached
+    assert st.n_simulated == 0 and st.n_cached == 1 and score[0] == pair.best_score
+    other = next(t for t in (pair.terrain.mutate(run.rng, 0.4) for _ in range(20))
+                 if t.key() not in {p.terrain.key() for p in run.pairs})  # fmt: skip
+    _, st = run.evaluate([(other, [best, best])])  # a new terrain: simulated once
+    assert st.n_simulated == 1 and st.n_cached == 1 and run.n_simulated == n + 1
+
+
 # ---------------------------------------------------------------------- physics, figures
 def test_simulated_run_writes_pairs_and_figures(tmp_path):
     exp = tiny("obstacles-attempt2", seconds=1.0, pop_size=3)

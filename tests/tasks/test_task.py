@@ -157,3 +157,40 @@ def test_task_strings_files_and_fifos_are_refused_with_typed_errors(tmp_path):
         out = refused_in_child(fifo_code("from softgym.tasks import get_task", "get_task",
                                          str(fifo), "InvalidParameterError"))  # fmt: skip
         assert "not a regular file" in out
+
+
+@pytest.mark.parametrize("spec", ["flat", "wall", "swim", "incline:angle=20", "ice"])
+def test_engine_settings_are_assembled_in_one_place(spec, monkeypatch):
+    # Task.config builds what task.py, softgym.evaluate and the envs' make_config each built
+    from softgym.engine import SimConfig
+    from softgym.envs.walker import make_config
+
+    task = get_task(spec, sim={"actuation": "symmetric"}, trace_interval=0.25, seconds=0.05)
+    base = SimConfig(voxel_size=0.02, friction=2.0, trace_interval=0.3)
+    own = task.engine_settings
+    assert task.config() == SimConfig(**own).replace(trace_interval=0.25)
+    assert task.config(base) == base.replace(**own).replace(trace_interval=0.25)
+    assert task.config(base, settings=False) == base.replace(trace_interval=0.25)
+    assert make_config(base, "seed", False, task) == base.replace(**own).replace(
+        trace_interval=1e9, actuation="seed", self_collision=False
+    )
+    assert make_config(base, None, None, task) == base.replace(**own).replace(trace_interval=1e9)
+    assert make_config(None, "symmetric", None, None) == SimConfig(
+        trace_interval=1e9, actuation="symmetric"
+    )
+    built = []
+    config = Task.config
+
+    def spy(self, *args, **kwargs):
+        built.append(config(self, *args, **kwargs))
+        return built[-1]
+
+    monkeypatch.setattr(Task, "config", spy)
+    softgym.evaluate([small_design()], task=task)
+    softgym.evaluate([small_design()], task=task, config=base)
+    make_config(base, "seed", True, task)
+    assert built == [
+        SimConfig(**own).replace(trace_interval=0.25),
+        base.replace(trace_interval=0.25),  # a full config replaces the task's settings
+        base.replace(**own).replace(trace_interval=1e9, actuation="seed", self_collision=True),
+    ]
