@@ -223,6 +223,9 @@ cdef extern from "softgym_seed.h":
                              const float64_t* k_axial, const float64_t* k_torsion,
                              const float64_t* k_bend, const float64_t* c_seed,
                              float64_t* link_last, float64_t* const* out) noexcept nogil
+    void softgym_seed_scatter(int ax, intp_t lo, intp_t hi, intp_t n, const intp_t* v1,
+                              const intp_t* v2, const float64_t* rot, const float64_t* o,
+                              float64_t* force, float64_t* moment) noexcept nogil
 
 
 cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n) noexcept nogil:
@@ -337,7 +340,6 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
         float64_t* moment = b.moment
         const float64_t* inp[14]
         float64_t* out[12]
-        const float64_t* R1
     if hi <= lo:
         return STATUS_OK
     _seed_geom(lo, hi, ax, v1, v2, b.pos, rot, b.quat, b.scale, o, o + n, o + 2 * n,
@@ -362,16 +364,9 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
     out[11] = o + 24 * n
     softgym_seed_forces(lo, end, b.n_links, b.L, bz, bzh, inv_dt, inp, b.k_axial, b.k_torsion,
                         b.k_bend, b.c_seed, b.link_last, out)
-    for li in range(lo, end):
-        # back to the world (the inverse axis turn, voxel 1's rotation) and
-        # the scatter, in link order (the seed's summation order)
-        i = v1[li]
-        j = v2[li]
-        R1 = rot + 9 * i
-        _add_bond_to_world(ax, R1, o[li], o[n + li], o[2 * n + li], force + 3 * i)
-        _add_bond_to_world(ax, R1, o[3 * n + li], o[4 * n + li], o[5 * n + li], force + 3 * j)
-        _add_bond_to_world(ax, R1, o[6 * n + li], o[7 * n + li], o[8 * n + li], moment + 3 * i)
-        _add_bond_to_world(ax, R1, o[9 * n + li], o[21 * n + li], o[24 * n + li], moment + 3 * j)
+    # back to the world (the inverse axis turn, voxel 1's rotation) and the
+    # scatter, in link order (the seed's summation order)
+    softgym_seed_scatter(ax, lo, end, n, v1, v2, rot, o, force, moment)
     return STATUS_OK if end == hi else STATUS_STRAIN
 
 
