@@ -68,39 +68,6 @@ cdef inline float64_t _rotvec_k(float64_t w) noexcept nogil:
     return 2.0 * acos(w) / sqrt(sl)
 
 
-cdef inline void _bond_to_world(const int ax, const float64_t* R, float64_t v0, float64_t v1,
-                                float64_t v2, float64_t* o) noexcept nogil:
-    # o = R P^T v: a bond-frame vector v back to the world through the inverse
-    # axis turn P^T (ax: a compile-time constant once inlined) and the voxel
-    # rotation R (row-major 3x3)
-    cdef float64_t x, y, z
-    if ax == 0:
-        x = v0
-        y = v1
-        z = v2
-    elif ax == 1:
-        x = -v1
-        y = v0
-        z = v2
-    else:
-        x = -v2
-        y = v1
-        z = v0
-    o[0] = R[0] * x + R[1] * y + R[2] * z
-    o[1] = R[3] * x + R[4] * y + R[5] * z
-    o[2] = R[6] * x + R[7] * y + R[8] * z
-
-
-cdef inline void _add_bond_to_world(const int ax, const float64_t* R, float64_t v0, float64_t v1,
-                                    float64_t v2, float64_t* acc) noexcept nogil:
-    # acc += R P^T v (_bond_to_world, then the sum)
-    cdef float64_t w[3]
-    _bond_to_world(ax, R, v0, v1, v2, w)
-    acc[0] += w[0]
-    acc[1] += w[1]
-    acc[2] += w[2]
-
-
 cdef void _seed_geom(intp_t lo, intp_t hi, intp_t ax, cintp_rp v1, cintp_rp v2,
                      cf64_rp pos, cf64_rp rot, cf64_rp quat, cf64_rp scale,
                      f64_rp o_p0, f64_rp o_p1, f64_rp o_p2, f64_rp o_qw,
@@ -223,6 +190,10 @@ cdef extern from "softgym_seed.h":
                              const float64_t* k_axial, const float64_t* k_torsion,
                              const float64_t* k_bend, const float64_t* c_seed,
                              float64_t* link_last, float64_t* const* out) noexcept nogil
+    intp_t softgym_seed_modes(intp_t lo, intp_t hi, intp_t n, float64_t max_ext,
+                              float64_t sa_w, float64_t sah_w, float64_t st_in, float64_t ex_in,
+                              float64_t st_out, float64_t ex_out, flag_t* link_sa,
+                              const flag_t* homog, float64_t* o) noexcept nogil
     void softgym_seed_scatter(int ax, intp_t lo, intp_t hi, intp_t n, const intp_t* v1,
                               const intp_t* v2, const float64_t* rot, const float64_t* o,
                               float64_t* force, float64_t* moment) noexcept nogil
@@ -312,7 +283,7 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
     # at once, the same IEEE operations as the seed's scalar code):
     #   _seed_geom           rows 0-9: relative position p, orientation (qw, n),
     #                        nominal length, chord length, transverse ratio
-    #   _seed_modes          the mode (link_sa; row 9 becomes 1.0 small / 0.0
+    #   softgym_seed_modes   the mode (link_sa; row 9 becomes 1.0 small / 0.0
     #                        large angle), row 22 1.0 on a mode-change step,
     #                        row 23 1.0 where voxel 2 takes -F1, the strain
     #                        check (stops at the first strained link)
@@ -323,7 +294,7 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
     #   softgym_seed_forces  rows 0-9, 21, 24: forces and moments in the bond
     #                        frame (stiffness, the seed's damping from the
     #                        link's memory; rq^-1 for large angles)
-    #   the loop below       back to the world, scattered in link order
+    #   softgym_seed_scatter back to the world, scattered in link order
     # The bond frame is voxel 1's frame turned by the proper rotation P that
     # takes the link axis onto +x (the seed's ToXDirBond): (x, y, z) ->
     # (x, y, z), (y, -x, z), (z, y, -x) for ax 0, 1, 2.
@@ -344,7 +315,9 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
         return STATUS_OK
     _seed_geom(lo, hi, ax, v1, v2, b.pos, rot, b.quat, b.scale, o, o + n, o + 2 * n,
                o + 3 * n, o + 4 * n, o + 5 * n, o + 6 * n, o + 7 * n, o + 8 * n, o + 9 * n)
-    end = _seed_modes(b, lo, hi, o, n)
+    end = softgym_seed_modes(lo, hi, n, b.max_strain * b.L, SMALL_ANGLE_W, SMALLISH_ANGLE_W,
+                             SA_BOND_BEND_RAD, SA_BOND_EXT_PERC, HYSTERESIS * SA_BOND_BEND_RAD,
+                             HYSTERESIS * SA_BOND_EXT_PERC, b.link_sa, b.homog, o)
     softgym_seed_frames(lo, end, SMALL_ANGLE_RAD, SLTHRESH_ACOS2SQRT, o, o + n, o + 2 * n,
                         o + 3 * n, o + 4 * n, o + 5 * n, o + 6 * n, o + 7 * n, o + 8 * n,
                         o + 9 * n, o + 10 * n, o + 11 * n, o + 12 * n, o + 13 * n, o + 14 * n,
