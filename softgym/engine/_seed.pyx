@@ -129,50 +129,6 @@ cdef void _seed_geom(intp_t lo, intp_t hi, intp_t ax, cintp_rp v1, cintp_rp v2,
         o_st[li] = (fabs(p2) + fabs(p1)) / p0
 
 
-cdef intp_t _seed_modes(Batch* b, intp_t lo, intp_t hi, float64_t* o, intp_t n) noexcept nogil:
-    # First pass of _seed_links_along over its links [lo, hi): each link's
-    # mode, small or large angle, with the seed's hysteresis (updates
-    # link_sa), then the strain check. Row 9 (the transverse ratio) becomes
-    # the mode as 1.0 / 0.0, row 22 1.0 on a mode-change step, row 23 1.0
-    # when voxel 2 takes -F1 (then or for a single material). Returns hi, or
-    # the first link whose extension is beyond max_strain.
-    cdef:
-        intp_t li
-        float64_t max_ext = b.max_strain * b.L
-        float64_t sa_w = SMALL_ANGLE_W
-        float64_t sah_w = SMALLISH_ANGLE_W
-        float64_t st_in = SA_BOND_BEND_RAD
-        float64_t ex_in = SA_BOND_EXT_PERC
-        float64_t st_out = HYSTERESIS * SA_BOND_BEND_RAD
-        float64_t ex_out = HYSTERESIS * SA_BOND_EXT_PERC
-        flag_t* link_sa = b.link_sa
-        const flag_t* homog = b.homog
-        float64_t qw, p0, nom, st, ex, P0
-        int32 sa, changed
-    for li in range(lo, hi):
-        p0 = o[li]
-        qw = o[3 * n + li]
-        nom = o[7 * n + li]
-        st = o[9 * n + li]
-        ex = p0 / nom
-        sa = link_sa[li]
-        changed = 0
-        if not sa and qw > sa_w and st < st_in and ex < ex_in:
-            sa = 1
-            changed = 1
-        elif sa and (not (qw > sah_w) or st > st_out or ex > ex_out):
-            sa = 0
-            changed = 1
-        link_sa[li] = sa
-        o[9 * n + li] = 1.0 if sa else 0.0
-        o[22 * n + li] = 1.0 if changed else 0.0
-        o[23 * n + li] = 1.0 if changed or homog[li] else 0.0
-        P0 = p0 - nom if sa else o[8 * n + li] - nom
-        if not (fabs(P0) <= max_ext):
-            return li  # also catches NaN
-    return hi
-
-
 cdef extern from "softgym_seed.h":
     # the second and third passes of _seed_links_along (C, for the
     # vectorising pragma; documented in include/softgym_seed.h)
@@ -370,7 +326,7 @@ def seed_frames(float64_t[:, ::1] geom, bint scalar=False):
     """The seed model's bond-frame pass on given link geometry (for tests).
 
     ``geom`` is (10, n): rows 0-9 of the link scratch as ``_seed_geom`` and
-    ``_seed_modes`` leave them (relative position p0, p1, p2; relative
+    ``softgym_seed_modes`` leave them (relative position p0, p1, p2; relative
     orientation qw, n1, n2, n3; nominal length; chord length; the mode, 1.0
     small / 0.0 large angle). Returns (11, n): the displacement P, voxel 1's
     rotation vector (y, z), voxel 2's, the large-angle frame (rw, ry, rz),
