@@ -68,39 +68,6 @@ cdef inline float64_t _rotvec_k(float64_t w) noexcept nogil:
     return 2.0 * acos(w) / sqrt(sl)
 
 
-cdef inline void _bond_to_world(const int ax, const float64_t* R, float64_t v0, float64_t v1,
-                                float64_t v2, float64_t* o) noexcept nogil:
-    # o = R P^T v: a bond-frame vector v back to the world through the inverse
-    # axis turn P^T (ax: a compile-time constant once inlined) and the voxel
-    # rotation R (row-major 3x3)
-    cdef float64_t x, y, z
-    if ax == 0:
-        x = v0
-        y = v1
-        z = v2
-    elif ax == 1:
-        x = -v1
-        y = v0
-        z = v2
-    else:
-        x = -v2
-        y = v1
-        z = v0
-    o[0] = R[0] * x + R[1] * y + R[2] * z
-    o[1] = R[3] * x + R[4] * y + R[5] * z
-    o[2] = R[6] * x + R[7] * y + R[8] * z
-
-
-cdef inline void _add_bond_to_world(const int ax, const float64_t* R, float64_t v0, float64_t v1,
-                                    float64_t v2, float64_t* acc) noexcept nogil:
-    # acc += R P^T v (_bond_to_world, then the sum)
-    cdef float64_t w[3]
-    _bond_to_world(ax, R, v0, v1, v2, w)
-    acc[0] += w[0]
-    acc[1] += w[1]
-    acc[2] += w[2]
-
-
 cdef void _seed_geom(intp_t lo, intp_t hi, intp_t ax, cintp_rp v1, cintp_rp v2,
                      cf64_rp pos, cf64_rp rot, cf64_rp quat, cf64_rp scale,
                      f64_rp o_p0, f64_rp o_p1, f64_rp o_p2, f64_rp o_qw,
@@ -162,50 +129,6 @@ cdef void _seed_geom(intp_t lo, intp_t hi, intp_t ax, cintp_rp v1, cintp_rp v2,
         o_st[li] = (fabs(p2) + fabs(p1)) / p0
 
 
-cdef intp_t _seed_modes(Batch* b, intp_t lo, intp_t hi, float64_t* o, intp_t n) noexcept nogil:
-    # First pass of _seed_links_along over its links [lo, hi): each link's
-    # mode, small or large angle, with the seed's hysteresis (updates
-    # link_sa), then the strain check. Row 9 (the transverse ratio) becomes
-    # the mode as 1.0 / 0.0, row 22 1.0 on a mode-change step, row 23 1.0
-    # when voxel 2 takes -F1 (then or for a single material). Returns hi, or
-    # the first link whose extension is beyond max_strain.
-    cdef:
-        intp_t li
-        float64_t max_ext = b.max_strain * b.L
-        float64_t sa_w = SMALL_ANGLE_W
-        float64_t sah_w = SMALLISH_ANGLE_W
-        float64_t st_in = SA_BOND_BEND_RAD
-        float64_t ex_in = SA_BOND_EXT_PERC
-        float64_t st_out = HYSTERESIS * SA_BOND_BEND_RAD
-        float64_t ex_out = HYSTERESIS * SA_BOND_EXT_PERC
-        flag_t* link_sa = b.link_sa
-        const flag_t* homog = b.homog
-        float64_t qw, p0, nom, st, ex, P0
-        int32 sa, changed
-    for li in range(lo, hi):
-        p0 = o[li]
-        qw = o[3 * n + li]
-        nom = o[7 * n + li]
-        st = o[9 * n + li]
-        ex = p0 / nom
-        sa = link_sa[li]
-        changed = 0
-        if not sa and qw > sa_w and st < st_in and ex < ex_in:
-            sa = 1
-            changed = 1
-        elif sa and (not (qw > sah_w) or st > st_out or ex > ex_out):
-            sa = 0
-            changed = 1
-        link_sa[li] = sa
-        o[9 * n + li] = 1.0 if sa else 0.0
-        o[22 * n + li] = 1.0 if changed else 0.0
-        o[23 * n + li] = 1.0 if changed or homog[li] else 0.0
-        P0 = p0 - nom if sa else o[8 * n + li] - nom
-        if not (fabs(P0) <= max_ext):
-            return li  # also catches NaN
-    return hi
-
-
 cdef extern from "softgym_seed.h":
     # the second and third passes of _seed_links_along (C, for the
     # vectorising pragma; documented in include/softgym_seed.h)
@@ -223,6 +146,13 @@ cdef extern from "softgym_seed.h":
                              const float64_t* k_axial, const float64_t* k_torsion,
                              const float64_t* k_bend, const float64_t* c_seed,
                              float64_t* link_last, float64_t* const* out) noexcept nogil
+    intp_t softgym_seed_modes(intp_t lo, intp_t hi, intp_t n, float64_t max_ext,
+                              float64_t sa_w, float64_t sah_w, float64_t st_in, float64_t ex_in,
+                              float64_t st_out, float64_t ex_out, flag_t* link_sa,
+                              const flag_t* homog, float64_t* o) noexcept nogil
+    void softgym_seed_scatter(int ax, intp_t lo, intp_t hi, intp_t n, const intp_t* v1,
+                              const intp_t* v2, const float64_t* rot, const float64_t* o,
+                              float64_t* force, float64_t* moment) noexcept nogil
 
 
 cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n) noexcept nogil:
@@ -309,7 +239,7 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
     # at once, the same IEEE operations as the seed's scalar code):
     #   _seed_geom           rows 0-9: relative position p, orientation (qw, n),
     #                        nominal length, chord length, transverse ratio
-    #   _seed_modes          the mode (link_sa; row 9 becomes 1.0 small / 0.0
+    #   softgym_seed_modes   the mode (link_sa; row 9 becomes 1.0 small / 0.0
     #                        large angle), row 22 1.0 on a mode-change step,
     #                        row 23 1.0 where voxel 2 takes -F1, the strain
     #                        check (stops at the first strained link)
@@ -320,7 +250,7 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
     #   softgym_seed_forces  rows 0-9, 21, 24: forces and moments in the bond
     #                        frame (stiffness, the seed's damping from the
     #                        link's memory; rq^-1 for large angles)
-    #   the loop below       back to the world, scattered in link order
+    #   softgym_seed_scatter back to the world, scattered in link order
     # The bond frame is voxel 1's frame turned by the proper rotation P that
     # takes the link axis onto +x (the seed's ToXDirBond): (x, y, z) ->
     # (x, y, z), (y, -x, z), (z, y, -x) for ax 0, 1, 2.
@@ -337,12 +267,13 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
         float64_t* moment = b.moment
         const float64_t* inp[14]
         float64_t* out[12]
-        const float64_t* R1
     if hi <= lo:
         return STATUS_OK
     _seed_geom(lo, hi, ax, v1, v2, b.pos, rot, b.quat, b.scale, o, o + n, o + 2 * n,
                o + 3 * n, o + 4 * n, o + 5 * n, o + 6 * n, o + 7 * n, o + 8 * n, o + 9 * n)
-    end = _seed_modes(b, lo, hi, o, n)
+    end = softgym_seed_modes(lo, hi, n, b.max_strain * b.L, SMALL_ANGLE_W, SMALLISH_ANGLE_W,
+                             SA_BOND_BEND_RAD, SA_BOND_EXT_PERC, HYSTERESIS * SA_BOND_BEND_RAD,
+                             HYSTERESIS * SA_BOND_EXT_PERC, b.link_sa, b.homog, o)
     softgym_seed_frames(lo, end, SMALL_ANGLE_RAD, SLTHRESH_ACOS2SQRT, o, o + n, o + 2 * n,
                         o + 3 * n, o + 4 * n, o + 5 * n, o + 6 * n, o + 7 * n, o + 8 * n,
                         o + 9 * n, o + 10 * n, o + 11 * n, o + 12 * n, o + 13 * n, o + 14 * n,
@@ -362,16 +293,9 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
     out[11] = o + 24 * n
     softgym_seed_forces(lo, end, b.n_links, b.L, bz, bzh, inv_dt, inp, b.k_axial, b.k_torsion,
                         b.k_bend, b.c_seed, b.link_last, out)
-    for li in range(lo, end):
-        # back to the world (the inverse axis turn, voxel 1's rotation) and
-        # the scatter, in link order (the seed's summation order)
-        i = v1[li]
-        j = v2[li]
-        R1 = rot + 9 * i
-        _add_bond_to_world(ax, R1, o[li], o[n + li], o[2 * n + li], force + 3 * i)
-        _add_bond_to_world(ax, R1, o[3 * n + li], o[4 * n + li], o[5 * n + li], force + 3 * j)
-        _add_bond_to_world(ax, R1, o[6 * n + li], o[7 * n + li], o[8 * n + li], moment + 3 * i)
-        _add_bond_to_world(ax, R1, o[9 * n + li], o[21 * n + li], o[24 * n + li], moment + 3 * j)
+    # back to the world (the inverse axis turn, voxel 1's rotation) and the
+    # scatter, in link order (the seed's summation order)
+    softgym_seed_scatter(ax, lo, end, n, v1, v2, rot, o, force, moment)
     return STATUS_OK if end == hi else STATUS_STRAIN
 
 
@@ -402,7 +326,7 @@ def seed_frames(float64_t[:, ::1] geom, bint scalar=False):
     """The seed model's bond-frame pass on given link geometry (for tests).
 
     ``geom`` is (10, n): rows 0-9 of the link scratch as ``_seed_geom`` and
-    ``_seed_modes`` leave them (relative position p0, p1, p2; relative
+    ``softgym_seed_modes`` leave them (relative position p0, p1, p2; relative
     orientation qw, n1, n2, n3; nominal length; chord length; the mode, 1.0
     small / 0.0 large angle). Returns (11, n): the displacement P, voxel 1's
     rotation vector (y, z), voxel 2's, the large-angle frame (rw, ry, rz),
