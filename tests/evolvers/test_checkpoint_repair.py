@@ -18,8 +18,8 @@ import numpy as np
 import pytest
 from evolver_helpers import tiny
 
-from evolvers.recorder import read_run_notes
-from evolvers.runner import EvolutionRun, population_summary
+from evolvers.drivers.runner import EvolutionRun, population_summary
+from evolvers.recording.recorder import read_run_notes
 from softgym.design import CompositionRules
 from softgym.exceptions import CheckpointError
 from softgym.io import list_checkpoints, load_checkpoint, read_json, save_checkpoint

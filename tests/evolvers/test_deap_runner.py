@@ -4,8 +4,8 @@ import numpy as np
 from deap import tools
 from evolver_helpers import tiny
 
-from evolvers.deap_runner import DeapRun, make_toolbox
-from evolvers.runner import population_summary
+from evolvers.drivers.deap_runner import DeapRun, make_toolbox
+from evolvers.drivers.runner import population_summary
 
 
 def test_toolbox_is_built_the_deap_way_and_map_is_batched():

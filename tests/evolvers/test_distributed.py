@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 from evolver_helpers import tiny
 
-from evolvers.distributed import DaskBatchFn, dask_client, split_batches
-from evolvers.evaluation import local_batch_fn
-from evolvers.genome import Individual
-from evolvers.runner import EvolutionRun, population_summary
+from evolvers.drivers.runner import EvolutionRun, population_summary
+from evolvers.evaluation.distributed import DaskBatchFn, dask_client, split_batches
+from evolvers.evaluation.evaluator import local_batch_fn
+from evolvers.operators.genome import Individual
 
 pytest.importorskip("distributed")
 

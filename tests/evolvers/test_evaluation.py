@@ -3,8 +3,8 @@ import pytest
 from evolver_helpers import tiny
 
 import softgym
-from evolvers.evaluation import STORED_METRICS, Evaluator, PhenotypeCache
-from evolvers.genome import Individual
+from evolvers.evaluation.evaluator import STORED_METRICS, Evaluator, PhenotypeCache
+from evolvers.operators.genome import Individual
 from softgym.design import default_walker
 from softgym.evaluate import Task
 from softgym.exceptions import CheckpointError
@@ -124,7 +124,7 @@ def test_seed_centre_of_mass_scores_obstacle_runs_as_the_seed_did():
     # the seed's centre of mass counts the fence's 1-kg wall voxels: MaxXYDist shrinks by
     # m_robot / (m_robot + m_walls), the L coefficient by its square (the time of the maximum
     # stays within a trace sample); the trace stays the robot's own
-    from evolvers.experiments import Experiment
+    from evolvers.evaluation.experiments import Experiment
 
     exp = tiny("obstacles-attempt2", shape=(6, 6, 6), seconds=2.0)
     seed = exp.replace(seed_centre_of_mass=True)

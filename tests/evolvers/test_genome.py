@@ -2,7 +2,7 @@ import json
 
 import numpy as np
 
-from evolvers.genome import INITIAL_MATERIAL_GENES, Individual
+from evolvers.operators.genome import INITIAL_MATERIAL_GENES, Individual
 from softgym.design import MATERIAL_TREE_8, CompositionRules, Controller
 
 

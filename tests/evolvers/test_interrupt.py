@@ -5,10 +5,10 @@ import logging
 import pytest
 from evolver_helpers import tiny
 
-from evolvers.deap_runner import DeapRun
-from evolvers.pymoo_runner import PymooRun
-from evolvers.recorder import RunInterrupted
-from evolvers.runner import EvolutionRun, population_summary
+from evolvers.drivers.deap_runner import DeapRun
+from evolvers.drivers.pymoo_runner import PymooRun
+from evolvers.drivers.runner import EvolutionRun, population_summary
+from evolvers.recording.recorder import RunInterrupted
 from softgym.exceptions import CheckpointError
 
 

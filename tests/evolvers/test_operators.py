@@ -1,7 +1,7 @@
 import numpy as np
 
-from evolvers.genome import Individual
-from evolvers.operators import cx_arithmetic, make_children, mut_controller, mut_materials
+from evolvers.operators.genome import Individual
+from evolvers.operators.variation import cx_arithmetic, make_children, mut_controller, mut_materials
 from softgym.design import CONTROLLER_BOUNDS, CompositionRules, Controller
 
 SHAPE = (4, 4, 4)

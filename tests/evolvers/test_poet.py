@@ -1,4 +1,4 @@
-"""POET co-evolution (evolvers.poet) with a fake evaluation: criterion, PATA-EC, ANNECS, resume.
+"""POET co-evolution (evolvers.drivers.poet) with a fake evaluation: criterion, PATA-EC, ANNECS, resume.
 
 The fake (poet_helpers.fake_batch_fn) scores a robot from its muscle share and controller
 and a terrain from its obstacles: the search logic is the point, not the physics. One
@@ -18,7 +18,7 @@ import pytest
 from evolver_helpers import tiny
 from poet_helpers import fake_batch_fn
 
-from evolvers.poet import (
+from evolvers.drivers.poet import (
     PoetConfig,
     PoetRun,
     centered_ranks,
@@ -27,7 +27,7 @@ from evolvers.poet import (
     poet_experiment,
     poet_thresholds,
 )
-from evolvers.recorder import RunInterrupted
+from evolvers.recording.recorder import RunInterrupted
 from softgym.exceptions import CheckpointError, InvalidParameterError
 from softgym.io import list_checkpoints
 
@@ -160,7 +160,7 @@ def test_kill9_then_corrupt_latest_resumes_identically(tmp_path):
         import os, signal, sys
         sys.path.insert(0, {str(HERE)!r})
         from poet_helpers import fake_batch_fn
-        from evolvers.poet import PoetConfig, PoetRun, poet_experiment
+        from evolvers.drivers.poet import PoetConfig, PoetRun, poet_experiment
 
         def kill9(run, row):
             if row["generation"] == 4:
@@ -187,8 +187,8 @@ def test_kill9_then_corrupt_latest_resumes_identically(tmp_path):
 
 
 def test_poet_evaluates_through_the_drivers_evaluator_keyed_by_terrain(tmp_path):
-    from evolvers.evaluation import Evaluator, PhenotypeCache
-    from evolvers.runner import EvolutionRun
+    from evolvers.drivers.runner import EvolutionRun
+    from evolvers.evaluation.evaluator import Evaluator, PhenotypeCache
 
     run = _run(tmp_path / "r", iterations=4)
     ordinary = EvolutionRun(tiny(), tmp_path / "o", figures=False, progress=False)
@@ -224,7 +224,7 @@ def test_simulated_run_writes_pairs_and_figures(tmp_path):
 
 def test_pairs_on_dask_equal_local(tmp_path):
     pytest.importorskip("distributed")
-    from evolvers.distributed import DaskBatchFn, dask_client
+    from evolvers.evaluation.distributed import DaskBatchFn, dask_client
 
     exp = tiny("obstacles-attempt2", seconds=1.0, pop_size=3)
     cfg = PoetConfig(reproduce_every=1, transfer_every=1, mc_low=0.0, mc_high=50.0,

@@ -6,10 +6,10 @@ from evolver_helpers import tiny
 from pymoo.algorithms.moo.nsga2 import NSGA2
 from pymoo.core.problem import Problem
 
-from evolvers.evaluation import Evaluator
-from evolvers.genome import Individual
-from evolvers.pymoo_runner import PymooRun, SoftbotProblem, constraint_values
-from evolvers.runner import population_summary
+from evolvers.drivers.pymoo_runner import PymooRun, SoftbotProblem, constraint_values
+from evolvers.drivers.runner import population_summary
+from evolvers.evaluation.evaluator import Evaluator
+from evolvers.operators.genome import Individual
 from softgym.design import CompositionRules
 from softgym.exceptions import CheckpointError
 

@@ -1,4 +1,4 @@
-"""MAP-Elites on pyribs (evolvers.qd): descriptors, emitter, archive stats, resume, export.
+"""MAP-Elites on pyribs (evolvers.drivers.qd): descriptors, emitter, archive stats, resume, export.
 
 Most runs use a fake batch evaluation (a distance computed from the grid): the
 archive logic is the point, not the physics. One run simulates, with figures.
@@ -12,16 +12,16 @@ from evolver_helpers import tiny
 
 pytest.importorskip("ribs")
 
-from evolvers.descriptors import DESCRIPTORS, descriptor_values  # noqa: E402
-from evolvers.genome import Individual  # noqa: E402
-from evolvers.qd import (  # noqa: E402
+from evolvers.drivers.qd import (  # noqa: E402
     QDConfig,
     QDRun,
     SoftbotEmitter,
     export_elites,
     make_archive,
 )
-from evolvers.recorder import RunInterrupted  # noqa: E402
+from evolvers.evaluation.descriptors import DESCRIPTORS, descriptor_values  # noqa: E402
+from evolvers.operators.genome import Individual  # noqa: E402
+from evolvers.recording.recorder import RunInterrupted  # noqa: E402
 from softgym.design import RobotDesign  # noqa: E402
 from softgym.exceptions import CheckpointError, InvalidParameterError  # noqa: E402
 from softgym.metrics import composition_counts  # noqa: E402

@@ -5,7 +5,7 @@ import logging
 import pytest
 from evolver_helpers import tiny
 
-from evolvers.runner import EvolutionRun, population_summary
+from evolvers.drivers.runner import EvolutionRun, population_summary
 from softgym.design import CompositionRules
 from softgym.exceptions import CheckpointError
 from softgym.io import list_checkpoints, load_checkpoint

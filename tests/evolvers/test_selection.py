@@ -1,7 +1,7 @@
 import numpy as np
 
-from evolvers.genome import Individual
-from evolvers.selection import (
+from evolvers.operators.genome import Individual
+from evolvers.operators.selection import (
     Objective,
     pareto_levels,
     sel_fitness_tournament,

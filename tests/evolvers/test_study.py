@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 from evolver_helpers import tiny
 
-from evolvers.evaluation import EvalStats
-from evolvers.genome import Individual
-from evolvers.recorder import add_run_note, read_run_notes, study_columns
+from evolvers.evaluation.evaluator import EvalStats
+from evolvers.operators.genome import Individual
+from evolvers.recording.recorder import add_run_note, read_run_notes, study_columns
 from evolvers.study.data import load_runs
 from evolvers.study.runs import (
     SEED_REPORT,

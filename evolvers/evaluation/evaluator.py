@@ -4,7 +4,7 @@ An :class:`Evaluator` turns individuals into designs, skips those whose
 phenotype (grid + used materials + controller, :meth:`Individual.phenotype_key`)
 was already simulated on the same task, and simulates all the others **in one
 batched Simulation per task** (locally) or in a few batches spread over Dask
-workers (:mod:`evolvers.distributed`). The ordinary drivers evaluate on their
+workers (:mod:`evolvers.evaluation.distributed`). The ordinary drivers evaluate on their
 experiment's task (:meth:`Evaluator.evaluate`); POET scores robots on many
 terrains at once (:meth:`Evaluator.evaluate_jobs`, the cache keyed by terrain
 and phenotype, :meth:`PhenotypeCache.key`). A robot's result does not depend on
@@ -22,8 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from evolvers.experiments import Experiment
-from evolvers.genome import Individual
+from evolvers.evaluation.experiments import Experiment
+from evolvers.operators.genome import Individual
 from softgym.design import RobotDesign
 from softgym.evaluate import METRIC_KEYS, evaluate
 from softgym.exceptions import CheckpointError
@@ -53,7 +53,7 @@ MAXIMIZED: tuple[str, ...] = (*FITNESS_METRICS, "score")
 
 #: ``(designs, task) -> softgym.evaluate output with traces``. The designs are
 #: :class:`~softgym.design.RobotDesign` objects (plain dicts only across Dask, where
-#: :class:`evolvers.distributed.DaskBatchFn` turns them into ``to_dict()``).
+#: :class:`evolvers.evaluation.distributed.DaskBatchFn` turns them into ``to_dict()``).
 BatchFn = Callable[[list[RobotDesign], Task], dict[str, Any]]
 #: ``[(designs, task), ...] -> [softgym.evaluate output, ...]``: several tasks' batches at once.
 JobsFn = Callable[[list[tuple[list[RobotDesign], Task]]], list[dict[str, Any]]]
@@ -227,7 +227,7 @@ class Evaluator:
         Gives the task (:meth:`Experiment.make_task`), the grid shape and the rules.
     batch_fn : callable, optional
         ``(designs, task) -> metrics`` (default :func:`local_batch_fn`:
-        one local Simulation). :class:`evolvers.distributed.DaskBatchFn` spreads
+        one local Simulation). :class:`evolvers.evaluation.distributed.DaskBatchFn` spreads
         the batch over Dask workers.
     n_threads : int, optional
         OpenMP threads of local simulations.
@@ -238,7 +238,7 @@ class Evaluator:
         that shows none of its own, e.g. inside a study).
     jobs_fn : callable, optional
         Several tasks' batches at once (:data:`JobsFn`, e.g.
-        :meth:`evolvers.distributed.DaskBatchFn.jobs`); default ``batch_fn``
+        :meth:`evolvers.evaluation.distributed.DaskBatchFn.jobs`); default ``batch_fn``
         on each batch in turn.
     traces : bool
         Keep each robot's centre-of-mass trace (in the cache and on the

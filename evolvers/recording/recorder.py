@@ -45,9 +45,9 @@ from typing import Any
 
 import numpy as np
 
-from evolvers.evaluation import FITNESS_METRICS, MAXIMIZED, EvalStats
-from evolvers.experiments import Experiment
-from evolvers.genome import Individual
+from evolvers.evaluation.evaluator import FITNESS_METRICS, MAXIMIZED, EvalStats
+from evolvers.evaluation.experiments import Experiment
+from evolvers.operators.genome import Individual
 from softgym.evaluate import caller_shows_progress
 from softgym.exceptions import CheckpointError, InvalidParameterError
 from softgym.io import (
@@ -239,7 +239,7 @@ def study_columns(
     of muscle voxels over the population's valid bodies. ``new_individuals``
     and ``repeated_phenotypes``: individuals evaluated for the first time this
     generation, and how many of them had a phenotype already simulated in the
-    run (:class:`~evolvers.evaluation.EvalStats`). On a task with obstacles:
+    run (:class:`~evolvers.evaluation.evaluator.EvalStats`). On a task with obstacles:
     ``crossed`` (individuals whose final centre of mass is outside the
     obstacles' footprint, :func:`softgym.metrics.obstacle_footprint`), ``top_crossed``, and
     ``crosser_*`` (the best of those, or id -1 and NaN).

@@ -7,7 +7,7 @@ population (31 for the seed) is evaluated in one batched Simulation, cached
 phenotypes not re-run; selection brings it back to ``pop_size``.
 
 The loop, progress, Ctrl-C, checkpoints and resume are the
-:class:`~evolvers.driver.Driver`'s, the skeleton every driver shares; this
+:class:`~evolvers.drivers.base.Driver`'s, the skeleton every driver shares; this
 module supplies the seed's generation. A run killed at any moment resumes from
 its last checkpoint and ends with the same population as an uninterrupted run
 with the same seed.
@@ -19,17 +19,17 @@ from typing import Any
 
 import numpy as np
 
-from evolvers.driver import Checkpoint, Driver
-from evolvers.evaluation import (
+from evolvers.drivers.base import Checkpoint, Driver
+from evolvers.evaluation.evaluator import (
     EvalStats,
     PhenotypeCache,
     pack_traces,
     unpack_traces,
 )
-from evolvers.genome import Individual
-from evolvers.operators import make_children
-from evolvers.recorder import RUN_SCHEMA, RunInterrupted, population_summary
-from evolvers.selection import select
+from evolvers.operators.genome import Individual
+from evolvers.operators.selection import select
+from evolvers.operators.variation import make_children
+from evolvers.recording.recorder import RUN_SCHEMA, RunInterrupted, population_summary
 from softgym.io import (
     python_random_state,
     rng_from_state,
@@ -42,9 +42,9 @@ __all__ = ["RUN_SCHEMA", "EvolutionRun", "RunInterrupted", "population_summary"]
 
 
 class EvolutionRun(Driver):
-    """A resumable evolutionary run of an :class:`~evolvers.experiments.Experiment` (native backend).
+    """A resumable evolutionary run of an :class:`~evolvers.evaluation.experiments.Experiment` (native backend).
 
-    Parameters: those of :class:`~evolvers.driver.Driver` (``seed`` seeds the run's single
+    Parameters: those of :class:`~evolvers.drivers.base.Driver` (``seed`` seeds the run's single
     ``numpy.random.Generator``: every random choice, genomes, variation, selection).
     """
 

@@ -1,7 +1,7 @@
 """Population evaluation on Dask: a LocalCluster or an existing scheduler.
 
 :class:`DaskBatchFn` is a drop-in ``batch_fn`` for
-:class:`~evolvers.evaluation.Evaluator`: it splits a generation's designs into
+:class:`~evolvers.evaluation.evaluator.Evaluator`: it splits a generation's designs into
 one contiguous batch per worker thread, ships each batch as plain JSON-ready
 data (``design.to_dict()``) to :func:`softgym.evaluate.evaluate_payload`, and
 concatenates the results in order. Each batch is one batched Simulation on the
@@ -12,7 +12,7 @@ another worker (tasks are submitted with ``retries``).
 Dask is an optional extra: ``pip install "softgym[distributed]"``. Without it,
 :func:`dask_client` raises :class:`MissingExtraError` naming the extra.
 
->>> from evolvers.distributed import dask_client
+>>> from evolvers.evaluation.distributed import dask_client
 >>> with dask_client("local", n_workers=2) as client:   # doctest: +SKIP
 ...     run = EvolutionRun(exp, "runs/x", batch_fn=DaskBatchFn(client))
 """
@@ -113,7 +113,7 @@ class DaskBatchFn:
             return 1
 
     def __call__(self, designs: list[Any], task: Task) -> dict[str, Any]:
-        """``(designs, task) -> metrics``, like :func:`evolvers.evaluation.local_batch_fn`
+        """``(designs, task) -> metrics``, like :func:`evolvers.evaluation.evaluator.local_batch_fn`
         (RobotDesigns or their dicts).
         """
         slices = split_batches(len(designs), self.n_batches or self._default_batches())
@@ -121,7 +121,7 @@ class DaskBatchFn:
 
     def jobs(self, jobs: list[tuple[list[Any], Task]]) -> list[dict[str, Any]]:
         """``[(designs, task), ...] -> [metrics, ...]``: one Dask task per batch, all at
-        once (POET's terrains; :class:`~evolvers.poet.PoetRun` uses it when given this
+        once (POET's terrains; :class:`~evolvers.drivers.poet.PoetRun` uses it when given this
         ``batch_fn``). Designs travel as plain dicts (``RobotDesign.to_dict()``).
         """
         # one engine thread per batch: workers already run batches in parallel

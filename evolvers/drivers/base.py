@@ -1,21 +1,21 @@
 """The one run skeleton every driver shares: construction, the generation loop, progress,
 Ctrl-C, checkpoints and exact resume.
 
-A driver (:class:`~evolvers.runner.EvolutionRun`, ``DeapRun``, ``PymooRun``,
+A driver (:class:`~evolvers.drivers.runner.EvolutionRun`, ``DeapRun``, ``PymooRun``,
 ``QDRun``, ``PoetRun``) subclasses :class:`Driver` and supplies hooks:
 
 * :meth:`Driver._fresh` - the state of a run that has not started (seeded
   generators, counters, archive, algorithm); called by the constructor and
   again when a run starts, so a run object can be started twice.
 * :meth:`Driver._step` - one generation (or POET iteration): evaluate, select,
-  advance :attr:`generation`; returns its :class:`~evolvers.evaluation.EvalStats`.
+  advance :attr:`generation`; returns its :class:`~evolvers.evaluation.evaluator.EvalStats`.
 * :meth:`Driver._checkpoint_state` - the driver's part of the checkpoint: a
   JSON-ready dict, plain arrays, extra log columns and the individuals the
   recorder logs; :meth:`Driver._restore` - the inverse.
 * :attr:`Driver.label`, :meth:`Driver.result`, and :meth:`Driver.finish`
   where the driver writes more than the recorder.
 
-Everything on disk goes through one :class:`~evolvers.recorder.RunRecorder`
+Everything on disk goes through one :class:`~evolvers.recording.recorder.RunRecorder`
 at ``self.recorder``; :class:`Driver` also shows its views (log rows, hall of
 fame, totals). Resume is exact: a run killed at any moment and resumed ends as
 an uninterrupted run with the same seed.
@@ -30,10 +30,10 @@ from typing import Any
 
 import numpy as np
 
-from evolvers.evaluation import BatchFn, EvalStats, Evaluator
-from evolvers.experiments import Experiment, smoke_sizes
-from evolvers.genome import Individual
-from evolvers.recorder import RunRecorder
+from evolvers.evaluation.evaluator import BatchFn, EvalStats, Evaluator
+from evolvers.evaluation.experiments import Experiment, smoke_sizes
+from evolvers.operators.genome import Individual
+from evolvers.recording.recorder import RunRecorder
 from softgym.exceptions import CheckpointError, InvalidParameterError
 from softgym.io import RunLock
 
@@ -73,7 +73,7 @@ class Driver:
         Generations after generation 0 (default the experiment's).
     batch_fn : callable, optional
         Batch evaluation (default: one local Simulation; see
-        :class:`evolvers.distributed.DaskBatchFn`).
+        :class:`evolvers.evaluation.distributed.DaskBatchFn`).
     n_threads : int, optional
         OpenMP threads of local simulations.
     on_generation : callable, optional

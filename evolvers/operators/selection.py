@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from evolvers.genome import Individual
+from evolvers.operators.genome import Individual
 from softgym.exceptions import InvalidParameterError
 from softgym.metrics import WORST_FITNESS, NoveltyArchive, novelty_scores
 

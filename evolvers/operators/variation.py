@@ -19,7 +19,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from evolvers.genome import Individual
+from evolvers.operators.genome import Individual
 from softgym.design import CONTROLLER_BOUNDS, CompositionRules, Controller
 
 __all__ = [

@@ -2,20 +2,20 @@
 
 The pieces are pyribs' own (``pip install "softgym[qd]"``, pyribs 0.12):
 
-* an archive of softgym genomes (:class:`~evolvers.genome.Individual`; pyribs
+* an archive of softgym genomes (:class:`~evolvers.operators.genome.Individual`; pyribs
   stores them with ``solution_dtype=object``): a
   :class:`ribs.archives.GridArchive` over body descriptors
-  (:mod:`evolvers.descriptors`; by default Mouret and Clune's 2015 pair, stiff
+  (:mod:`evolvers.evaluation.descriptors`; by default Mouret and Clune's 2015 pair, stiff
   fraction x filled fraction, 128 x 128 cells) or a
   :class:`ribs.archives.CVTArchive` (``archive="cvt"``);
 * :class:`SoftbotEmitter`, a :class:`ribs.emitters.EmitterBase` that draws
   parents uniformly from the elites and varies them with softgym's operators
-  (:func:`~evolvers.operators.make_children`: CPPN mutation with validity
+  (:func:`~evolvers.operators.variation.make_children`: CPPN mutation with validity
   retries, arithmetic crossover and bounded Gaussian mutation of the
   controller / material genes when the experiment evolves them); while the
   archive is empty it asks for random valid robots;
 * a :class:`ribs.schedulers.Scheduler` ask/tell loop, each ask evaluated by
-  softgym's :class:`~evolvers.evaluation.Evaluator` (one batched Simulation,
+  softgym's :class:`~evolvers.evaluation.evaluator.Evaluator` (one batched Simulation,
   phenotype-cached, or Dask through ``batch_fn``).
 
 The objective is the experiment's fitness (``norm_final_dist`` or
@@ -24,7 +24,7 @@ if it had not moved (pyribs' archives have no infeasibility; its
 ``threshold_min`` is for CMA-MAE only).
 
 :class:`QDRun` writes the run folder every driver writes
-(:class:`~evolvers.recorder.RunRecorder`: config, log, hall of fame, atomic
+(:class:`~evolvers.recording.recorder.RunRecorder`: config, log, hall of fame, atomic
 pickle-free checkpoints, figures). Per generation the log gets the archive's
 statistics (``qd_score``, ``coverage``, ``num_elites``, ``qd_best``,
 ``qd_mean``, ``norm_qd_score``, ``new_cells``, ``improved_cells``); they are
@@ -50,18 +50,18 @@ from typing import Any
 
 import numpy as np
 
-from evolvers.descriptors import MOURET_CLUNE_2015, check_descriptors, descriptor_values
-from evolvers.distributed import MissingExtraError
-from evolvers.driver import Checkpoint, Driver, IdCounter
-from evolvers.evaluation import (
+from evolvers.drivers.base import Checkpoint, Driver, IdCounter
+from evolvers.evaluation.descriptors import MOURET_CLUNE_2015, check_descriptors, descriptor_values
+from evolvers.evaluation.distributed import MissingExtraError
+from evolvers.evaluation.evaluator import (
     EvalStats,
     PhenotypeCache,
     pack_traces,
     unpack_traces,
 )
-from evolvers.experiments import Experiment
-from evolvers.genome import Individual
-from evolvers.operators import make_children
+from evolvers.evaluation.experiments import Experiment
+from evolvers.operators.genome import Individual
+from evolvers.operators.variation import make_children
 from softgym.exceptions import CheckpointError, InvalidParameterError
 from softgym.io import (
     atomic_write_json,
@@ -115,7 +115,7 @@ class QDConfig:
     Parameters
     ----------
     descriptors : tuple of str
-        Names of :data:`evolvers.descriptors.DESCRIPTORS` (default ``("stiff",
+        Names of :data:`evolvers.evaluation.descriptors.DESCRIPTORS` (default ``("stiff",
         "filled")``, Mouret and Clune 2015); each spans [0, 1].
     cells : tuple of int
         ``"grid"``: cells per descriptor (one value is used for every
@@ -268,7 +268,7 @@ class SoftbotEmitter(EmitterBase):
     :meth:`ask` draws ``batch_size`` parents uniformly (with replacement)
     from the elites, taken in cell-index order, with the emitter's own
     generator, and returns their children from
-    :func:`~evolvers.operators.make_children` (CPPN mutation until the body
+    :func:`~evolvers.operators.variation.make_children` (CPPN mutation until the body
     changes and stays valid; arithmetic crossover and bounded Gaussian
     mutation of the controller and material genes when the experiment
     evolves them). While the archive is empty it returns ``batch_size``
@@ -314,7 +314,7 @@ class SoftbotEmitter(EmitterBase):
         Returns
         -------
         ndarray of shape (batch_size,), dtype=object
-            :class:`~evolvers.genome.Individual` objects, not yet evaluated.
+            :class:`~evolvers.operators.genome.Individual` objects, not yet evaluated.
         """
         exp = self.experiment
         if self.archive.empty:
@@ -368,8 +368,8 @@ class QDRun(Driver):
         The archive (default: Mouret and Clune's 128 x 128 grid).
     **driver
         ``batch_fn``, ``n_threads``, ``on_generation``, ``figures``, ``gif``,
-        ``progress``: as for :class:`~evolvers.driver.Driver` (Ctrl-C raises
-        :class:`~evolvers.recorder.RunInterrupted` the same way).
+        ``progress``: as for :class:`~evolvers.drivers.base.Driver` (Ctrl-C raises
+        :class:`~evolvers.recording.recorder.RunInterrupted` the same way).
     """
 
     backend = "qd"

@@ -1,7 +1,7 @@
 """The seed's experiments in pymoo's idiom: a Problem, custom operators, any pymoo algorithm.
 
 * :class:`SoftbotProblem`: one object variable per solution (an
-  :class:`~evolvers.genome.Individual`); the vectorised ``_evaluate`` scores the
+  :class:`~evolvers.operators.genome.Individual`); the vectorised ``_evaluate`` scores the
   whole population in one batched Simulation and fills ``out["F"]`` (every
   objective minimised: maximised ones negated) and ``out["G"]`` (the
   experiment's composition rules as ``needed - count``, feasible when <= 0).
@@ -14,7 +14,7 @@
   ``"nsga3"``, ``"sms-emoa"``, ``"ga"``, or any pymoo algorithm class)
   driven through pymoo's public ask-and-tell interface
   (``algorithm.setup``, ``ask``, ``evaluator.eval``, ``tell``), with the same
-  run folder as every driver (:class:`~evolvers.recorder.RunRecorder`).
+  run folder as every driver (:class:`~evolvers.recording.recorder.RunRecorder`).
   Resume is exact: the checkpoint holds every simulated result (the phenotype
   cache), and the run replays its generations from the seed without
   simulating (the algorithm's state is never reached into), then checks that
@@ -42,13 +42,13 @@ from pymoo.core.mutation import Mutation
 from pymoo.core.problem import Problem
 from pymoo.core.sampling import Sampling
 
-from evolvers.driver import Checkpoint, Driver, IdCounter
-from evolvers.evaluation import EvalStats, Evaluator, PhenotypeCache, pack_traces
-from evolvers.experiments import Experiment
-from evolvers.genome import Individual
-from evolvers.operators import mut_controller, mut_cppn, mut_materials, set_counterphase
-from evolvers.recorder import population_summary
-from evolvers.selection import Objective, minimised_matrix
+from evolvers.drivers.base import Checkpoint, Driver, IdCounter
+from evolvers.evaluation.evaluator import EvalStats, Evaluator, PhenotypeCache, pack_traces
+from evolvers.evaluation.experiments import Experiment
+from evolvers.operators.genome import Individual
+from evolvers.operators.selection import Objective, minimised_matrix
+from evolvers.operators.variation import mut_controller, mut_cppn, mut_materials, set_counterphase
+from evolvers.recording.recorder import population_summary
 from softgym.design import CompositionRules, Controller
 from softgym.exceptions import CheckpointError, InvalidParameterError
 from softgym.io import rng_state
@@ -336,15 +336,15 @@ class PymooRun(Driver):
     """An experiment run with a pymoo algorithm through ask and tell (see the module docstring).
 
     Same run folder, log, figures and checkpoints as every driver
-    (:class:`~evolvers.recorder.RunRecorder`). ``generations`` counts the
+    (:class:`~evolvers.recording.recorder.RunRecorder`). ``generations`` counts the
     generations after the initial population (pymoo's ``n_gen`` is one more).
 
     Parameters
     ----------
     experiment, out, seed, generations, **driver
-        As for :class:`~evolvers.driver.Driver` (``batch_fn``, ``n_threads``,
+        As for :class:`~evolvers.drivers.base.Driver` (``batch_fn``, ``n_threads``,
         ``on_generation``, ``figures``, ``gif``, ``progress``; Ctrl-C raises
-        :class:`~evolvers.recorder.RunInterrupted` the same way).
+        :class:`~evolvers.recording.recorder.RunInterrupted` the same way).
     algorithm : str or callable
         ``"nsga2"`` (default), ``"nsga3"``, ``"sms-emoa"``, ``"ga"``
         (single-objective, on the experiment's fitness), or a pymoo algorithm

@@ -9,7 +9,7 @@
         ind.fitness.values = fit
     pop = toolbox.select(pop + offspring, 15)          # selPareto / tools.selNSGA2 / ...
 
-Individuals are ``creator.Softbot`` (an :class:`~evolvers.genome.Individual`
+Individuals are ``creator.Softbot`` (an :class:`~evolvers.operators.genome.Individual`
 with a ``fitness``). ``toolbox.map`` is batched: given ``toolbox.evaluate``
 it evaluates the whole list in one Simulation (or over Dask), other functions
 are mapped normally. DEAP's global ``random`` is seeded from the run's numpy
@@ -27,13 +27,13 @@ from typing import Any
 
 import numpy as np
 
-from evolvers.driver import IdCounter
-from evolvers.evaluation import BatchFn, EvalStats, Evaluator
-from evolvers.experiments import Experiment
-from evolvers.genome import Individual
-from evolvers.operators import cx_arithmetic, mut_controller, mut_cppn, mut_materials
-from evolvers.runner import EvolutionRun
-from evolvers.selection import sel_fitness_tournament, sel_novelty, sel_pareto
+from evolvers.drivers.base import IdCounter
+from evolvers.drivers.runner import EvolutionRun
+from evolvers.evaluation.evaluator import BatchFn, EvalStats, Evaluator
+from evolvers.evaluation.experiments import Experiment
+from evolvers.operators.genome import Individual
+from evolvers.operators.selection import sel_fitness_tournament, sel_novelty, sel_pareto
+from evolvers.operators.variation import cx_arithmetic, mut_controller, mut_cppn, mut_materials
 
 __all__ = ["BatchedMap", "DeapRun", "make_toolbox", "softbot_classes"]
 
@@ -120,7 +120,7 @@ def make_toolbox(
     rng : numpy.random.Generator, int or None
         Randomness of our operators; Python's ``random`` is seeded from it.
     batch_fn, n_threads, evaluator
-        Evaluation (see :class:`~evolvers.evaluation.Evaluator`).
+        Evaluation (see :class:`~evolvers.evaluation.evaluator.Evaluator`).
     next_id : callable, optional
         Id source (default: a counter from 0).
     archive : NoveltyArchive, optional
@@ -212,7 +212,7 @@ class DeapRun(EvolutionRun):
     """The seed's loop written with a DEAP toolbox (see :func:`make_toolbox`).
 
     Same run folder, log, checkpoints and exact resume as
-    :class:`~evolvers.runner.EvolutionRun`; variation, evaluation and
+    :class:`~evolvers.drivers.runner.EvolutionRun`; variation, evaluation and
     selection go through ``toolbox.clone / mutate / mate / map / select``,
     with ``tools.Statistics``, ``tools.Logbook`` and ``tools.HallOfFame``.
     """

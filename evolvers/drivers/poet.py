@@ -3,7 +3,7 @@
 POET keeps a set of active *pairs*, each a terrain
 (:class:`~softgym.tasks.terrain_genome.TerrainGenome`, a bounded vector that
 the task layer turns into boxes) and a population of robots
-(:class:`~evolvers.genome.Individual`) that softgym's operators improve on it.
+(:class:`~evolvers.operators.genome.Individual`) that softgym's operators improve on it.
 One :class:`PoetRun` iteration:
 
 1. **Reproduction** (every ``reproduce_every`` iterations, K): pairs whose best
@@ -29,7 +29,7 @@ One :class:`PoetRun` iteration:
    varies them, ``n_random`` random newcomers join; elitist fitness
    tournament back to ``pop_size``). The new robots of all pairs are
    evaluated together: one batched Simulation per terrain, or all terrains at
-   once on Dask (:meth:`evolvers.distributed.DaskBatchFn.jobs`).
+   once on Dask (:meth:`evolvers.evaluation.distributed.DaskBatchFn.jobs`).
 3. **Transfers** (every ``transfer_every`` iterations, T): the best robot of
    every active pair is scored on every active terrain; a pair adopts another
    pair's robot that beats its own best there (replacing its worst robot).
@@ -60,7 +60,7 @@ the band. ``PoetConfig(score_cap=12.13)`` (reward 300 through the same map)
 makes scores saturate too; it is off by default (``benchmarks/RESULTS.md``
 compares both).
 
-The run folder is the one every driver writes (:class:`~evolvers.recorder.RunRecorder`):
+The run folder is the one every driver writes (:class:`~evolvers.recording.recorder.RunRecorder`):
 config.json, log.jsonl / log.csv with one row per iteration (the standard
 columns over the active pairs' best robots, plus ``annecs``,
 ``annecs_archive``, ``n_active``, ``n_archived``, ``n_solved``, the
@@ -83,12 +83,12 @@ from typing import Any
 
 import numpy as np
 
-from evolvers.driver import Checkpoint, Driver, IdCounter
-from evolvers.evaluation import BatchFn, EvalStats, Evaluator, JobsFn, PhenotypeCache
-from evolvers.experiments import Experiment, get_experiment
-from evolvers.genome import Individual
-from evolvers.operators import make_children
-from evolvers.selection import sel_fitness_tournament
+from evolvers.drivers.base import Checkpoint, Driver, IdCounter
+from evolvers.evaluation.evaluator import BatchFn, EvalStats, Evaluator, JobsFn, PhenotypeCache
+from evolvers.evaluation.experiments import Experiment, get_experiment
+from evolvers.operators.genome import Individual
+from evolvers.operators.selection import sel_fitness_tournament
+from evolvers.operators.variation import make_children
 from softgym.design import CONTROLLER_BOUNDS, Controller
 from softgym.exceptions import InvalidParameterError
 from softgym.io import rng_from_state, rng_state
@@ -465,10 +465,10 @@ class PoetRun(Driver):
     config : PoetConfig, optional
     batch_fn : callable, optional
         ``(design dicts, task) -> metrics`` of one terrain (default: one local
-        Simulation); tests pass a fake. A :class:`~evolvers.distributed.DaskBatchFn`
+        Simulation); tests pass a fake. A :class:`~evolvers.evaluation.distributed.DaskBatchFn`
         evaluates all terrains at once (its ``jobs``).
     jobs_fn : callable, optional
-        Several terrains' batches at once (:data:`~evolvers.evaluation.JobsFn`);
+        Several terrains' batches at once (:data:`~evolvers.evaluation.evaluator.JobsFn`);
         overrides ``batch_fn``.
     n_threads : int, optional
         OpenMP threads of local simulations.

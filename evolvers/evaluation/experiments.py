@@ -32,7 +32,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
-from evolvers.selection import SELECTORS, Objective
+from evolvers.operators.selection import SELECTORS, Objective
 from softgym.design import MATERIAL_TREE_4, MATERIAL_TREE_8, CompositionRules
 from softgym.exceptions import InvalidParameterError
 from softgym.metrics import WALK_METRICS

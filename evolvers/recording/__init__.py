@@ -1,0 +1,8 @@
+"""The run folder every driver writes and the study reads.
+
+* :mod:`~evolvers.recording.recorder` - :class:`~evolvers.recording.recorder.RunRecorder`
+  (config, log, hall of fame, atomic checkpoints, best designs, figures, progress,
+  Ctrl-C), the folder's config and notes, one log row per generation.
+
+Uses :mod:`evolvers.operators` and :mod:`evolvers.evaluation`; imports no driver.
+"""
