@@ -48,7 +48,7 @@ from evolvers.evaluation.experiments import Experiment
 from evolvers.operators.genome import Individual
 from evolvers.operators.selection import Objective, minimised_matrix
 from evolvers.operators.variation import mut_controller, mut_cppn, mut_materials, set_counterphase
-from evolvers.recording.recorder import population_summary
+from evolvers.recording.rows import population_summary
 from softgym.design import CompositionRules, Controller
 from softgym.exceptions import CheckpointError, InvalidParameterError
 from softgym.io import rng_state

@@ -29,7 +29,8 @@ from evolvers.evaluation.evaluator import (
 from evolvers.operators.genome import Individual
 from evolvers.operators.selection import select
 from evolvers.operators.variation import make_children
-from evolvers.recording.recorder import RUN_SCHEMA, RunInterrupted, population_summary
+from evolvers.recording.recorder import RUN_SCHEMA, RunInterrupted
+from evolvers.recording.rows import population_summary
 from softgym.io import (
     python_random_state,
     rng_from_state,

@@ -9,7 +9,8 @@ from evolver_helpers import tiny
 
 from evolvers.evaluation.evaluator import EvalStats
 from evolvers.operators.genome import Individual
-from evolvers.recording.recorder import add_run_note, read_run_notes, study_columns
+from evolvers.recording.recorder import add_run_note, read_run_notes
+from evolvers.recording.rows import study_columns
 from evolvers.study.data import load_runs
 from evolvers.study.runs import (
     SEED_REPORT,
