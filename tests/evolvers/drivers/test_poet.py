@@ -31,7 +31,7 @@ from evolvers.recording.recorder import RunInterrupted
 from softgym.exceptions import CheckpointError, InvalidParameterError
 from softgym.io import list_checkpoints
 
-HERE = Path(__file__).resolve().parent
+HELPERS = Path(__file__).resolve().parents[1]  # tests/evolvers: poet_helpers
 EXP = {"pop_size": 4, "seconds": 1.5}
 CFG = {"reproduce_every": 2, "transfer_every": 2, "max_active": 3, "mutation_sigma": 0.4}
 
@@ -158,7 +158,7 @@ def test_kill9_then_corrupt_latest_resumes_identically(tmp_path):
     child = textwrap.dedent(
         f"""
         import os, signal, sys
-        sys.path.insert(0, {str(HERE)!r})
+        sys.path.insert(0, {str(HELPERS)!r})
         from poet_helpers import fake_batch_fn
         from evolvers.drivers.poet import PoetConfig, PoetRun, poet_experiment
 

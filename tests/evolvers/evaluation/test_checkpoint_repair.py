@@ -24,7 +24,7 @@ from softgym.design import CompositionRules
 from softgym.exceptions import CheckpointError
 from softgym.io import list_checkpoints, load_checkpoint, read_json, save_checkpoint
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 _spec = importlib.util.spec_from_file_location(
     "repair", ROOT / "scripts" / "repair_cache_columns.py"
 )

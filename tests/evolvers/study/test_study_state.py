@@ -6,7 +6,7 @@ from pathlib import Path
 
 from softgym_cli import main
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 _spec = importlib.util.spec_from_file_location("study_state", ROOT / "scripts" / "study_state.py")
 study_state = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(study_state)

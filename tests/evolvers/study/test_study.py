@@ -285,7 +285,7 @@ def test_t1_final_names_the_flying_winners():
 
     from evolvers.study.claims import LIGHT_MUSCLE, claims, winner_of
 
-    root = Path(__file__).resolve().parents[2] / "benchmarks" / "data" / "study" / "runs"
+    root = Path(__file__).resolve().parents[3] / "benchmarks" / "data" / "study" / "runs"
     runs = load_runs(root / "materials-t1")
     seed0 = next(r for r in runs["materials-t1"] if r.seed == 0)
     assert seed0.complete and winner_of(seed0).muscle_density < LIGHT_MUSCLE
