@@ -31,11 +31,11 @@ import time
 import numpy as np
 import results_log
 
-from evolvers.evaluation import Evaluator, PhenotypeCache
-from evolvers.experiments import get_experiment
-from evolvers.genome import Individual
-from evolvers.operators import make_children
-from evolvers.selection import sel_fitness_tournament
+from evolvers.evaluation.evaluator import Evaluator, PhenotypeCache
+from evolvers.evaluation.experiments import get_experiment
+from evolvers.operators.genome import Individual
+from evolvers.operators.selection import sel_fitness_tournament
+from evolvers.operators.variation import make_children
 from softgym.engine import default_num_threads, openmp_enabled
 
 SEED_SOFT_S = 0.75  # s per soft 6x6x6 robot, 5 s simulated, the seed's engine at -O3, one core

@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 import results_log
 
-from evolvers.poet import PoetConfig, PoetRun, plot_annecs, poet_experiment
+from evolvers.drivers.poet import PoetConfig, PoetRun, plot_annecs, poet_experiment
 
 
 class BudgetReached(Exception):

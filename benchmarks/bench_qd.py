@@ -36,12 +36,12 @@ from pathlib import Path
 import numpy as np
 import results_log
 
-from evolvers.descriptors import MOURET_CLUNE_2015, descriptor_values
-from evolvers.evaluation import local_batch_fn
-from evolvers.experiments import get_experiment
-from evolvers.pymoo_runner import PymooRun
-from evolvers.qd import QDConfig, QDRun, archive_stats, make_archive
-from evolvers.runner import EvolutionRun
+from evolvers.drivers.pymoo_runner import PymooRun
+from evolvers.drivers.qd import QDConfig, QDRun, archive_stats, make_archive
+from evolvers.drivers.runner import EvolutionRun
+from evolvers.evaluation.descriptors import MOURET_CLUNE_2015, descriptor_values
+from evolvers.evaluation.evaluator import local_batch_fn
+from evolvers.evaluation.experiments import get_experiment
 from softgym.io import atomic_write_text
 
 METHODS = ("map-elites", "nsga2", "novelty")

@@ -276,9 +276,9 @@ def codesign(task: str, seed: int, args: argparse.Namespace) -> dict[str, float]
     of ``1 + episode`` s (the same 1 s settling and 3 s window). Returns the
     best score any generation reached and the evaluations it took.
     """
-    from evolvers.experiments import get_experiment
-    from evolvers.runner import EvolutionRun
-    from evolvers.selection import Objective
+    from evolvers.drivers.runner import EvolutionRun
+    from evolvers.evaluation.experiments import get_experiment
+    from evolvers.operators.selection import Objective
 
     exp = get_experiment("controller-tournament", task=task, seconds=1.0 + args.episode,
                          pop_size=args.cd_pop, objectives=(Objective("score", True),))  # fmt: skip

@@ -468,7 +468,7 @@ RANDOM_COUNTS = dict(plain=30, bone=14, obstacle_rules=8, mutated=14)
 
 
 def _random_individual(seed: tuple[int, ...], rules: Any = None):
-    from evolvers.genome import Individual
+    from evolvers.operators.genome import Individual
 
     return Individual.random(np.random.default_rng(list(seed)), id=int(seed[-1]), rules=rules)
 
@@ -492,7 +492,7 @@ def random_bodies() -> list[Case]:
     * ``rand_mNN_xK``: a seed-style draw of ``default_rng([16, 4, NN])`` mutated K = 1..5
       times by ``evolvers.operators.mut_cppn`` with ``default_rng([16, 5, NN])``.
     """
-    from evolvers.operators import mut_cppn
+    from evolvers.operators.variation import mut_cppn
     from softgym.design import CompositionRules
 
     cases = []

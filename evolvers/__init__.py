@@ -1,37 +1,57 @@
-"""Evolve soft robots as the seed study did: genomes, operators, selections, runners.
+"""Evolve soft robots as the seed study did, in one folder per job (each imports only those above it).
 
-* :class:`Individual` (:mod:`evolvers.genome`): CPPN + material genes + controller genes + age + lineage.
-* :mod:`evolvers.operators`: arithmetic crossover, bounded Gaussian mutation, CPPN mutation.
-* :mod:`evolvers.selection`: the seed's Pareto (with age), NSGA-II, fitness tournament, AMSS novelty.
-* :class:`Evaluator` (:mod:`evolvers.evaluation`): batched, phenotype-cached evaluation.
-* :data:`EXPERIMENTS` (:mod:`evolvers.experiments`): the seed's scenarios by name.
-* Drivers with exact resume, each a :class:`~evolvers.driver.Driver` (the one run
-  skeleton: construction, generation loop, progress, Ctrl-C, checkpoint, resume) writing
-  its run folder through one :class:`RunRecorder` (config, log, hall of fame, atomic
-  checkpoints, figures): :class:`EvolutionRun` (the seed's loop), :class:`~evolvers.deap_runner.DeapRun`
-  (the same loop on a DEAP toolbox), :class:`~evolvers.pymoo_runner.PymooRun`
-  (any pymoo algorithm through ask and tell: NSGA-II, NSGA-III, SMS-EMOA, GA...);
-  Dask evaluation in :mod:`evolvers.distributed` (``pip install "softgym[distributed]"``).
-* Open-ended search: :mod:`evolvers.qd` (MAP-Elites on pyribs) and :mod:`evolvers.poet`
+* :mod:`evolvers.operators` - the genome and what a search does to it:
+  :class:`Individual` (:mod:`~evolvers.operators.genome`: CPPN + material genes +
+  controller genes + age + lineage), crossover and mutations
+  (:mod:`~evolvers.operators.variation`), the seed's Pareto (with age), NSGA-II, fitness
+  tournament and AMSS novelty (:mod:`~evolvers.operators.selection`).
+* :mod:`evolvers.evaluation` - what a robot is scored on and how: :data:`EXPERIMENTS`
+  (:mod:`~evolvers.evaluation.experiments`: the seed's scenarios by name),
+  :class:`Evaluator` (:mod:`~evolvers.evaluation.evaluator`: batched, phenotype-cached
+  evaluation), Dask evaluation (:mod:`~evolvers.evaluation.distributed`,
+  ``pip install "softgym[distributed]"``) and body descriptors
+  (:mod:`~evolvers.evaluation.descriptors`).
+* :mod:`evolvers.recording` - the run folder: one :class:`RunRecorder` (config, log, hall
+  of fame, atomic checkpoints, figures) for every driver.
+* :mod:`evolvers.drivers` - drivers with exact resume, each a
+  :class:`~evolvers.drivers.base.Driver` (the one run skeleton: construction, generation
+  loop, progress, Ctrl-C, checkpoint, resume): :class:`EvolutionRun` (the seed's loop),
+  :class:`~evolvers.drivers.deap_runner.DeapRun` (the same loop on a DEAP toolbox),
+  :class:`~evolvers.drivers.pymoo_runner.PymooRun` (any pymoo algorithm through ask and
+  tell: NSGA-II, NSGA-III, SMS-EMOA, GA...); open-ended search:
+  :mod:`~evolvers.drivers.qd` (MAP-Elites on pyribs) and :mod:`~evolvers.drivers.poet`
   (co-evolution of robots and terrains after Enhanced POET).
+* :mod:`evolvers.study` - the seed study over many seeds and its report (nothing else
+  imports it).
 
-The DEAP, pymoo and Dask modules are imported on demand (``from evolvers.deap_runner import DeapRun``).
+The DEAP, pymoo and Dask modules are imported on demand (``from evolvers.drivers.deap_runner import DeapRun``).
 """
 
-from evolvers.driver import Driver, IdCounter
-from evolvers.evaluation import Evaluator, PhenotypeCache
-from evolvers.experiments import EXPERIMENTS, Experiment, get_experiment, list_experiments
-from evolvers.genome import Individual
-from evolvers.operators import cx_arithmetic, make_children, mut_controller, mut_cppn, mut_materials
-from evolvers.recorder import RunRecorder
-from evolvers.runner import EvolutionRun
-from evolvers.selection import (
+from evolvers.drivers.base import Driver, IdCounter
+from evolvers.drivers.runner import EvolutionRun
+from evolvers.evaluation.evaluator import Evaluator, PhenotypeCache
+from evolvers.evaluation.experiments import (
+    EXPERIMENTS,
+    Experiment,
+    get_experiment,
+    list_experiments,
+)
+from evolvers.operators.genome import Individual
+from evolvers.operators.selection import (
     Objective,
     sel_fitness_tournament,
     sel_novelty,
     sel_nsga2,
     sel_pareto,
 )
+from evolvers.operators.variation import (
+    cx_arithmetic,
+    make_children,
+    mut_controller,
+    mut_cppn,
+    mut_materials,
+)
+from evolvers.recording.recorder import RunRecorder
 
 __all__ = [
     "EXPERIMENTS",

@@ -49,9 +49,9 @@ from typing import Any
 
 import numpy as np
 
-from evolvers.evaluation import STORED_METRICS
-from evolvers.experiments import Experiment
-from evolvers.recorder import RunRecorder, add_run_note
+from evolvers.evaluation.evaluator import STORED_METRICS
+from evolvers.evaluation.experiments import Experiment
+from evolvers.recording.recorder import RunRecorder, add_run_note
 from softgym.io import list_checkpoints, load_checkpoint, read_json, save_checkpoint
 
 #: The stored metrics when the damage happened (``score`` fourth); the current list.

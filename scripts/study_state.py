@@ -43,7 +43,7 @@ import shutil
 import sys
 from pathlib import Path
 
-from evolvers.recorder import IDENTITY_FILE
+from evolvers.recording.recorder import IDENTITY_FILE
 from evolvers.study import run_status
 from softgym.exceptions import CheckpointError
 from softgym.io import list_checkpoints, load_latest_intact, read_json

@@ -46,7 +46,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     return 0
 
 def _cmd_replay(args: argparse.Namespace) -> int:
-    from evolvers.experiments import Experiment
+    from evolvers.evaluation.experiments import Experiment
     from softgym.design import RobotDesign
     from softgym.evaluate import evaluate
     from softgym.exceptions import SoftGymError
@@ -100,7 +100,7 @@ def _cmd_replay(args: argparse.Namespace) -> int:
 
 def _config_key(cfg: dict) -> str:
     """What makes two runs the same configuration: everything but the seed."""
-    from evolvers.experiments import Experiment
+    from evolvers.evaluation.experiments import Experiment
 
     exp = Experiment.from_dict(cfg["experiment"]).to_dict()
     exp.pop("generations", None)
@@ -111,7 +111,7 @@ def _config_key(cfg: dict) -> str:
 def _cmd_compare(args: argparse.Namespace) -> int:
     import statistics
 
-    from evolvers.recorder import config_difference, read_run_config
+    from evolvers.recording.recorder import config_difference, read_run_config
     from softgym.render.figures import figure_path, plot_compare, read_log
 
     figure_path(args.out)  # a format matplotlib writes, checked before the runs are read
@@ -170,8 +170,8 @@ def _cmd_view(args: argparse.Namespace) -> int:
     src = Path(args.source)
     task, seconds, name = args.task or "flat", args.seconds, src.stem
     if src.is_dir():
-        from evolvers.experiments import Experiment
-        from evolvers.recorder import read_run_config
+        from evolvers.evaluation.experiments import Experiment
+        from evolvers.recording.recorder import read_run_config
         from softgym.design import RobotDesign
 
         cfg = read_run_config(src)
@@ -227,7 +227,7 @@ def _cmd_convert(args: argparse.Namespace) -> int:
 
 
 def _cmd_experiments(args: argparse.Namespace) -> int:
-    from evolvers.experiments import EXPERIMENTS
+    from evolvers.evaluation.experiments import EXPERIMENTS
 
     for name, exp in EXPERIMENTS.items():
         objs = ", ".join(f"{o.name} ({'max' if o.maximize else 'min'})" for o in exp.objectives)

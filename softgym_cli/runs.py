@@ -21,8 +21,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from evolvers.experiments import Experiment, get_experiment
-from evolvers.recorder import RunInterrupted, read_run_config
+from evolvers.evaluation.experiments import Experiment, get_experiment
+from evolvers.recording.recorder import RunInterrupted, read_run_config
 from softgym.exceptions import CheckpointError
 from softgym_cli.flags import subcommands
 
@@ -95,7 +95,7 @@ def build_run(args: argparse.Namespace, stack: contextlib.ExitStack, make: Maker
     """
     run_cls, experiment, kw = make(args, recorded_config(args))
     if args.dask:
-        from evolvers.distributed import DaskBatchFn, dask_client
+        from evolvers.evaluation.distributed import DaskBatchFn, dask_client
 
         quiet_dask(args.verbose)
         client = stack.enter_context(dask_client(args.dask, n_workers=args.workers))
@@ -216,13 +216,13 @@ def _evolve_run(args: argparse.Namespace, cfg: dict | None) -> tuple[type, Exper
               "generations": args.generations}  # fmt: skip
     kw: dict[str, Any] = {"seed": st["seed"], "generations": st["generations"]}
     if st["backend"] == "deap":
-        from evolvers.deap_runner import DeapRun as Run
+        from evolvers.drivers.deap_runner import DeapRun as Run
     elif st["backend"] == "pymoo":
-        from evolvers.pymoo_runner import PymooRun as Run
+        from evolvers.drivers.pymoo_runner import PymooRun as Run
 
         kw["algorithm"] = st["algorithm"]
     else:
-        from evolvers.runner import EvolutionRun as Run
+        from evolvers.drivers.runner import EvolutionRun as Run
     return Run, st["experiment"], kw
 
 
@@ -295,7 +295,7 @@ def _seed_and_length(args: argparse.Namespace, cfg: dict | None, length: int | N
 
 def _qd_run(args: argparse.Namespace, cfg: dict | None) -> tuple[type, Experiment, dict]:
     """A QDRun's settings; under --resume the folder's, a mismatch with a typed flag named by QDRun.run."""
-    from evolvers.qd import QDConfig, QDRun
+    from evolvers.drivers.qd import QDConfig, QDRun
 
     if cfg is not None and args.experiment is None:
         exp = Experiment.from_dict(cfg["experiment"])
@@ -328,7 +328,7 @@ def _qd_summary(run: Any, _: Any) -> dict[str, Any]:
 def cmd_qd(args: argparse.Namespace) -> int:
     """``softgym qd [run]`` and ``softgym qd export``."""
     if getattr(args, "qd_command", None) == "export":
-        from evolvers.qd import export_elites
+        from evolvers.drivers.qd import export_elites
 
         index = export_elites(args.run, args.export_out, top=args.top)
         n = len(json.loads(index.read_text())["elites"])
@@ -386,7 +386,7 @@ _POET_FLAGS = ("reproduce_every", "transfer_every", "max_children", "max_admitte
 
 def _poet_run(args: argparse.Namespace, cfg: dict | None) -> tuple[type, Experiment, dict]:
     """A PoetRun's settings; under --resume the folder's, a mismatch with a typed flag named by PoetRun.run."""
-    from evolvers.poet import PoetConfig, PoetRun, poet_experiment
+    from evolvers.drivers.poet import PoetConfig, PoetRun, poet_experiment
     from softgym.io import read_json
 
     exp = Experiment.from_dict(cfg["experiment"]) if cfg is not None else poet_experiment()
@@ -421,7 +421,7 @@ def cmd_poet(args: argparse.Namespace) -> int:
 
 
 def _cmd_poet_compare(args: argparse.Namespace) -> int:
-    from evolvers.poet import plot_annecs
+    from evolvers.drivers.poet import plot_annecs
     from softgym.render.figures import read_log
 
     groups: dict[str, list] = {}

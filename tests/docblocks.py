@@ -3,7 +3,7 @@
 Python blocks run as scripts and bash blocks line by line, in order, in one scratch
 folder, with ``SOFTGYM_SMOKE=1`` (every evolution run cut to one generation of four
 small robots). Lines that install (``pip``, venvs), run the test suite or the linter, or
-run ``softgym study`` (its own test, tests/evolvers/test_study.py) are left out.
+run ``softgym study`` (its own test, tests/evolvers/study/test_study.py) are left out.
 """
 
 import os

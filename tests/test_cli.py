@@ -104,7 +104,7 @@ def test_evolve_on_stairs_and_on_a_terrain_file(tmp_path, capsys):
 
 def test_dask_without_the_extra_names_it(tmp_path, capsys, monkeypatch):
     monkeypatch.setitem(sys.modules, "distributed", None)  # as if Dask were not installed
-    from evolvers.distributed import MissingExtraError, require_distributed
+    from evolvers.evaluation.distributed import MissingExtraError, require_distributed
 
     with pytest.raises(MissingExtraError, match=r"softgym\[distributed\]") as err:
         require_distributed()
@@ -117,7 +117,7 @@ def test_dask_without_the_extra_names_it(tmp_path, capsys, monkeypatch):
 def test_a_task_string_is_read_once_per_command(tmp_path, monkeypatch, capsys):
     import importlib
 
-    import evolvers.experiments
+    import evolvers.evaluation.experiments
     from softgym.tasks import get_task
 
     strings = []
@@ -128,7 +128,7 @@ def test_a_task_string_is_read_once_per_command(tmp_path, monkeypatch, capsys):
         return get_task(spec, **kw)
 
     evaluate_module = importlib.import_module("softgym.evaluate")  # not the function
-    for module in (evolvers.experiments, evaluate_module):
+    for module in (evolvers.evaluation.experiments, evaluate_module):
         monkeypatch.setattr(module, "get_task", spy)
     args = ["evolve", "--task", "stairs", "--generations", "1", "--no-figures", "--no-gif"]
     assert main([*args, "--out", str(tmp_path / "r"), *TINY]) == 0

@@ -16,16 +16,16 @@ import textwrap
 
 import pytest
 
-from evolvers.deap_runner import DeapRun
-from evolvers.experiments import get_experiment
-from evolvers.pymoo_runner import PymooRun
-from evolvers.runner import EvolutionRun, population_summary
+from evolvers.drivers.deap_runner import DeapRun
+from evolvers.drivers.pymoo_runner import PymooRun
+from evolvers.drivers.runner import EvolutionRun, population_summary
+from evolvers.evaluation.experiments import get_experiment
 from softgym.io import list_checkpoints
 
 RUNS = {
-    "native": ("evolvers.runner", "EvolutionRun", EvolutionRun, "controller-tournament"),
-    "deap": ("evolvers.deap_runner", "DeapRun", DeapRun, "controller-tournament"),
-    "pymoo": ("evolvers.pymoo_runner", "PymooRun", PymooRun, "controller-pareto"),
+    "native": ("evolvers.drivers.runner", "EvolutionRun", EvolutionRun, "controller-tournament"),
+    "deap": ("evolvers.drivers.deap_runner", "DeapRun", DeapRun, "controller-tournament"),
+    "pymoo": ("evolvers.drivers.pymoo_runner", "PymooRun", PymooRun, "controller-pareto"),
 }
 TINY = {"pop_size": 4, "seconds": 1.5, "shape": (4, 4, 4)}  # as tests/evolvers' tiny()
 
@@ -45,7 +45,7 @@ def test_kill9_then_corrupt_latest_resumes_identically(tmp_path, backend, caplog
     child = textwrap.dedent(
         f"""
         import os, signal
-        from evolvers.experiments import get_experiment
+        from evolvers.evaluation.experiments import get_experiment
         from {module} import {cls_name}
 
         def kill9(run, row):

@@ -13,8 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from evolvers.genome import Individual
-from evolvers.recorder import read_run_notes
+from evolvers.operators.genome import Individual
+from evolvers.recording.recorder import read_run_notes
 from softgym.exceptions import CheckpointError
 from softgym.render.figures import read_log
 
@@ -108,7 +108,7 @@ class RunData:
     rows: list[dict[str, Any]]
     best: dict[str, Any] | None
     complete: bool
-    #: The run folder's notes (:func:`evolvers.recorder.read_run_notes`).
+    #: The run folder's notes (:func:`evolvers.recording.recorder.read_run_notes`).
     notes: list[dict[str, Any]] = field(default_factory=list)
 
     @property

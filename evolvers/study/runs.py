@@ -1,7 +1,7 @@
 """A study: the seed report's scenarios re-run over many seeds, each an ordinary run folder.
 
 The seed report ran every scenario once. A :class:`Study` names a set of
-:class:`Scenario` s (an experiment of :mod:`evolvers.experiments`, a number of
+:class:`Scenario` s (an experiment of :mod:`evolvers.evaluation.experiments`, a number of
 generations and of seeds); :func:`plan` expands it into one :class:`RunSpec`
 per scenario and seed, and :func:`run_study` runs them::
 
@@ -10,7 +10,7 @@ per scenario and seed, and :func:`run_study` runs them::
     OUT/<scenario>/seed-<k>/            an ordinary run folder (config, log, checkpoints,
                                         best designs), made by EvolutionRun
 
-Each run is an :class:`~evolvers.runner.EvolutionRun` started with
+Each run is an :class:`~evolvers.drivers.runner.EvolutionRun` started with
 ``resume=True``: a complete run (its log reaches the asked generation and its
 final population is written) is skipped, an interrupted one continues from its
 last checkpoint (bit for bit as if never stopped), a missing one starts. So a
@@ -60,7 +60,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from evolvers.experiments import Experiment, get_experiment
+from evolvers.evaluation.experiments import Experiment, get_experiment
 from softgym.exceptions import InvalidParameterError, SoftGymError
 from softgym.io import atomic_write_json
 
@@ -96,7 +96,7 @@ class Scenario:
     name : str
         The scenario's name (its folder under the study's root).
     experiment : str
-        A named experiment (:data:`evolvers.experiments.EXPERIMENTS`).
+        A named experiment (:data:`evolvers.evaluation.experiments.EXPERIMENTS`).
     generations : int
         Generations after generation 0.
     seeds : int
@@ -104,7 +104,7 @@ class Scenario:
     description : str
         What the scenario tests.
     overrides : dict
-        :class:`~evolvers.experiments.Experiment` field overrides.
+        :class:`~evolvers.evaluation.experiments.Experiment` field overrides.
     cpu_per_generation : float, optional
         Measured CPU seconds of one generation at the default sizes (one
         thread): orders the runs longest first within a round of seeds and gives
@@ -172,7 +172,7 @@ class Study:
 
 #: The seed's obstacle runs scored MaxXYDist and the L coefficient on a centre of mass that
 #: counts the 44 one-kilogram wall voxels (the seed study); the study's obstacle scenarios
-#: do the same (:attr:`evolvers.experiments.Experiment.seed_centre_of_mass`).
+#: do the same (:attr:`evolvers.evaluation.experiments.Experiment.seed_centre_of_mass`).
 SEED_COM: Mapping[str, Any] = {"seed_centre_of_mass": True}
 
 #: The report's obstacle scenarios (section III-D), scored as the seed's runs were.
@@ -439,7 +439,7 @@ def settings_difference(spec: RunSpec) -> str | None:
     A complete run with other settings (e.g. a scenario whose overrides
     changed) must not be counted as this spec's run.
     """
-    from evolvers.recorder import config_difference
+    from evolvers.recording.recorder import config_difference
 
     try:
         cfg = json.loads((Path(spec.out) / "config.json").read_text())
@@ -466,7 +466,7 @@ def run_one(spec: Mapping[str, Any] | RunSpec) -> dict[str, Any]:
         complete; ``"ran"``; ``"resumed"``; ``"failed"`` with ``error``),
         ``generation`` reached and ``wall`` seconds.
     """
-    from evolvers.runner import EvolutionRun
+    from evolvers.drivers.runner import EvolutionRun
 
     spec = spec if isinstance(spec, RunSpec) else RunSpec.from_dict(spec)
     out = {"scenario": spec.scenario, "seed": spec.seed, "out": str(spec.out)}
@@ -608,7 +608,7 @@ def run_study(
             done(res)
         return results
 
-    from evolvers.distributed import dask_client, require_distributed
+    from evolvers.evaluation.distributed import dask_client, require_distributed
 
     distributed = require_distributed()
     one_thread = [replace(s, n_threads=1) if s.n_threads is None else s for s in ordered]

@@ -1,6 +1,6 @@
 """A terrain genome: a bounded, fixed-length vector that the task layer turns into boxes.
 
-POET-style co-evolution (:mod:`evolvers.poet`) mutates terrains the way an
+POET-style co-evolution (:mod:`evolvers.drivers.poet`) mutates terrains the way an
 evolver mutates robots, so a terrain needs a genome: seven numbers, each in a
 documented range, that build a :class:`~softgym.terrain.Terrain` around a
 robot's grid. The obstacles are square rings centred on the robot's footprint

@@ -1,6 +1,6 @@
 """Helpers of the evolver tests: tiny, fast experiments (4x4x4 robots, 1.5 s simulated)."""
 
-from evolvers.experiments import get_experiment
+from evolvers.evaluation.experiments import get_experiment
 
 
 def tiny(name: str = "controller-tournament", **overrides):

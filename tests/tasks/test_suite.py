@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import softgym
-from evolvers.experiments import get_experiment
+from evolvers.evaluation.experiments import get_experiment
 from softgym.design import RobotDesign, default_walker
 from softgym.exceptions import InvalidParameterError
 from softgym.metrics import WORST_FITNESS, task_measure_from_arrays

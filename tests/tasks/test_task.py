@@ -8,7 +8,7 @@ import pytest
 from fuzzing import fifo_code, refused_in_child
 
 import softgym
-from evolvers.experiments import Experiment, get_experiment
+from evolvers.evaluation.experiments import Experiment, get_experiment
 from softgym.design import RobotDesign, default_walker
 from softgym.exceptions import InvalidParameterError
 from softgym.tasks import ALIASES, TASKS, Task, get_task, register_task, task_names

@@ -1,0 +1,14 @@
+"""The searches: one run skeleton and the drivers built on it.
+
+* :mod:`~evolvers.drivers.base` - :class:`~evolvers.drivers.base.Driver` (construction,
+  generation loop, progress, Ctrl-C, checkpoint, exact resume) and the one
+  :class:`~evolvers.drivers.base.IdCounter`;
+* :mod:`~evolvers.drivers.runner` - :class:`~evolvers.drivers.runner.EvolutionRun`, the
+  seed's loop (the native backend);
+* :mod:`~evolvers.drivers.deap_runner` - the same loop on a DEAP toolbox;
+* :mod:`~evolvers.drivers.pymoo_runner` - any pymoo algorithm through ask and tell;
+* :mod:`~evolvers.drivers.qd` - MAP-Elites on pyribs (the ``.[qd]`` extra);
+* :mod:`~evolvers.drivers.poet` - co-evolution of robots and terrains after Enhanced POET.
+
+Each module is imported on demand (the DEAP, pymoo and pyribs ones need their library).
+"""

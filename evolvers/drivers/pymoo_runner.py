@@ -1,0 +1,451 @@
+"""The seed's experiments in pymoo's idiom: a Problem, custom operators, any pymoo algorithm.
+
+* :class:`SoftbotProblem`: one object variable per solution (an
+  :class:`~evolvers.operators.genome.Individual`); the vectorised ``_evaluate`` scores the
+  whole population in one batched Simulation and fills ``out["F"]`` (every
+  objective minimised: maximised ones negated) and ``out["G"]`` (the
+  experiment's composition rules as ``needed - count``, feasible when <= 0).
+* :class:`SoftbotSampling` (random valid CPPN robots),
+  :class:`SoftbotCrossover` (the seed's arithmetic crossover of controller /
+  material genes, probability 0.4), :class:`SoftbotMutation` (CPPN mutation
+  with validity retries + bounded Gaussian gene mutation) and
+  :class:`SoftbotDuplicateElimination` (same phenotype hash).
+* :class:`PymooRun`: a pymoo algorithm (``algorithm=``: NSGA-II by default,
+  ``"nsga3"``, ``"sms-emoa"``, ``"ga"``, or any pymoo algorithm class)
+  driven through pymoo's public ask-and-tell interface
+  (``algorithm.setup``, ``ask``, ``evaluator.eval``, ``tell``), with the same
+  run folder as every driver (:class:`~evolvers.recording.recorder.RunRecorder`).
+  Resume is exact: the checkpoint holds every simulated result (the phenotype
+  cache), and the run replays its generations from the seed without
+  simulating (the algorithm's state is never reached into), then checks that
+  it reached the checkpointed population before it goes on.
+
+Differences from the seed's loop (inherent to pymoo's algorithms): survival is
+the algorithm's (rank and crowding for NSGA-II, whatever the experiment's
+``selection``), no random newcomer joins each generation, the age objective is
+the age at evaluation, and novelty experiments score against an archive of
+past behaviours.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pymoo.core.algorithm import Algorithm
+from pymoo.core.crossover import Crossover
+from pymoo.core.duplicate import ElementwiseDuplicateElimination
+from pymoo.core.mutation import Mutation
+from pymoo.core.problem import Problem
+from pymoo.core.sampling import Sampling
+
+from evolvers.drivers.base import Checkpoint, Driver, IdCounter
+from evolvers.evaluation.evaluator import EvalStats, Evaluator, PhenotypeCache, pack_traces
+from evolvers.evaluation.experiments import Experiment
+from evolvers.operators.genome import Individual
+from evolvers.operators.selection import Objective, minimised_matrix
+from evolvers.operators.variation import mut_controller, mut_cppn, mut_materials, set_counterphase
+from evolvers.recording.rows import population_summary
+from softgym.design import CompositionRules, Controller
+from softgym.exceptions import CheckpointError, InvalidParameterError
+from softgym.io import rng_state
+from softgym.metrics import NoveltyArchive
+
+__all__ = [
+    "ALGORITHMS",
+    "PymooRun",
+    "SoftbotCrossover",
+    "SoftbotDuplicateElimination",
+    "SoftbotMutation",
+    "SoftbotProblem",
+    "SoftbotSampling",
+    "constraint_values",
+    "make_algorithm",
+    "n_constraints",
+]
+
+
+def _need(fraction: float, total: int) -> int:
+    return max(0, math.ceil(fraction * total - 1e-9))
+
+
+def n_constraints(rules: CompositionRules) -> int:
+    """Number of inequality constraints :func:`constraint_values` returns for ``rules``."""
+    return len(constraint_values(np.ones((1, 1, 1), dtype=np.int8), rules))
+
+
+def constraint_values(grid: np.ndarray, rules: CompositionRules) -> np.ndarray:
+    """Composition rules as pymoo inequality constraints (feasible when every value <= 0).
+
+    One value per active rule, ``needed - count`` in voxels: filled
+    fraction of the grid, muscle fraction of the grid, muscle and tissue
+    fractions of the filled voxels, bone voxels.
+
+    Returns
+    -------
+    ndarray of shape (n_constraints,), float64
+    """
+    grid = np.asarray(grid)
+    total, filled = grid.size, int(np.count_nonzero(grid))
+    n_muscle = int(np.isin(grid, rules.muscle_ids).sum())
+    n_tissue = int(np.isin(grid, rules.tissue_ids).sum())
+    n_bone = int(np.isin(grid, rules.bone_ids).sum())
+    g = []
+    if rules.min_filled_fraction > 0:
+        g.append(_need(rules.min_filled_fraction, total) - filled)
+    if rules.min_muscle_fraction_of_grid > 0:
+        g.append(_need(rules.min_muscle_fraction_of_grid, total) - n_muscle)
+    if rules.min_muscle_fraction_of_filled > 0:
+        g.append(_need(rules.min_muscle_fraction_of_filled, filled) - n_muscle)
+    if rules.min_tissue_fraction_of_filled > 0:
+        g.append(_need(rules.min_tissue_fraction_of_filled, filled) - n_tissue)
+    if rules.min_bone_voxels > 0:
+        g.append(rules.min_bone_voxels - n_bone)
+    g.append(0 if filled else 1)  # non-empty
+    return np.asarray(g, dtype=np.float64)
+
+
+class SoftbotProblem(Problem):
+    """A soft-robot experiment as a pymoo Problem (one object variable per solution).
+
+    Parameters
+    ----------
+    experiment : Experiment
+    evaluator : Evaluator
+        Batched, cached evaluation (one Simulation per call, or Dask).
+    archive : NoveltyArchive, optional
+        For novelty experiments: ``F`` is the k-nearest-neighbour AMSS
+        similarity to the batch and the archive (minimised).
+    objectives : tuple of Objective, optional
+        The objectives in ``F`` (default the experiment's; its first alone
+        for a single-objective algorithm).
+    """
+
+    def __init__(
+        self,
+        experiment: Experiment,
+        evaluator: Evaluator,
+        archive: NoveltyArchive | None = None,
+        objectives: tuple[Objective, ...] | None = None,
+    ) -> None:
+        self.experiment = experiment
+        self.evaluator = evaluator
+        self.archive = archive
+        self.objectives = tuple(experiment.objectives if objectives is None else objectives)
+        self.novelty = experiment.selection.startswith("novelty")
+        self.last_stats = EvalStats()
+        n_obj = 1 if self.novelty else len(self.objectives)
+        super().__init__(
+            n_var=1, n_obj=n_obj, n_ieq_constr=n_constraints(experiment.rules), vtype=object
+        )
+
+    def _evaluate(self, X, out, *args, **kwargs):
+        inds = [x[0] for x in X]
+        self.last_stats = self.evaluator.evaluate(inds)
+        if self.novelty:
+            trajs = [ind.trace for ind in inds]
+            scores = self.archive.update(trajs) if self.archive is not None else np.zeros(len(inds))
+            for ind, s in zip(inds, scores):
+                ind.novelty = float(s)
+            out["F"] = np.asarray(scores, dtype=np.float64).reshape(-1, 1)
+        else:
+            out["F"] = minimised_matrix(inds, self.objectives)
+        exp = self.experiment
+        out["G"] = np.array([constraint_values(ind.grid(exp.shape), exp.rules) for ind in inds])
+
+
+class SoftbotSampling(Sampling):
+    """Random valid individuals (the seed's generation 0)."""
+
+    def __init__(self, experiment: Experiment, next_id: Any) -> None:
+        super().__init__()
+        self.experiment = experiment
+        self.next_id = next_id
+
+    def _do(self, problem, n_samples, *args, random_state=None, **kwargs):
+        exp = self.experiment
+        X = np.empty((n_samples, 1), dtype=object)
+        for i in range(n_samples):
+            X[i, 0] = Individual.random(
+                random_state, self.next_id(), exp.shape, exp.cppn_outputs, exp.rules
+            )
+        return X
+
+
+class SoftbotCrossover(Crossover):
+    """The seed's arithmetic crossover: a child of parent A with the mean genes of A and B.
+
+    Controller genes (and material genes 6-8, 9 as the counter-phase of 8)
+    are averaged; the CPPN is A's. Applied with probability ``prob`` (0.4).
+    """
+
+    def __init__(self, experiment: Experiment, next_id: Any, prob: float | None = None) -> None:
+        super().__init__(2, 1, prob=experiment.crossover_rate if prob is None else prob)
+        self.experiment = experiment
+        self.next_id = next_id
+
+    def _do(self, problem, X, *args, random_state=None, **kwargs):
+        _, n_matings, _ = X.shape
+        Q = np.empty((1, n_matings, 1), dtype=object)
+        for k in range(n_matings):
+            a, b = X[0, k, 0], X[1, k, 0]
+            child = a.child(self.next_id())
+            if self.experiment.evolve_controller:
+                ca, cb = a.controller, b.controller
+                child.controller = Controller.clipped(
+                    (ca.temp_amplitude + cb.temp_amplitude) / 2.0,
+                    (ca.period + cb.period) / 2.0,
+                    (ca.muscle_cte + cb.muscle_cte) / 2.0,
+                )
+            if self.experiment.evolve_materials:
+                child.materials[:3] = (a.materials[:3] + b.materials[:3]) / 2.0
+                set_counterphase(child.materials)
+            Q[0, k, 0] = child
+        return Q
+
+
+class SoftbotMutation(Mutation):
+    """CPPN mutation with validity retries, then bounded Gaussian controller / material mutation.
+
+    Evaluated individuals (parents copied through by the crossover) are
+    cloned first, so parents are never modified.
+    """
+
+    def __init__(self, experiment: Experiment, next_id: Any) -> None:
+        super().__init__(prob=1.0)
+        self.experiment = experiment
+        self.next_id = next_id
+
+    def _do(self, problem, X, *args, random_state=None, **kwargs):
+        exp = self.experiment
+        Y = np.empty_like(X)
+        for i in range(len(X)):
+            ind = X[i, 0]
+            child = ind.child(self.next_id()) if ind.objectives else ind
+            child.age = ind.age + 1
+            mut_cppn(child, random_state, shape=exp.shape, rules=exp.rules)
+            if exp.evolve_controller:
+                mut_controller(child, random_state)
+            if exp.evolve_materials:
+                mut_materials(child, random_state)
+            Y[i, 0] = child
+        return Y
+
+
+class SoftbotDuplicateElimination(ElementwiseDuplicateElimination):
+    """Two solutions are duplicates when their phenotypes hash equal (grid, materials, controller)."""
+
+    def __init__(self, experiment: Experiment) -> None:
+        super().__init__()
+        self.shape = experiment.shape
+
+    def is_equal(self, a, b) -> bool:
+        """Whether two pymoo individuals hold the same phenotype."""
+        return a.X[0].phenotype_key(self.shape) == b.X[0].phenotype_key(self.shape)
+
+
+def _nsga3(pop_size: int, n_obj: int, **operators: Any) -> Algorithm:
+    from pymoo.algorithms.moo.nsga3 import NSGA3
+    from pymoo.util.ref_dirs import get_reference_directions
+
+    # about one reference direction per individual ("das-dennis" on the objective simplex)
+    p = 1
+    while math.comb(p + 1 + n_obj - 1, n_obj - 1) <= pop_size:
+        p += 1
+    ref_dirs = get_reference_directions("das-dennis", n_obj, n_partitions=p)
+    return NSGA3(ref_dirs=ref_dirs, pop_size=pop_size, **operators)
+
+
+def _named(name: str) -> Callable[..., Algorithm]:
+    if name == "nsga2":
+        from pymoo.algorithms.moo.nsga2 import NSGA2
+
+        return NSGA2
+    if name == "sms-emoa":
+        from pymoo.algorithms.moo.sms import SMSEMOA
+
+        return SMSEMOA
+    if name == "ga":
+        from pymoo.algorithms.soo.nonconvex.ga import GA
+
+        return GA
+    raise InvalidParameterError(f"unknown algorithm {name!r}; expected one of {ALGORITHMS}")
+
+
+#: Algorithms known by name (``"ga"`` is single-objective: it optimises the experiment's fitness).
+ALGORITHMS: tuple[str, ...] = ("nsga2", "nsga3", "sms-emoa", "ga")
+
+
+def make_algorithm(
+    algorithm: str | Callable[..., Algorithm],
+    experiment: Experiment,
+    ids: IdCounter,
+    n_obj: int,
+    **kwargs: Any,
+) -> Algorithm:
+    """A pymoo algorithm with the softbot operators, for ``experiment``.
+
+    Parameters
+    ----------
+    algorithm : str or callable
+        A name of :data:`ALGORITHMS`, or a pymoo algorithm class (or any
+        callable) that takes ``pop_size``, ``sampling``, ``crossover``,
+        ``mutation``, ``eliminate_duplicates`` and ``n_offsprings`` keywords
+        (NSGA2, NSGA3 with ``ref_dirs=`` in ``kwargs``, SMSEMOA, GA, ...).
+    experiment : Experiment
+    ids : IdCounter
+        The id source of new individuals.
+    n_obj : int
+        Objectives of the problem (NSGA-III's reference directions).
+    **kwargs
+        More keywords for the algorithm.
+
+    Returns
+    -------
+    pymoo.core.algorithm.Algorithm
+    """
+    exp = experiment
+    operators: dict[str, Any] = {
+        "sampling": SoftbotSampling(exp, ids),
+        "crossover": SoftbotCrossover(exp, ids),
+        "mutation": SoftbotMutation(exp, ids),
+        "eliminate_duplicates": SoftbotDuplicateElimination(exp),
+        "n_offsprings": exp.pop_size,
+        **kwargs,
+    }
+    if algorithm == "nsga3" and "ref_dirs" not in kwargs:
+        return _nsga3(exp.pop_size, n_obj, **operators)
+    factory = _named(algorithm) if isinstance(algorithm, str) else algorithm
+    if not callable(factory):
+        raise InvalidParameterError(
+            f"algorithm must be a name of {ALGORITHMS} or a pymoo algorithm class, got {algorithm!r}"
+        )
+    return factory(pop_size=exp.pop_size, **operators)
+
+
+def _algorithm_label(algorithm: Any) -> str:
+    if isinstance(algorithm, str):
+        return algorithm
+    return getattr(algorithm, "__name__", type(algorithm).__name__)
+
+
+class PymooRun(Driver):
+    """An experiment run with a pymoo algorithm through ask and tell (see the module docstring).
+
+    Same run folder, log, figures and checkpoints as every driver
+    (:class:`~evolvers.recording.recorder.RunRecorder`). ``generations`` counts the
+    generations after the initial population (pymoo's ``n_gen`` is one more).
+
+    Parameters
+    ----------
+    experiment, out, seed, generations, **driver
+        As for :class:`~evolvers.drivers.base.Driver` (``batch_fn``, ``n_threads``,
+        ``on_generation``, ``figures``, ``gif``, ``progress``; Ctrl-C raises
+        :class:`~evolvers.recording.recorder.RunInterrupted` the same way).
+    algorithm : str or callable
+        ``"nsga2"`` (default), ``"nsga3"``, ``"sms-emoa"``, ``"ga"``
+        (single-objective, on the experiment's fitness), or a pymoo algorithm
+        class or factory (:func:`make_algorithm`); a fresh algorithm is built
+        for every :meth:`run`.
+    algorithm_kwargs : dict, optional
+        More keywords for the algorithm (e.g. NSGA-III's ``ref_dirs``).
+    single_objective : bool, optional
+        Optimise the fitness alone (default: True for ``"ga"``).
+    """
+
+    backend = "pymoo"
+
+    def __init__(self, experiment: Experiment, out: str | Path, seed: int = 0,
+                 generations: int | None = None, *,
+                 algorithm: str | Callable[..., Algorithm] = "nsga2",
+                 algorithm_kwargs: dict[str, Any] | None = None,
+                 single_objective: bool | None = None, **driver: Any) -> None:  # fmt: skip
+        if isinstance(algorithm, str) and algorithm not in ALGORITHMS:
+            raise InvalidParameterError(
+                f"unknown algorithm {algorithm!r}; expected one of {ALGORITHMS}"
+            )
+        self.algorithm_spec = algorithm
+        self.algorithm_kwargs = dict(algorithm_kwargs or {})
+        self.single_objective = (
+            (algorithm == "ga") if single_objective is None else single_objective
+        )
+        super().__init__(experiment, out, seed, generations,
+                         extra_config={"algorithm": _algorithm_label(algorithm)}, **driver)  # fmt: skip
+
+    # ------------------------------------------------------------------ the loop
+    def _fresh(self) -> None:
+        super()._fresh()
+        exp = self.experiment
+        novelty = exp.selection.startswith("novelty")
+        self.archive: NoveltyArchive | None = (
+            NoveltyArchive(k=exp.pop_size, n_add=2, variant="normalized") if novelty else None
+        )
+        objectives = exp.objectives[:1] if self.single_objective else exp.objectives
+        self.problem = SoftbotProblem(exp, self.evaluator, self.archive, objectives)
+        self.algorithm: Algorithm = make_algorithm(
+            self.algorithm_spec, exp, self.ids, self.problem.n_obj, **self.algorithm_kwargs
+        )
+        self.algorithm.setup(
+            self.problem, termination=("n_gen", self.generations + 1), seed=self.seed,
+            verbose=False,
+        )  # fmt: skip
+
+    @property
+    def label(self) -> str:
+        """The progress bar's description."""
+        return f"{self.experiment.name} [pymoo {_algorithm_label(self.algorithm_spec)}]"
+
+    def _generation(self, problem: SoftbotProblem, algorithm: Algorithm) -> list[Individual]:
+        """One ask / evaluate / tell round; returns the evaluated infills."""
+        infills = algorithm.ask()
+        algorithm.evaluator.eval(problem, infills)
+        algorithm.tell(infills=infills)
+        self.generation += 1
+        self.population = [x[0] for x in algorithm.pop.get("X")]
+        return [x[0] for x in infills.get("X")]
+
+    def _replay(self, problem: SoftbotProblem, algorithm: Algorithm, state: dict[str, Any]) -> None:
+        """Re-run the checkpointed generations from the seed; every result comes from the cache."""
+        target = int(state["generation"])
+        counter = self.evaluator.n_evaluations
+        while self.generation < target:
+            self._generation(problem, algorithm)
+        self.evaluator.n_evaluations = counter
+        if population_summary(self.population) != state["population"] or self.ids.value != int(
+            state["next_id"]
+        ):
+            raise CheckpointError(
+                f"{self.recorder.checkpoint_dir}: replaying generations 0-{target} did not "
+                "reach the checkpointed population (another softgym, pymoo or algorithm?)"
+            )
+
+    def _step(self) -> EvalStats:
+        infills = self._generation(self.problem, self.algorithm)
+        self.recorder.update_hall_of_fame(infills, self.generation)
+        return self.problem.last_stats
+
+    def _restore(self, state: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
+        self.evaluator.cache = PhenotypeCache.from_arrays(arrays)
+        self.evaluator.n_evaluations = int(state.get("evaluations_counter", 0))
+        self._replay(self.problem, self.algorithm, state)
+
+    def _checkpoint_state(self) -> Checkpoint:
+        algorithm = self.algorithm
+        pop = algorithm.pop
+        data, lengths = pack_traces([ind.trace for ind in self.population])
+        arrays = {
+            "pop_traces": data, "pop_trace_len": lengths,
+            "F": pop.get("F"), "G": pop.get("G"), "CV": pop.get("CV"),
+            **self.evaluator.cache.to_arrays(),
+        }  # fmt: skip
+        state = {
+            "rng": rng_state(algorithm.random_state),
+            "next_id": self.ids.value,
+            "archive": None if self.archive is None else self.archive.to_dict(),
+            "n_eval": int(algorithm.evaluator.n_eval),
+            "evaluations_counter": self.evaluator.n_evaluations,
+        }
+        return state, arrays, None, self.population

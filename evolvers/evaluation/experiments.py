@@ -1,0 +1,361 @@
+"""The seed study's scenarios as named, runnable configurations.
+
+==========================  =====================  ==============  ============================================
+name                        variation              selection       objectives
+==========================  =====================  ==============  ============================================
+``basic``                   CPPN                   Pareto          NormFinalDist (max), muscle voxels (min)
+``materials-t1``            CPPN + material GA     Pareto          NormFinalDist (max), old materials (min)
+``materials-t2``            CPPN + material GA     Pareto          ... + robot voxels (min)
+``novelty``                 CPPN                   AMSS (seed)     novelty; fitness and energy logged
+``novelty-archive``         CPPN                   AMSS + archive  novelty against past generations too
+``controller-tournament``   CPPN + controller GA   tournament (2)  NormFinalDist (max)
+``controller-pareto``       CPPN + controller GA   Pareto          NormFinalDist (max), muscle voxels (min)
+``obstacles``               CPPN + controller GA   Pareto + age    MaxXYDist (max), L coeff. (max), age (min)
+``obstacles-attempt1``      CPPN                   Pareto          MaxXYDist (max), muscle voxels (min)
+``obstacles-attempt2``      CPPN + controller GA   tournament (2)  MaxXYDist (max)
+==========================  =====================  ==============  ============================================
+
+``materials`` is an alias of ``materials-t1``. Obstacle experiments run on the
+``wall`` task (:mod:`softgym.tasks`: the seed's 1-voxel-high fence, 10-voxel
+interior) with centre-of-mass samples every 0.1 s; ``obstacles`` also applies
+the seed's composition constraints (>= 10 % tissue, >= 1 bone, >= 10 % muscle).
+Any experiment runs on another task with ``get_experiment(name, task="stairs")``
+(or a Terrain, or a terrain JSON file: ``softgym evolve --task FILE.json``). Every experiment: 6x6x6 CPPN robots,
+population 15, 15 children and 1 random newcomer per generation, 5 s simulated.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields, replace
+from typing import Any
+
+from evolvers.operators.selection import SELECTORS, Objective
+from softgym.design import MATERIAL_TREE_4, MATERIAL_TREE_8, CompositionRules
+from softgym.exceptions import InvalidParameterError
+from softgym.metrics import WALK_METRICS
+from softgym.tasks import Task, get_task
+from softgym.terrain import Terrain
+from softgym.validate import is_int, show
+
+__all__ = [
+    "EXPERIMENTS",
+    "MAX_POP_SIZE",
+    "SELECTIONS",
+    "Experiment",
+    "get_experiment",
+    "list_experiments",
+]
+
+#: Largest population an experiment accepts (each individual is simulated every
+#: generation: 100,000 6x6x6 robots are ~10 CPU-hours a generation).
+MAX_POP_SIZE = 100_000
+
+#: Selection schemes an experiment may name.
+SELECTIONS: tuple[str, ...] = tuple(SELECTORS)
+
+
+@dataclass(frozen=True)
+class Experiment:
+    """A runnable evolutionary scenario.
+
+    Parameters
+    ----------
+    name : str
+    description : str
+    objectives : tuple of Objective
+        Selection objectives, most important first (the first is "the
+        fitness" shown in progress bars and trend figures).
+    logged : tuple of str
+        Extra metrics recorded in the log (not selected on).
+    selection : {"pareto", "tournament", "novelty", "novelty-archive", "nsga2"}
+    evolve_controller, evolve_materials : bool
+        Whether the controller / material genes evolve (crossover + mutation).
+    cppn_outputs : tuple of str
+        CPPN outputs: the 4-output tree, or the 8-output tree of materials evolution.
+    rules : CompositionRules
+        Validity of a body (enforced by generation and mutation; pymoo's G).
+    task : Task, str or Terrain
+        The world: a task name of :mod:`softgym.tasks` (``"flat"``, ``"wall"``,
+        ``"stairs"``, ``"gap:width=3"``; ``"fence"`` is read as ``"wall"``), a
+        custom :class:`~softgym.terrain.Terrain` (a terrain JSON file's path is
+        read into one, so the run folder's config.json holds the whole world) or
+        a Task. Read once, here: the experiment holds it as a
+        :class:`~softgym.tasks.Task` of the world alone (terrain and arguments);
+        :meth:`make_task` adds the duration and sampling.
+    seconds : float
+        Simulated seconds per evaluation (5).
+    trace_interval : float
+        Seconds between centre-of-mass samples (0.5 novelty, 0.1 otherwise).
+    pop_size, n_random : int
+        Population size (15) and random newcomers per generation (1).
+    generations : int
+        Default number of generations (the report's).
+    crossover_rate : float
+        Arithmetic crossover rate (0.4).
+    shape : tuple of 3 int
+        Robot grid (6, 6, 6).
+    sim : dict
+        :class:`~softgym.engine.SimConfig` overrides.
+    seed_centre_of_mass : bool
+        Score on the seed's centre of mass, which counts the obstacles' 1-kg
+        wall voxels (``Task(seed_centre_of_mass=True)``,
+        :func:`softgym.metrics.dilute`): the MaxXYDist and L coefficient the
+        seed's obstacle runs selected on. Off by default (the robot's own
+        voxels); the study's obstacle scenarios turn it on. Traces, and so a
+        crossing of the wall, stay the robot's own.
+    """
+
+    name: str
+    description: str
+    objectives: tuple[Objective, ...]
+    logged: tuple[str, ...] = ()
+    selection: str = "pareto"
+    evolve_controller: bool = False
+    evolve_materials: bool = False
+    cppn_outputs: tuple[str, ...] = MATERIAL_TREE_4
+    rules: CompositionRules = field(default_factory=CompositionRules.seed)
+    task: Task | str | Terrain = "flat"
+    seconds: float = 5.0
+    trace_interval: float = 0.1
+    pop_size: int = 15
+    n_random: int = 1
+    generations: int = 40
+    crossover_rate: float = 0.4
+    shape: tuple[int, int, int] = (6, 6, 6)
+    sim: dict[str, Any] = field(default_factory=dict)
+    seed_centre_of_mass: bool = False
+
+    def __post_init__(self) -> None:
+        if self.selection not in SELECTIONS:
+            raise InvalidParameterError(
+                f"unknown selection {self.selection!r}; expected one of {SELECTIONS}"
+            )
+        if not is_int(self.pop_size) or not 2 <= self.pop_size <= MAX_POP_SIZE:
+            raise InvalidParameterError(
+                f"pop_size must be an integer in [2, {MAX_POP_SIZE}], got {show(self.pop_size)}"
+            )
+        if not self.objectives:
+            raise InvalidParameterError("an experiment needs at least one objective")
+        object.__setattr__(self, "shape", tuple(int(s) for s in self.shape))
+        task = get_task(self.task)  # a name, alias, Terrain, JSON file or Task; raises if unknown
+        # the world alone (what config.json records, Task.spec): the experiment sets the rest
+        task = Task(terrain=task.terrain, options=dict(task.options))
+        object.__setattr__(self, "task", task)
+        if task.reward not in WALK_METRICS:
+            # a suite task that is not about walking: its score replaces the walking distances
+            objectives, seen = [], set()
+            for o in self.objectives:
+                if o.name in ("norm_final_dist", "max_xy_dist"):
+                    o = Objective("score", True)
+                if o.name not in seen:
+                    objectives.append(o)
+                    seen.add(o.name)
+            object.__setattr__(self, "objectives", tuple(objectives))
+
+    @property
+    def fitness(self) -> Objective:
+        """The first (most important) objective."""
+        return self.objectives[0]
+
+    @property
+    def metrics(self) -> tuple[str, ...]:
+        """Every metric recorded: the objectives' (age excluded) and the logged ones."""
+        names = [o.name for o in self.objectives if o.name != "age"] + list(self.logged)
+        return tuple(dict.fromkeys(names))
+
+    def make_task(self, n_threads: int | None = None) -> Task:
+        """The :class:`softgym.tasks.Task` evaluations run (the task with this duration and sampling)."""
+        return self.task.replace(
+            seconds=self.seconds,
+            trace_interval=self.trace_interval,
+            sim=dict(self.sim),
+            n_threads=n_threads,
+            seed_centre_of_mass=self.seed_centre_of_mass,
+        )
+
+    def replace(self, **changes: Any) -> Experiment:
+        """A copy with some fields changed (e.g. ``pop_size``, ``seconds``, ``shape``)."""
+        return replace(self, **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready dict."""
+        out: dict[str, Any] = {}
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if f.name == "objectives":
+                v = [o.to_dict() for o in v]
+            elif f.name == "task":  # as get_task reads it: "name", "name:arg=value", a terrain
+                v = v.spec.to_dict() if isinstance(v.spec, Terrain) else v.spec
+            elif f.name == "rules":
+                v = v.to_dict()
+            elif isinstance(v, tuple):
+                v = list(v)
+            out[f.name] = v
+        return out
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> Experiment:
+        """Inverse of :meth:`to_dict` (also reads older run folders' ``terrain`` key)."""
+        kw = dict(data)
+        if "terrain" in kw:  # before the task layer: "terrain": "flat" | "fence"
+            kw["task"] = kw.pop("terrain")
+        if isinstance(kw.get("task"), Mapping):
+            kw["task"] = Terrain.from_dict(dict(kw["task"]))
+        kw["objectives"] = tuple(Objective(**o) for o in kw["objectives"])
+        kw["rules"] = CompositionRules.from_dict(kw["rules"])
+        for name in ("logged", "cppn_outputs", "shape"):
+            kw[name] = tuple(kw[name])
+        return cls(**kw)
+
+
+_FIT = Objective("norm_final_dist", True)
+_ENERGY = Objective("n_muscle", False)
+
+EXPERIMENTS: dict[str, Experiment] = {
+    e.name: e
+    for e in (
+        Experiment(
+            "basic",
+            "evosoro's baseline: CPPN mutation, Pareto on distance and muscle count (report Fig. 4)",
+            (_FIT, _ENERGY),
+            selection="pareto",
+            generations=40,
+        ),
+        Experiment(
+            "materials-t1",
+            "materials evolution, treatment 1: distance vs. use of the old materials (report Fig. 1)",
+            (_FIT, Objective("n_old_materials", False)),
+            logged=("n_voxels",),
+            evolve_materials=True,
+            cppn_outputs=MATERIAL_TREE_8,
+            generations=300,
+        ),
+        Experiment(
+            "materials-t2",
+            "materials evolution, treatment 2: treatment 1 plus fewer voxels",
+            (_FIT, Objective("n_old_materials", False), Objective("n_voxels", False)),
+            evolve_materials=True,
+            cppn_outputs=MATERIAL_TREE_8,
+            generations=50,
+        ),
+        Experiment(
+            "novelty",
+            "novelty search: AMSS similarity of centre-of-mass trajectories within the generation",
+            (_FIT,),
+            logged=("n_muscle",),
+            selection="novelty",
+            trace_interval=0.5,
+            generations=200,
+        ),
+        Experiment(
+            "novelty-archive",
+            "novelty search with an archive of past behaviours (k nearest neighbours)",
+            (_FIT,),
+            logged=("n_muscle",),
+            selection="novelty-archive",
+            trace_interval=0.5,
+            generations=200,
+        ),
+        Experiment(
+            "controller-tournament",
+            "controller evolution with the fitness tournament (report Fig. 4)",
+            (_FIT,),
+            logged=("n_muscle",),
+            selection="tournament",
+            evolve_controller=True,
+            generations=40,
+        ),
+        Experiment(
+            "controller-pareto",
+            "controller evolution with Pareto on distance and muscle count (report Fig. 4)",
+            (_FIT, _ENERGY),
+            selection="pareto",
+            evolve_controller=True,
+            generations=40,
+        ),
+        Experiment(
+            "obstacles",
+            "evolution vs. a 1-voxel wall, final setup: MaxXYDist, L coefficient and age, composition rules",
+            (
+                Objective("max_xy_dist", True),
+                Objective("l_coefficient", True),
+                Objective("age", False),
+            ),
+            logged=("n_muscle", "n_bone"),
+            selection="pareto",
+            evolve_controller=True,
+            rules=CompositionRules.obstacles(),
+            task="wall",
+            generations=80,
+        ),
+        Experiment(
+            "obstacles-attempt1",
+            "evolution vs. a wall, attempt 1: default controller, Pareto on MaxXYDist and muscle count",
+            (Objective("max_xy_dist", True), _ENERGY),
+            logged=("l_coefficient",),
+            selection="pareto",
+            task="wall",
+            generations=20,
+        ),
+        Experiment(
+            "obstacles-attempt2",
+            "evolution vs. a wall, attempt 2: controller evolution with the fitness tournament on MaxXYDist",
+            (Objective("max_xy_dist", True),),
+            logged=("l_coefficient", "n_muscle"),
+            selection="tournament",
+            evolve_controller=True,
+            task="wall",
+            generations=20,
+        ),
+    )
+}
+EXPERIMENTS["materials"] = EXPERIMENTS["materials-t1"]
+
+
+def list_experiments() -> list[str]:
+    """Names of the named experiments."""
+    return list(EXPERIMENTS)
+
+
+def get_experiment(name: str, **overrides: Any) -> Experiment:
+    """A named experiment, with optional field overrides.
+
+    Raises
+    ------
+    InvalidParameterError
+        If the name is unknown.
+    """
+    try:
+        exp = EXPERIMENTS[name]
+    except KeyError:
+        raise InvalidParameterError(
+            f"unknown experiment {name!r}; expected one of {list_experiments()}"
+        ) from None
+    return exp.replace(**overrides) if overrides else exp
+
+
+#: Environment variable: ``SOFTGYM_SMOKE=1`` cuts every run to smoke-test sizes
+#: (:func:`smoke_sizes`), so documentation examples run verbatim in seconds (the
+#: README's test sets it). Never set it for a real run: a warning says it is on.
+SMOKE_ENV = "SOFTGYM_SMOKE"
+
+
+def smoke_sizes(experiment: Experiment, generations: int) -> tuple[Experiment, int]:
+    """``(experiment, generations)``, cut to 1 generation of 4 robots of 4x4x4, 1.5 s each,
+    when ``SOFTGYM_SMOKE`` is set to a non-zero value (else unchanged).
+    """
+    if os.environ.get(SMOKE_ENV, "0").strip() in ("", "0"):
+        return experiment, generations
+    logging.getLogger("evolvers").warning(
+        "%s is set: %s cut to smoke-test sizes (1 generation, 4 robots of 4x4x4, 1.5 s)",
+        SMOKE_ENV, experiment.name,
+    )  # fmt: skip
+    small = experiment.replace(
+        pop_size=min(experiment.pop_size, 4),
+        seconds=min(experiment.seconds, 1.5),
+        shape=tuple(min(n, 4) for n in experiment.shape),
+    )
+    return small, min(int(generations), 1)

@@ -1,0 +1,85 @@
+import json
+
+import numpy as np
+import pytest
+from evolver_helpers import tiny
+from pymoo.algorithms.moo.nsga2 import NSGA2
+from pymoo.core.problem import Problem
+
+from evolvers.drivers.pymoo_runner import PymooRun, SoftbotProblem, constraint_values
+from evolvers.drivers.runner import population_summary
+from evolvers.evaluation.evaluator import Evaluator
+from evolvers.operators.genome import Individual
+from softgym.design import CompositionRules
+from softgym.exceptions import CheckpointError
+
+
+def test_problem_fills_minimised_F_and_feasible_G():
+    exp = tiny("obstacles", rules=CompositionRules.obstacles())
+    problem = SoftbotProblem(exp, Evaluator(exp))
+    assert isinstance(problem, Problem) and problem.n_obj == 3 and problem.n_ieq_constr == 5
+    rng = np.random.default_rng(0)
+    X = np.array(
+        [[Individual.random(rng, i, exp.shape, rules=exp.rules)] for i in range(2)], dtype=object
+    )
+    out = problem.evaluate(X, return_as_dictionary=True)
+    assert out["F"].shape == (2, 3) and out["G"].shape == (2, 5)
+    assert (out["G"] <= 0).all()  # valid robots are feasible
+    np.testing.assert_array_equal(out["F"][:, 0], [-x[0].objectives["max_xy_dist"] for x in X])
+    grid = np.zeros(exp.shape, dtype=np.int8)
+    grid[0, 0, 0] = 3
+    assert (constraint_values(grid, exp.rules) > 0).any()
+
+
+def test_pymoo_nsga2_runs_and_resumes_exactly(tmp_path):
+    exp = tiny("controller-pareto")
+    ref_run = PymooRun(exp, tmp_path / "a", seed=3, generations=2, figures=False)
+    ref = ref_run.run()
+    assert [r["generation"] for r in ref_run.rows] == [0, 1, 2]
+
+    class Crash(Exception):
+        pass
+
+    def crash(run, row):
+        if row["generation"] == 1:
+            raise Crash
+
+    try:
+        PymooRun(
+            exp, tmp_path / "b", seed=3, generations=2, figures=False, on_generation=crash
+        ).run()
+    except Crash:
+        pass
+    resumed = PymooRun(exp, tmp_path / "b", seed=3, generations=2, figures=False).run(resume=True)
+    assert population_summary(resumed) == population_summary(ref)
+
+
+@pytest.mark.parametrize("algorithm", ["nsga3", "sms-emoa", "ga", NSGA2])
+def test_any_pymoo_algorithm_through_ask_and_tell(tmp_path, algorithm):
+    exp = tiny("controller-pareto")
+    run = PymooRun(exp, tmp_path / "r", seed=1, generations=1, figures=False, algorithm=algorithm)
+    pop = run.run()
+    assert len(pop) == exp.pop_size and [r["generation"] for r in run.rows] == [0, 1]
+    assert run.algorithm.problem.n_obj == (1 if algorithm == "ga" else 2)
+    cfg = json.loads((tmp_path / "r" / "config.json").read_text())
+    assert cfg["algorithm"] == (algorithm if isinstance(algorithm, str) else "NSGA2")
+
+
+def test_ga_resumes_exactly_and_resume_refuses_another_algorithm(tmp_path):
+    exp = tiny("controller-tournament")
+    ref = PymooRun(exp, tmp_path / "a", seed=2, generations=2, figures=False, algorithm="ga").run()
+
+    def crash(run, row):
+        if row["generation"] == 1:
+            raise RuntimeError("crash")
+
+    with pytest.raises(RuntimeError):
+        PymooRun(
+            exp, tmp_path / "b", seed=2, generations=2, figures=False, algorithm="ga",
+            on_generation=crash,
+        ).run()  # fmt: skip
+    resumed = PymooRun(exp, tmp_path / "b", seed=2, generations=2, figures=False, algorithm="ga")
+    assert population_summary(resumed.run(resume=True)) == population_summary(ref)
+    assert resumed.rows[-1]["evaluations"] > 0 and resumed.evaluations_total > 0
+    with pytest.raises(CheckpointError, match="algorithm"):
+        PymooRun(exp, tmp_path / "b", seed=2, generations=3, figures=False).run(resume=True)
