@@ -1,11 +1,11 @@
 """POET co-evolution against a random-terrain control and against direct evolution.
 
 Per seed, three searches over the same robots (4x4x4 CPPN bodies with the
-controller GA, 3 s simulated, :func:`evolvers.poet.poet_experiment`) and the same
+controller GA, 3 s simulated, :func:`evolvers.drivers.poet.poet_experiment`) and the same
 thresholds (voxel lengths of ``max_xy_dist``; POET's rewards mapped by
-:func:`evolvers.poet.poet_thresholds`):
+:func:`evolvers.drivers.poet.poet_thresholds`):
 
-* ``poet``: :class:`evolvers.poet.PoetRun`, candidate terrains mutated from eligible parents;
+* ``poet``: :class:`evolvers.drivers.poet.PoetRun`, candidate terrains mutated from eligible parents;
 * ``control``: the same loop with candidate terrains drawn uniformly (``generator="random"``);
 * ``direct``: for the hardest terrain the POET run solved (fewest kept robots at the
   solved threshold, then the lowest mean score; the start terrain excluded), one

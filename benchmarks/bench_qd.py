@@ -4,11 +4,11 @@ Three searches over CPPN robots (the ``basic`` experiment's bodies on flat
 ground) each get the same budget of simulations (distinct phenotypes; cache
 hits are free for all three) and the same seeds:
 
-* ``map-elites``: :class:`evolvers.qd.QDRun` (pyribs GridArchive, stiff x
+* ``map-elites``: :class:`evolvers.drivers.qd.QDRun` (pyribs GridArchive, stiff x
   filled descriptors, softgym's mutation);
-* ``nsga2``: :class:`evolvers.pymoo_runner.PymooRun` on ``basic`` (distance up,
+* ``nsga2``: :class:`evolvers.drivers.pymoo_runner.PymooRun` on ``basic`` (distance up,
   muscle voxels down);
-* ``novelty``: :class:`evolvers.runner.EvolutionRun` on ``novelty`` (the seed's
+* ``novelty``: :class:`evolvers.drivers.runner.EvolutionRun` on ``novelty`` (the seed's
   AMSS novelty within each generation).
 
 Every simulated robot of a run is recorded (a wrapper around the batch

@@ -21,9 +21,9 @@ Sets
   blocks, layers, checkerboards, legged bodies, L-shapes, bars, with and without
   bone; many mirror-symmetric).
 * :func:`random_bodies`: bodies of softgym's seed-style random CPPN genomes
-  (``evolvers.genome.Individual.random``), some filtered to contain bone, some drawn
+  (``evolvers.operators.genome.Individual.random``), some filtered to contain bone, some drawn
   under the obstacle experiment's rules (>= 1 bone voxel), some mutated a few times
-  with ``evolvers.operators.mut_cppn``.
+  with ``evolvers.operators.variation.mut_cppn``.
 * :func:`fence_cases`: 6x6x6 bodies on the seed's fence task (a 1-voxel-high,
   1-voxel-thick square wall with a 10x10 interior, 2 voxels from the robot on every
   side; the seed study).
@@ -490,7 +490,7 @@ def random_bodies() -> list[Case]:
       that contain bone (Passive_Hard).
     * ``rand_oNN``: draws under ``CompositionRules.obstacles()`` (>= 1 bone voxel).
     * ``rand_mNN_xK``: a seed-style draw of ``default_rng([16, 4, NN])`` mutated K = 1..5
-      times by ``evolvers.operators.mut_cppn`` with ``default_rng([16, 5, NN])``.
+      times by ``evolvers.operators.variation.mut_cppn`` with ``default_rng([16, 5, NN])``.
     """
     from evolvers.operators.variation import mut_cppn
     from softgym.design import CompositionRules

@@ -42,8 +42,7 @@ sys.path.insert(0, HERE)
 import fidelity_cases as fc  # noqa: E402
 import make_oracle_data as mod  # noqa: E402
 
-from evolvers.experiments import Experiment  # noqa: E402
-from evolvers.genome import Individual  # noqa: E402
+from evolvers import Experiment, Individual  # noqa: E402
 from softgym.design.robot import RobotDesign  # noqa: E402
 from softgym.design.vxa import to_vxa  # noqa: E402
 from softgym.io import latest_checkpoint, load_checkpoint, read_json  # noqa: E402
