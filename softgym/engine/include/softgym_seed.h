@@ -1,7 +1,8 @@
 /* The seed model's vectorised link and voxel passes (softgym/engine/_seed.pyx
    calls them; declared for Cython in _seed.pyx's `cdef extern from`).
-   Compiled with -ffp-contract=off: the same IEEE operations as the seed's
-   scalar code, bit for bit. Py_ssize_t comes from Python.h, which Cython
+   The same operations as the seed's scalar code; compiled with
+   -ffp-contract=fast, so builds with FMA instructions fuse a * b + c (setup.py).
+   Py_ssize_t comes from Python.h, which Cython
    includes first. */
 #ifndef SOFTGYM_SEED_H
 #define SOFTGYM_SEED_H
@@ -13,9 +14,9 @@
    quantities of links lo..hi in the mode the first pass gave them, without
    branches so the loop vectorises (the outputs are distinct rows of the
    scratch: no two iterations touch the same element). Every candidate
-   value is computed and one is selected, the same IEEE result as the
-   branchy scalar code (_seed_frame_one; -ffp-contract=off: no fused
-   multiply-adds). Outputs: the displacement P, voxel 1's rotation vector
+   value is computed and one is selected: the branchy scalar code's result
+   (_seed_frame_one), bit for bit where multiply-adds are not fused, else
+   to within the fusing's rounding (~1e-12 relative). Outputs: the displacement P, voxel 1's rotation vector
    (y, z; its x is 0), voxel 2's, the large-angle frame rq = (rw, 0, ry,
    rz). A link whose rotation vector needs the seed's acos branch (angles
    beyond ~5.6 degrees), or whose chord points backwards, gets fix = 1 and
@@ -59,16 +60,22 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_frames_impl(
         /* large angle: rq onto the chord (exactly along it when the
            transverse ratios are small) */
         long long zero = (p0 == 0.0) & (p1 == 0.0) & (p2 == 0.0);
-        double yx = p1 / p0, zx = p2 / p0;
+        double inv_p0 = 1.0 / p0;
+        double yx = p1 * inv_p0, zx = p2 * inv_p0;
         long long small = (yx < sa_rad) & (yx > -sa_rad) & (zx < sa_rad) & (zx > -sa_rad);
         double ry_s = 0.5 * zx, rz_s = -0.5 * yx;
         double rw_s = 1.0 + 0.5 * (-ry_s * ry_s - rz_s * rz_s);
+        /* the half-angle quaternion onto the chord n = p / |p|: (1 + nx, 0,
+           nz, -ny) / sqrt(2 (1 + nx)), i.e. (|p| + p0, 0, p2, -p1) / s with
+           s = sqrt(2 |p| (|p| + p0)): two square roots and one division
+           (the seed's cos(th / 2), sin(th / 2) and 1 / |n_yz| took four and
+           four) */
         double ln = sqrt(p0 * p0 + p1 * p1 + p2 * p2);
-        double nx = p0 / ln, ny = p1 / ln, nz = p2 / ln;
-        double rho = 1.0 / sqrt(nz * nz + ny * ny);
-        double ch = sqrt(0.5 * (1.0 + nx)), sh = sqrt(0.5 * (1.0 - nx));
-        double ry_l = nz * rho * sh, rz_l = -ny * rho * sh;
-        fix |= (1 - is_sa) & (1 - zero) & (1 - small) & (nx < -0.5);
+        double lp = ln + p0;
+        double inv_s = 1.0 / sqrt(2.0 * ln * lp);
+        double ch = lp * inv_s;
+        double ry_l = p2 * inv_s, rz_l = -p1 * inv_s;
+        fix |= (1 - is_sa) & (1 - zero) & (1 - small) & (p0 < -0.5 * ln);
         double rw = zero ? 1.0 : (small ? rw_s : ch);
         double ry = zero ? 0.0 : (small ? ry_s : ry_l);
         double rz = zero ? 0.0 : (small ? rz_s : rz_l);
