@@ -370,24 +370,40 @@ static Py_ssize_t softgym_seed_modes(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
 #if defined(__AVX__) && (defined(__GNUC__) || defined(__clang__))
 #define SOFTGYM_SCATTER_V4 1
 typedef double softgym_v4d __attribute__((vector_size(32)));
-#define SOFTGYM_SCATTER_TURN(acc, x, y, z) do { \
+#define SOFTGYM_SCATTER_W(w, x, y, z) do { \
         double x_ = (x), y_ = (y), z_ = (z); \
-        softgym_v4d w_ = c0 * x_ + c1 * y_ + c2 * z_; \
-        (acc)[0] += w_[0]; \
-        (acc)[1] += w_[1]; \
-        (acc)[2] += w_[2]; \
+        softgym_v4d t_ = c0 * x_ + c1 * y_ + c2 * z_; \
+        (w)[0] = t_[0]; \
+        (w)[1] = t_[1]; \
+        (w)[2] = t_[2]; \
     } while (0)
 #else
-#define SOFTGYM_SCATTER_TURN(acc, x, y, z) do { \
+#define SOFTGYM_SCATTER_W(w, x, y, z) do { \
         double x_ = (x), y_ = (y), z_ = (z); \
-        double w0_ = R[0] * x_ + R[1] * y_ + R[2] * z_; \
-        double w1_ = R[3] * x_ + R[4] * y_ + R[5] * z_; \
-        double w2_ = R[6] * x_ + R[7] * y_ + R[8] * z_; \
-        (acc)[0] += w0_; \
-        (acc)[1] += w1_; \
-        (acc)[2] += w2_; \
+        (w)[0] = R[0] * x_ + R[1] * y_ + R[2] * z_; \
+        (w)[1] = R[3] * x_ + R[4] * y_ + R[5] * z_; \
+        (w)[2] = R[6] * x_ + R[7] * y_ + R[8] * z_; \
     } while (0)
 #endif
+#define SOFTGYM_SCATTER_TURN(acc, x, y, z) do { \
+        SOFTGYM_SCATTER_W(w, x, y, z); \
+        (acc)[0] += w[0]; \
+        (acc)[1] += w[1]; \
+        (acc)[2] += w[2]; \
+    } while (0)
+/* voxel 2's force where it is minus voxel 1's (row 23: a single material or
+   a mode change): the turn of -f1 is exactly minus the turn of f1 (negation
+   is exact and rounding symmetric, fused or not), and a + (-b) is a - b, so
+   voxel 1's turned force is subtracted, one turn fewer, the same bits */
+#define SOFTGYM_SCATTER_F2(x, y, z) do { \
+        if (neg2) { \
+            fj[0] -= w[0]; \
+            fj[1] -= w[1]; \
+            fj[2] -= w[2]; \
+        } else { \
+            SOFTGYM_SCATTER_TURN(fj, x, y, z); \
+        } \
+    } while (0)
 SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
                                                    Py_ssize_t n, const Py_ssize_t *v1,
                                                    const Py_ssize_t *v2, const double *rot,
@@ -406,28 +422,32 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
         double R[9];
         memcpy(R, Rp, sizeof R);
 #endif
+        double w[3];
         const double *q = o + li;
+        int neg2 = q[23 * n] != 0.0;
         double *fi = force + 3 * i, *fj = force + 3 * j;
         double *mi = moment + 3 * i, *mj = moment + 3 * j;
         if (ax == 0) {
             SOFTGYM_SCATTER_TURN(fi, q[0], q[n], q[2 * n]);
-            SOFTGYM_SCATTER_TURN(fj, q[3 * n], q[4 * n], q[5 * n]);
+            SOFTGYM_SCATTER_F2(q[3 * n], q[4 * n], q[5 * n]);
             SOFTGYM_SCATTER_TURN(mi, q[6 * n], q[7 * n], q[8 * n]);
             SOFTGYM_SCATTER_TURN(mj, q[9 * n], q[21 * n], q[24 * n]);
         } else if (ax == 1) {
             SOFTGYM_SCATTER_TURN(fi, -q[n], q[0], q[2 * n]);
-            SOFTGYM_SCATTER_TURN(fj, -q[4 * n], q[3 * n], q[5 * n]);
+            SOFTGYM_SCATTER_F2(-q[4 * n], q[3 * n], q[5 * n]);
             SOFTGYM_SCATTER_TURN(mi, -q[7 * n], q[6 * n], q[8 * n]);
             SOFTGYM_SCATTER_TURN(mj, -q[21 * n], q[9 * n], q[24 * n]);
         } else {
             SOFTGYM_SCATTER_TURN(fi, -q[2 * n], q[n], q[0]);
-            SOFTGYM_SCATTER_TURN(fj, -q[5 * n], q[4 * n], q[3 * n]);
+            SOFTGYM_SCATTER_F2(-q[5 * n], q[4 * n], q[3 * n]);
             SOFTGYM_SCATTER_TURN(mi, -q[8 * n], q[7 * n], q[6 * n]);
             SOFTGYM_SCATTER_TURN(mj, -q[24 * n], q[21 * n], q[9 * n]);
         }
     }
 }
+#undef SOFTGYM_SCATTER_F2
 #undef SOFTGYM_SCATTER_TURN
+#undef SOFTGYM_SCATTER_W
 #undef SOFTGYM_SCATTER_V4
 
 static void softgym_seed_scatter(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
