@@ -4,7 +4,7 @@ One :class:`Simulation` holds many robots (:class:`Body`) in flat arrays and
 advances them in parallel; :meth:`Simulation.run` returns a :class:`Rollout`.
 """
 
-from softgym.engine._dispatch import available_kernels, install, kernel_build
+from softgym.engine._dispatch import FUSED_KERNELS, available_kernels, install, kernel_build
 
 install()  # the kernel build for this CPU, before any kernel module is imported
 
@@ -23,6 +23,7 @@ from softgym.engine.simulation import (  # noqa: E402
 
 __all__ = [
     "AUX_NAMES",
+    "FUSED_KERNELS",
     "Body",
     "Rollout",
     "SimConfig",

@@ -32,6 +32,8 @@ cdef struct Contacts:
     intp_t n_opairs          # obstacle pairs in use
     intp_t ocapacity         # obstacle pairs allocated
     KeyIndex* ocells         # (n_obs_r,) obstacles sorted by spatial-hash cell
+    intp_t* dense            # the voxel hash's cell table (SpatialHash.start), kept
+    intp_t dense_capacity    # entries allocated in dense
 
 
 # The spatial hash of the candidate lists (_contact.pyx, _hash_*): points in
@@ -44,6 +46,11 @@ cdef struct SpatialHash:
     float64_t y0
     float64_t z0
     int64_t offset           # keeps the packed cell coordinates (20 bits each) non-negative
+    intp_t* start            # NULL, or a dense table over the cells (0..nx-1, 0..ny-1,
+                             # 0..nz-1): start[(i ny + j) nz + k] = the first point whose
+                             # cell is not before (i, j, k), for lookups without a search
+    intp_t ny                # the table's extent along j and k
+    intp_t nz
 
 
 # Candidate lists (called once per robot per rebuild; each returns a STATUS_*).

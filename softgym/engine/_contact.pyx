@@ -16,7 +16,7 @@
 from libc.math cimport sqrt, floor
 from libc.stdint cimport int64_t
 from libc.stdlib cimport malloc, realloc, qsort
-from libc.string cimport memcpy
+from libc.string cimport memcpy, memset
 
 from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_MEMORY
 from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t
@@ -28,8 +28,12 @@ from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t
 # each cell's points in index order: as the key packs k in its lowest bits,
 # the three cells dk = -1, 0, +1 of one (di, dj) are one run of the sorted
 # points (_hash_first of the first key, then up to the last), so a query
-# makes 9 binary searches, not 27. Used for the voxel pairs of both models and
-# for the seed's voxel-obstacle pairs.
+# makes 9 binary searches, not 27. The voxel hash of a robot (cells from its
+# lowest centre, a few per axis) also gets a dense table of where each cell's
+# run starts (_hash_table), so its 9 runs are found without a search (profiled:
+# the searches' dependent loads were the collision list's time); the obstacle
+# hash (cells anywhere within +-2^19) keeps the searches. Used for the voxel
+# pairs of both models and for the seed's voxel-obstacle pairs.
 
 cdef enum:
     CELL_BITS = 20           # bits of each packed cell coordinate
@@ -95,6 +99,9 @@ cdef inline void _hash_init(SpatialHash* h, KeyIndex* cells, float64_t cell, flo
     h.cells = cells
     h.n = 0
     h.inv_cell = 1.0 / cell
+    h.start = NULL
+    h.ny = 0
+    h.nz = 0
     h.x0 = x0
     h.y0 = y0
     h.z0 = z0
@@ -132,11 +139,65 @@ cdef inline intp_t _hash_first(const SpatialHash* h, int64_t key) noexcept nogil
 
 
 cdef inline intp_t _hash_column(const SpatialHash* h, const int64_t* ijk, int di, int dj,
-                                int64_t* last) noexcept nogil:
-    # the first point of the cells (i + di, j + dj, k - 1 .. k + 1) around the
-    # cell ijk: one run of keys, up to *last (OUT) inclusive
-    last[0] = _pack(ijk[0] + di, ijk[1] + dj, ijk[2] + 1)
-    return _hash_first(h, last[0] - 2)
+                                intp_t* end) noexcept nogil:
+    # the points of the cells (i + di, j + dj, k - 1 .. k + 1) around the cell
+    # ijk: one run, from the returned index up to *end (OUT) exclusive
+    cdef int64_t last
+    cdef intp_t d
+    if h.start != NULL:
+        d = ((ijk[0] + di) * h.ny + ijk[1] + dj) * h.nz + ijk[2] - 1
+        end[0] = h.start[d + 3]
+        return h.start[d]
+    last = _pack(ijk[0] + di, ijk[1] + dj, ijk[2] + 1)
+    end[0] = _hash_first(h, last + 1)
+    return _hash_first(h, last - 2)
+
+
+cdef inline void _hash_table(SpatialHash* h, Contacts* c) noexcept nogil:
+    # the dense cell table of a filled hash whose cells start at 1 on each
+    # axis (VOXEL_OFF; a query reaches one cell beyond the occupied ones):
+    # start[d] = the number of points in cells before d, i.e. the first point
+    # of cell d's run (the packed key and d order cells alike). Skipped (the
+    # queries search) when the cells spread too far for a small table or
+    # when memory runs out.
+    cdef:
+        intp_t k, d, nd, total
+        int64_t key, mask = (<int64_t> 1 << CELL_BITS) - 1
+        int64_t mi = 0, mj = 0, mk = 0
+        intp_t* grown
+    if h.n == 0:
+        return
+    for k in range(h.n):
+        key = h.cells[k].key
+        if key < 0 or (key >> (2 * CELL_BITS)) < 1 or ((key >> CELL_BITS) & mask) < 1 \
+                or (key & mask) < 1:
+            return  # not a robot's hash from its lowest centre (or a non-finite point)
+        mi = max(mi, key >> (2 * CELL_BITS))
+        mj = max(mj, (key >> CELL_BITS) & mask)
+        mk = max(mk, key & mask)
+    if mi > 4096 or mj > 4096 or mk > 4096:
+        return
+    nd = (mi + 2) * (mj + 2) * (mk + 2)
+    if nd > 64 * h.n + 4096:
+        return
+    if nd + 1 > c.dense_capacity:
+        grown = <intp_t*> realloc(c.dense, (nd + 1) * sizeof(intp_t))
+        if grown == NULL:
+            return
+        c.dense = grown
+        c.dense_capacity = nd + 1
+    h.ny = mj + 2
+    h.nz = mk + 2
+    memset(c.dense, 0, (nd + 1) * sizeof(intp_t))
+    for k in range(h.n):
+        key = h.cells[k].key
+        d = ((key >> (2 * CELL_BITS)) * h.ny + ((key >> CELL_BITS) & mask)) * h.nz + (key & mask)
+        c.dense[d + 1] += 1
+    total = 0
+    for d in range(nd + 1):
+        total += c.dense[d]
+        c.dense[d] = total
+    h.start = c.dense
 
 
 # ---------------------------------------------------------------------------
@@ -164,12 +225,11 @@ cdef inline int _voxel_pairs(Batch* b, intp_t r, Contacts* c, const float64_t* P
     cdef:
         intp_t vs = b.vox_start[r]
         intp_t ve = b.vox_start[r + 1]
-        intp_t i, j, k, m, n_row
+        intp_t i, j, k, m, n_row, end
         float64_t L = b.L
         float64_t h2 = horizon * horizon, x0, y0, z0, dx, dy, dz, d2, act
         intp_t first
         int di, dj
-        int64_t key
         int64_t ijk[3]
         intp_t* grown
         SpatialHash h
@@ -187,6 +247,7 @@ cdef inline int _voxel_pairs(Batch* b, intp_t r, Contacts* c, const float64_t* P
     # an interior voxel is shielded by its six bonded neighbours
     _hash_init(&h, c.cells, horizon, x0, y0, z0, VOXEL_OFF)
     _hash_fill(&h, P, stride, b.surface, vs, ve)
+    _hash_table(&h, c)
     for i in range(vs, ve):
         if not b.surface[i]:
             continue
@@ -194,8 +255,8 @@ cdef inline int _voxel_pairs(Batch* b, intp_t r, Contacts* c, const float64_t* P
         _hash_cell(&h, P + stride * i, ijk)
         for di in range(-1, 2):
             for dj in range(-1, 2):
-                k = _hash_column(&h, ijk, di, dj, &key)
-                while k < h.n and h.cells[k].key <= key:
+                k = _hash_column(&h, ijk, di, dj, &end)
+                while k < end:
                     j = h.cells[k].index
                     k += 1
                     if j <= i:
@@ -311,9 +372,8 @@ cdef int _obstacle_pairs(Batch* b, intp_t r, Contacts* c, float64_t horizon) noe
         intp_t o0 = b.obs_start[r]
         intp_t o1 = b.obs_start[r + 1]
         intp_t n_o = o1 - o0
-        intp_t i, m, k, n_row, mm
+        intp_t i, m, k, n_row, mm, end
         int di, dj
-        int64_t key
         int64_t ijk[3]
         float64_t L = b.L
         float64_t dx, dy, dz, d2, act, s_first
@@ -336,8 +396,8 @@ cdef int _obstacle_pairs(Batch* b, intp_t r, Contacts* c, float64_t horizon) noe
         _hash_cell(&h, R + 4 * i, ijk)
         for di in range(-1, 2):
             for dj in range(-1, 2):
-                k = _hash_column(&h, ijk, di, dj, &key)
-                while k < h.n and h.cells[k].key <= key:
+                k = _hash_column(&h, ijk, di, dj, &end)
+                while k < end:
                     m = h.cells[k].index
                     k += 1
                     dx = b.obs[4 * m] - R[4 * i]

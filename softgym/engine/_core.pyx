@@ -355,6 +355,7 @@ cdef class ContactCache:
                 free(self.items[r].ref)
                 free(self.items[r].opairs)
                 free(self.items[r].ocells)
+                free(self.items[r].dense)
             free(self.items)
         free(self.link_scratch)
 

@@ -6,9 +6,11 @@ the portable instruction set and, on x86-64, again from the same C with
 folders ``_x86_64_v3/`` and ``_x86_64_v4/`` beside this file. :func:`install`
 (called by ``softgym/engine/__init__.py`` before any of them is imported)
 makes Python load the newest set this CPU runs under the modules' own names,
-so the modules' calls into one another stay within one build. Every build
-gives bit-identical results (no fused multiply-adds, no result-changing
-fast-math flag); only the speed differs.
+so the modules' calls into one another stay within one build. The
+x86-64-v3 and v4 builds fuse multiply-adds and give bit-identical results to
+each other; the portable build (no FMA instructions on x86-64) differs from
+them in the last bits (``setup.py``'s docstring). Within one build, results
+never depend on the thread count or on batching.
 
 The environment variable ``SOFTGYM_KERNEL`` forces one (``baseline``,
 ``x86-64-v3`` or ``x86-64-v4``), e.g. to compare them; a build that was not
@@ -27,7 +29,7 @@ from pathlib import Path
 from softgym.engine._cpu import cpu_level
 from softgym.exceptions import InvalidParameterError
 
-__all__ = ["KERNELS", "available_kernels", "install", "kernel_build"]
+__all__ = ["FUSED_KERNELS", "KERNELS", "available_kernels", "install", "kernel_build"]
 
 #: Kernel builds by name: (folder beside this file, x86-64 level it needs).
 KERNELS: dict[str, tuple[str | None, int]] = {
@@ -35,6 +37,9 @@ KERNELS: dict[str, tuple[str | None, int]] = {
     "x86-64-v3": ("_x86_64_v3", 3),
     "x86-64-v4": ("_x86_64_v4", 4),
 }
+
+#: The builds that fuse multiply-adds (bit-identical to one another, not to "baseline").
+FUSED_KERNELS: frozenset[str] = frozenset({"x86-64-v3", "x86-64-v4"})
 
 _HERE = Path(__file__).resolve().parent
 _chosen: str | None = None

@@ -166,7 +166,7 @@ cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n) noexcept nogil:
         float64_t nom = o[7 * n + li]
         float64_t k, rw = 1.0, ry = 0.0, rz = 0.0, tw, tx, ty, tz
         float64_t a1y = 0.0, a1z = 0.0, a2x, a2y, a2z, P0, P1, P2
-        float64_t len_, nx, ny, nz, rho, ch, sh, yx, zx
+        float64_t len_, lp, inv_s, inv_p0, yx, zx
     if o[9 * n + li] != 0.0:
         # small angle: voxel 1's frame, offsets along its axes
         k = _rotvec_k(qw)
@@ -180,28 +180,28 @@ cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n) noexcept nogil:
         # large angle: the frame turned by rq = (rw, 0, ry, rz) onto the
         # chord (the seed's ToXDirBond of the relative position)
         if not (p0 == 0.0 and p1 == 0.0 and p2 == 0.0):
-            yx = p1 / p0
-            zx = p2 / p0
+            inv_p0 = 1.0 / p0
+            yx = p1 * inv_p0
+            zx = p2 * inv_p0
             if yx < sa_rad and yx > -sa_rad and zx < sa_rad and zx > -sa_rad:
                 ry = 0.5 * zx
                 rz = -0.5 * yx
                 rw = 1.0 + 0.5 * (-ry * ry - rz * rz)
             else:
                 len_ = sqrt(p0 * p0 + p1 * p1 + p2 * p2)
-                nx = p0 / len_
-                ny = p1 / len_
-                nz = p2 / len_
-                # acos(nx) > pi - 1e-7 (acos(x) <= acos(-0.5) < 2.1 for x >= -0.5)
-                if nx < -0.5 and acos(nx) > th_discard:
+                # acos(nx) > pi - 1e-7, nx = p0 / |p| (acos(x) <= acos(-0.5) < 2.1
+                # for x >= -0.5)
+                if p0 < -0.5 * len_ and acos(p0 / len_) > th_discard:
                     rw = 0.0
                     ry = 1.0
                 else:
-                    rho = 1.0 / sqrt(nz * nz + ny * ny)
-                    ch = sqrt(0.5 * (1.0 + nx))  # cos(th / 2)
-                    sh = sqrt(0.5 * (1.0 - nx))  # sin(th / 2)
-                    rw = ch
-                    ry = nz * rho * sh
-                    rz = -ny * rho * sh
+                    # (cos(th / 2), 0, nz sin(th / 2) / |n_yz|, -ny ...) with
+                    # nx = cos(th): (|p| + p0, 0, p2, -p1) / sqrt(2 |p| (|p| + p0))
+                    lp = len_ + p0
+                    inv_s = 1.0 / sqrt(2.0 * len_ * lp)
+                    rw = lp * inv_s
+                    ry = p2 * inv_s
+                    rz = -p1 * inv_s
             k = _rotvec_k(rw)  # the seed's, with its acos approximation
             a1y = ry * k
             a1z = rz * k
@@ -331,8 +331,9 @@ def seed_frames(float64_t[:, ::1] geom, bint scalar=False):
     small / 0.0 large angle). Returns (11, n): the displacement P, voxel 1's
     rotation vector (y, z), voxel 2's, the large-angle frame (rw, ry, rz),
     from the vectorised kernel with its scalar fix-ups, or (``scalar``) from
-    the seed's branchy scalar code for every link. The two must be equal bit
-    for bit.
+    the seed's branchy scalar code for every link. The two are equal bit
+    for bit in a build that does not fuse multiply-adds, and within the
+    fusing's rounding (~1e-12 relative) in one that does (setup.py).
     """
     cdef:
         intp_t n = geom.shape[1], li, k

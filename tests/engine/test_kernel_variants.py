@@ -1,10 +1,12 @@
-"""Every build of the compiled engine gives the same bits (softgym/engine/_dispatch.py).
+"""The builds of the compiled engine agree (softgym/engine/_dispatch.py).
 
 setup.py compiles the engine's kernel for the portable instruction set and for
 newer x86-64 levels; the newest one the CPU runs is loaded. Each build runs
 here in its own process (``SOFTGYM_KERNEL``) on the same bodies (both presets,
-self-collision on, large-angle links from a drop) and its whole final state is
-compared bit for bit with the portable build's.
+self-collision on, large-angle links from a drop). The builds that fuse
+multiply-adds (x86-64-v3, v4) must give the same final state bit for bit; the
+portable build, which rounds every product, must stay within rounding-level
+distance of them (the bodies here are not chaotic over 0.4 s).
 """
 
 import os
@@ -14,7 +16,7 @@ import sys
 import numpy as np
 import pytest
 
-from softgym.engine import available_kernels, kernel_build
+from softgym.engine import FUSED_KERNELS, available_kernels, kernel_build
 from softgym.engine._dispatch import install
 from softgym.exceptions import InvalidParameterError
 
@@ -51,16 +53,27 @@ def _run(kernel, path):
         return {k: z[k] for k in z.files}
 
 
-def test_every_kernel_build_gives_the_portable_builds_bits(tmp_path):
+def test_the_fused_builds_agree_bit_for_bit_and_the_portable_one_to_rounding(tmp_path):
     kernels = available_kernels()
     assert kernels[0] == "baseline"
     ref = _run("baseline", tmp_path / "baseline.npz")
     assert any(np.abs(v).sum() > 0 for k, v in ref.items() if k.endswith("/vel"))
+    fused = None
     for name in kernels[1:]:
+        assert name in FUSED_KERNELS
         state = _run(name, tmp_path / f"{name}.npz")
         assert state.keys() == ref.keys()
-        for key in ref:
-            assert np.array_equal(state[key], ref[key], equal_nan=True), (name, key)
+        if fused is None:
+            fused = state
+            for key in ref:
+                if key.endswith(("/steps", "/diverged")):
+                    assert np.array_equal(state[key], ref[key]), (name, key)
+                elif np.issubdtype(ref[key].dtype, np.floating):
+                    np.testing.assert_allclose(state[key], ref[key], rtol=1e-6, atol=1e-9,
+                                               err_msg=f"{name} {key}")  # fmt: skip
+        else:
+            for key in fused:
+                assert np.array_equal(state[key], fused[key], equal_nan=True), (name, key)
 
 
 def test_the_newest_available_build_is_used():

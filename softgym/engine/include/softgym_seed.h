@@ -1,7 +1,8 @@
 /* The seed model's vectorised link and voxel passes (softgym/engine/_seed.pyx
    calls them; declared for Cython in _seed.pyx's `cdef extern from`).
-   Compiled with -ffp-contract=off: the same IEEE operations as the seed's
-   scalar code, bit for bit. Py_ssize_t comes from Python.h, which Cython
+   The same operations as the seed's scalar code; compiled with
+   -ffp-contract=fast, so builds with FMA instructions fuse a * b + c (setup.py).
+   Py_ssize_t comes from Python.h, which Cython
    includes first. */
 #ifndef SOFTGYM_SEED_H
 #define SOFTGYM_SEED_H
@@ -13,9 +14,9 @@
    quantities of links lo..hi in the mode the first pass gave them, without
    branches so the loop vectorises (the outputs are distinct rows of the
    scratch: no two iterations touch the same element). Every candidate
-   value is computed and one is selected, the same IEEE result as the
-   branchy scalar code (_seed_frame_one; -ffp-contract=off: no fused
-   multiply-adds). Outputs: the displacement P, voxel 1's rotation vector
+   value is computed and one is selected: the branchy scalar code's result
+   (_seed_frame_one), bit for bit where multiply-adds are not fused, else
+   to within the fusing's rounding (~1e-12 relative). Outputs: the displacement P, voxel 1's rotation vector
    (y, z; its x is 0), voxel 2's, the large-angle frame rq = (rw, 0, ry,
    rz). A link whose rotation vector needs the seed's acos branch (angles
    beyond ~5.6 degrees), or whose chord points backwards, gets fix = 1 and
@@ -59,16 +60,22 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_frames_impl(
         /* large angle: rq onto the chord (exactly along it when the
            transverse ratios are small) */
         long long zero = (p0 == 0.0) & (p1 == 0.0) & (p2 == 0.0);
-        double yx = p1 / p0, zx = p2 / p0;
+        double inv_p0 = 1.0 / p0;
+        double yx = p1 * inv_p0, zx = p2 * inv_p0;
         long long small = (yx < sa_rad) & (yx > -sa_rad) & (zx < sa_rad) & (zx > -sa_rad);
         double ry_s = 0.5 * zx, rz_s = -0.5 * yx;
         double rw_s = 1.0 + 0.5 * (-ry_s * ry_s - rz_s * rz_s);
+        /* the half-angle quaternion onto the chord n = p / |p|: (1 + nx, 0,
+           nz, -ny) / sqrt(2 (1 + nx)), i.e. (|p| + p0, 0, p2, -p1) / s with
+           s = sqrt(2 |p| (|p| + p0)): two square roots and one division
+           (the seed's cos(th / 2), sin(th / 2) and 1 / |n_yz| took four and
+           four) */
         double ln = sqrt(p0 * p0 + p1 * p1 + p2 * p2);
-        double nx = p0 / ln, ny = p1 / ln, nz = p2 / ln;
-        double rho = 1.0 / sqrt(nz * nz + ny * ny);
-        double ch = sqrt(0.5 * (1.0 + nx)), sh = sqrt(0.5 * (1.0 - nx));
-        double ry_l = nz * rho * sh, rz_l = -ny * rho * sh;
-        fix |= (1 - is_sa) & (1 - zero) & (1 - small) & (nx < -0.5);
+        double lp = ln + p0;
+        double inv_s = 1.0 / sqrt(2.0 * ln * lp);
+        double ch = lp * inv_s;
+        double ry_l = p2 * inv_s, rz_l = -p1 * inv_s;
+        fix |= (1 - is_sa) & (1 - zero) & (1 - small) & (p0 < -0.5 * ln);
         double rw = zero ? 1.0 : (small ? rw_s : ch);
         double ry = zero ? 0.0 : (small ? ry_s : ry_l);
         double rz = zero ? 0.0 : (small ? rz_s : rz_l);
@@ -363,24 +370,40 @@ static Py_ssize_t softgym_seed_modes(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
 #if defined(__AVX__) && (defined(__GNUC__) || defined(__clang__))
 #define SOFTGYM_SCATTER_V4 1
 typedef double softgym_v4d __attribute__((vector_size(32)));
-#define SOFTGYM_SCATTER_TURN(acc, x, y, z) do { \
+#define SOFTGYM_SCATTER_W(w, x, y, z) do { \
         double x_ = (x), y_ = (y), z_ = (z); \
-        softgym_v4d w_ = c0 * x_ + c1 * y_ + c2 * z_; \
-        (acc)[0] += w_[0]; \
-        (acc)[1] += w_[1]; \
-        (acc)[2] += w_[2]; \
+        softgym_v4d t_ = c0 * x_ + c1 * y_ + c2 * z_; \
+        (w)[0] = t_[0]; \
+        (w)[1] = t_[1]; \
+        (w)[2] = t_[2]; \
     } while (0)
 #else
-#define SOFTGYM_SCATTER_TURN(acc, x, y, z) do { \
+#define SOFTGYM_SCATTER_W(w, x, y, z) do { \
         double x_ = (x), y_ = (y), z_ = (z); \
-        double w0_ = R[0] * x_ + R[1] * y_ + R[2] * z_; \
-        double w1_ = R[3] * x_ + R[4] * y_ + R[5] * z_; \
-        double w2_ = R[6] * x_ + R[7] * y_ + R[8] * z_; \
-        (acc)[0] += w0_; \
-        (acc)[1] += w1_; \
-        (acc)[2] += w2_; \
+        (w)[0] = R[0] * x_ + R[1] * y_ + R[2] * z_; \
+        (w)[1] = R[3] * x_ + R[4] * y_ + R[5] * z_; \
+        (w)[2] = R[6] * x_ + R[7] * y_ + R[8] * z_; \
     } while (0)
 #endif
+#define SOFTGYM_SCATTER_TURN(acc, x, y, z) do { \
+        SOFTGYM_SCATTER_W(w, x, y, z); \
+        (acc)[0] += w[0]; \
+        (acc)[1] += w[1]; \
+        (acc)[2] += w[2]; \
+    } while (0)
+/* voxel 2's force where it is minus voxel 1's (row 23: a single material or
+   a mode change): the turn of -f1 is exactly minus the turn of f1 (negation
+   is exact and rounding symmetric, fused or not), and a + (-b) is a - b, so
+   voxel 1's turned force is subtracted, one turn fewer, the same bits */
+#define SOFTGYM_SCATTER_F2(x, y, z) do { \
+        if (neg2) { \
+            fj[0] -= w[0]; \
+            fj[1] -= w[1]; \
+            fj[2] -= w[2]; \
+        } else { \
+            SOFTGYM_SCATTER_TURN(fj, x, y, z); \
+        } \
+    } while (0)
 SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
                                                    Py_ssize_t n, const Py_ssize_t *v1,
                                                    const Py_ssize_t *v2, const double *rot,
@@ -399,28 +422,32 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
         double R[9];
         memcpy(R, Rp, sizeof R);
 #endif
+        double w[3];
         const double *q = o + li;
+        int neg2 = q[23 * n] != 0.0;
         double *fi = force + 3 * i, *fj = force + 3 * j;
         double *mi = moment + 3 * i, *mj = moment + 3 * j;
         if (ax == 0) {
             SOFTGYM_SCATTER_TURN(fi, q[0], q[n], q[2 * n]);
-            SOFTGYM_SCATTER_TURN(fj, q[3 * n], q[4 * n], q[5 * n]);
+            SOFTGYM_SCATTER_F2(q[3 * n], q[4 * n], q[5 * n]);
             SOFTGYM_SCATTER_TURN(mi, q[6 * n], q[7 * n], q[8 * n]);
             SOFTGYM_SCATTER_TURN(mj, q[9 * n], q[21 * n], q[24 * n]);
         } else if (ax == 1) {
             SOFTGYM_SCATTER_TURN(fi, -q[n], q[0], q[2 * n]);
-            SOFTGYM_SCATTER_TURN(fj, -q[4 * n], q[3 * n], q[5 * n]);
+            SOFTGYM_SCATTER_F2(-q[4 * n], q[3 * n], q[5 * n]);
             SOFTGYM_SCATTER_TURN(mi, -q[7 * n], q[6 * n], q[8 * n]);
             SOFTGYM_SCATTER_TURN(mj, -q[21 * n], q[9 * n], q[24 * n]);
         } else {
             SOFTGYM_SCATTER_TURN(fi, -q[2 * n], q[n], q[0]);
-            SOFTGYM_SCATTER_TURN(fj, -q[5 * n], q[4 * n], q[3 * n]);
+            SOFTGYM_SCATTER_F2(-q[5 * n], q[4 * n], q[3 * n]);
             SOFTGYM_SCATTER_TURN(mi, -q[8 * n], q[7 * n], q[6 * n]);
             SOFTGYM_SCATTER_TURN(mj, -q[24 * n], q[21 * n], q[9 * n]);
         }
     }
 }
+#undef SOFTGYM_SCATTER_F2
 #undef SOFTGYM_SCATTER_TURN
+#undef SOFTGYM_SCATTER_W
 #undef SOFTGYM_SCATTER_V4
 
 static void softgym_seed_scatter(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
