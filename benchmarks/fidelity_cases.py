@@ -1,5 +1,9 @@
 """The case set of the seed-engine fidelity benchmark (issue 16, point 4).
 
+The protocol's vocabulary (regimes, cases read from stored data, perturbations) is
+:mod:`softgym.fidelity`, re-exported here; this file adds the generation of the three
+case sets (the random bodies need ``evolvers``).
+
 Deterministic definitions of every robot, actuation regime and perturbation that
 ``benchmarks/data/seed_engine/make_oracle_data.py`` ran on the seed's own engine
 (the oracle) and that ``benchmarks/fidelity_seed.py`` runs in softgym. Importable
@@ -48,16 +52,26 @@ silently comparing different robots.
 
 from __future__ import annotations
 
-import hashlib
 from collections.abc import Iterable
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from softgym.design.controller import Controller
 from softgym.design.material import default_palette
 from softgym.design.robot import RobotDesign
+from softgym.fidelity import (
+    FENCE,
+    PERTURBATION,
+    REGIMES,
+    SIM_SETTINGS,
+    Case,
+    case_design,
+    cases_from_data,
+    check_grid,
+    controller,
+    perturb,
+    perturbed_voxel,
+)
 
 __all__ = [
     "FENCE",
@@ -77,203 +91,6 @@ __all__ = [
     "random_bodies",
     "structured_bodies",
 ]
-
-#: Actuation regimes: temperature amplitude dT (degC), period (s), muscle CTE magnitude
-#: (1/degC; Active_+ gets +cte, Active_- gets -cte). "gentle" is the seed's default.
-REGIMES: dict[str, dict[str, float]] = {
-    "gentle": dict(dT=14, period=0.25, cte=0.01),
-    "medium": dict(dT=18, period=0.15, cte=0.025),
-    "strong": dict(dT=20, period=0.1, cte=0.04),
-}
-
-#: Simulation settings of every run (``softgym.design.vxa.to_vxa`` keyword arguments;
-#: these are its defaults and the seed's, docs/PHYSICS.md). to_vxa also writes
-#: BondDampingZ 1, ColDampingZ 0.8, SlowDampingZ 0.01, ColSystem 3, CollisionHorizon 2,
-#: flat floor, gravity -9.81, Lattice_Dim 0.01 m.
-SIM_SETTINGS: dict[str, Any] = dict(
-    voxel_size=0.01, sim_time=5.0, init_time=1.0, dt_frac=0.9, self_collisions=True
-)
-
-#: Relative density change of the perturbed voxel.
-PERTURBATION = 1e-6
-
-#: The seed's fence task (docs/PHYSICS.md): a 50x50x6 workspace, the 6x6x6
-#: robot box at voxel indices x, y in 22..27, z in 0..5, a square wall of material 5
-#: (Obstacle, E 5e9 Pa, 1 kg per voxel) 1 voxel thick and 1 high at x in {19, 30}
-#: (y 19..30) and y in {19, 30} (x 19..30): 44 fixed voxels. In softgym:
-#: ``Terrain.fence()`` with the robot's grid corner at the origin (the wall at -3 and 8).
-FENCE: dict[str, Any] = dict(
-    env_size=(50, 50, 6),
-    robot_offset=(22, 22, 0),
-    side=12,
-    wall_lo=19,
-    wall_hi=30,
-    height=1,
-    wall_material=5,
-    n_wall_voxels=44,
-    wall_mass_kg=44.0,
-    softgym_terrain="Terrain.fence(inner=10, height=1, thickness=1, center=(3, 3))",
-)
-
-
-@dataclass(frozen=True)
-class Case:
-    """One robot of the benchmark.
-
-    Attributes
-    ----------
-    name : str
-        Stable, unique name (also the seed of its perturbations).
-    set : str
-        ``"structured"``, ``"random"`` or ``"fence"``.
-    design : RobotDesign
-        The body with the default (seed) palette and controller; see :func:`case_design`.
-    terrain : str
-        ``"flat"`` or ``"fence"`` (:data:`FENCE`).
-    meta : dict
-        Description and facts: ``has_bone``, ``n_voxels``, ``robot_mass_kg``,
-        ``mirror_x`` / ``mirror_y`` (grid equal to its mirror image), origin of a
-        random body (``seed``, ``rules``, ``mutations``).
-    """
-
-    name: str
-    set: str
-    design: RobotDesign
-    terrain: str = "flat"
-    meta: dict[str, Any] = field(default_factory=dict, compare=False)
-
-
-# --------------------------------------------------------------------------------------------
-# Regimes, perturbation, designs
-# --------------------------------------------------------------------------------------------
-
-
-def controller(regime: str) -> Controller:
-    """The :class:`~softgym.design.Controller` of a regime name of :data:`REGIMES`."""
-    r = REGIMES[regime]
-    return Controller(temp_amplitude=r["dT"], period=r["period"], muscle_cte=r["cte"])
-
-
-def _name_seed(name: str) -> int:
-    return int.from_bytes(hashlib.sha256(name.encode("utf-8")).digest()[:8], "little")
-
-
-def perturbed_voxel(
-    case: Case | RobotDesign, draw: int, name: str | None = None
-) -> tuple[int, int, int] | None:
-    """The voxel (i, j, k) whose density draw ``draw`` perturbs; None for draw 0.
-
-    Parameters
-    ----------
-    case : Case or RobotDesign
-        The case (its name seeds the choice) or a design with ``name`` given.
-    draw : int
-        0 (unperturbed) or k >= 1.
-    name : str, optional
-        Seed of the choice when ``case`` is a bare design.
-
-    The filled voxels, in C order, are permuted by a generator seeded with the name;
-    draw k takes entry ``(k - 1) % n_voxels``, so draws 1..n_voxels differ.
-    """
-    if draw < 0 or int(draw) != draw:
-        raise ValueError(f"draw must be an integer >= 0, got {draw!r}")
-    if draw == 0:
-        return None
-    design, key = _design_and_name(case, name)
-    filled = np.flatnonzero(design.grid.ravel())
-    order = np.random.default_rng(_name_seed(key)).permutation(filled.size)
-    flat = int(filled[order[(int(draw) - 1) % filled.size]])
-    i, j, k = np.unravel_index(flat, design.shape)
-    return int(i), int(j), int(k)
-
-
-def _design_and_name(case: Case | RobotDesign, name: str | None) -> tuple[RobotDesign, str]:
-    if isinstance(case, Case):
-        return case.design, case.name if name is None else name
-    if name is None:
-        raise ValueError("perturbing a bare RobotDesign needs the case name (name=...)")
-    return case, name
-
-
-def perturb(case: Case | RobotDesign, draw: int, name: str | None = None) -> RobotDesign:
-    """The design with one voxel's density multiplied by ``1 + PERTURBATION`` (draw 0: unchanged).
-
-    Parameters
-    ----------
-    case : Case or RobotDesign
-        A case (perturbs ``case.design``) or a design (then ``name`` is required;
-        pass the case name, e.g. ``perturb(case_design(c, "strong"), 3, name=c.name)``).
-    draw : int
-        0 (unperturbed) or k >= 1 (see :func:`perturbed_voxel`).
-    name : str, optional
-        The case name when ``case`` is a bare design.
-
-    Returns
-    -------
-    RobotDesign
-        Same controller; the voxel :func:`perturbed_voxel` holds a new palette id
-        (``palette.max_id + 1``) whose material copies the voxel's material with the
-        density multiplied.
-    """
-    design, key = _design_and_name(case, name)
-    voxel = perturbed_voxel(design, draw, key)
-    if voxel is None:
-        return design
-    mid = int(design.grid[voxel])
-    new_id = design.palette.max_id + 1
-    mat = design.palette[mid]
-    copy = mat.replace(name=f"{mat.name}_perturbed", density=mat.density * (1.0 + PERTURBATION))
-    grid = design.grid.copy()
-    grid[voxel] = new_id
-    return design.replace(grid=grid, palette=design.palette.with_material(new_id, copy))
-
-
-def case_design(case: Case, regime: str, draw: int = 0) -> RobotDesign:
-    """The design of ``case`` driven by ``regime``'s controller, with draw ``draw``'s perturbation."""
-    return perturb(case.design.with_controller(controller(regime)), draw, name=case.name)
-
-
-def cases_from_data(data: dict[str, Any]) -> list[Case]:
-    """The cases of a loaded oracle data file (``json.load`` of ``structured.json``, ...), from its stored grids.
-
-    Needs neither the CPPN code nor ``evolvers``: each case gets the stored grid, the
-    default (seed) palette and controller, its stored terrain and meta, and the set
-    named in the file's header. :func:`case_design` and :func:`perturbed_voxel` then
-    give the same designs and voxels as for the generated cases.
-    """
-    from softgym.design.robot import DESIGN_SCHEMA, DESIGN_VERSION
-
-    out = []
-    set_ = data["header"]["set"]
-    for name, entry in data["cases"].items():
-        design = RobotDesign.from_dict(
-            {
-                "schema": DESIGN_SCHEMA,
-                "version": DESIGN_VERSION,
-                "grid": entry["grid"],
-                "palette": default_palette().to_list(),
-                "controller": Controller().to_dict(),
-            }
-        )
-        out.append(
-            Case(name, set_, design, entry.get("terrain", "flat"), dict(entry.get("meta", {})))
-        )
-    return out
-
-
-def check_grid(case: Case, stored: dict[str, Any]) -> None:
-    """Raise ValueError unless ``case``'s grid equals a grid stored by the oracle data.
-
-    ``stored`` is the ``"grid"`` entry of :meth:`RobotDesign.to_dict` (as written in
-    the data files' ``"cases"``).
-    """
-    mine = case.design.to_dict()["grid"]
-    if mine != stored:
-        raise ValueError(
-            f"case {case.name!r}: the grid differs from the one the oracle ran "
-            "(did the CPPN code change?); use the stored grid"
-        )
-
 
 # --------------------------------------------------------------------------------------------
 # Helpers

@@ -44,6 +44,7 @@ from fidelity_seed import METRIC, SOFTGYM_METRIC, agreement, fence_terrain  # no
 from evolvers.study.stats import a12, permutation_pvalue  # noqa: E402
 from softgym.design.robot import RobotDesign  # noqa: E402
 from softgym.engine import SimConfig, Simulation  # noqa: E402
+from softgym.fidelity import load_evolved  # noqa: E402
 from softgym.metrics import dilute, walk_metrics  # noqa: E402
 
 DATA = HERE / "data" / "seed_engine" / "evolved.json"
@@ -51,15 +52,7 @@ DATA = HERE / "data" / "seed_engine" / "evolved.json"
 
 def load(path: Path = DATA) -> tuple[dict[str, dict[str, Any]], dict[tuple[str, int], float]]:
     """The embedded designs and the oracle's metric by (design, draw) (NaN when it hung)."""
-    data = json.loads(path.read_text())
-    values = {}
-    for rec in data["records"]:
-        terrain = data["cases"][rec["case"]]["terrain"]
-        v = rec.get(METRIC[terrain])
-        values[(rec["case"], int(rec["draw"]))] = (
-            float("nan") if rec.get("hung") or v is None else float(v)
-        )
-    return data["cases"], values
+    return load_evolved(path)
 
 
 def run_softgym(cases: dict[str, dict[str, Any]], draws: list[int],

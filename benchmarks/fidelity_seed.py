@@ -48,8 +48,8 @@ sys.path.insert(0, str(HERE))
 import fidelity_cases as fc  # noqa: E402
 
 from softgym.engine import SimConfig, Simulation  # noqa: E402
+from softgym.fidelity import METRIC, SOFTGYM_METRIC, fence_terrain, micro_trace  # noqa: E402, F401
 from softgym.metrics import dilute, walk_metrics  # noqa: E402
-from softgym.terrain import Terrain  # noqa: E402
 
 DATA = HERE / "data" / "seed_engine"
 FLOOR = 0.01  # voxel lengths: smaller distances count as "stays put"
@@ -58,27 +58,6 @@ ORACLE_HALVES = ((1, 2, 3), (4, 5, 6))  # perturbed oracle draws split in two ha
 
 
 # ------------------------------------------------------------------------ micro-cases
-def micro_trace(case: dict[str, Any], model: str = "seed") -> tuple[np.ndarray, np.ndarray]:
-    """softgym's centre of mass at the oracle's sample steps of a micro-case.
-
-    Returns ``(ours, oracle)``, each of shape (n_samples, 3) in metres.
-    """
-    from softgym.design.controller import Controller
-    from softgym.design.robot import RobotDesign
-
-    dT, period, cte = (fc.REGIMES[case["regime"]][k] for k in ("dT", "period", "cte"))
-    design = RobotDesign(np.asarray(case["grid"]), controller=Controller(dT, period, cte))
-    cfg = SimConfig(init_time=case["init_time"], model=model)
-    sim = Simulation([design], cfg, n_threads=1)
-    dt = float(sim.dt[0])
-    sim = Simulation([design], cfg.replace(trace_interval=dt), n_threads=1)
-    rollout = sim.run(case["sim_time"])
-    oracle = np.asarray(case["trace"], dtype=np.float64)
-    steps = np.rint(oracle[:, 3] / dt).astype(np.intp)  # the oracle samples at step times
-    steps = np.clip(steps, 0, rollout.cm.shape[1] - 1)
-    return rollout.cm[0, steps], oracle[:, :3]
-
-
 def micro_errors(model: str = "seed") -> dict[str, dict[str, Any]]:
     """Per micro-case: max |softgym - oracle| over the samples, as a fraction of the
     oracle's displacement scale (its largest range of x, y or z). The oracle prints 6
@@ -117,17 +96,6 @@ def agreement(x: np.ndarray, y: np.ndarray) -> dict[str, float]:
         "within_3x": float(np.mean(lr <= math.log10(3))) if lr.size else float("nan"),
         "moved_vs_still": moved_still,
     }
-
-
-#: The metric compared per terrain: the seed's fitness on flat ground and on its fence.
-METRIC = {"flat": "NormFinalDist", "fence": "MaxXYDist"}
-#: softgym's name of each oracle metric.
-SOFTGYM_METRIC = {"NormFinalDist": "norm_final_dist", "MaxXYDist": "max_xy_dist"}
-
-
-def fence_terrain() -> Terrain:
-    """The seed's fence around a 6x6x6 robot at the origin (benchmarks/fidelity_cases.FENCE)."""
-    return Terrain.fence(inner=10, height=1, thickness=1, center=(3, 3))
 
 
 def load_oracle(sets: list[str]) -> tuple[list[Any], dict[tuple[str, str, int], float]]:

@@ -1,28 +1,36 @@
-"""The stored PPO runs (benchmarks/data/rl/) and the figure script that draws them (issue 13)."""
+"""The stored PPO runs (benchmarks/data/rl/) and the scripts that draw them (issues 13, 33).
 
-import importlib.util
+The scripts run as a user runs them (child processes): tests import nothing from
+benchmarks/. The stored records are read here as the JSON files they are.
+"""
+
+import hashlib
+import json
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
 
 BENCH = Path(__file__).resolve().parents[1] / "benchmarks"
+DATA = BENCH / "data" / "rl"
 KEYS = {"command", "preset", "timesteps", "train_seconds", "wall_seconds", "actuation",
         "control_dt", "curve", "ppo", "ppo_sampled", "random", "sinusoid"}  # fmt: skip
 
 
-def _plot_rl():
-    spec = importlib.util.spec_from_file_location("plot_rl", BENCH / "plot_rl.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+def _script(name, *args, check=True):
+    res = subprocess.run([sys.executable, str(BENCH / name), *map(str, args)],
+                         capture_output=True, text=True, timeout=300)  # fmt: skip
+    if check:
+        assert res.returncode == 0, res.stderr[-3000:]
+    return res
 
 
 def test_stored_rl_runs_are_complete():
-    plot_rl = _plot_rl()
-    paths = plot_rl.stored_runs()
+    paths = sorted(DATA.glob("*.json"))
     assert len(paths) >= 2
     for path in paths:
-        run = plot_rl.load(path)
+        run = json.loads(path.read_text())
         assert KEYS <= run.keys(), f"{path.name} lacks {KEYS - run.keys()}"
         assert run["preset"] == "seed"
         assert run["curve"][-1][0] >= run["timesteps"]
@@ -32,31 +40,27 @@ def test_stored_rl_runs_are_complete():
 def test_plot_rl_draws_the_stored_runs(tmp_path):
     pytest.importorskip("matplotlib")
     out = tmp_path / "ppo.png"
-    assert _plot_rl().main(["--out", str(out)]) == 0
+    _script("plot_rl.py", "--out", out)
     assert out.stat().st_size > 10_000
 
 
 def test_plot_rl_reads_a_log_ending_with_the_json_line(tmp_path):
+    pytest.importorskip("matplotlib")
+    run = json.loads(sorted(DATA.glob("*.json"))[0].read_text())
     log = tmp_path / "run.log"
-    log.write_text('training...\n{"curve": [[2048, 0.1]], "ppo": 0.2}\n')
-    assert _plot_rl().load(log)["ppo"] == 0.2
+    log.write_text("training...\n" + json.dumps(run) + "\n")
+    out = tmp_path / "one.png"
+    _script("plot_rl.py", log, "--out", out)
+    assert out.stat().st_size > 10_000
     log.write_text("no json here\n")
-    with pytest.raises(SystemExit):
-        _plot_rl().load(log)
-
-
-def _rl_table():
-    spec = importlib.util.spec_from_file_location("rl_table", BENCH / "rl_table.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    res = _script("plot_rl.py", log, "--out", tmp_path / "none.png", check=False)
+    assert res.returncode != 0
+    assert "the last line is not rl_ppo.py's JSON" in res.stderr
+    assert not (tmp_path / "none.png").exists()
 
 
 def test_stored_ppo_baseline_runs_are_resumable_records():
-    import hashlib
-    import json
-
-    root = BENCH / "data" / "rl" / "ppo"
+    root = DATA / "ppo"
     dirs = sorted(p.parent for p in root.glob("*/run.json"))
     assert dirs, "no PPO baseline run is stored"
     for d in dirs:
@@ -75,15 +79,18 @@ def test_stored_ppo_baseline_runs_are_resumable_records():
             assert hashlib.sha256((d / "ckpt" / name).read_bytes()).hexdigest() == digest, name
 
 
-def test_rl_table_prints_every_task_and_draws_the_curves(tmp_path, capsys):
+def test_rl_table_prints_every_task_and_draws_the_curves(tmp_path):
     pytest.importorskip("matplotlib")
-    mod = _rl_table()
-    runs = mod.load_runs()
     out = tmp_path / "curves.png"
-    assert mod.main(["--out", str(out)]) == 0
-    text = capsys.readouterr().out
-    for task in runs:
-        assert f"| {task} | {len(runs[task])} |" in text
+    text = _script("rl_table.py", "--out", out).stdout
+    by_task = {}
+    for d in (DATA / "ppo").glob("*/run.json"):
+        task = json.loads(d.read_text())["task"]
+        by_task[task] = by_task.get(task, 0) + 1
+    for task, n in by_task.items():
+        assert f"| {task} | {n} |" in text
     assert out.stat().st_size > 10_000
-    evolved = mod.evolved()
-    assert evolved["flat"]["evolved_median"] == 4.56 and len(evolved) == 16
+    # the evolved column: bench_tasks.py's controllers, 3 s episodes (flat 4.56 [4.45, 4.73])
+    assert "| flat | 3 |" in text and "4.56 [4.45, 4.73]" in text
+    evolved = json.loads((DATA / "baselines" / "evolved_controllers.json").read_text())
+    assert len(evolved["tasks"]) == 16 and evolved["tasks"]["flat"]["evolved_median"] == 4.56

@@ -6,24 +6,24 @@ the tests never run the engine itself.
 """
 
 import json
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from softgym.design.robot import RobotDesign
 from softgym.engine import SimConfig, Simulation
-from softgym.metrics import norm_final_dist
+from softgym.fidelity import (
+    case_design,
+    cases_from_data,
+    fence_terrain,
+    load_evolved,
+    micro_trace,
+    perturb,
+)
+from softgym.metrics import dilute, norm_final_dist, walk_metrics
 
-BENCH = Path(__file__).resolve().parents[2] / "benchmarks"
-sys.path.insert(0, str(BENCH))
-
-import fidelity_cases as fc  # noqa: E402
-import fidelity_evolved as fe  # noqa: E402
-import fidelity_seed as fs  # noqa: E402
-
-from softgym.design.robot import RobotDesign  # noqa: E402
-from softgym.metrics import dilute, walk_metrics  # noqa: E402
+BENCH = Path(__file__).resolve().parents[2] / "benchmarks"  # the committed oracle data
 
 MICRO = json.loads((BENCH / "data" / "seed_engine" / "micro.json").read_text())["cases"]
 STRUCTURED = json.loads((BENCH / "data" / "seed_engine" / "structured.json").read_text())
@@ -33,7 +33,7 @@ STRUCTURED = json.loads((BENCH / "data" / "seed_engine" / "structured.json").rea
 def test_micro_case_traces_follow_the_seed_engine(name):
     # every sample of the centre of mass within 1 % of the oracle's displacement
     # scale (half a unit of its 6th printed digit forgiven); measured: <= 1e-5
-    ours, oracle = fs.micro_trace(MICRO[name])
+    ours, oracle = micro_trace(MICRO[name])
     scale = np.ptp(oracle, axis=0).max()
     err = np.maximum(np.abs(ours - oracle) - 5e-6 * np.abs(oracle), 0.0).max()
     assert err <= 0.01 * scale, f"{name}: {err:.3g} m against a scale of {scale:.3g} m"
@@ -41,7 +41,7 @@ def test_micro_case_traces_follow_the_seed_engine(name):
 
 def test_the_corotational_model_does_not_follow_a_folding_column():
     # the control: the same check fails for the pre-fidelity step, so the test above has teeth
-    ours, oracle = fs.micro_trace(MICRO["column6_active_minus_strong"], model="corotational")
+    ours, oracle = micro_trace(MICRO["column6_active_minus_strong"], model="corotational")
     assert np.abs(ours - oracle).max() > 0.05 * np.ptp(oracle, axis=0).max()
 
 
@@ -68,8 +68,8 @@ BODIES = [
 
 
 def test_whole_bodies_fall_inside_the_oracles_perturbed_range():
-    cases = {c.name: c for c in fc.cases_from_data(STRUCTURED)}
-    designs = [fc.case_design(cases[n], regime, 1) for n, regime in BODIES]
+    cases = {c.name: c for c in cases_from_data(STRUCTURED)}
+    designs = [case_design(cases[n], regime, 1) for n, regime in BODIES]
     ours = norm_final_dist(Simulation(designs, SimConfig()).run(5.0))
     for (n, regime), v in zip(BODIES, ours):
         draws = _oracle_draws(n, regime)
@@ -87,12 +87,12 @@ def test_evolved_fence_robots_match_the_seed_engine(name):
     # robots evolved by softgym on the seed's obstacle task (bone, evolved controller),
     # inside the seed's fence: its diluted MaxXYDist agrees with the seed's engine
     # (evolved.json, made by make_evolved_data.py) to 1 %, unperturbed and perturbed
-    cases, oracle = fe.load(EVOLVED)
+    cases, oracle = load_evolved(EVOLVED)
     drawn = sorted(d for n, d in oracle if n == name and np.isfinite(oracle[(n, d)]))
     designs = [
-        fc.perturb(RobotDesign.from_dict(cases[name]["design"]), d, name=name) for d in drawn
+        perturb(RobotDesign.from_dict(cases[name]["design"]), d, name=name) for d in drawn
     ]
-    r = dilute(Simulation(designs, SimConfig(), terrain=fs.fence_terrain()).run(5.0))
+    r = dilute(Simulation(designs, SimConfig(), terrain=fence_terrain()).run(5.0))
     for d, v in zip(drawn, walk_metrics(r)["max_xy_dist"]):
         ref = oracle[(name, d)]
         assert abs(v - ref) <= 0.01 * ref + 1e-4, (

@@ -1,0 +1,306 @@
+"""The protocol that holds the seed preset to the seed study's own engine.
+
+softgym's seed preset is checked against the engine the seed study ran (a
+program not shipped with softgym; its outputs are committed as JSON data under
+``benchmarks/data/seed_engine/``, with the scripts that made them). This module
+is that protocol's vocabulary, shared by the benchmark (``benchmarks/
+fidelity_seed.py``, ``fidelity_evolved.py``), the scripts that generated the
+data and the tests (``tests/engine/test_seed_oracle.py``):
+
+* :data:`REGIMES`: the three actuation regimes (temperature amplitude, period,
+  muscle CTE), "gentle" being the seed's default;
+* :class:`Case` and :func:`cases_from_data`: the robots of a stored data file;
+* :func:`perturb`, :func:`perturbed_voxel`, :func:`case_design`: draw ``k > 0``
+  multiplies the density of one voxel (the ``k``-th of a permutation seeded by
+  the case name) by ``1 + 1e-6`` (:data:`PERTURBATION`), the probe of how
+  sensitive a body is (the seed's engine changes by up to 10x under it);
+* :data:`METRIC`, :func:`fence_terrain`: what is compared on flat ground and in
+  the seed's fence (:data:`FENCE`);
+* :func:`micro_trace`: softgym's centre-of-mass trace at the sample steps of a
+  stored micro-case;
+* :func:`load_evolved`: the evolved robots of ``evolved.json`` and the seed
+  engine's metric per draw.
+
+The statistics (rank correlation against the engine's own self-agreement, the
+within-2x share, moved-vs-still mismatches) and the targets live in
+``benchmarks/fidelity_seed.py``; the results in ``benchmarks/RESULTS.md``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from softgym.design.controller import Controller
+from softgym.design.material import default_palette
+from softgym.design.robot import RobotDesign
+from softgym.engine import SimConfig, Simulation
+from softgym.terrain import Terrain
+
+__all__ = [
+    "FENCE",
+    "METRIC",
+    "PERTURBATION",
+    "REGIMES",
+    "SIM_SETTINGS",
+    "SOFTGYM_METRIC",
+    "Case",
+    "case_design",
+    "cases_from_data",
+    "check_grid",
+    "controller",
+    "fence_terrain",
+    "load_evolved",
+    "micro_trace",
+    "perturb",
+    "perturbed_voxel",
+]
+
+#: Actuation regimes: temperature amplitude dT (degC), period (s), muscle CTE magnitude
+#: (1/degC; Active_+ gets +cte, Active_- gets -cte). "gentle" is the seed's default.
+REGIMES: dict[str, dict[str, float]] = {
+    "gentle": dict(dT=14, period=0.25, cte=0.01),
+    "medium": dict(dT=18, period=0.15, cte=0.025),
+    "strong": dict(dT=20, period=0.1, cte=0.04),
+}
+
+#: Simulation settings of every run (``softgym.design.vxa.to_vxa`` keyword arguments;
+#: these are its defaults and the seed's, docs/PHYSICS.md). to_vxa also writes
+#: BondDampingZ 1, ColDampingZ 0.8, SlowDampingZ 0.01, ColSystem 3, CollisionHorizon 2,
+#: flat floor, gravity -9.81, Lattice_Dim 0.01 m.
+SIM_SETTINGS: dict[str, Any] = dict(
+    voxel_size=0.01, sim_time=5.0, init_time=1.0, dt_frac=0.9, self_collisions=True
+)
+
+#: Relative density change of the perturbed voxel.
+PERTURBATION = 1e-6
+
+#: The seed's fence task (docs/PHYSICS.md): a 50x50x6 workspace, the 6x6x6
+#: robot box at voxel indices x, y in 22..27, z in 0..5, a square wall of material 5
+#: (Obstacle, E 5e9 Pa, 1 kg per voxel) 1 voxel thick and 1 high at x in {19, 30}
+#: (y 19..30) and y in {19, 30} (x 19..30): 44 fixed voxels. In softgym:
+#: ``Terrain.fence()`` with the robot's grid corner at the origin (the wall at -3 and 8).
+FENCE: dict[str, Any] = dict(
+    env_size=(50, 50, 6),
+    robot_offset=(22, 22, 0),
+    side=12,
+    wall_lo=19,
+    wall_hi=30,
+    height=1,
+    wall_material=5,
+    n_wall_voxels=44,
+    wall_mass_kg=44.0,
+    softgym_terrain="Terrain.fence(inner=10, height=1, thickness=1, center=(3, 3))",
+)
+
+
+@dataclass(frozen=True)
+class Case:
+    """One robot of the benchmark.
+
+    Attributes
+    ----------
+    name : str
+        Stable, unique name (also the seed of its perturbations).
+    set : str
+        ``"structured"``, ``"random"`` or ``"fence"``.
+    design : RobotDesign
+        The body with the default (seed) palette and controller; see :func:`case_design`.
+    terrain : str
+        ``"flat"`` or ``"fence"`` (:data:`FENCE`).
+    meta : dict
+        Description and facts: ``has_bone``, ``n_voxels``, ``robot_mass_kg``,
+        ``mirror_x`` / ``mirror_y`` (grid equal to its mirror image), origin of a
+        random body (``seed``, ``rules``, ``mutations``).
+    """
+
+    name: str
+    set: str
+    design: RobotDesign
+    terrain: str = "flat"
+    meta: dict[str, Any] = field(default_factory=dict, compare=False)
+
+
+# --------------------------------------------------------------------------------------------
+# Regimes, perturbation, designs
+# --------------------------------------------------------------------------------------------
+
+
+def controller(regime: str) -> Controller:
+    """The :class:`~softgym.design.Controller` of a regime name of :data:`REGIMES`."""
+    r = REGIMES[regime]
+    return Controller(temp_amplitude=r["dT"], period=r["period"], muscle_cte=r["cte"])
+
+
+def _name_seed(name: str) -> int:
+    return int.from_bytes(hashlib.sha256(name.encode("utf-8")).digest()[:8], "little")
+
+
+def perturbed_voxel(
+    case: Case | RobotDesign, draw: int, name: str | None = None
+) -> tuple[int, int, int] | None:
+    """The voxel (i, j, k) whose density draw ``draw`` perturbs; None for draw 0.
+
+    Parameters
+    ----------
+    case : Case or RobotDesign
+        The case (its name seeds the choice) or a design with ``name`` given.
+    draw : int
+        0 (unperturbed) or k >= 1.
+    name : str, optional
+        Seed of the choice when ``case`` is a bare design.
+
+    The filled voxels, in C order, are permuted by a generator seeded with the name;
+    draw k takes entry ``(k - 1) % n_voxels``, so draws 1..n_voxels differ.
+    """
+    if draw < 0 or int(draw) != draw:
+        raise ValueError(f"draw must be an integer >= 0, got {draw!r}")
+    if draw == 0:
+        return None
+    design, key = _design_and_name(case, name)
+    filled = np.flatnonzero(design.grid.ravel())
+    order = np.random.default_rng(_name_seed(key)).permutation(filled.size)
+    flat = int(filled[order[(int(draw) - 1) % filled.size]])
+    i, j, k = np.unravel_index(flat, design.shape)
+    return int(i), int(j), int(k)
+
+
+def _design_and_name(case: Case | RobotDesign, name: str | None) -> tuple[RobotDesign, str]:
+    if isinstance(case, Case):
+        return case.design, case.name if name is None else name
+    if name is None:
+        raise ValueError("perturbing a bare RobotDesign needs the case name (name=...)")
+    return case, name
+
+
+def perturb(case: Case | RobotDesign, draw: int, name: str | None = None) -> RobotDesign:
+    """The design with one voxel's density multiplied by ``1 + PERTURBATION`` (draw 0: unchanged).
+
+    Parameters
+    ----------
+    case : Case or RobotDesign
+        A case (perturbs ``case.design``) or a design (then ``name`` is required;
+        pass the case name, e.g. ``perturb(case_design(c, "strong"), 3, name=c.name)``).
+    draw : int
+        0 (unperturbed) or k >= 1 (see :func:`perturbed_voxel`).
+    name : str, optional
+        The case name when ``case`` is a bare design.
+
+    Returns
+    -------
+    RobotDesign
+        Same controller; the voxel :func:`perturbed_voxel` holds a new palette id
+        (``palette.max_id + 1``) whose material copies the voxel's material with the
+        density multiplied.
+    """
+    design, key = _design_and_name(case, name)
+    voxel = perturbed_voxel(design, draw, key)
+    if voxel is None:
+        return design
+    mid = int(design.grid[voxel])
+    new_id = design.palette.max_id + 1
+    mat = design.palette[mid]
+    copy = mat.replace(name=f"{mat.name}_perturbed", density=mat.density * (1.0 + PERTURBATION))
+    grid = design.grid.copy()
+    grid[voxel] = new_id
+    return design.replace(grid=grid, palette=design.palette.with_material(new_id, copy))
+
+
+def case_design(case: Case, regime: str, draw: int = 0) -> RobotDesign:
+    """The design of ``case`` driven by ``regime``'s controller, with draw ``draw``'s perturbation."""
+    return perturb(case.design.with_controller(controller(regime)), draw, name=case.name)
+
+
+def cases_from_data(data: dict[str, Any]) -> list[Case]:
+    """The cases of a loaded oracle data file (``json.load`` of ``structured.json``, ...), from its stored grids.
+
+    Needs neither the CPPN code nor ``evolvers``: each case gets the stored grid, the
+    default (seed) palette and controller, its stored terrain and meta, and the set
+    named in the file's header. :func:`case_design` and :func:`perturbed_voxel` then
+    give the same designs and voxels as for the generated cases.
+    """
+    from softgym.design.robot import DESIGN_SCHEMA, DESIGN_VERSION
+
+    out = []
+    set_ = data["header"]["set"]
+    for name, entry in data["cases"].items():
+        design = RobotDesign.from_dict(
+            {
+                "schema": DESIGN_SCHEMA,
+                "version": DESIGN_VERSION,
+                "grid": entry["grid"],
+                "palette": default_palette().to_list(),
+                "controller": Controller().to_dict(),
+            }
+        )
+        out.append(
+            Case(name, set_, design, entry.get("terrain", "flat"), dict(entry.get("meta", {})))
+        )
+    return out
+
+
+def check_grid(case: Case, stored: dict[str, Any]) -> None:
+    """Raise ValueError unless ``case``'s grid equals a grid stored by the oracle data.
+
+    ``stored`` is the ``"grid"`` entry of :meth:`RobotDesign.to_dict` (as written in
+    the data files' ``"cases"``).
+    """
+    mine = case.design.to_dict()["grid"]
+    if mine != stored:
+        raise ValueError(
+            f"case {case.name!r}: the grid differs from the one the oracle ran "
+            "(did the CPPN code change?); use the stored grid"
+        )
+
+
+#: The metric compared per terrain: the seed's fitness on flat ground and on its fence.
+METRIC = {"flat": "NormFinalDist", "fence": "MaxXYDist"}
+#: softgym's name of each oracle metric.
+SOFTGYM_METRIC = {"NormFinalDist": "norm_final_dist", "MaxXYDist": "max_xy_dist"}
+
+
+def fence_terrain() -> Terrain:
+    """The seed's fence around a 6x6x6 robot at the origin (:data:`FENCE`)."""
+    return Terrain.fence(inner=10, height=1, thickness=1, center=(3, 3))
+
+
+def micro_trace(case: dict[str, Any], model: str = "seed") -> tuple[np.ndarray, np.ndarray]:
+    """The centre of mass softgym computes at the oracle's sample steps of a micro-case.
+
+    ``case`` is one entry of ``micro.json``'s ``"cases"`` (grid, regime, times and
+    the seed engine's trace). Returns ``(ours, oracle)``, each of shape
+    (n_samples, 3) in metres.
+    """
+    dT, period, cte = (REGIMES[case["regime"]][k] for k in ("dT", "period", "cte"))
+    design = RobotDesign(np.asarray(case["grid"]), controller=Controller(dT, period, cte))
+    cfg = SimConfig(init_time=case["init_time"], model=model)
+    sim = Simulation([design], cfg, n_threads=1)
+    dt = float(sim.dt[0])
+    sim = Simulation([design], cfg.replace(trace_interval=dt), n_threads=1)
+    rollout = sim.run(case["sim_time"])
+    oracle = np.asarray(case["trace"], dtype=np.float64)
+    steps = np.rint(oracle[:, 3] / dt).astype(np.intp)  # the oracle samples at step times
+    steps = np.clip(steps, 0, rollout.cm.shape[1] - 1)
+    return rollout.cm[0, steps], oracle[:, :3]
+
+
+def load_evolved(path: str | Path) -> tuple[dict[str, dict[str, Any]], dict[tuple[str, int], float]]:
+    """The designs of an ``evolved.json`` file and the oracle's metric by (design, draw).
+
+    The metric is :data:`METRIC` of each design's terrain; NaN where the seed's
+    engine hung.
+    """
+    data = json.loads(Path(path).read_text())
+    values = {}
+    for rec in data["records"]:
+        terrain = data["cases"][rec["case"]]["terrain"]
+        v = rec.get(METRIC[terrain])
+        values[(rec["case"], int(rec["draw"]))] = (
+            float("nan") if rec.get("hung") or v is None else float(v)
+        )
+    return data["cases"], values
