@@ -62,7 +62,7 @@ __all__ = [
 ]
 
 #: Actuation regimes: temperature amplitude dT (degC), period (s), muscle CTE magnitude
-#: (1/degC; Active_+ gets +cte, Active_- gets -cte). "gentle" is the seed's default.
+#: (1/degC; ``Active_+`` gets +cte, ``Active_-`` gets -cte). "gentle" is the seed's default.
 REGIMES: dict[str, dict[str, float]] = {
     "gentle": dict(dT=14, period=0.25, cte=0.01),
     "medium": dict(dT=18, period=0.15, cte=0.025),
