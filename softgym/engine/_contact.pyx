@@ -178,7 +178,7 @@ cdef inline void _hash_table(SpatialHash* h, Contacts* c) noexcept nogil:
     if mi > 4096 or mj > 4096 or mk > 4096:
         return
     nd = (mi + 2) * (mj + 2) * (mk + 2)
-    if nd > 64 * h.n + 4096:
+    if nd > 8 * h.n + 512:  # at most ~64 bytes per point beyond a 4 KiB floor
         return
     if nd + 1 > c.dense_capacity:
         grown = <intp_t*> realloc(c.dense, (nd + 1) * sizeof(intp_t))
