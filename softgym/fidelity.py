@@ -40,6 +40,7 @@ from softgym.design.controller import Controller
 from softgym.design.material import default_palette
 from softgym.design.robot import RobotDesign
 from softgym.engine import SimConfig, Simulation
+from softgym.exceptions import InvalidDesignError, InvalidParameterError
 from softgym.terrain import Terrain
 
 __all__ = [
@@ -159,7 +160,7 @@ def perturbed_voxel(
     draw k takes entry ``(k - 1) % n_voxels``, so draws 1..n_voxels differ.
     """
     if draw < 0 or int(draw) != draw:
-        raise ValueError(f"draw must be an integer >= 0, got {draw!r}")
+        raise InvalidParameterError(f"draw must be an integer >= 0, got {draw!r}")
     if draw == 0:
         return None
     design, key = _design_and_name(case, name)
@@ -174,7 +175,7 @@ def _design_and_name(case: Case | RobotDesign, name: str | None) -> tuple[RobotD
     if isinstance(case, Case):
         return case.design, case.name if name is None else name
     if name is None:
-        raise ValueError("perturbing a bare RobotDesign needs the case name (name=...)")
+        raise InvalidParameterError("perturbing a bare RobotDesign needs the case name (name=...)")
     return case, name
 
 
@@ -245,14 +246,14 @@ def cases_from_data(data: dict[str, Any]) -> list[Case]:
 
 
 def check_grid(case: Case, stored: dict[str, Any]) -> None:
-    """Raise ValueError unless ``case``'s grid equals a grid stored by the oracle data.
+    """Raise InvalidDesignError unless ``case``'s grid equals a grid stored by the oracle data.
 
     ``stored`` is the ``"grid"`` entry of :meth:`RobotDesign.to_dict` (as written in
     the data files' ``"cases"``).
     """
     mine = case.design.to_dict()["grid"]
     if mine != stored:
-        raise ValueError(
+        raise InvalidDesignError(
             f"case {case.name!r}: the grid differs from the one the oracle ran "
             "(did the CPPN code change?); use the stored grid"
         )

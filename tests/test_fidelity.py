@@ -1,0 +1,86 @@
+"""softgym.fidelity: the seed-fidelity protocol's cases, perturbations and data readers."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from softgym.design.robot import RobotDesign
+from softgym.exceptions import InvalidDesignError, InvalidParameterError
+from softgym.fidelity import (
+    PERTURBATION,
+    REGIMES,
+    case_design,
+    cases_from_data,
+    check_grid,
+    load_evolved,
+    perturb,
+    perturbed_voxel,
+)
+
+DATA = Path(__file__).resolve().parents[1] / "benchmarks" / "data" / "seed_engine"
+STRUCTURED = json.loads((DATA / "structured.json").read_text())
+
+
+@st.composite
+def bodies(draw):
+    shape = tuple(draw(st.integers(1, 4)) for _ in range(3))
+    grid = np.asarray(draw(st.lists(st.integers(0, 4), min_size=int(np.prod(shape)),
+                                    max_size=int(np.prod(shape)))), dtype=np.int8).reshape(shape)  # fmt: skip
+    if not grid.any():
+        grid.flat[0] = 1
+    return RobotDesign(grid)
+
+
+@settings(max_examples=40, deadline=None)
+@given(bodies(), st.integers(1, 12), st.text(min_size=1, max_size=8))
+def test_a_draw_changes_one_voxels_density_by_the_perturbation(design, draw, name):
+    out = perturb(design, draw, name=name)
+    voxel = perturbed_voxel(design, draw, name=name)
+    assert voxel == perturbed_voxel(design, draw, name=name)  # seeded by the name alone
+    changed = np.argwhere(out.grid != design.grid)
+    assert [tuple(v) for v in changed] == [voxel]
+    old, new = design.palette[int(design.grid[voxel])], out.palette[int(out.grid[voxel])]
+    assert new.density == old.density * (1.0 + PERTURBATION)
+    assert new.youngs_modulus == old.youngs_modulus and new.cte == old.cte
+    assert perturb(design, 0, name=name) is design
+
+
+def test_draws_one_to_six_perturb_six_different_voxels_of_a_case():
+    case = cases_from_data(STRUCTURED)[0]
+    voxels = {perturbed_voxel(case, d) for d in range(1, 7)}
+    assert len(voxels) == 6
+
+
+def test_a_case_design_carries_its_regimes_controller():
+    case = cases_from_data(STRUCTURED)[0]
+    for regime, r in REGIMES.items():
+        c = case_design(case, regime).controller
+        assert (c.temp_amplitude, c.period, c.muscle_cte) == (r["dT"], r["period"], r["cte"])
+
+
+def test_stored_cases_are_the_grids_the_oracle_ran():
+    cases = cases_from_data(STRUCTURED)
+    assert len(cases) == len(STRUCTURED["cases"]) == 30
+    for case in cases:
+        check_grid(case, STRUCTURED["cases"][case.name]["grid"])
+    other = STRUCTURED["cases"][cases[1].name]["grid"]
+    with pytest.raises(InvalidDesignError, match="differs from the one the oracle ran"):
+        check_grid(cases[0], other)
+
+
+def test_bad_draws_and_nameless_designs_are_refused():
+    design = cases_from_data(STRUCTURED)[0].design
+    with pytest.raises(InvalidParameterError, match="draw must be an integer >= 0"):
+        perturbed_voxel(design, -1, name="x")
+    with pytest.raises(InvalidParameterError, match="needs the case name"):
+        perturb(design, 1)
+
+
+def test_load_evolved_gives_every_draws_metric():
+    cases, values = load_evolved(DATA / "evolved.json")
+    assert cases and all((name, 0) in values for name in cases)
+    assert all(np.isnan(v) or v >= 0.0 for v in values.values())
