@@ -39,20 +39,15 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 import fidelity_cases as fc  # noqa: E402
-from fidelity_seed import METRIC, SOFTGYM_METRIC, agreement, fence_terrain  # noqa: E402
+from fidelity_seed import agreement  # noqa: E402
 
 from evolvers.study.stats import a12, permutation_pvalue  # noqa: E402
 from softgym.design.robot import RobotDesign  # noqa: E402
 from softgym.engine import SimConfig, Simulation  # noqa: E402
-from softgym.fidelity import load_evolved  # noqa: E402
+from softgym.fidelity import METRIC, SOFTGYM_METRIC, fence_terrain, load_evolved  # noqa: E402
 from softgym.metrics import dilute, walk_metrics  # noqa: E402
 
 DATA = HERE / "data" / "seed_engine" / "evolved.json"
-
-
-def load(path: Path = DATA) -> tuple[dict[str, dict[str, Any]], dict[tuple[str, int], float]]:
-    """The embedded designs and the oracle's metric by (design, draw) (NaN when it hung)."""
-    return load_evolved(path)
 
 
 def run_softgym(cases: dict[str, dict[str, Any]], draws: list[int],
@@ -84,7 +79,7 @@ def main() -> int:
     ap.add_argument("--softgym-values", type=Path, default=None,
                     help="JSON of softgym's values: read if it exists, else written")  # fmt: skip
     a = ap.parse_args()
-    cases, oracle = load()
+    cases, oracle = load_evolved(DATA)
     draws = sorted({d for _, d in oracle})
     half_a, half_b = draws[: (len(draws) + 1) // 2], draws[(len(draws) + 1) // 2 :]
     t0 = time.time()

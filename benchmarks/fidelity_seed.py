@@ -48,7 +48,7 @@ sys.path.insert(0, str(HERE))
 import fidelity_cases as fc  # noqa: E402
 
 from softgym.engine import SimConfig, Simulation  # noqa: E402
-from softgym.fidelity import METRIC, SOFTGYM_METRIC, fence_terrain, micro_trace  # noqa: E402, F401
+from softgym.fidelity import METRIC, SOFTGYM_METRIC, fence_terrain, micro_trace  # noqa: E402
 from softgym.metrics import dilute, walk_metrics  # noqa: E402
 
 DATA = HERE / "data" / "seed_engine"

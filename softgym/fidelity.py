@@ -38,7 +38,7 @@ import numpy as np
 
 from softgym.design.controller import Controller
 from softgym.design.material import default_palette
-from softgym.design.robot import RobotDesign
+from softgym.design.robot import DESIGN_SCHEMA, DESIGN_VERSION, RobotDesign
 from softgym.engine import SimConfig, Simulation
 from softgym.exceptions import InvalidDesignError, InvalidParameterError
 from softgym.terrain import Terrain
@@ -225,8 +225,6 @@ def cases_from_data(data: dict[str, Any]) -> list[Case]:
     named in the file's header. :func:`case_design` and :func:`perturbed_voxel` then
     give the same designs and voxels as for the generated cases.
     """
-    from softgym.design.robot import DESIGN_SCHEMA, DESIGN_VERSION
-
     out = []
     set_ = data["header"]["set"]
     for name, entry in data["cases"].items():

@@ -12,9 +12,13 @@ TESTS = Path(__file__).resolve().parent
 
 
 def _mentions_benchmarks(node):
-    return any(isinstance(n, ast.Constant) and isinstance(n.value, str) and "benchmarks" in n.value
-               for n in ast.walk(node)) or any(isinstance(n, ast.Name) and n.id in {"BENCH", "BENCHMARKS"}
-                                                for n in ast.walk(node))  # fmt: skip
+    """True when a call's arguments name the benchmarks folder (a string or BENCH)."""
+    for n in ast.walk(node):
+        if isinstance(n, ast.Constant) and isinstance(n.value, str) and "benchmarks" in n.value:
+            return True
+        if isinstance(n, ast.Name) and n.id in {"BENCH", "BENCHMARKS"}:
+            return True
+    return False
 
 
 def test_no_test_imports_a_benchmark_script():

@@ -175,8 +175,6 @@ cdef inline void _hash_table(SpatialHash* h, Contacts* c) noexcept nogil:
         mi = max(mi, key >> (2 * CELL_BITS))
         mj = max(mj, (key >> CELL_BITS) & mask)
         mk = max(mk, key & mask)
-    if mi > 4096 or mj > 4096 or mk > 4096:
-        return
     nd = (mi + 2) * (mj + 2) * (mk + 2)
     if nd > 8 * h.n + 512:  # at most ~64 bytes per point beyond a 4 KiB floor
         return
