@@ -63,8 +63,10 @@ cdef struct Batch:
     float64_t* quat          # (n_voxels, 4) orientation, unit quaternion (w, x, y, z)
     float64_t* angvel        # (n_voxels, 3) angular velocity, world frame (rad/s)
     float64_t* rot           # (n_voxels, 9) rotation matrix of quat, row-major (derived)
-    float64_t* force         # (n_voxels, 3) scratch: accumulated force (N)
-    float64_t* moment        # (n_voxels, 3) scratch: accumulated moment (N m)
+    float64_t* force         # (n_voxels, 4) scratch: accumulated force (N) in columns 0-2;
+                             #   column 3 pads a voxel's row to 4 lanes (the seed scatter
+                             #   adds whole rows) and is never read
+    float64_t* moment        # (n_voxels, 4) scratch: accumulated moment (N m), as force
     float64_t* vox_out       # scratch of the seed model's new orientations: row k of voxel i at
                              #   vox_out[k * vox_stride + i], i among the robot's voxels
     intp_t vox_stride        # its row stride (the most voxels of one robot)

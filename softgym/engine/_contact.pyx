@@ -444,9 +444,9 @@ cdef void collide_obstacles(Batch* b, Contacts* c) noexcept nogil:
         dist = sqrt(d2)
         kk = b.k_floor[i] * b.obs[4 * m + 3] / (b.k_floor[i] + b.obs[4 * m + 3])
         fmag = kk * (env - dist) / dist
-        b.force[3 * i] += fmag * dx
-        b.force[3 * i + 1] += fmag * dy
-        b.force[3 * i + 2] += fmag * dz
+        b.force[4 * i] += fmag * dx
+        b.force[4 * i + 1] += fmag * dy
+        b.force[4 * i + 2] += fmag * dz
 
 
 cdef void collide(Batch* b, Contacts* c) noexcept nogil:
@@ -469,9 +469,9 @@ cdef void collide(Batch* b, Contacts* c) noexcept nogil:
         # E_h L = harmonic mean of the voxels' E L = k1 k2 / (k1 + k2), k = 2 E L
         kk = b.k_floor[i] * b.k_floor[j] / (b.k_floor[i] + b.k_floor[j])
         fmag = kk * (env - dist) / dist
-        b.force[3 * j] += fmag * dx
-        b.force[3 * j + 1] += fmag * dy
-        b.force[3 * j + 2] += fmag * dz
-        b.force[3 * i] -= fmag * dx
-        b.force[3 * i + 1] -= fmag * dy
-        b.force[3 * i + 2] -= fmag * dz
+        b.force[4 * j] += fmag * dx
+        b.force[4 * j + 1] += fmag * dy
+        b.force[4 * j + 2] += fmag * dz
+        b.force[4 * i] -= fmag * dx
+        b.force[4 * i + 1] -= fmag * dy
+        b.force[4 * i + 2] -= fmag * dz

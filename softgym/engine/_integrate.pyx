@@ -54,19 +54,21 @@ cdef inline void _fluid_drag(Batch* b, intp_t i, float64_t* f) noexcept nogil:
 
 
 cdef inline void _clear(Batch* b, intp_t i) noexcept nogil:
-    b.force[3 * i] = 0.0
-    b.force[3 * i + 1] = 0.0
-    b.force[3 * i + 2] = 0.0
-    b.moment[3 * i] = 0.0
-    b.moment[3 * i + 1] = 0.0
-    b.moment[3 * i + 2] = 0.0
+    b.force[4 * i] = 0.0
+    b.force[4 * i + 1] = 0.0
+    b.force[4 * i + 2] = 0.0
+    b.force[4 * i + 3] = 0.0
+    b.moment[4 * i] = 0.0
+    b.moment[4 * i + 1] = 0.0
+    b.moment[4 * i + 2] = 0.0
+    b.moment[4 * i + 3] = 0.0
 
 
 cdef void clear_robot(Batch* b, intp_t r) noexcept nogil:
     # zero the robot's force/moment scratch (after an early exit)
     cdef intp_t vs = b.vox_start[r], ve = b.vox_start[r + 1]
-    memset(b.force + 3 * vs, 0, 3 * (ve - vs) * sizeof(float64_t))
-    memset(b.moment + 3 * vs, 0, 3 * (ve - vs) * sizeof(float64_t))
+    memset(b.force + 4 * vs, 0, 4 * (ve - vs) * sizeof(float64_t))
+    memset(b.moment + 4 * vs, 0, 4 * (ve - vs) * sizeof(float64_t))
 
 
 cdef inline float64_t _drift2(const float64_t* pos, const float64_t* ref, intp_t i, intp_t vs,
@@ -136,12 +138,12 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
             continue
         m = b.mass[i]
         cg = b.c_global[i]
-        f[0] = b.force[3 * i] + b.ext_force[3 * i] - cg * vel[3 * i]
-        f[1] = b.force[3 * i + 1] + b.ext_force[3 * i + 1] - cg * vel[3 * i + 1]
-        f[2] = b.force[3 * i + 2] + b.ext_force[3 * i + 2] - cg * vel[3 * i + 2] + m * g
-        mx = b.moment[3 * i]
-        my = b.moment[3 * i + 1]
-        mz = b.moment[3 * i + 2]
+        f[0] = b.force[4 * i] + b.ext_force[3 * i] - cg * vel[3 * i]
+        f[1] = b.force[4 * i + 1] + b.ext_force[3 * i + 1] - cg * vel[3 * i + 1]
+        f[2] = b.force[4 * i + 2] + b.ext_force[3 * i + 2] - cg * vel[3 * i + 2] + m * g
+        mx = b.moment[4 * i]
+        my = b.moment[4 * i + 1]
+        mz = b.moment[4 * i + 2]
         _clear(b, i)  # the scratch is zero again for the next step
         if has_fluid:
             _fluid_drag(b, i, f)
@@ -248,12 +250,12 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
             _clear(b, i)
             continue
         cg = b.c_global[i]
-        f[0] = -cg * vel[3 * i] + b.force[3 * i] + b.ext_force[3 * i]
-        f[1] = -cg * vel[3 * i + 1] + b.force[3 * i + 1] + b.ext_force[3 * i + 1]
-        f[2] = -cg * vel[3 * i + 2] + b.force[3 * i + 2] + b.mass[i] * b.gravity + b.ext_force[3 * i + 2]
-        mx = b.moment[3 * i]
-        my = b.moment[3 * i + 1]
-        mz = b.moment[3 * i + 2]
+        f[0] = -cg * vel[3 * i] + b.force[4 * i] + b.ext_force[3 * i]
+        f[1] = -cg * vel[3 * i + 1] + b.force[4 * i + 1] + b.ext_force[3 * i + 1]
+        f[2] = -cg * vel[3 * i + 2] + b.force[4 * i + 2] + b.mass[i] * b.gravity + b.ext_force[3 * i + 2]
+        mx = b.moment[4 * i]
+        my = b.moment[4 * i + 1]
+        mz = b.moment[4 * i + 2]
         _clear(b, i)
         if has_fluid:
             _fluid_drag(b, i, f)

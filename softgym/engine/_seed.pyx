@@ -38,8 +38,7 @@ from libc.math cimport cos, acos, sqrt, fabs
 cimport numpy as cnp
 import numpy as np
 
-from softgym.engine._batch cimport (Batch, STATUS_OK, STATUS_STRAIN, N_LINK_OUT, f64_rp,
-                                    cf64_rp, cintp_rp)
+from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_STRAIN, N_LINK_OUT
 from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t
 
 cnp.import_array()
@@ -68,70 +67,12 @@ cdef inline float64_t _rotvec_k(float64_t w) noexcept nogil:
     return 2.0 * acos(w) / sqrt(sl)
 
 
-cdef void _seed_geom(intp_t lo, intp_t hi, intp_t ax, cintp_rp v1, cintp_rp v2,
-                     cf64_rp pos, cf64_rp rot, cf64_rp quat, cf64_rp scale,
-                     f64_rp o_p0, f64_rp o_p1, f64_rp o_p2, f64_rp o_qw,
-                     f64_rp o_n1, f64_rp o_n2, f64_rp o_n3, f64_rp o_nom,
-                     f64_rp o_len, f64_rp o_st) noexcept nogil:
-    # Model 0's link geometry for links lo..hi, all along axis ax, without
-    # branches so the loop vectorises: the relative position p and voxel 2's
-    # orientation relative to voxel 1 (q1* q2 = (qw, n)), both in the bond
-    # frame (voxel 1's frame turned by the proper rotation P that takes the
-    # link axis onto +x, the seed's ToXDirBond: (x, y, z) -> (x, y, z),
-    # (y, -x, z), (z, y, -x) for ax 0, 1, 2); the nominal length, the chord
-    # length and the transverse ratio. Component c of a bond-frame vector is
-    # s_c times local component a_c (s = +-1: exact).
-    cdef:
-        intp_t li, i, j
-        intp_t a0 = ax
-        intp_t a1 = 0 if ax == 1 else 1
-        intp_t a2 = 0 if ax == 2 else 2
-        float64_t s1 = -1.0 if ax == 1 else 1.0
-        float64_t s2 = -1.0 if ax == 2 else 1.0
-        # n = W (qx, qy, qz): W's rows one-hot (x 1 + y 0 + z 0 = x exactly)
-        float64_t w00 = 1.0 if a0 == 0 else 0.0
-        float64_t w01 = 1.0 if a0 == 1 else 0.0
-        float64_t w02 = 1.0 if a0 == 2 else 0.0
-        float64_t w10 = s1 if a1 == 0 else 0.0
-        float64_t w11 = s1 if a1 == 1 else 0.0
-        float64_t w12 = s1 if a1 == 2 else 0.0
-        float64_t w20 = s2 if a2 == 0 else 0.0
-        float64_t w21 = s2 if a2 == 1 else 0.0
-        float64_t w22 = s2 if a2 == 2 else 0.0
-        float64_t dx, dy, dz, qw, qx, qy, qz, p0, p1, p2
-    for li in range(lo, hi):
-        i = v1[li]
-        j = v2[li]
-        dx = pos[3 * j] - pos[3 * i]
-        dy = pos[3 * j + 1] - pos[3 * i + 1]
-        dz = pos[3 * j + 2] - pos[3 * i + 2]
-        # relative position in voxel 1's frame (column a of its rotation . d)
-        p0 = rot[9 * i + a0] * dx + rot[9 * i + 3 + a0] * dy + rot[9 * i + 6 + a0] * dz
-        p1 = s1 * (rot[9 * i + a1] * dx + rot[9 * i + 3 + a1] * dy + rot[9 * i + 6 + a1] * dz)
-        p2 = s2 * (rot[9 * i + a2] * dx + rot[9 * i + 3 + a2] * dy + rot[9 * i + 6 + a2] * dz)
-        qw = (quat[4 * i] * quat[4 * j] + quat[4 * i + 1] * quat[4 * j + 1]
-              + quat[4 * i + 2] * quat[4 * j + 2] + quat[4 * i + 3] * quat[4 * j + 3])
-        qx = (quat[4 * i] * quat[4 * j + 1] - quat[4 * i + 1] * quat[4 * j]
-              - quat[4 * i + 2] * quat[4 * j + 3] + quat[4 * i + 3] * quat[4 * j + 2])
-        qy = (quat[4 * i] * quat[4 * j + 2] + quat[4 * i + 1] * quat[4 * j + 3]
-              - quat[4 * i + 2] * quat[4 * j] - quat[4 * i + 3] * quat[4 * j + 1])
-        qz = (quat[4 * i] * quat[4 * j + 3] - quat[4 * i + 1] * quat[4 * j + 2]
-              + quat[4 * i + 2] * quat[4 * j + 1] - quat[4 * i + 3] * quat[4 * j])
-        o_p0[li] = p0
-        o_p1[li] = p1
-        o_p2[li] = p2
-        o_qw[li] = qw
-        o_n1[li] = qx * w00 + qy * w01 + qz * w02
-        o_n2[li] = qx * w10 + qy * w11 + qz * w12
-        o_n3[li] = qx * w20 + qy * w21 + qz * w22
-        o_nom[li] = 0.5 * (scale[i] + scale[j])
-        o_len[li] = sqrt(dx * dx + dy * dy + dz * dz)
-        o_st[li] = (fabs(p2) + fabs(p1)) / p0
-
-
 cdef extern from "softgym_seed.h":
-    # the second and third passes of _seed_links_along (C, for the
-    # vectorising pragma; documented in include/softgym_seed.h)
+    # the passes of _seed_links_along (C, for the vectorising pragma and one
+    # copy per link axis; documented in include/softgym_seed.h)
+    void softgym_seed_geom(int ax, intp_t lo, intp_t hi, intp_t n, const intp_t* v1,
+                           const intp_t* v2, const float64_t* pos, const float64_t* quat,
+                           const float64_t* scale, float64_t* o) noexcept nogil
     void softgym_seed_frames(intp_t lo, intp_t hi, float64_t sa_rad, float64_t thr,
                              const float64_t* p0_, const float64_t* p1_, const float64_t* p2_,
                              const float64_t* qw_, const float64_t* n1_, const float64_t* n2_,
@@ -237,7 +178,7 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
     # (profiled: the square roots and divisions of the large-angle frames
     # dominated the step; one branch-free vector loop does them for many links
     # at once, the same IEEE operations as the seed's scalar code):
-    #   _seed_geom           rows 0-9: relative position p, orientation (qw, n),
+    #   softgym_seed_geom    rows 0-9: relative position p, orientation (qw, n),
     #                        nominal length, chord length, transverse ratio
     #   softgym_seed_modes   the mode (link_sa; row 9 becomes 1.0 small / 0.0
     #                        large angle), row 22 1.0 on a mode-change step,
@@ -269,8 +210,7 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
         float64_t* out[12]
     if hi <= lo:
         return STATUS_OK
-    _seed_geom(lo, hi, ax, v1, v2, b.pos, rot, b.quat, b.scale, o, o + n, o + 2 * n,
-               o + 3 * n, o + 4 * n, o + 5 * n, o + 6 * n, o + 7 * n, o + 8 * n, o + 9 * n)
+    softgym_seed_geom(ax, lo, hi, n, v1, v2, b.pos, b.quat, b.scale, o)
     end = softgym_seed_modes(lo, hi, n, b.max_strain * b.L, SMALL_ANGLE_W, SMALLISH_ANGLE_W,
                              SA_BOND_BEND_RAD, SA_BOND_EXT_PERC, HYSTERESIS * SA_BOND_BEND_RAD,
                              HYSTERESIS * SA_BOND_EXT_PERC, b.link_sa, b.homog, o)

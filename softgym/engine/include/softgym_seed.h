@@ -10,6 +10,85 @@
 #include <math.h>
 #include "softgym_simd.h"
 
+/* The first pass of _seed_links_along: links lo..hi (all along axis ax, a
+   compile-time constant in each copy) measured in the bond frame, without
+   branches so the loop vectorises; rows of o (stride n): 0-2 the relative
+   position p, 3-6 voxel 2's orientation relative to voxel 1 (q1* q2 = (qw,
+   n)), both in the bond frame (voxel 1's frame turned by the proper
+   rotation P that takes the link axis onto +x, the seed's ToXDirBond:
+   (x, y, z) -> (x, y, z), (y, -x, z), (z, y, -x) for ax 0, 1, 2); 7 the
+   nominal length, 8 the chord length, 9 the transverse ratio. Component c
+   of a bond-frame vector is s_c times local component a_c (s = +-1: exact).
+   Voxel 1's rotation matrix is computed in the lanes from its quaternion,
+   with the expressions of the voxel update's (_integrate._rotation_matrix):
+   the same bits as the stored matrix, and 9 fewer gathered loads a link. */
+SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
+                                                Py_ssize_t n, const Py_ssize_t *v1,
+                                                const Py_ssize_t *v2, const double *pos,
+                                                const double *quat, const double *scale,
+                                                double *o)
+{
+    const int a0 = ax, a1 = ax == 1 ? 0 : 1, a2 = ax == 2 ? 0 : 2;
+    const double s1 = ax == 1 ? -1.0 : 1.0, s2 = ax == 2 ? -1.0 : 1.0;
+    /* n = W (qx, qy, qz): W's rows one-hot (x 1 + y 0 + z 0 = x exactly) */
+    const double w00 = a0 == 0, w01 = a0 == 1, w02 = a0 == 2;
+    const double w10 = a1 == 0 ? s1 : 0.0, w11 = a1 == 1 ? s1 : 0.0, w12 = a1 == 2 ? s1 : 0.0;
+    const double w20 = a2 == 0 ? s2 : 0.0, w21 = a2 == 1 ? s2 : 0.0, w22 = a2 == 2 ? s2 : 0.0;
+    double *__restrict__ o_p0 = o, *__restrict__ o_p1 = o + n, *__restrict__ o_p2 = o + 2 * n;
+    double *__restrict__ o_qw = o + 3 * n, *__restrict__ o_n1 = o + 4 * n, *__restrict__ o_n2 = o + 5 * n;
+    double *__restrict__ o_n3 = o + 6 * n, *__restrict__ o_nom = o + 7 * n, *__restrict__ o_len = o + 8 * n;
+    double *__restrict__ o_st = o + 9 * n;
+    Py_ssize_t li;
+    SOFTGYM_IVDEP
+    for (li = lo; li < hi; li++) {
+        Py_ssize_t i = v1[li], j = v2[li];
+        double dx = pos[3 * j] - pos[3 * i];
+        double dy = pos[3 * j + 1] - pos[3 * i + 1];
+        double dz = pos[3 * j + 2] - pos[3 * i + 2];
+        double w = quat[4 * i], x = quat[4 * i + 1], y = quat[4 * i + 2], z = quat[4 * i + 3];
+        double wj = quat[4 * j], xj = quat[4 * j + 1], yj = quat[4 * j + 2], zj = quat[4 * j + 3];
+        double R[9];
+        R[0] = (1.0 - (2.0 * ((y * y) + (z * z))));
+        R[1] = (2.0 * ((x * y) - (w * z)));
+        R[2] = (2.0 * ((x * z) + (w * y)));
+        R[3] = (2.0 * ((x * y) + (w * z)));
+        R[4] = (1.0 - (2.0 * ((x * x) + (z * z))));
+        R[5] = (2.0 * ((y * z) - (w * x)));
+        R[6] = (2.0 * ((x * z) - (w * y)));
+        R[7] = (2.0 * ((y * z) + (w * x)));
+        R[8] = (1.0 - (2.0 * ((x * x) + (y * y))));
+        /* relative position in voxel 1's frame (column a of its rotation . d) */
+        double p0 = (((R[a0] * dx) + (R[3 + a0] * dy)) + (R[6 + a0] * dz));
+        double p1 = (s1 * (((R[a1] * dx) + (R[3 + a1] * dy)) + (R[6 + a1] * dz)));
+        double p2 = (s2 * (((R[a2] * dx) + (R[3 + a2] * dy)) + (R[6 + a2] * dz)));
+        double qw = ((((w * wj) + (x * xj)) + (y * yj)) + (z * zj));
+        double qx = ((((w * xj) - (x * wj)) - (y * zj)) + (z * yj));
+        double qy = ((((w * yj) + (x * zj)) - (y * wj)) - (z * xj));
+        double qz = ((((w * zj) - (x * yj)) + (y * xj)) - (z * wj));
+        o_p0[li] = p0;
+        o_p1[li] = p1;
+        o_p2[li] = p2;
+        o_qw[li] = qw;
+        o_n1[li] = (((qx * w00) + (qy * w01)) + (qz * w02));
+        o_n2[li] = (((qx * w10) + (qy * w11)) + (qz * w12));
+        o_n3[li] = (((qx * w20) + (qy * w21)) + (qz * w22));
+        o_nom[li] = (0.5 * (scale[i] + scale[j]));
+        o_len[li] = sqrt((((dx * dx) + (dy * dy)) + (dz * dz)));
+        o_st[li] = ((fabs(p2) + fabs(p1)) / p0);
+    }
+}
+static void softgym_seed_geom(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
+                              const Py_ssize_t *v1, const Py_ssize_t *v2, const double *pos,
+                              const double *quat, const double *scale, double *o)
+{
+    if (ax == 0)
+        softgym_seed_geom_ax(0, lo, hi, n, v1, v2, pos, quat, scale, o);
+    else if (ax == 1)
+        softgym_seed_geom_ax(1, lo, hi, n, v1, v2, pos, quat, scale, o);
+    else
+        softgym_seed_geom_ax(2, lo, hi, n, v1, v2, pos, quat, scale, o);
+}
+
 /* The second pass of _seed_links_along, in C for one pragma: the bond-frame
    quantities of links lo..hi in the mode the first pass gave them, without
    branches so the loop vectorises (the outputs are distinct rows of the
@@ -363,33 +442,52 @@ static Py_ssize_t softgym_seed_modes(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
    rotation, row-major) and is added to force / moment of voxel 1 or 2.
    Component c of R1 P^T v is R[3c] x + R[3c+1] y + R[3c+2] z, evaluated in
    that order: here as lane c of C0 x + C1 y + C2 z with the columns C_k of
-   R1 in the lanes (lane 3 unused), so one link's four turns are 12
-   multiplies and 8 adds of 4 lanes instead of 36 and 24 scalar ones: the
-   same IEEE operations, bit for bit. Without AVX (2 lanes) the scalar turn,
-   with R1 in locals (the stores to force may alias rot for the compiler). */
+   R1 in the lanes (lane 3 zero), so one link's four turns are 12
+   multiplies and 8 adds of 4 lanes instead of 36 and 24 scalar ones, and
+   each turned vector is added to the voxel's whole row of force / moment
+   (4 lanes; lane 3 is the row's padding, never read): the same IEEE
+   operations, bit for bit. Without AVX (2 lanes) the scalar turn, with R1
+   in locals (the stores to force may alias rot for the compiler). */
 #if defined(__AVX__) && (defined(__GNUC__) || defined(__clang__))
 #define SOFTGYM_SCATTER_V4 1
 typedef double softgym_v4d __attribute__((vector_size(32)));
-#define SOFTGYM_SCATTER_W(w, x, y, z) do { \
+#define SOFTGYM_SCATTER_W(x, y, z) do { \
         double x_ = (x), y_ = (y), z_ = (z); \
-        softgym_v4d t_ = c0 * x_ + c1 * y_ + c2 * z_; \
-        (w)[0] = t_[0]; \
-        (w)[1] = t_[1]; \
-        (w)[2] = t_[2]; \
+        w = c0 * x_ + c1 * y_ + c2 * z_; \
+    } while (0)
+#define SOFTGYM_SCATTER_ADD(acc) do { \
+        softgym_v4d a_; \
+        memcpy(&a_, (acc), sizeof a_); \
+        a_ += w; \
+        memcpy((acc), &a_, sizeof a_); \
+    } while (0)
+#define SOFTGYM_SCATTER_SUB(acc) do { \
+        softgym_v4d a_; \
+        memcpy(&a_, (acc), sizeof a_); \
+        a_ -= w; \
+        memcpy((acc), &a_, sizeof a_); \
     } while (0)
 #else
-#define SOFTGYM_SCATTER_W(w, x, y, z) do { \
+#define SOFTGYM_SCATTER_W(x, y, z) do { \
         double x_ = (x), y_ = (y), z_ = (z); \
-        (w)[0] = R[0] * x_ + R[1] * y_ + R[2] * z_; \
-        (w)[1] = R[3] * x_ + R[4] * y_ + R[5] * z_; \
-        (w)[2] = R[6] * x_ + R[7] * y_ + R[8] * z_; \
+        w[0] = R[0] * x_ + R[1] * y_ + R[2] * z_; \
+        w[1] = R[3] * x_ + R[4] * y_ + R[5] * z_; \
+        w[2] = R[6] * x_ + R[7] * y_ + R[8] * z_; \
     } while (0)
-#endif
-#define SOFTGYM_SCATTER_TURN(acc, x, y, z) do { \
-        SOFTGYM_SCATTER_W(w, x, y, z); \
+#define SOFTGYM_SCATTER_ADD(acc) do { \
         (acc)[0] += w[0]; \
         (acc)[1] += w[1]; \
         (acc)[2] += w[2]; \
+    } while (0)
+#define SOFTGYM_SCATTER_SUB(acc) do { \
+        (acc)[0] -= w[0]; \
+        (acc)[1] -= w[1]; \
+        (acc)[2] -= w[2]; \
+    } while (0)
+#endif
+#define SOFTGYM_SCATTER_TURN(acc, x, y, z) do { \
+        SOFTGYM_SCATTER_W(x, y, z); \
+        SOFTGYM_SCATTER_ADD(acc); \
     } while (0)
 /* voxel 2's force where it is minus voxel 1's (row 23: a single material or
    a mode change): the turn of -f1 is exactly minus the turn of f1 (negation
@@ -397,9 +495,7 @@ typedef double softgym_v4d __attribute__((vector_size(32)));
    voxel 1's turned force is subtracted, one turn fewer, the same bits */
 #define SOFTGYM_SCATTER_F2(x, y, z) do { \
         if (neg2) { \
-            fj[0] -= w[0]; \
-            fj[1] -= w[1]; \
-            fj[2] -= w[2]; \
+            SOFTGYM_SCATTER_SUB(fj); \
         } else { \
             SOFTGYM_SCATTER_TURN(fj, x, y, z); \
         } \
@@ -418,15 +514,16 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
         softgym_v4d c0 = {Rp[0], Rp[3], Rp[6], 0.0};
         softgym_v4d c1 = {Rp[1], Rp[4], Rp[7], 0.0};
         softgym_v4d c2 = {Rp[2], Rp[5], Rp[8], 0.0};
+        softgym_v4d w;
 #else
         double R[9];
         memcpy(R, Rp, sizeof R);
-#endif
         double w[3];
+#endif
         const double *q = o + li;
         int neg2 = q[23 * n] != 0.0;
-        double *fi = force + 3 * i, *fj = force + 3 * j;
-        double *mi = moment + 3 * i, *mj = moment + 3 * j;
+        double *fi = force + 4 * i, *fj = force + 4 * j;
+        double *mi = moment + 4 * i, *mj = moment + 4 * j;
         if (ax == 0) {
             SOFTGYM_SCATTER_TURN(fi, q[0], q[n], q[2 * n]);
             SOFTGYM_SCATTER_F2(q[3 * n], q[4 * n], q[5 * n]);
@@ -447,6 +544,8 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
 }
 #undef SOFTGYM_SCATTER_F2
 #undef SOFTGYM_SCATTER_TURN
+#undef SOFTGYM_SCATTER_ADD
+#undef SOFTGYM_SCATTER_SUB
 #undef SOFTGYM_SCATTER_W
 #undef SOFTGYM_SCATTER_V4
 
