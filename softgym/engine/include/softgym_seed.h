@@ -133,9 +133,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_frames_impl(
         double p0 = p0_[li], p1 = p1_[li], p2 = p2_[li], qw = qw_[li];
         double n1 = n1_[li], n2 = n2_[li], n3 = n3_[li], nom = nom_[li], cl = len_[li];
         long long is_sa = all_small ? 1 : sa_[li] != 0.0;
-        /* small angle: k of qw */
-        double k = softgym_rotvec_k_sqrt(qw);
-        long long fix = is_sa & softgym_rotvec_needs_acos(qw, thr);
+        long long fix = 0;
         /* large angle: rq onto the chord (exactly along it when the
            transverse ratios are small) */
         long long zero = (p0 == 0.0) & (p1 == 0.0) & (p2 == 0.0);
@@ -166,10 +164,13 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_frames_impl(
         double tx = rw * n1 + ry * n3 - rz * n2;
         double ty = rw * n2 + ry * qw + rz * n1;
         double tz = rw * n3 - ry * n1 + rz * qw;
-        double k2 = softgym_rotvec_k_sqrt(tw);
-        fix |= (1 - is_sa) & softgym_rotvec_needs_acos(tw, thr);
+        /* voxel 2's rotation vector: k of qw (small angle) or of tw (large),
+           one square root and one division for either */
+        double w2 = softgym_pick(is_sa, qw, tw);
+        double k2 = softgym_rotvec_k_sqrt(w2);
+        fix |= softgym_rotvec_needs_acos(w2, thr);
         double P0_s = p0 - nom, P0_l = cl - nom;
-        double a2x_s = n1 * k, a2y_s = n2 * k, a2z_s = n3 * k;
+        double a2x_s = n1 * k2, a2y_s = n2 * k2, a2z_s = n3 * k2;
         double a2x_l = tx * k2, a2y_l = ty * k2, a2z_l = tz * k2;
         o_P0[li] = softgym_pick(is_sa, P0_s, P0_l);
         o_P1[li] = softgym_pick(is_sa, p1, 0.0);
