@@ -206,7 +206,7 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
         float64_t* o = b.link_out
         float64_t* force = b.force
         float64_t* moment = b.moment
-        const float64_t* inp[14]
+        const float64_t* inp[13]
         float64_t* out[12]
     if hi <= lo:
         return STATUS_OK
@@ -226,7 +226,6 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
         inp[k] = o + (10 + k) * n
     inp[11] = o + 9 * n
     inp[12] = o + 22 * n
-    inp[13] = o + 23 * n
     for k in range(10):
         out[k] = o + k * n
     out[10] = o + 21 * n

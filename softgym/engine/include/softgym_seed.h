@@ -209,8 +209,9 @@ static void softgym_seed_frames(
    quantities (stiffness; the seed's damping from the link's memory of the
    last step, skipped on a mode-change step), turned back by rq^-1 for a
    large-angle link, without branches. Outputs what the scatter turns to
-   the world and adds: voxel 1's force, voxel 2's force (the first negated
-   for a single material or on a mode-change step), voxel 1's and voxel 2's
+   the world and adds: voxel 1's force, voxel 2's damped force (read only
+   where voxel 2 does not take -F1: two materials, no mode change; the
+   scatter subtracts voxel 1's turned force otherwise), voxel 1's and voxel 2's
    moments negated (the seed subtracts them; x - y is x + (-y) exactly, and
    a rotation of -v is exactly minus the rotation of v). Updates the memory
    unless the mode changed. The same operations as the seed's scalar code. */
@@ -222,14 +223,14 @@ static void softgym_seed_forces(
 {
     const double *P0_ = in[0], *P1_ = in[1], *P2_ = in[2], *a1y_ = in[3], *a1z_ = in[4];
     const double *a2x_ = in[5], *a2y_ = in[6], *a2z_ = in[7], *rw_ = in[8], *ry_ = in[9];
-    const double *rz_ = in[10], *sa_ = in[11], *chg_ = in[12], *neg2_ = in[13];
+    const double *rz_ = in[10], *sa_ = in[11], *chg_ = in[12];
     double *o0 = out[0], *o1 = out[1], *o2 = out[2], *o3 = out[3], *o4 = out[4];
     double *o5 = out[5], *o6 = out[6], *o7 = out[7], *o8 = out[8], *o9 = out[9];
     double *o10 = out[10], *o11 = out[11];
     Py_ssize_t li;
     SOFTGYM_IVDEP
     for (li = lo; li < hi; li++) {
-        long long sa = sa_[li] != 0.0, changed = chg_[li] != 0.0, neg2 = neg2_[li] != 0.0;
+        long long sa = sa_[li] != 0.0, changed = chg_[li] != 0.0;
         double P0 = P0_[li], P1 = P1_[li], P2 = P2_[li];
         double a1x = 0.0, a1y = a1y_[li], a1z = a1z_[li];
         double a2x = a2x_[li], a2y = a2y_[li], a2z = a2z_[li];
@@ -243,7 +244,6 @@ static void softgym_seed_forces(
         double m1y = b2 * P2 + kb * (2.0 * a1y + a2y);
         double m1z = -b2 * P1 + kb * (2.0 * a1z + a2z);
         double m2x = -m1x;
-        double f2x = -f1x, f2y = -f1y, f2z = -f1z;
         double m2y = b2 * P2 + kb * (a1y + 2.0 * a2y);
         double m2z = -b2 * P1 + kb * (a1z + 2.0 * a2z);
         /* damping: rates from the memory of the last step */
@@ -267,9 +267,9 @@ static void softgym_seed_forces(
         cb2 = c_seed[5 * n + li];
         ca2 = c_seed[6 * n + li];
         cb3 = c_seed[7 * n + li];
-        double d2x = f2x + bz * (-ca * vx);
-        double d2y = f2y + bz * (-ca * vy + cb2 * (ra1z + ra2z));
-        double d2z = f2z + bz * (-ca * vz - cb2 * (ra1y + ra2y));
+        double f2x = -f1x + bz * (-ca * vx);
+        double f2y = -f1y + bz * (-ca * vy + cb2 * (ra1z + ra2z));
+        double f2z = -f1z + bz * (-ca * vz - cb2 * (ra1y + ra2y));
         double e2x = m2x + bzh * (ca2 * (ra2x - ra1x));
         double e2y = m2y + bzh * (cb2 * vz + cb3 * (ra1y + 2.0 * ra2y));
         double e2z = m2z + bzh * (-cb2 * vy + cb3 * (ra1z + 2.0 * ra2z));
@@ -290,7 +290,6 @@ static void softgym_seed_forces(
         } while (0)
         SOFTGYM_KEEP3(changed, f1x, f1y, f1z, d1x, d1y, d1z);
         SOFTGYM_KEEP3(changed, m1x, m1y, m1z, e1x, e1y, e1z);
-        SOFTGYM_KEEP3(neg2, f2x, f2y, f2z, d2x, d2y, d2z);
         SOFTGYM_KEEP3(changed, m2x, m2y, m2z, e2x, e2y, e2z);
         /* large angle: G = RQ^T v rotates by rq^-1 (RQ the matrix of rq,
            normalised by |rq|^2: the small-ratio rq is not exactly unit) */
@@ -316,9 +315,9 @@ static void softgym_seed_forces(
         o0[li] = f1x;
         o1[li] = f1y;
         o2[li] = f1z;
-        o3[li] = softgym_pick(neg2, -f1x, f2x);
-        o4[li] = softgym_pick(neg2, -f1y, f2y);
-        o5[li] = softgym_pick(neg2, -f1z, f2z);
+        o3[li] = f2x;
+        o4[li] = f2y;
+        o5[li] = f2z;
         o6[li] = -m1x;
         o7[li] = -m1y;
         o8[li] = -m1z;
