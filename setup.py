@@ -194,6 +194,9 @@ ext_kwargs = dict(
     define_macros=[
         ("NPY_NO_DEPRECATED_API", "NPY_1_7_API_VERSION"),
         ("SOFTGYM_OPENMP", "1" if omp is not None else "0"),
+        # cycle probes around the passes (include/softgym_prof.h), for
+        # `benchmarks/profile_engine.py --cycles`, which builds a copy with it
+        *([("SOFTGYM_PROFILE_CYCLES", "1")] if os.environ.get("SOFTGYM_PROFILE_CYCLES") else []),
     ],
     extra_compile_args=opt + omp_cflags,
     extra_link_args=omp_lflags,

@@ -18,6 +18,17 @@ its instructions per voxel-step and per link-step:
 Profile another build of the kernel with ``SOFTGYM_KERNEL=baseline`` (the
 portable one; ``x86-64-v3``, ``x86-64-v4``: ``softgym/engine/_dispatch.py``).
 Needs valgrind (``apt-get install valgrind``).
+
+``--cycles`` measures time instead, in the build this machine loads: it copies the
+working tree to a temporary folder, builds it with ``SOFTGYM_PROFILE_CYCLES=1`` (cycle
+probes around each stage and pass of the seed model's step,
+``softgym/engine/include/softgym_prof.h``; about 2 minutes), runs the reference robot
+``--repeats`` times and prints the time-stamp-counter cycles per voxel-step of each
+stage and pass in the quickest run (x86-64 only; the counter ticks at a constant rate,
+which it prints). It sees what instruction counts miss (a gather or a division costs
+more than one instruction):
+
+    python benchmarks/profile_engine.py --cycles --repeats 6
 """
 
 from __future__ import annotations
@@ -101,6 +112,95 @@ def profile(model: str, collisions: bool, seconds: float, n: int, toggle: str) -
             "functions": dict(sorted(funcs.items(), key=lambda kv: -kv[1]))}  # fmt: skip
 
 
+# the child of --cycles: the reference robot in the probed build, one thread
+CYCLES_CHILD = r"""
+import json, sys, time
+sys.path.insert(0, {bench!r})
+from bench_engine import reference_robot
+from softgym.engine import SimConfig, Simulation, kernel_build, _core
+sim = Simulation([reference_robot({n})], SimConfig(self_collision={coll}, model="seed"),
+                 n_threads=1)
+_core.cycle_counts(reset=True)
+t0 = time.perf_counter()
+r = sim.run({seconds})
+wall = time.perf_counter() - t0
+print("CYCLES", json.dumps(dict(counts=_core.cycle_counts(), steps=int(r.steps[0]),
+      n_voxels=sim.n_voxels, wall=wall, build=kernel_build(), module=_core.__file__)))
+"""
+
+#: the rows of the --cycles table: (label, key, indented under "links")
+CYCLE_ROWS = (
+    ("contacts_seed (collision list)", "contacts", False),
+    ("links_seed", "links", False),
+    ("softgym_seed_geom", "geometry", True),
+    ("softgym_seed_modes", "modes", True),
+    ("softgym_seed_frames", "frames", True),
+    ("_seed_frame_one (acos links)", "frames_acos", True),
+    ("softgym_seed_forces", "forces", True),
+    ("softgym_seed_scatter", "scatter", True),
+    ("collide (contact forces)", "collide", False),
+    ("integrate_seed", "integrate", False),
+    ("drive, record", "drive_record", False),
+)
+
+
+def _tree_copy(dest: Path) -> None:
+    """The repository's tracked and untracked (not ignored) files, copied to ``dest``."""
+    root = HERE.parent
+    listed = subprocess.run(["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"],
+                            cwd=root, capture_output=True, check=True).stdout  # fmt: skip
+    for rel in listed.decode().split("\0"):
+        if rel and (root / rel).is_file():
+            (dest / rel).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(root / rel, dest / rel)
+
+
+def profile_cycles(collisions: bool, seconds: float, n: int, repeats: int) -> dict:
+    """Build a probed copy of the tree, run it ``repeats`` times; the quickest run's counts."""
+    with tempfile.TemporaryDirectory(prefix="softgym-cycles-") as tmp:
+        tree = Path(tmp)
+        _tree_copy(tree)
+        env = dict(os.environ, SOFTGYM_PROFILE_CYCLES="1")
+        res = subprocess.run([sys.executable, "setup.py", "build_ext", "--inplace"], cwd=tree,
+                             env=env, capture_output=True, text=True, check=False)  # fmt: skip
+        if res.returncode != 0:
+            raise SystemExit(f"profile_engine: the probed build failed:\n{res.stderr[-2000:]}")
+        env = dict(os.environ, PYTHONPATH=str(tree))
+        code = CYCLES_CHILD.format(bench=str(tree / "benchmarks"), n=n, coll=collisions,
+                                   seconds=seconds)  # fmt: skip
+        runs = []
+        for _ in range(repeats):
+            res = subprocess.run([sys.executable, "-c", code], cwd=tree, env=env,
+                                 capture_output=True, text=True, check=False)  # fmt: skip
+            m = re.search(r"^CYCLES (.*)$", res.stdout, re.M)
+            if res.returncode != 0 or m is None:
+                raise SystemExit(f"profile_engine: the probed run failed:\n{res.stderr[-2000:]}")
+            run = json.loads(m.group(1))
+            if run["counts"] is None or not run["module"].startswith(str(tree)):
+                raise SystemExit("profile_engine: the run did not load the probed build")
+            runs.append(run)
+    best = min(runs, key=lambda r: sum(r["counts"][k] for _, k, sub in CYCLE_ROWS if not sub))
+    best["repeats"] = repeats
+    best["totals"] = sorted(sum(r["counts"][k] for _, k, sub in CYCLE_ROWS if not sub)
+                            / (r["steps"] * r["n_voxels"]) for r in runs)  # fmt: skip
+    return best
+
+
+def print_cycles(p: dict, n: int, collisions: bool) -> None:
+    vs = p["steps"] * p["n_voxels"]
+    c = p["counts"]
+    total = sum(c[k] for _, k, sub in CYCLE_ROWS if not sub)
+    print(f"seed preset, kernel build {p['build']}, {n}^3 reference robot, self-collision "
+          f"{'on' if collisions else 'off'}, {p['steps']} steps, one thread: the quickest of "
+          f"{p['repeats']} runs, {total / vs:.1f} cycles per voxel-step (time-stamp counter at "
+          f"{total / p['wall'] / 1e9:.2f} GHz; every run: "
+          f"{', '.join(f'{t:.1f}' for t in p['totals'])})")
+    print(f"{'stage / pass':40s} {'cycles/voxel-step':>18s} {'share':>7s}")
+    for label, key, sub in CYCLE_ROWS:
+        name = ("  " + label) if sub else label
+        print(f"{name:40s} {c[key] / vs:18.1f} {100 * c[key] / total:6.1f}%")
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", default="seed", choices=("seed", "corotational"))
@@ -109,7 +209,20 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--size", type=int, default=6, help="robot edge in voxels")
     ap.add_argument("--toggle", default=TOGGLE, help="callgrind --toggle-collect pattern")
     ap.add_argument("--json", action="store_true", help="print one JSON object as the last line")
+    ap.add_argument("--cycles", action="store_true",
+                    help="time each pass (a probed build of a copy of the tree; seed preset)")
+    ap.add_argument("--repeats", type=int, default=5, help="--cycles: runs, the quickest kept")
     args = ap.parse_args(argv)
+    if args.cycles:
+        if args.model != "seed":
+            raise SystemExit("profile_engine: --cycles times the seed preset's passes only")
+        if args.repeats < 1:
+            raise SystemExit("profile_engine: --repeats must be at least 1")
+        c = profile_cycles(not args.no_collision, args.seconds, args.size, args.repeats)
+        print_cycles(c, args.size, not args.no_collision)
+        if args.json:
+            print(json.dumps(c))
+        return 0
     p = profile(args.model, not args.no_collision, args.seconds, args.size, args.toggle)
     vs = p["steps"] * p["n_voxels"]
     ls = p["steps"] * p["n_links"]

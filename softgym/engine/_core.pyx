@@ -34,6 +34,7 @@ from softgym.engine._typedefs cimport float64_t, intp_t, step_t, int32, flag_t
 
 from softgym.engine._integrate import refresh_rotations  # noqa: F401 (Python API)
 from softgym.engine._seed import seed_frames  # noqa: F401 (Python API, for tests)
+from softgym.engine._seed import cycle_counts as seed_cycle_counts
 
 cnp.import_array()
 
@@ -102,13 +103,42 @@ cdef inline float64_t _max_speed(Batch* b, intp_t r) noexcept nogil:
     return sqrt(m)
 
 
+cdef extern from "softgym_prof.h":
+    # cycle probes (empty unless built with SOFTGYM_PROFILE_CYCLES)
+    int softgym_prof_enabled() noexcept nogil
+    unsigned long long softgym_prof_tsc() noexcept nogil
+    void softgym_prof_add(int k, unsigned long long t0) noexcept nogil
+    unsigned long long softgym_prof_get(int k) noexcept nogil
+    void softgym_prof_reset() noexcept nogil
+
+#: the stages of the seed model's step that the cycle probes time, in slot order
+CYCLE_STAGES = ("contacts", "links", "collide", "integrate", "drive_record")
+
+
+def cycle_counts(bint reset=False):
+    """TSC cycles spent in each stage of the seed model's step (``CYCLE_STAGES``) and in
+    each pass of its links (``_seed.CYCLE_PASSES``) since the last reset, as a dict; None
+    unless the engine was built with SOFTGYM_PROFILE_CYCLES (setup.py;
+    ``benchmarks/profile_engine.py --cycles`` builds such a copy). One thread only."""
+    if not softgym_prof_enabled():
+        return None
+    out = {name: int(softgym_prof_get(k)) for k, name in enumerate(CYCLE_STAGES)}
+    out.update(seed_cycle_counts(reset))
+    if reset:
+        softgym_prof_reset()
+    return out
+
+
 cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept nogil:
     # advance_robot for model 0: links, contacts, voxels, then the drive at
     # the step's start time sets the sizes the next step's links see
+    # (softgym_prof_*: cycle probes, empty in a normal build)
     cdef:
         int status = STATUS_OK
         float64_t smax = 0.0, dmax2 = 0.0
+        unsigned long long t0
     while b.steps[r] < target:
+        t0 = softgym_prof_tsc()
         if b.self_collision:
             # the seed's schedule: rebuild once the fastest voxel may have
             # covered half a voxel since the last rebuild
@@ -118,13 +148,21 @@ cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
                 b.col_acc[r] = 0.0
             elif c.stale:
                 status = contacts_seed(b, r, c, 0)
+        softgym_prof_add(0, t0)
+        t0 = softgym_prof_tsc()
         if status == STATUS_OK:
             status = links_seed(b, r)
+        softgym_prof_add(1, t0)
+        t0 = softgym_prof_tsc()
         if status == STATUS_OK and b.self_collision:
             collide(b, c)
             collide_obstacles(b, c)
+        softgym_prof_add(2, t0)
+        t0 = softgym_prof_tsc()
         if status == STATUS_OK:
             status = integrate_seed(b, r, NULL, &dmax2)
+        softgym_prof_add(3, t0)
+        t0 = softgym_prof_tsc()
         if status != STATUS_OK:
             clear_robot(b, r)
             b.diverged[r] = 1
@@ -136,6 +174,7 @@ cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
         smax = _actuate(b, r)
         b.steps[r] += 1
         record(b, r)
+        softgym_prof_add(4, t0)
     return status
 
 

@@ -96,6 +96,29 @@ cdef extern from "softgym_seed.h":
                               float64_t* force, float64_t* moment) noexcept nogil
 
 
+cdef extern from "softgym_prof.h":
+    # cycle probes (empty unless built with SOFTGYM_PROFILE_CYCLES)
+    int softgym_prof_enabled() noexcept nogil
+    unsigned long long softgym_prof_tsc() noexcept nogil
+    void softgym_prof_add(int k, unsigned long long t0) noexcept nogil
+    unsigned long long softgym_prof_get(int k) noexcept nogil
+    void softgym_prof_reset() noexcept nogil
+
+#: the passes of _seed_links_along that the cycle probes time, in slot order
+CYCLE_PASSES = ("geometry", "modes", "frames", "frames_acos", "forces", "scatter")
+
+
+def cycle_counts(bint reset=False):
+    """TSC cycles spent in each of ``CYCLE_PASSES`` since the last reset (a dict), or
+    None when the module was built without SOFTGYM_PROFILE_CYCLES (setup.py)."""
+    if not softgym_prof_enabled():
+        return None
+    out = {name: int(softgym_prof_get(k)) for k, name in enumerate(CYCLE_PASSES)}
+    if reset:
+        softgym_prof_reset()
+    return out
+
+
 cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n) noexcept nogil:
     # softgym_seed_frames for one link, with the seed's branches (its acos
     # approximation and the backward-chord rule)
@@ -208,20 +231,30 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
         float64_t* moment = b.moment
         const float64_t* inp[13]
         float64_t* out[12]
+        unsigned long long t0
     if hi <= lo:
         return STATUS_OK
+    t0 = softgym_prof_tsc()
     softgym_seed_geom(ax, lo, hi, n, v1, v2, b.pos, b.quat, b.scale, o)
+    softgym_prof_add(0, t0)
+    t0 = softgym_prof_tsc()
     end = softgym_seed_modes(lo, hi, n, b.max_strain * b.L, SMALL_ANGLE_W, SMALLISH_ANGLE_W,
                              SA_BOND_BEND_RAD, SA_BOND_EXT_PERC, HYSTERESIS * SA_BOND_BEND_RAD,
                              HYSTERESIS * SA_BOND_EXT_PERC, b.link_sa, b.homog, o)
+    softgym_prof_add(1, t0)
+    t0 = softgym_prof_tsc()
     softgym_seed_frames(lo, end, SMALL_ANGLE_RAD, SLTHRESH_ACOS2SQRT, o, o + n, o + 2 * n,
                         o + 3 * n, o + 4 * n, o + 5 * n, o + 6 * n, o + 7 * n, o + 8 * n,
                         o + 9 * n, o + 10 * n, o + 11 * n, o + 12 * n, o + 13 * n, o + 14 * n,
                         o + 15 * n, o + 16 * n, o + 17 * n, o + 18 * n, o + 19 * n, o + 20 * n,
                         o + 21 * n)
+    softgym_prof_add(2, t0)
+    t0 = softgym_prof_tsc()
     for li in range(lo, end):
         if o[21 * n + li] != 0.0:
             _seed_frame_one(li, o, n)
+    softgym_prof_add(3, t0)
+    t0 = softgym_prof_tsc()
     for k in range(11):
         inp[k] = o + (10 + k) * n
     inp[11] = o + 9 * n
@@ -232,9 +265,12 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
     out[11] = o + 24 * n
     softgym_seed_forces(lo, end, b.n_links, b.L, bz, bzh, inv_dt, inp, b.k_axial, b.k_torsion,
                         b.k_bend, b.c_seed, b.link_last, out)
+    softgym_prof_add(4, t0)
+    t0 = softgym_prof_tsc()
     # back to the world (the inverse axis turn, voxel 1's rotation) and the
     # scatter, in link order (the seed's summation order)
     softgym_seed_scatter(ax, lo, end, n, v1, v2, rot, o, force, moment)
+    softgym_prof_add(5, t0)
     return STATUS_OK if end == hi else STATUS_STRAIN
 
 

@@ -95,3 +95,14 @@ def test_an_unknown_or_missing_build_is_refused_in_one_line():
         assert res.returncode != 0
         assert InvalidParameterError.__name__ in res.stderr
         assert any(m in res.stderr for m in message.split("|")), res.stderr[-500:]
+
+
+def test_a_normal_build_has_no_cycle_probes():
+    # the probes around the seed step's passes (include/softgym_prof.h) are compiled in
+    # only for `benchmarks/profile_engine.py --cycles`; an installed kernel has none
+    from softgym.engine import _core, _seed
+
+    assert _core.cycle_counts() is None
+    assert _seed.cycle_counts() is None
+    assert _core.CYCLE_STAGES == ("contacts", "links", "collide", "integrate", "drive_record")
+    assert len(_seed.CYCLE_PASSES) == 6
