@@ -451,6 +451,15 @@ static Py_ssize_t softgym_seed_modes(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
 #if defined(__AVX__) && (defined(__GNUC__) || defined(__clang__))
 #define SOFTGYM_SCATTER_V4 1
 typedef double softgym_v4d __attribute__((vector_size(32)));
+typedef long long softgym_v4i __attribute__((vector_size(32)));
+#if defined(__clang__)
+#define SOFTGYM_SHUFFLE4(a, b, i, j, k, l) __builtin_shufflevector(a, b, i, j, k, l)
+#else
+#define SOFTGYM_SHUFFLE4(a, b, i, j, k, l) __builtin_shuffle(a, b, (softgym_v4i){i, j, k, l})
+#endif
+/* the first input of a y or z link's turn, negated in the portable build;
+   the vector build negates the first column instead (SOFTGYM_SCATTER_V4) */
+#define SOFTGYM_NEG1(x) (x)
 #define SOFTGYM_SCATTER_W(x, y, z) do { \
         double x_ = (x), y_ = (y), z_ = (z); \
         w = c0 * x_ + c1 * y_ + c2 * z_; \
@@ -468,6 +477,7 @@ typedef double softgym_v4d __attribute__((vector_size(32)));
         memcpy((acc), &a_, sizeof a_); \
     } while (0)
 #else
+#define SOFTGYM_NEG1(x) (-(x))
 #define SOFTGYM_SCATTER_W(x, y, z) do { \
         double x_ = (x), y_ = (y), z_ = (z); \
         w[0] = R[0] * x_ + R[1] * y_ + R[2] * z_; \
@@ -511,9 +521,19 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
         Py_ssize_t i = v1[li], j = v2[li];
         const double *Rp = rot + 9 * i;
 #if defined(SOFTGYM_SCATTER_V4)
-        softgym_v4d c0 = {Rp[0], Rp[3], Rp[6], 0.0};
-        softgym_v4d c1 = {Rp[1], Rp[4], Rp[7], 0.0};
-        softgym_v4d c2 = {Rp[2], Rp[5], Rp[8], 0.0};
+        /* the columns from two row loads and R[8] (lane 3 is padding: the
+           rows' padding lane takes what it gets); for the y and z links the
+           first column negated instead of the first input, (-c0) a =
+           c0 (-a) exactly, so the inputs stay loads */
+        softgym_v4d r03, r47;
+        memcpy(&r03, Rp, sizeof r03);
+        memcpy(&r47, Rp + 4, sizeof r47);
+        softgym_v4d r8 = {Rp[8], Rp[8], Rp[8], Rp[8]};
+        softgym_v4d c0 = SOFTGYM_SHUFFLE4(r03, r47, 0, 3, 6, 7);
+        softgym_v4d c1 = SOFTGYM_SHUFFLE4(r03, r47, 1, 4, 7, 7);
+        softgym_v4d c2 = SOFTGYM_SHUFFLE4(SOFTGYM_SHUFFLE4(r03, r47, 2, 5, 2, 5), r8, 0, 1, 4, 4);
+        if (ax != 0)
+            c0 = -c0;
         softgym_v4d w;
 #else
         double R[9];
@@ -530,15 +550,15 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
             SOFTGYM_SCATTER_TURN(mi, q[6 * n], q[7 * n], q[8 * n]);
             SOFTGYM_SCATTER_TURN(mj, q[9 * n], q[21 * n], q[24 * n]);
         } else if (ax == 1) {
-            SOFTGYM_SCATTER_TURN(fi, -q[n], q[0], q[2 * n]);
-            SOFTGYM_SCATTER_F2(-q[4 * n], q[3 * n], q[5 * n]);
-            SOFTGYM_SCATTER_TURN(mi, -q[7 * n], q[6 * n], q[8 * n]);
-            SOFTGYM_SCATTER_TURN(mj, -q[21 * n], q[9 * n], q[24 * n]);
+            SOFTGYM_SCATTER_TURN(fi, SOFTGYM_NEG1(q[n]), q[0], q[2 * n]);
+            SOFTGYM_SCATTER_F2(SOFTGYM_NEG1(q[4 * n]), q[3 * n], q[5 * n]);
+            SOFTGYM_SCATTER_TURN(mi, SOFTGYM_NEG1(q[7 * n]), q[6 * n], q[8 * n]);
+            SOFTGYM_SCATTER_TURN(mj, SOFTGYM_NEG1(q[21 * n]), q[9 * n], q[24 * n]);
         } else {
-            SOFTGYM_SCATTER_TURN(fi, -q[2 * n], q[n], q[0]);
-            SOFTGYM_SCATTER_F2(-q[5 * n], q[4 * n], q[3 * n]);
-            SOFTGYM_SCATTER_TURN(mi, -q[8 * n], q[7 * n], q[6 * n]);
-            SOFTGYM_SCATTER_TURN(mj, -q[24 * n], q[21 * n], q[9 * n]);
+            SOFTGYM_SCATTER_TURN(fi, SOFTGYM_NEG1(q[2 * n]), q[n], q[0]);
+            SOFTGYM_SCATTER_F2(SOFTGYM_NEG1(q[5 * n]), q[4 * n], q[3 * n]);
+            SOFTGYM_SCATTER_TURN(mi, SOFTGYM_NEG1(q[8 * n]), q[7 * n], q[6 * n]);
+            SOFTGYM_SCATTER_TURN(mj, SOFTGYM_NEG1(q[24 * n]), q[21 * n], q[9 * n]);
         }
     }
 }
@@ -548,6 +568,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
 #undef SOFTGYM_SCATTER_SUB
 #undef SOFTGYM_SCATTER_W
 #undef SOFTGYM_SCATTER_V4
+#undef SOFTGYM_NEG1
 
 static void softgym_seed_scatter(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
                                  const Py_ssize_t *v1, const Py_ssize_t *v2, const double *rot,
