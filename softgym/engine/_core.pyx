@@ -29,6 +29,8 @@ from softgym.engine._contact cimport (Contacts, contacts_corotational, contacts_
 from softgym.engine._corotational cimport links_corotational
 from softgym.engine._integrate cimport integrate_corotational, integrate_seed, clear_robot
 from softgym.engine._record cimport record, robot_aux, robot_energy
+from softgym.engine._prof cimport (softgym_prof_enabled, softgym_prof_tsc, softgym_prof_add,
+                                   softgym_prof_get, softgym_prof_reset)
 from softgym.engine._seed cimport links_seed
 from softgym.engine._typedefs cimport float64_t, intp_t, step_t, int32, flag_t
 
@@ -102,14 +104,6 @@ cdef inline float64_t _max_speed(Batch* b, intp_t r) noexcept nogil:
             m = v2
     return sqrt(m)
 
-
-cdef extern from "softgym_prof.h":
-    # cycle probes (empty unless built with SOFTGYM_PROFILE_CYCLES)
-    int softgym_prof_enabled() noexcept nogil
-    unsigned long long softgym_prof_tsc() noexcept nogil
-    void softgym_prof_add(int k, unsigned long long t0) noexcept nogil
-    unsigned long long softgym_prof_get(int k) noexcept nogil
-    void softgym_prof_reset() noexcept nogil
 
 #: the stages of the seed model's step that the cycle probes time, in slot order
 CYCLE_STAGES = ("contacts", "links", "collide", "integrate", "drive_record")

@@ -39,6 +39,8 @@ cimport numpy as cnp
 import numpy as np
 
 from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_STRAIN, N_LINK_OUT
+from softgym.engine._prof cimport (softgym_prof_enabled, softgym_prof_tsc, softgym_prof_add,
+                                   softgym_prof_get, softgym_prof_reset)
 from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t
 
 cnp.import_array()
@@ -95,14 +97,6 @@ cdef extern from "softgym_seed.h":
                               const intp_t* v2, const float64_t* rot, const float64_t* o,
                               float64_t* force, float64_t* moment) noexcept nogil
 
-
-cdef extern from "softgym_prof.h":
-    # cycle probes (empty unless built with SOFTGYM_PROFILE_CYCLES)
-    int softgym_prof_enabled() noexcept nogil
-    unsigned long long softgym_prof_tsc() noexcept nogil
-    void softgym_prof_add(int k, unsigned long long t0) noexcept nogil
-    unsigned long long softgym_prof_get(int k) noexcept nogil
-    void softgym_prof_reset() noexcept nogil
 
 #: the passes of _seed_links_along that the cycle probes time, in slot order
 CYCLE_PASSES = ("geometry", "modes", "frames", "frames_acos", "forces", "scatter")

@@ -10,6 +10,17 @@
 #include <math.h>
 #include "softgym_simd.h"
 
+/* f(a, ...) with the link axis a = ax as a compile-time constant: one copy of an
+   always-inline pass per axis */
+#define SOFTGYM_BY_AXIS(ax, f, ...) do { \
+        if ((ax) == 0) \
+            f(0, __VA_ARGS__); \
+        else if ((ax) == 1) \
+            f(1, __VA_ARGS__); \
+        else \
+            f(2, __VA_ARGS__); \
+    } while (0)
+
 /* The first pass of _seed_links_along: links lo..hi (all along axis ax, a
    compile-time constant in each copy) measured in the bond frame, without
    branches so the loop vectorises; rows of o (stride n): 0-2 the relative
@@ -81,12 +92,7 @@ static void softgym_seed_geom(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n
                               const Py_ssize_t *v1, const Py_ssize_t *v2, const double *pos,
                               const double *quat, const double *scale, double *o)
 {
-    if (ax == 0)
-        softgym_seed_geom_ax(0, lo, hi, n, v1, v2, pos, quat, scale, o);
-    else if (ax == 1)
-        softgym_seed_geom_ax(1, lo, hi, n, v1, v2, pos, quat, scale, o);
-    else
-        softgym_seed_geom_ax(2, lo, hi, n, v1, v2, pos, quat, scale, o);
+    SOFTGYM_BY_AXIS(ax, softgym_seed_geom_ax, lo, hi, n, v1, v2, pos, quat, scale, o);
 }
 
 /* The second pass of _seed_links_along, in C for one pragma: the bond-frame
@@ -574,12 +580,7 @@ static void softgym_seed_scatter(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_
                                  const Py_ssize_t *v1, const Py_ssize_t *v2, const double *rot,
                                  const double *o, double *force, double *moment)
 {
-    if (ax == 0)
-        softgym_seed_scatter_ax(0, lo, hi, n, v1, v2, rot, o, force, moment);
-    else if (ax == 1)
-        softgym_seed_scatter_ax(1, lo, hi, n, v1, v2, rot, o, force, moment);
-    else
-        softgym_seed_scatter_ax(2, lo, hi, n, v1, v2, rot, o, force, moment);
+    SOFTGYM_BY_AXIS(ax, softgym_seed_scatter_ax, lo, hi, n, v1, v2, rot, o, force, moment);
 }
 
 #endif  /* SOFTGYM_SEED_H */
