@@ -448,7 +448,7 @@ static Py_ssize_t softgym_seed_modes(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
    rotation, row-major) and is added to force / moment of voxel 1 or 2.
    Component c of R1 P^T v is R[3c] x + R[3c+1] y + R[3c+2] z, evaluated in
    that order: here as lane c of C0 x + C1 y + C2 z with the columns C_k of
-   R1 in the lanes (lane 3 zero), so one link's four turns are 12
+   R1 in lanes 0-2 (lane 3 holds whatever the shuffles leave), so one link's four turns are 12
    multiplies and 8 adds of 4 lanes instead of 36 and 24 scalar ones, and
    each turned vector is added to the voxel's whole row of force / moment
    (4 lanes; lane 3 is the row's padding, never read): the same IEEE
