@@ -17,18 +17,9 @@ from softgym.engine._typedefs cimport float64_t, intp_t, int32
 cdef float64_t RUNAWAY = 1.0e6  # |coordinate| (m) beyond which a robot diverged
 
 
-cdef inline void _rotation_matrix(const float64_t* q, float64_t* R) noexcept nogil:
-    # R = rotation matrix of the unit quaternion q = (w, x, y, z), row-major.
-    cdef float64_t w = q[0], x = q[1], y = q[2], z = q[3]
-    R[0] = 1.0 - 2.0 * (y * y + z * z)
-    R[1] = 2.0 * (x * y - w * z)
-    R[2] = 2.0 * (x * z + w * y)
-    R[3] = 2.0 * (x * y + w * z)
-    R[4] = 1.0 - 2.0 * (x * x + z * z)
-    R[5] = 2.0 * (y * z - w * x)
-    R[6] = 2.0 * (x * z - w * y)
-    R[7] = 2.0 * (y * z + w * x)
-    R[8] = 1.0 - 2.0 * (x * x + y * y)
+cdef extern from "softgym_simd.h":
+    # R = the rotation matrix of the unit quaternion q = (w, x, y, z), row-major
+    void _rotation_matrix "softgym_quat_matrix" (const float64_t* q, float64_t* R) noexcept nogil
 
 
 cdef inline void _fluid_drag(Batch* b, intp_t i, float64_t* f) noexcept nogil:

@@ -30,9 +30,9 @@
    (x, y, z) -> (x, y, z), (y, -x, z), (z, y, -x) for ax 0, 1, 2); 7 the
    nominal length, 8 the chord length, 9 the transverse ratio. Component c
    of a bond-frame vector is s_c times local component a_c (s = +-1: exact).
-   Voxel 1's rotation matrix is computed in the lanes from its quaternion,
-   with the expressions of the voxel update's (_integrate._rotation_matrix):
-   the same bits as the stored matrix, and 9 fewer gathered loads a link. */
+   Voxel 1's rotation matrix is computed in the lanes from its quaternion
+   (softgym_quat_matrix, as the voxel update stores it): the same bits as
+   the stored matrix, and 9 fewer gathered loads a link. */
 SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
                                                 Py_ssize_t n, const Py_ssize_t *v1,
                                                 const Py_ssize_t *v2, const double *pos,
@@ -59,15 +59,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
         double w = quat[4 * i], x = quat[4 * i + 1], y = quat[4 * i + 2], z = quat[4 * i + 3];
         double wj = quat[4 * j], xj = quat[4 * j + 1], yj = quat[4 * j + 2], zj = quat[4 * j + 3];
         double R[9];
-        R[0] = (1.0 - (2.0 * ((y * y) + (z * z))));
-        R[1] = (2.0 * ((x * y) - (w * z)));
-        R[2] = (2.0 * ((x * z) + (w * y)));
-        R[3] = (2.0 * ((x * y) + (w * z)));
-        R[4] = (1.0 - (2.0 * ((x * x) + (z * z))));
-        R[5] = (2.0 * ((y * z) - (w * x)));
-        R[6] = (2.0 * ((x * z) - (w * y)));
-        R[7] = (2.0 * ((y * z) + (w * x)));
-        R[8] = (1.0 - (2.0 * ((x * x) + (y * y))));
+        softgym_quat_matrix(quat + 4 * i, R);
         /* relative position in voxel 1's frame (column a of its rotation . d) */
         double p0 = (((R[a0] * dx) + (R[3 + a0] * dy)) + (R[6 + a0] * dz));
         double p1 = (s1 * (((R[a1] * dx) + (R[3 + a1] * dy)) + (R[6 + a1] * dz)));
@@ -470,16 +462,11 @@ typedef long long softgym_v4i __attribute__((vector_size(32)));
         double x_ = (x), y_ = (y), z_ = (z); \
         w = c0 * x_ + c1 * y_ + c2 * z_; \
     } while (0)
-#define SOFTGYM_SCATTER_ADD(acc) do { \
+/* acc op= w on the voxel's whole row (op: += or -=) */
+#define SOFTGYM_SCATTER_ACC(acc, op) do { \
         softgym_v4d a_; \
         memcpy(&a_, (acc), sizeof a_); \
-        a_ += w; \
-        memcpy((acc), &a_, sizeof a_); \
-    } while (0)
-#define SOFTGYM_SCATTER_SUB(acc) do { \
-        softgym_v4d a_; \
-        memcpy(&a_, (acc), sizeof a_); \
-        a_ -= w; \
+        a_ op w; \
         memcpy((acc), &a_, sizeof a_); \
     } while (0)
 #else
@@ -490,20 +477,15 @@ typedef long long softgym_v4i __attribute__((vector_size(32)));
         w[1] = R[3] * x_ + R[4] * y_ + R[5] * z_; \
         w[2] = R[6] * x_ + R[7] * y_ + R[8] * z_; \
     } while (0)
-#define SOFTGYM_SCATTER_ADD(acc) do { \
-        (acc)[0] += w[0]; \
-        (acc)[1] += w[1]; \
-        (acc)[2] += w[2]; \
-    } while (0)
-#define SOFTGYM_SCATTER_SUB(acc) do { \
-        (acc)[0] -= w[0]; \
-        (acc)[1] -= w[1]; \
-        (acc)[2] -= w[2]; \
+#define SOFTGYM_SCATTER_ACC(acc, op) do { \
+        (acc)[0] op w[0]; \
+        (acc)[1] op w[1]; \
+        (acc)[2] op w[2]; \
     } while (0)
 #endif
 #define SOFTGYM_SCATTER_TURN(acc, x, y, z) do { \
         SOFTGYM_SCATTER_W(x, y, z); \
-        SOFTGYM_SCATTER_ADD(acc); \
+        SOFTGYM_SCATTER_ACC(acc, +=); \
     } while (0)
 /* voxel 2's force where it is minus voxel 1's (row 23: a single material or
    a mode change): the turn of -f1 is exactly minus the turn of f1 (negation
@@ -511,7 +493,7 @@ typedef long long softgym_v4i __attribute__((vector_size(32)));
    voxel 1's turned force is subtracted, one turn fewer, the same bits */
 #define SOFTGYM_SCATTER_F2(x, y, z) do { \
         if (neg2) { \
-            SOFTGYM_SCATTER_SUB(fj); \
+            SOFTGYM_SCATTER_ACC(fj, -=); \
         } else { \
             SOFTGYM_SCATTER_TURN(fj, x, y, z); \
         } \
@@ -570,8 +552,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
 }
 #undef SOFTGYM_SCATTER_F2
 #undef SOFTGYM_SCATTER_TURN
-#undef SOFTGYM_SCATTER_ADD
-#undef SOFTGYM_SCATTER_SUB
+#undef SOFTGYM_SCATTER_ACC
 #undef SOFTGYM_SCATTER_W
 #undef SOFTGYM_SCATTER_V4
 #undef SOFTGYM_NEG1

@@ -25,6 +25,22 @@ static inline double softgym_pick(long long c, double a, double b)
     memcpy(&r, &ua, sizeof r);
     return r;
 }
+/* R = the rotation matrix of the unit quaternion q = (w, x, y, z), row-major: the
+   one formula of the engine (the voxel update stores it, the seed geometry
+   recomputes it in its vector lanes from the same quaternion, bit for bit) */
+static inline void softgym_quat_matrix(const double *q, double *R)
+{
+    double w = q[0], x = q[1], y = q[2], z = q[3];
+    R[0] = 1.0 - 2.0 * (y * y + z * z);
+    R[1] = 2.0 * (x * y - w * z);
+    R[2] = 2.0 * (x * z + w * y);
+    R[3] = 2.0 * (x * y + w * z);
+    R[4] = 1.0 - 2.0 * (x * x + z * z);
+    R[5] = 2.0 * (y * z - w * x);
+    R[6] = 2.0 * (x * z - w * y);
+    R[7] = 2.0 * (y * z + w * x);
+    R[8] = 1.0 - 2.0 * (x * x + y * y);
+}
 #if defined(_MSC_VER)
 #define SOFTGYM_ALWAYS_INLINE static __forceinline
 #else
