@@ -59,7 +59,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
         double w = quat[4 * i], x = quat[4 * i + 1], y = quat[4 * i + 2], z = quat[4 * i + 3];
         double wj = quat[4 * j], xj = quat[4 * j + 1], yj = quat[4 * j + 2], zj = quat[4 * j + 3];
         double R[9];
-        softgym_quat_matrix(quat + 4 * i, R);
+        softgym_quat_matrix_wxyz(w, x, y, z, R);
         /* relative position in voxel 1's frame (column a of its rotation . d) */
         double p0 = (((R[a0] * dx) + (R[3 + a0] * dy)) + (R[6 + a0] * dz));
         double p1 = (s1 * (((R[a1] * dx) + (R[3 + a1] * dy)) + (R[6 + a1] * dz)));

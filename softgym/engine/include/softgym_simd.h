@@ -28,9 +28,8 @@ static inline double softgym_pick(long long c, double a, double b)
 /* R = the rotation matrix of the unit quaternion q = (w, x, y, z), row-major: the
    one formula of the engine (the voxel update stores it, the seed geometry
    recomputes it in its vector lanes from the same quaternion, bit for bit) */
-static inline void softgym_quat_matrix(const double *q, double *R)
+static inline void softgym_quat_matrix_wxyz(double w, double x, double y, double z, double *R)
 {
-    double w = q[0], x = q[1], y = q[2], z = q[3];
     R[0] = 1.0 - 2.0 * (y * y + z * z);
     R[1] = 2.0 * (x * y - w * z);
     R[2] = 2.0 * (x * z + w * y);
@@ -40,6 +39,10 @@ static inline void softgym_quat_matrix(const double *q, double *R)
     R[6] = 2.0 * (x * z - w * y);
     R[7] = 2.0 * (y * z + w * x);
     R[8] = 1.0 - 2.0 * (x * x + y * y);
+}
+static inline void softgym_quat_matrix(const double *q, double *R)
+{
+    softgym_quat_matrix_wxyz(q[0], q[1], q[2], q[3], R);
 }
 #if defined(_MSC_VER)
 #define SOFTGYM_ALWAYS_INLINE static __forceinline
