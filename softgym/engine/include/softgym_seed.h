@@ -462,12 +462,10 @@ typedef long long softgym_v4i __attribute__((vector_size(32)));
         double x_ = (x), y_ = (y), z_ = (z); \
         w = c0 * x_ + c1 * y_ + c2 * z_; \
     } while (0)
-/* acc op= w on the voxel's whole row (op: += or -=) */
+/* acc op= w on the voxel's whole row (op: += or -=), held in the register
+   acc_v (loaded before the link's turns, stored after them) */
 #define SOFTGYM_SCATTER_ACC(acc, op) do { \
-        softgym_v4d a_; \
-        memcpy(&a_, (acc), sizeof a_); \
-        a_ op w; \
-        memcpy((acc), &a_, sizeof a_); \
+        acc##_v op w; \
     } while (0)
 #else
 #define SOFTGYM_NEG1(x) (-(x))
@@ -505,6 +503,14 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
                                                    double *moment)
 {
     Py_ssize_t li;
+#if defined(SOFTGYM_SCATTER_V4)
+    /* voxel 2's rows after the last link, kept in registers: where a link's
+       voxel 1 is the last link's voxel 2 (runs along the lattice's fastest
+       axis) its rows come from them instead of a load that would wait on
+       the store just made (the same values, added in the same order) */
+    softgym_v4d cf = {0.0, 0.0, 0.0, 0.0}, cm = cf;
+    Py_ssize_t pj = -1;
+#endif
     for (li = lo; li < hi; li++) {
         Py_ssize_t i = v1[li], j = v2[li];
         const double *Rp = rot + 9 * i;
@@ -532,6 +538,18 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
         int neg2 = q[23 * n] != 0.0;
         double *fi = force + 4 * i, *fj = force + 4 * j;
         double *mi = moment + 4 * i, *mj = moment + 4 * j;
+#if defined(SOFTGYM_SCATTER_V4)
+        softgym_v4d fi_v, fj_v, mi_v, mj_v;
+        if (i == pj) {
+            fi_v = cf;
+            mi_v = cm;
+        } else {
+            memcpy(&fi_v, fi, sizeof fi_v);
+            memcpy(&mi_v, mi, sizeof mi_v);
+        }
+        memcpy(&fj_v, fj, sizeof fj_v);
+        memcpy(&mj_v, mj, sizeof mj_v);
+#endif
         if (ax == 0) {
             SOFTGYM_SCATTER_TURN(fi, q[0], q[n], q[2 * n]);
             SOFTGYM_SCATTER_F2(q[3 * n], q[4 * n], q[5 * n]);
@@ -548,6 +566,15 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
             SOFTGYM_SCATTER_TURN(mi, SOFTGYM_NEG1(q[8 * n]), q[7 * n], q[6 * n]);
             SOFTGYM_SCATTER_TURN(mj, SOFTGYM_NEG1(q[24 * n]), q[21 * n], q[9 * n]);
         }
+#if defined(SOFTGYM_SCATTER_V4)
+        memcpy(fi, &fi_v, sizeof fi_v);
+        memcpy(fj, &fj_v, sizeof fj_v);
+        memcpy(mi, &mi_v, sizeof mi_v);
+        memcpy(mj, &mj_v, sizeof mj_v);
+        cf = fj_v;
+        cm = mj_v;
+        pj = j;
+#endif
     }
 }
 #undef SOFTGYM_SCATTER_F2
