@@ -34,6 +34,11 @@ cdef struct Contacts:
     KeyIndex* ocells         # (n_obs_r,) obstacles sorted by spatial-hash cell
     intp_t* dense            # the voxel hash's cell table (SpatialHash.start), kept
     intp_t dense_capacity    # entries allocated in dense
+    float64_t* sur           # (4, n_voxels_r) scratch of the all-pairs test: the surface
+                             #   voxels' x, y, z and size
+    intp_t* sur_idx          # (2, n_voxels_r) scratch: their voxel indices, then their
+                             #   ranks in the seed's order
+    unsigned char* hit       # (n_voxels_r,) scratch: 1 where a pair is a candidate
 
 
 # The spatial hash of the candidate lists (_contact.pyx, _hash_*): points in

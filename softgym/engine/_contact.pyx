@@ -39,6 +39,7 @@ cdef enum:
     CELL_BITS = 20           # bits of each packed cell coordinate
     VOXEL_OFF = 1            # cell offset of a robot's voxel hash (origin: its lowest centre)
     OBS_OFF = 1 << 19        # cell offset of the obstacle hash (origin 0): cells within +-2^19 cells
+    ALL_PAIRS_MAX = 768      # default of _all_pairs_max
 
 
 cdef int _cmp_key_index(const void* a, const void* b) noexcept nogil:
@@ -207,8 +208,105 @@ cdef inline int _alloc_lists(Contacts* c, intp_t n) noexcept nogil:
         c.cells = <KeyIndex*> malloc(n * sizeof(KeyIndex))
         c.row = <intp_t*> malloc(n * sizeof(intp_t))
         c.ref = <float64_t*> malloc(3 * n * sizeof(float64_t))
-        if c.cells == NULL or c.row == NULL or c.ref == NULL:
+        c.sur = <float64_t*> malloc(4 * n * sizeof(float64_t))
+        c.sur_idx = <intp_t*> malloc(2 * n * sizeof(intp_t))
+        c.hit = <unsigned char*> malloc(n * sizeof(unsigned char))
+        if c.cells == NULL or c.row == NULL or c.ref == NULL or c.sur == NULL \
+                or c.sur_idx == NULL or c.hit == NULL:
             return STATUS_MEMORY
+    return STATUS_OK
+
+
+cdef extern from "softgym_pairs.h":
+    # the all-pairs test of one surface voxel against the later ones (C, for
+    # the vectorising pragma; documented in include/softgym_pairs.h)
+    void softgym_pair_hits(int seed_rule, intp_t a, intp_t n, const float64_t* x,
+                           const float64_t* y, const float64_t* z, const float64_t* s,
+                           const intp_t* rank, float64_t lim2,
+                           unsigned char* hit) noexcept nogil
+
+
+# robots with at most this many surface voxels get the all-pairs test
+# (_voxel_pairs_all), larger ones the spatial hash. Profiled on the 6^3 robot
+# (152 surface voxels): the hash's walk cost 19 cycles a voxel-step, as much
+# as the all-pairs test of ~1,000 surface voxels.
+cdef intp_t _all_pairs_max = ALL_PAIRS_MAX
+
+
+def all_pairs_max(n=None):
+    """The most surface voxels a robot may have for the all-pairs candidate test (the spatial
+    hash above it); ``n`` sets it (for tests: 0 gives every robot the hash). Returns the
+    value before the call."""
+    global _all_pairs_max
+    cdef intp_t old = _all_pairs_max
+    if n is not None:
+        _all_pairs_max = n
+    return old
+
+
+cdef inline int _append_row(Contacts* c, intp_t i, intp_t n_row) noexcept nogil:
+    # append the pairs (i, c.row[k]) of k < n_row to c.pairs. Returns a STATUS.
+    cdef intp_t k, m
+    cdef intp_t* grown
+    if c.n_pairs + n_row > c.capacity:
+        m = 2 * (c.n_pairs + n_row) + 64
+        grown = <intp_t*> realloc(c.pairs, 2 * m * sizeof(intp_t))
+        if grown == NULL:
+            return STATUS_MEMORY
+        c.pairs = grown
+        c.capacity = m
+    for k in range(n_row):
+        c.pairs[2 * c.n_pairs] = i
+        c.pairs[2 * c.n_pairs + 1] = c.row[k]
+        c.n_pairs += 1
+    return STATUS_OK
+
+
+cdef inline int _voxel_pairs_all(Batch* b, intp_t r, Contacts* c, const float64_t* P,
+                                 intp_t stride, float64_t horizon,
+                                 const int32 seed_rule) noexcept nogil:
+    # _voxel_pairs by testing every pair of surface voxels (softgym_pair_hits,
+    # one vector loop per voxel): the same pairs, found in (i, j) order
+    cdef:
+        intp_t vs = b.vox_start[r]
+        intp_t ve = b.vox_start[r + 1]
+        intp_t cap = ve - vs
+        intp_t i, j, a, k, ns = 0, n_row
+        float64_t L = b.L
+        float64_t lim2
+        float64_t* X = c.sur
+        float64_t* Y = c.sur + cap
+        float64_t* Z = c.sur + 2 * cap
+        float64_t* S = c.sur + 3 * cap
+        intp_t* RK = c.sur_idx + cap
+        int status
+    for i in range(vs, ve):
+        if not b.surface[i]:
+            continue
+        X[ns] = P[stride * i]
+        Y[ns] = P[stride * i + 1]
+        Z[ns] = P[stride * i + 2]
+        if seed_rule:
+            S[ns] = P[stride * i + 3]
+            RK[ns] = b.seed_rank[i]
+        c.sur_idx[ns] = i
+        ns += 1
+    lim2 = 9.0 * L * L if seed_rule else horizon * horizon
+    for a in range(ns):
+        softgym_pair_hits(seed_rule, a, ns, X, Y, Z, S, RK, lim2, c.hit)
+        i = c.sur_idx[a]
+        n_row = 0
+        for k in range(a + 1, ns):
+            if c.hit[k]:
+                j = c.sur_idx[k]
+                if _excluded(b, i, j):
+                    continue
+                c.row[n_row] = j
+                n_row += 1
+        if n_row:
+            status = _append_row(c, i, n_row)
+            if status != STATUS_OK:
+                return status
     return STATUS_OK
 
 
@@ -223,14 +321,17 @@ cdef inline int _voxel_pairs(Batch* b, intp_t r, Contacts* c, const float64_t* P
     cdef:
         intp_t vs = b.vox_start[r]
         intp_t ve = b.vox_start[r + 1]
-        intp_t i, j, k, m, n_row, end
+        intp_t i, j, k, n_row, end, ns = 0
         float64_t L = b.L
         float64_t h2 = horizon * horizon, x0, y0, z0, dx, dy, dz, d2, act
         intp_t first
-        int di, dj
+        int di, dj, status
         int64_t ijk[3]
-        intp_t* grown
         SpatialHash h
+    for i in range(vs, ve):
+        ns += b.surface[i] != 0
+    if ns <= _all_pairs_max:
+        return _voxel_pairs_all(b, r, c, P, stride, horizon, seed_rule)
     x0 = P[stride * vs]
     y0 = P[stride * vs + 1]
     z0 = P[stride * vs + 2]
@@ -279,17 +380,9 @@ cdef inline int _voxel_pairs(Batch* b, intp_t r, Contacts* c, const float64_t* P
         if n_row == 0:
             continue
         qsort(c.row, n_row, sizeof(intp_t), _cmp_intp)
-        if c.n_pairs + n_row > c.capacity:
-            m = 2 * (c.n_pairs + n_row) + 64
-            grown = <intp_t*> realloc(c.pairs, 2 * m * sizeof(intp_t))
-            if grown == NULL:
-                return STATUS_MEMORY
-            c.pairs = grown
-            c.capacity = m
-        for k in range(n_row):
-            c.pairs[2 * c.n_pairs] = i
-            c.pairs[2 * c.n_pairs + 1] = c.row[k]
-            c.n_pairs += 1
+        status = _append_row(c, i, n_row)
+        if status != STATUS_OK:
+            return status
     return STATUS_OK
 
 

@@ -372,6 +372,18 @@ cdef class ContactCache:
             raise MemoryError("cannot allocate the self-collision cache")
         self.invalidate()
 
+    def pairs(self, intp_t r):
+        """Robot r's self-collision candidate pairs (i, j) as of its last rebuild: an
+        (n_pairs, 2) int array of batch voxel indices, i < j, sorted (a copy)."""
+        cdef intp_t k
+        if not 0 <= r < self.n:
+            raise IndexError(f"robot {r} not in 0..{self.n - 1}")
+        out = np.empty((self.items[r].n_pairs, 2), dtype=np.intp)
+        for k in range(self.items[r].n_pairs):
+            out[k, 0] = self.items[r].pairs[2 * k]
+            out[k, 1] = self.items[r].pairs[2 * k + 1]
+        return out
+
     def invalidate(self):
         """Mark every robot's candidate list for a rebuild before its next use."""
         cdef intp_t r
@@ -389,6 +401,9 @@ cdef class ContactCache:
                 free(self.items[r].opairs)
                 free(self.items[r].ocells)
                 free(self.items[r].dense)
+                free(self.items[r].sur)
+                free(self.items[r].sur_idx)
+                free(self.items[r].hit)
             free(self.items)
         free(self.link_scratch)
 

@@ -376,6 +376,19 @@ class Simulation:
         """Voxel centres (m) of one robot, shape (n_voxels_r, 3) (a copy)."""
         return self._a["pos"][self._slice(robot)].copy()
 
+    def collision_candidates(self, robot: int) -> np.ndarray:
+        """The robot's self-collision candidate pairs as of their last rebuild.
+
+        Shape (n_pairs, 2), int: i < j, sorted; indices into the robot's voxels
+        (``positions`` rows) followed by its objects' (``object_positions``
+        rows). Empty before the first step and without self-collision. The
+        seed preset rebuilds them on the seed's schedule (once the fastest
+        voxel may have moved half a voxel), the corotational preset when a
+        voxel may have moved beyond its margin.
+        """
+        robot = self._robot(robot)
+        return self._contacts.pairs(robot) - int(self._a["vox_start"][robot])
+
     def velocities(self, robot: int) -> np.ndarray:
         """Voxel velocities (m/s) of one robot, shape (n_voxels_r, 3)."""
         return self._a["vel"][self._slice(robot)].copy()

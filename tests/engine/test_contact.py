@@ -88,12 +88,17 @@ def _c_shape_pulled_shut(self_collision):
     cfg = SimConfig(self_collision=self_collision, init_time=0.0, gravity=0.0, floor=False,
                     global_damping=0.05)  # fmt: skip
     sim = Simulation(body, cfg)
-    idx = sim.grid_index(0)
+    _pull_shut(sim, 0)
+    return sim
+
+
+def _pull_shut(sim, robot):
+    # the C's tips pulled towards each other
+    idx = sim.grid_index(robot)
     f = np.zeros((len(idx), 3))
     f[(idx[:, 0] == 5) & (idx[:, 1] == 0), 1] = 2.0
     f[(idx[:, 0] == 5) & (idx[:, 1] == 4), 1] = -2.0
-    sim.set_external_force(0, f)
-    return sim
+    sim.set_external_force(robot, f)
 
 
 def _min_distance_of_colliding_pairs(sim, seconds, hops=3):
@@ -221,3 +226,62 @@ def test_off_lattice_boxes_keep_the_penalty_contact_in_the_seed_model():
     sim = Simulation(body, SimConfig(init_time=0.0), terrain=platform)
     sim.advance(1.5)
     np.testing.assert_allclose(sim.positions(0)[:, 2], 2.5 * L + 0.5 * L, rtol=0.02)
+
+
+
+def _seed_rule_pairs(sim, robot):
+    # the seed's candidate rule by brute force on the robot's col_ref: surface
+    # voxels i < j, not excluded, closer than 3 L and than twice the size of
+    # the pair's first voxel in the seed's order (robot-local indices)
+    a = sim._a
+    lo, hi = int(a["vox_start"][robot]), int(a["vox_start"][robot + 1])
+    ref, rank, surface = a["col_ref"], a["seed_rank"], a["surface"]
+    out = []
+    for i in range(lo, hi):
+        excluded = set(a["excl_idx"][a["excl_start"][i] : a["excl_start"][i + 1]])
+        for j in range(i + 1, hi):
+            if not (surface[i] and surface[j]) or j in excluded:
+                continue
+            d = ref[j, :3] - ref[i, :3]
+            d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+            first = i if rank[i] < rank[j] else j
+            if d2 < 9.0 * L * L and d2 < (2.0 * ref[first, 3]) ** 2:
+                out.append((i - lo, j - lo))
+    return np.array(out, dtype=np.intp).reshape(-1, 2)
+
+
+@pytest.mark.parametrize("model", ["seed", "corotational"])
+def test_all_pairs_candidates_equal_the_spatial_hash(model):
+    # a small robot's candidates come from testing every pair of surface
+    # voxels, a large one's from the spatial hash: the same lists, step for
+    # step, and the same bits (the C pulled shut, and a block of muscles of
+    # unequal sizes, so the seed's rule picks the first voxel's size)
+    from softgym.engine import _contact
+
+    bodies = [_c_shape_pulled_shut(True).bodies[0], reference_robot(4, cte=0.03)]
+    cfg = SimConfig(self_collision=True, model=model, init_time=0.0, gravity=0.0, floor=False,
+                    global_damping=0.05)  # fmt: skip
+    runs = []
+    for limit in (10**9, 0):  # every robot all-pairs, then every robot hashed
+        old = _contact.all_pairs_max(limit)
+        try:
+            sim = Simulation(bodies, cfg, n_threads=1)
+            _pull_shut(sim, 0)
+            lists = []
+            for _ in range(12):
+                sim.advance(0.1)
+                lists.append([sim.collision_candidates(r) for r in range(2)])
+            runs.append((sim, lists))
+        finally:
+            _contact.all_pairs_max(old)
+    (sim_a, lists_a), (sim_b, lists_b) = runs
+    for r in range(2):  # both robots have candidates at some step
+        assert any(len(step[r]) for step in lists_a)
+    for step_a, step_b in zip(lists_a, lists_b):
+        for pa, pb in zip(step_a, step_b):
+            assert np.array_equal(pa, pb)
+    for r in range(2):
+        assert np.array_equal(sim_a.positions(r), sim_b.positions(r))
+    if model == "seed":
+        for r in range(2):
+            assert np.array_equal(lists_a[-1][r], _seed_rule_pairs(sim_a, r))

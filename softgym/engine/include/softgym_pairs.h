@@ -1,0 +1,52 @@
+/* The all-pairs test of the self-collision candidate lists (softgym/engine/
+   _contact.pyx, _voxel_pairs): for a small robot, every pair of its surface
+   voxels is tested in one vector loop instead of walking a spatial hash (the
+   hash's 27 cells of edge `horizon` hold most of a small robot, so its walk
+   tests nearly every pair anyway, one at a time). Py_ssize_t comes from
+   Python.h, which Cython includes first. */
+#ifndef SOFTGYM_PAIRS_H
+#define SOFTGYM_PAIRS_H
+
+#include "softgym_simd.h"
+
+/* hit[b] = 1 where the surface voxels a < b (b in a + 1 .. n - 1) are
+   candidates, else 0. Their centres: x, y, z; sizes s and ranks in the seed's
+   voxel order rank (used with seed_rule). seed_rule (a compile-time constant
+   in each copy): the pair is kept unless d2 >= lim2 (9 L^2) or d2 >= act^2,
+   act twice the size of the pair's first voxel in the seed's order; else
+   unless d2 >= lim2 (the horizon squared). The same expressions and
+   comparisons as the hash's scalar test (a NaN distance is kept, as there). */
+SOFTGYM_ALWAYS_INLINE void softgym_pair_hits_impl(const int seed_rule, Py_ssize_t a,
+                                                  Py_ssize_t n, const double *x,
+                                                  const double *y, const double *z,
+                                                  const double *s, const Py_ssize_t *rank,
+                                                  double lim2, unsigned char *hit)
+{
+    const double xa = x[a], ya = y[a], za = z[a], sa = s[a];
+    const Py_ssize_t ra = rank[a];
+    Py_ssize_t k;
+    SOFTGYM_IVDEP
+    for (k = a + 1; k < n; k++) {
+        double dx = x[k] - xa;
+        double dy = y[k] - ya;
+        double dz = z[k] - za;
+        double d2 = dx * dx + dy * dy + dz * dz;
+        long long out = d2 >= lim2;
+        if (seed_rule) {
+            double act = 2.0 * (ra < rank[k] ? sa : s[k]);
+            out |= d2 >= act * act;
+        }
+        hit[k] = (unsigned char)(out == 0);
+    }
+}
+static void softgym_pair_hits(int seed_rule, Py_ssize_t a, Py_ssize_t n, const double *x,
+                              const double *y, const double *z, const double *s,
+                              const Py_ssize_t *rank, double lim2, unsigned char *hit)
+{
+    if (seed_rule)
+        softgym_pair_hits_impl(1, a, n, x, y, z, s, rank, lim2, hit);
+    else
+        softgym_pair_hits_impl(0, a, n, x, y, z, s, rank, lim2, hit);
+}
+
+#endif  /* SOFTGYM_PAIRS_H */
