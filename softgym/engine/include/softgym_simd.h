@@ -27,7 +27,10 @@ static inline double softgym_pick(long long c, double a, double b)
 }
 /* R = the rotation matrix of the unit quaternion q = (w, x, y, z), row-major: the
    one formula of the engine (the voxel update stores it, the seed geometry
-   recomputes it in its vector lanes from the same quaternion, bit for bit) */
+   recomputes it in its vector lanes from the same quaternion, bit for bit).
+   The geometry passes the values it has loaded: given the pointer form inside
+   its loop, GCC 12 found the loads "not suitable for gather" and ran the loop
+   scalar (twice the cycles; check with -fopt-info-vec-missed) */
 static inline void softgym_quat_matrix_wxyz(double w, double x, double y, double z, double *R)
 {
     R[0] = 1.0 - 2.0 * (y * y + z * z);
