@@ -21,11 +21,11 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import statistics
-import subprocess
 import sys
 from pathlib import Path
+
+from tree_run import run_in_tree
 
 CHILD = """
 import json, sys, time
@@ -46,16 +46,8 @@ print("RESULT " + json.dumps({{"best": best, "module": softgym.__file__}}))
 
 def run_once(tree: Path, runs: int, seconds: float) -> float:
     """The quickest of ``runs`` runs of the reference robot with the softgym of ``tree`` (s)."""
-    env = dict(os.environ, PYTHONPATH=str(tree), OMP_NUM_THREADS="1")
     code = CHILD.format(bench=str(tree / "benchmarks"), runs=runs, seconds=seconds)
-    res = subprocess.run([sys.executable, "-c", code], cwd=tree, env=env, capture_output=True,
-                         text=True, check=False)  # fmt: skip
-    line = next((ln for ln in res.stdout.splitlines() if ln.startswith("RESULT ")), None)
-    if res.returncode != 0 or line is None:
-        raise SystemExit(f"compare_builds: the run in {tree} failed:\n{res.stderr[-2000:]}")
-    out = json.loads(line[len("RESULT "):])
-    if not Path(out["module"]).resolve().is_relative_to(tree):
-        raise SystemExit(f"compare_builds: the run in {tree} imported {out['module']}, not that tree")
+    out = run_in_tree(tree, code, "RESULT", "compare_builds", env={"OMP_NUM_THREADS": "1"})
     return float(out["best"])
 
 

@@ -43,6 +43,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from tree_run import run_in_tree
+
 HERE = Path(__file__).resolve().parent
 
 # the child: one reference robot, alone, one thread
@@ -165,18 +167,12 @@ def profile_cycles(collisions: bool, seconds: float, n: int, repeats: int) -> di
                              env=env, capture_output=True, text=True, check=False)  # fmt: skip
         if res.returncode != 0:
             raise SystemExit(f"profile_engine: the probed build failed:\n{res.stderr[-2000:]}")
-        env = dict(os.environ, PYTHONPATH=str(tree))
         code = CYCLES_CHILD.format(bench=str(tree / "benchmarks"), n=n, coll=collisions,
                                    seconds=seconds)  # fmt: skip
         runs = []
         for _ in range(repeats):
-            res = subprocess.run([sys.executable, "-c", code], cwd=tree, env=env,
-                                 capture_output=True, text=True, check=False)  # fmt: skip
-            m = re.search(r"^CYCLES (.*)$", res.stdout, re.M)
-            if res.returncode != 0 or m is None:
-                raise SystemExit(f"profile_engine: the probed run failed:\n{res.stderr[-2000:]}")
-            run = json.loads(m.group(1))
-            if run["counts"] is None or not run["module"].startswith(str(tree)):
+            run = run_in_tree(tree, code, "CYCLES", "profile_engine")
+            if run["counts"] is None:
                 raise SystemExit("profile_engine: the run did not load the probed build")
             runs.append(run)
     best = min(runs, key=lambda r: sum(r["counts"][k] for _, k, sub in CYCLE_ROWS if not sub))

@@ -375,14 +375,11 @@ cdef class ContactCache:
     def pairs(self, intp_t r):
         """Robot r's self-collision candidate pairs (i, j) as of its last rebuild: an
         (n_pairs, 2) int array of batch voxel indices, i < j, sorted (a copy)."""
-        cdef intp_t k
         if not 0 <= r < self.n:
             raise IndexError(f"robot {r} not in 0..{self.n - 1}")
-        out = np.empty((self.items[r].n_pairs, 2), dtype=np.intp)
-        for k in range(self.items[r].n_pairs):
-            out[k, 0] = self.items[r].pairs[2 * k]
-            out[k, 1] = self.items[r].pairs[2 * k + 1]
-        return out
+        if self.items[r].n_pairs == 0:
+            return np.empty((0, 2), dtype=np.intp)
+        return np.array(<intp_t[:self.items[r].n_pairs, :2]> self.items[r].pairs)
 
     def invalidate(self):
         """Mark every robot's candidate list for a rebuild before its next use."""

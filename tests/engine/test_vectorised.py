@@ -40,10 +40,9 @@ def _gcc():
     cc = shutil.which("gcc") or shutil.which("cc")
     if cc is None:
         return None
-    version = subprocess.run([cc, "--version"], capture_output=True, text=True).stdout
-    if "clang" in version.lower() or "gcc" not in version.lower() and "free software" not in version.lower():
-        return None
-    return cc
+    version = subprocess.run([cc, "--version"], capture_output=True, text=True).stdout.lower()
+    is_gcc = "clang" not in version and ("gcc" in version or "free software" in version)
+    return cc if is_gcc else None
 
 
 @pytest.mark.parametrize("name", sorted(PASSES))
