@@ -24,6 +24,7 @@ oracle's sample steps, as a fraction of the oracle's displacement scale).
     python benchmarks/fidelity_seed.py                      # everything (~30 min on 2 cores)
     python benchmarks/fidelity_seed.py --quick              # 12 cases per set
     python benchmarks/fidelity_seed.py --model corotational # the pre-fidelity step, for the "before" table
+    python benchmarks/fidelity_seed.py --link-precision single  # the seed model's float link math
     python benchmarks/fidelity_seed.py --json               # last line: the figures as JSON
 
 Values under 0.01 voxel lengths are raised to 0.01 before ratios are taken (a
@@ -58,14 +59,14 @@ ORACLE_HALVES = ((1, 2, 3), (4, 5, 6))  # perturbed oracle draws split in two ha
 
 
 # ------------------------------------------------------------------------ micro-cases
-def micro_errors(model: str = "seed") -> dict[str, dict[str, Any]]:
+def micro_errors(model: str = "seed", link_precision: str = "double") -> dict[str, dict[str, Any]]:
     """Per micro-case: max |softgym - oracle| over the samples, as a fraction of the
     oracle's displacement scale (its largest range of x, y or z). The oracle prints 6
     significant digits: half a unit of the last one is forgiven."""
     data = json.loads((DATA / "micro.json").read_text())
     out = {}
     for name, case in data["cases"].items():
-        ours, oracle = micro_trace(case, model)
+        ours, oracle = micro_trace(case, model, link_precision)
         scale = float(np.ptp(oracle, axis=0).max())
         err = float(np.maximum(np.abs(ours - oracle) - 5e-6 * np.abs(oracle), 0.0).max())
         out[name] = {"max_err_m": err, "scale_m": scale, "rel": err / max(scale, 1e-12),
@@ -116,12 +117,12 @@ def load_oracle(sets: list[str]) -> tuple[list[Any], dict[tuple[str, str, int], 
     return cases, values
 
 
-def run_softgym(cases: list[Any], draws: list[int], model: str, threads: int | None
-                ) -> dict[tuple[str, str, int], float]:
+def run_softgym(cases: list[Any], draws: list[int], model: str, threads: int | None,
+                link_precision: str = "double") -> dict[tuple[str, str, int], float]:
     """softgym's value of each case's metric (:data:`METRIC`) for every regime and draw,
     one batch per regime and terrain (fence metrics on the seed's diluted centre of mass)."""
     out = {}
-    cfg = SimConfig(model=model)
+    cfg = SimConfig(model=model, link_precision=link_precision)
     for regime in fc.REGIMES:
         for terrain in ("flat", "fence"):
             jobs = [(c, d) for c in cases for d in draws if c.terrain == terrain]
@@ -173,6 +174,8 @@ def compare(cases, oracle, ours, draws, terrain: str = "flat", halves=ORACLE_HAL
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--model", default="seed", choices=["seed", "corotational"])
+    ap.add_argument("--link-precision", default="double", choices=["double", "single"],
+                    help="SimConfig.link_precision of the seed model")
     ap.add_argument("--sets", default="structured,random,fence")
     ap.add_argument("--draws", type=int, default=3, help="perturbed softgym draws per case (>= 3)")
     ap.add_argument("--quick", action="store_true", help="12 cases per set")
@@ -191,14 +194,14 @@ def main() -> int:
         cases = [c for cs in by_set.values() for c in cs[:12]]
     draws = list(range(1, a.draws + 1))
     halves = tuple(tuple(int(x) for x in h.split(",")) for h in a.halves.split("/"))
-    ours = run_softgym(cases, draws, a.model, a.threads)
-    report = {"model": a.model, "sets": sets, "draws": draws, "n_cases": len(cases),
+    ours = run_softgym(cases, draws, a.model, a.threads, a.link_precision)
+    report = {"model": a.model, "link_precision": a.link_precision, "sets": sets, "draws": draws, "n_cases": len(cases),
               "halves": halves,
               "regimes": compare(cases, oracle, ours, draws, "flat", halves),
               "fence_regimes": compare(cases, oracle, ours, draws, "fence", halves),
-              "micro": micro_errors(a.model)}
+              "micro": micro_errors(a.model, a.link_precision)}
     report["wall_s"] = time.perf_counter() - t0
-    print(f"softgym model {a.model!r} against the seed's engine: {len(cases)} cases "
+    print(f"softgym model {a.model!r} (link precision {a.link_precision}) against the seed's engine: {len(cases)} cases "
           f"({', '.join(sets)}), {len(draws)} softgym draws, oracle halves {halves}")
     print(f"{'regime':8s} {'pair':18s} {'n':>4s} {'spearman':>9s} {'med|log10|':>10s} "
           f"{'<=2x':>6s} {'<=3x':>6s} {'moved/still':>11s}")

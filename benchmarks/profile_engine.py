@@ -53,8 +53,8 @@ import sys
 sys.path.insert(0, {bench!r})
 from bench_engine import reference_robot
 from softgym.engine import SimConfig, Simulation, kernel_build
-sim = Simulation([reference_robot({n})], SimConfig(self_collision={coll}, model={model!r}),
-                 n_threads=1)
+sim = Simulation([reference_robot({n})], SimConfig(self_collision={coll}, model={model!r},
+                 link_precision={prec!r}), n_threads=1)
 r = sim.run({seconds})
 print("STEPS", int(r.steps[0]), sim.n_voxels, sim.n_links, kernel_build())
 """
@@ -76,13 +76,15 @@ def demangle(name: str) -> str:
     return f"{parts[-1]}.{rest}" if parts else name
 
 
-def profile(model: str, collisions: bool, seconds: float, n: int, toggle: str) -> dict:
+def profile(model: str, collisions: bool, seconds: float, n: int, toggle: str,
+            precision: str = "double") -> dict:
     """Run the child under callgrind; return totals and per-function counts."""
     if shutil.which("valgrind") is None:
         raise SystemExit("profile_engine: valgrind is not installed (apt-get install valgrind)")
     with tempfile.TemporaryDirectory(prefix="softgym-cg-") as tmp:
         out = os.path.join(tmp, "cg.out")
-        code = CHILD.format(bench=str(HERE), n=n, coll=collisions, model=model, seconds=seconds)
+        code = CHILD.format(bench=str(HERE), n=n, coll=collisions, model=model, seconds=seconds,
+                            prec=precision)
         res = subprocess.run(
             ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}",
              f"--toggle-collect={toggle}", sys.executable, "-c", code],
@@ -120,8 +122,8 @@ import json, sys, time
 sys.path.insert(0, {bench!r})
 from bench_engine import reference_robot
 from softgym.engine import SimConfig, Simulation, kernel_build, _core
-sim = Simulation([reference_robot({n})], SimConfig(self_collision={coll}, model="seed"),
-                 n_threads=1)
+sim = Simulation([reference_robot({n})], SimConfig(self_collision={coll}, model="seed",
+                 link_precision={prec!r}), n_threads=1)
 _core.cycle_counts(reset=True)
 t0 = time.perf_counter()
 r = sim.run({seconds})
@@ -157,7 +159,8 @@ def _tree_copy(dest: Path) -> None:
             shutil.copy2(root / rel, dest / rel)
 
 
-def profile_cycles(collisions: bool, seconds: float, n: int, repeats: int) -> dict:
+def profile_cycles(collisions: bool, seconds: float, n: int, repeats: int,
+                   precision: str = "double") -> dict:
     """Build a probed copy of the tree, run it ``repeats`` times; the quickest run's counts."""
     with tempfile.TemporaryDirectory(prefix="softgym-cycles-") as tmp:
         tree = Path(tmp)
@@ -168,7 +171,7 @@ def profile_cycles(collisions: bool, seconds: float, n: int, repeats: int) -> di
         if res.returncode != 0:
             raise SystemExit(f"profile_engine: the probed build failed:\n{res.stderr[-2000:]}")
         code = CYCLES_CHILD.format(bench=str(tree / "benchmarks"), n=n, coll=collisions,
-                                   seconds=seconds)  # fmt: skip
+                                   seconds=seconds, prec=precision)  # fmt: skip
         runs = []
         for _ in range(repeats):
             run = run_in_tree(tree, code, "CYCLES", "profile_engine")
@@ -205,6 +208,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--size", type=int, default=6, help="robot edge in voxels")
     ap.add_argument("--toggle", default=TOGGLE, help="callgrind --toggle-collect pattern")
     ap.add_argument("--json", action="store_true", help="print one JSON object as the last line")
+    ap.add_argument("--link-precision", default="double", choices=("double", "single"),
+                    help="SimConfig.link_precision of the seed preset")
     ap.add_argument("--cycles", action="store_true",
                     help="time each pass (a probed build of a copy of the tree; seed preset)")
     ap.add_argument("--repeats", type=int, default=5, help="--cycles: runs, the quickest kept")
@@ -214,12 +219,14 @@ def main(argv: list[str] | None = None) -> int:
             raise SystemExit("profile_engine: --cycles times the seed preset's passes only")
         if args.repeats < 1:
             raise SystemExit("profile_engine: --repeats must be at least 1")
-        c = profile_cycles(not args.no_collision, args.seconds, args.size, args.repeats)
+        c = profile_cycles(not args.no_collision, args.seconds, args.size, args.repeats,
+                           args.link_precision)
         print_cycles(c, args.size, not args.no_collision)
         if args.json:
             print(json.dumps(c))
         return 0
-    p = profile(args.model, not args.no_collision, args.seconds, args.size, args.toggle)
+    p = profile(args.model, not args.no_collision, args.seconds, args.size, args.toggle,
+                args.link_precision)
     vs = p["steps"] * p["n_voxels"]
     ls = p["steps"] * p["n_links"]
     print(f"{p['model']} preset, kernel build {p['kernel_build']}, {args.size}^3 reference "

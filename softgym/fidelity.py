@@ -268,16 +268,19 @@ def fence_terrain() -> Terrain:
     return Terrain.fence(inner=10, height=1, thickness=1, center=(3, 3))
 
 
-def micro_trace(case: dict[str, Any], model: str = "seed") -> tuple[np.ndarray, np.ndarray]:
+def micro_trace(
+    case: dict[str, Any], model: str = "seed", link_precision: str = "double"
+) -> tuple[np.ndarray, np.ndarray]:
     """The centre of mass softgym computes at the oracle's sample steps of a micro-case.
 
     ``case`` is one entry of ``micro.json``'s ``"cases"`` (grid, regime, times and
-    the seed engine's trace). Returns ``(ours, oracle)``, each of shape
+    the seed engine's trace); ``model`` and ``link_precision`` as in
+    :class:`~softgym.engine.SimConfig`. Returns ``(ours, oracle)``, each of shape
     (n_samples, 3) in metres.
     """
     dT, period, cte = (REGIMES[case["regime"]][k] for k in ("dT", "period", "cte"))
     design = RobotDesign(np.asarray(case["grid"]), controller=Controller(dT, period, cte))
-    cfg = SimConfig(init_time=case["init_time"], model=model)
+    cfg = SimConfig(init_time=case["init_time"], model=model, link_precision=link_precision)
     sim = Simulation([design], cfg, n_threads=1)
     dt = float(sim.dt[0])
     sim = Simulation([design], cfg.replace(trace_interval=dt), n_threads=1)

@@ -27,6 +27,7 @@ cdef struct Batch:
     int32 actuation_mode     # 0: seed (contraction only, hold out-of-bounds); 1: symmetric
     int32 model              # 0: seed (the seed engine's step, see _seed.pyx); 1: corotational
     float64_t bond_zeta      # the seed's BondDampingZ (model 0's finite-difference link damping)
+    int32 link_f32           # model 0's frames and forces passes in single precision (1) or double (0)
     intp_t trace_capacity    # samples allocated per robot in trace_t / trace_cm
     float64_t fluid_drag     # 1/2 rho C_d of a surrounding fluid (kg/m^3): quadratic drag on
                              # each exposed face moving into it; 0: no fluid
@@ -110,6 +111,8 @@ cdef struct Batch:
     float64_t* c_seed        # (8, n_links) 2 sqrt(k m) damping constants of voxel 1 then voxel 2:
                              #   a1 M, b2 FM, a2 I, b3 I (FM = M L / 2, I = M L^2 / 6)
     flag_t* homog            # (n_links,) 1: both voxels of one material (voxel 2 gets -F1)
+    float* k_seed32          # (11, n_links) float32: k_axial, k_torsion, k_bend, c_seed's 8 rows
+                             #   (link_f32 only; NULL otherwise)
     flag_t* link_sa          # (n_links,) 1: small-angle mode (state)
     intp_t* seed_rank        # (n_voxels,) the voxel's index in the seed engine's order
     float64_t* col_ref       # (n_voxels, 4) position and size at the last candidate rebuild (state)

@@ -241,7 +241,7 @@ KERNEL_ARRAYS = (
     "c_global", "rot_damp", "mu_s", "mu_k", "fixed", "surface", "excl_start", "excl_idx",
     "seed_rank", "col_ref", "col_acc", "col_vmax", "obs_start", "obs", "obs_rank",
     "v1", "v2", "axis", "k_axial", "k_torsion", "k_bend", "c_axial", "c_torsion",
-    "c_bend", "c_seed", "homog", "link_sa", "link_last",
+    "c_bend", "c_seed", "k_seed32", "homog", "link_sa", "link_last",
     "body_end", "aux_init", "trace_aux", "faces",
 )
 
@@ -268,6 +268,7 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.actuation_mode = s["actuation_mode"]
     b.model = s["model"]
     b.bond_zeta = s["bond_zeta"]
+    b.link_f32 = s["link_f32"]
     b.trace_capacity = a["trace_t"].shape[1]
     b.fluid_drag = s["fluid_drag"]
     b.body_end = <intp_t*> _p(a, "body_end")
@@ -347,6 +348,7 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
         b.homog = <flag_t*> _p(a, "homog")
         b.link_sa = <flag_t*> _p(a, "link_sa")
         b.link_last = _f(a, "link_last")
+        b.k_seed32 = <float*> _p(a, "k_seed32") if b.link_f32 else NULL
     return 0
 
 

@@ -96,6 +96,12 @@ cdef extern from "softgym_seed.h":
     void softgym_seed_scatter(int ax, intp_t lo, intp_t hi, intp_t n, const intp_t* v1,
                               const intp_t* v2, const float64_t* rot, const float64_t* o,
                               float64_t* force, float64_t* moment) noexcept nogil
+    void softgym_seed_frames32(intp_t lo, intp_t hi, intp_t n, float sa_rad, float w_acos,
+                               const float64_t* o, float* const* f) noexcept nogil
+    void softgym_seed_forces32(intp_t lo, intp_t hi, intp_t n, float L, float bz, float bzh,
+                               float inv_dt, const float* const* inp, const float64_t* sa_,
+                               const float64_t* chg_, const float* k32, float64_t* link_last,
+                               float64_t* const* out) noexcept nogil
 
 
 #: the passes of _seed_links_along that the cycle probes time, in slot order
@@ -113,9 +119,10 @@ def cycle_counts(bint reset=False):
     return out
 
 
-cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n) noexcept nogil:
+cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n, bint f32, intp_t ls) noexcept nogil:
     # softgym_seed_frames for one link, with the seed's branches (its acos
-    # approximation and the backward-chord rule)
+    # approximation and the backward-chord rule); f32: into the float rows of
+    # the single-precision passes (_float_rows, ls: the robot's first link)
     cdef:
         float64_t sa_rad = SMALL_ANGLE_RAD
         float64_t th_discard = SEED_PI - DISCARD_ANGLE_RAD
@@ -175,21 +182,77 @@ cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n) noexcept nogil:
         P0 = o[8 * n + li] - nom
         P1 = 0.0
         P2 = 0.0
-    o[10 * n + li] = P0
-    o[11 * n + li] = P1
-    o[12 * n + li] = P2
-    o[13 * n + li] = a1y
-    o[14 * n + li] = a1z
-    o[15 * n + li] = a2x
-    o[16 * n + li] = a2y
-    o[17 * n + li] = a2z
-    o[18 * n + li] = rw
-    o[19 * n + li] = ry
-    o[20 * n + li] = rz
+    _put(o, n, ls, 10, li, P0, f32)
+    _put(o, n, ls, 11, li, P1, f32)
+    _put(o, n, ls, 12, li, P2, f32)
+    _put(o, n, ls, 13, li, a1y, f32)
+    _put(o, n, ls, 14, li, a1z, f32)
+    _put(o, n, ls, 15, li, a2x, f32)
+    _put(o, n, ls, 16, li, a2y, f32)
+    _put(o, n, ls, 17, li, a2z, f32)
+    _put(o, n, ls, 18, li, rw, f32)
+    _put(o, n, ls, 19, li, ry, f32)
+    _put(o, n, ls, 20, li, rz, f32)
+
+
+cdef inline float* _float_row(float64_t* o, intp_t n, intp_t ls, intp_t k) noexcept nogil:
+    # the float view of the scratch's row k (o + k n, indexed by link from the
+    # robot's first link ls: its floats start where its doubles do) so that
+    # [li] is link li's float
+    return <float*> (o + k * n + ls) - ls
+
+
+cdef inline void _put(float64_t* o, intp_t n, intp_t ls, intp_t k, intp_t li, float64_t v,
+                      bint f32) noexcept nogil:
+    # row k of link li: a double, or (f32) a float of the row's float view
+    if f32:
+        _float_row(o, n, ls, k)[li] = <float> v
+    else:
+        o[k * n + li] = v
+
+
+cdef inline void _seed_links_along32(Batch* b, intp_t lo, intp_t end, const int ax,
+                                     float64_t inv_dt, intp_t ls) noexcept nogil:
+    # _seed_links_along's frames and forces passes in single precision
+    # (SimConfig.link_precision = "single"; include/softgym_seed.h): float
+    # rows 10-21 from the frames, double rows 0-9, 21, 24 from the forces for
+    # the scatter. ls: the robot's first link (_float_row)
+    cdef:
+        intp_t li, k
+        intp_t n = b.link_stride
+        float64_t* o = b.link_out
+        float* f[12]
+        const float* inp[11]
+        float64_t* out[12]
+        unsigned long long t0
+    for k in range(12):
+        f[k] = _float_row(o, n, ls, 10 + k)
+    t0 = softgym_prof_tsc()
+    softgym_seed_frames32(lo, end, n, <float> SMALL_ANGLE_RAD, <float> 0.9988, o, f)
+    softgym_prof_add(2, t0)
+    t0 = softgym_prof_tsc()
+    for li in range(lo, end):
+        if f[11][li] != 0.0:
+            _seed_frame_one(li, o, n, 1, ls)
+    softgym_prof_add(3, t0)
+    t0 = softgym_prof_tsc()
+    for k in range(11):
+        inp[k] = f[k]
+    for k in range(10):
+        out[k] = o + k * n
+    out[10] = o + 21 * n
+    out[11] = o + 24 * n
+    softgym_seed_forces32(lo, end, b.n_links, <float> b.L, <float> (0.5 * b.bond_zeta),
+                          <float> (0.25 * b.bond_zeta), <float> inv_dt, inp, o + 9 * n,
+                          o + 22 * n, b.k_seed32, b.link_last, out)
+    softgym_prof_add(4, t0)
+    t0 = softgym_prof_tsc()
+    softgym_seed_scatter(ax, lo, end, n, b.v1, b.v2, b.rot, o, b.force, b.moment)
+    softgym_prof_add(5, t0)
 
 
 cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
-                                  float64_t inv_dt) noexcept nogil:
+                                  float64_t inv_dt, intp_t ls) noexcept nogil:
     # links_seed for its links [lo, hi), all along axis ax (a compile-time
     # constant once inlined), in passes over the link scratch b.link_out
     # (profiled: the square roots and divisions of the large-angle frames
@@ -236,6 +299,9 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
                              SA_BOND_BEND_RAD, SA_BOND_EXT_PERC, HYSTERESIS * SA_BOND_BEND_RAD,
                              HYSTERESIS * SA_BOND_EXT_PERC, b.link_sa, b.homog, o)
     softgym_prof_add(1, t0)
+    if b.link_f32:
+        _seed_links_along32(b, lo, end, ax, inv_dt, ls)
+        return STATUS_OK if end == hi else STATUS_STRAIN
     t0 = softgym_prof_tsc()
     softgym_seed_frames(lo, end, SMALL_ANGLE_RAD, SLTHRESH_ACOS2SQRT, o, o + n, o + 2 * n,
                         o + 3 * n, o + 4 * n, o + 5 * n, o + 6 * n, o + 7 * n, o + 8 * n,
@@ -246,7 +312,7 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
     t0 = softgym_prof_tsc()
     for li in range(lo, end):
         if o[21 * n + li] != 0.0:
-            _seed_frame_one(li, o, n)
+            _seed_frame_one(li, o, n, 0, 0)
     softgym_prof_add(3, t0)
     t0 = softgym_prof_tsc()
     for k in range(11):
@@ -281,17 +347,17 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
         intp_t nx = b.link_axis_count[3 * r]
         intp_t ny = b.link_axis_count[3 * r + 1]
         float64_t inv_dt = 1.0 / b.dt[r]
-    if _seed_links_along(b, lo, lo + nx, 0, inv_dt) != STATUS_OK:
+    if _seed_links_along(b, lo, lo + nx, 0, inv_dt, lo) != STATUS_OK:
         return STATUS_STRAIN
-    if _seed_links_along(b, lo + nx, lo + nx + ny, 1, inv_dt) != STATUS_OK:
+    if _seed_links_along(b, lo + nx, lo + nx + ny, 1, inv_dt, lo) != STATUS_OK:
         return STATUS_STRAIN
-    return _seed_links_along(b, lo + nx + ny, hi, 2, inv_dt)
+    return _seed_links_along(b, lo + nx + ny, hi, 2, inv_dt, lo)
 
 
 # ---------------------------------------------------------------------------
 # Python entry point (re-exported by _core)
 
-def seed_frames(float64_t[:, ::1] geom, bint scalar=False):
+def seed_frames(float64_t[:, ::1] geom, bint scalar=False, bint single=False):
     """The seed model's bond-frame pass on given link geometry (for tests).
 
     ``geom`` is (10, n): rows 0-9 of the link scratch as ``_seed_geom`` and
@@ -303,21 +369,34 @@ def seed_frames(float64_t[:, ::1] geom, bint scalar=False):
     the seed's branchy scalar code for every link. The two are equal bit
     for bit in a build that does not fuse multiply-adds, and within the
     fusing's rounding (~1e-12 relative) in one that does (setup.py).
+    ``single``: the single-precision pass (SimConfig.link_precision
+    "single") with its fix-ups in double, its float results as doubles.
     """
     cdef:
         intp_t n = geom.shape[1], li, k
         cnp.ndarray[float64_t, ndim=2] o = np.zeros((N_LINK_OUT, max(n, 1)))
         float64_t* op = <float64_t*> cnp.PyArray_DATA(o)
         intp_t stride = o.shape[1]
+        float* f[12]
     if geom.shape[0] != 10:
         raise ValueError("geom must have 10 rows")
     for k in range(10):
         for li in range(n):
             op[k * stride + li] = geom[k, li]
+    for k in range(12):
+        f[k] = <float*> (op + (10 + k) * stride)
     with nogil:
-        if scalar:
+        if single:
+            softgym_seed_frames32(0, n, stride, <float> SMALL_ANGLE_RAD, <float> 0.9988, op, f)
             for li in range(n):
-                _seed_frame_one(li, op, stride)
+                if f[11][li] != 0.0:
+                    _seed_frame_one(li, op, stride, 1, 0)
+            for k in range(11):
+                for li in range(n - 1, -1, -1):  # the float row widened in place
+                    op[(10 + k) * stride + li] = f[k][li]
+        elif scalar:
+            for li in range(n):
+                _seed_frame_one(li, op, stride, 0, 0)
         else:
             softgym_seed_frames(0, n, SMALL_ANGLE_RAD, SLTHRESH_ACOS2SQRT, op, op + stride,
                                 op + 2 * stride, op + 3 * stride, op + 4 * stride,
@@ -329,5 +408,5 @@ def seed_frames(float64_t[:, ::1] geom, bint scalar=False):
                                 op + 20 * stride, op + 21 * stride)
             for li in range(n):
                 if op[21 * stride + li] != 0.0:
-                    _seed_frame_one(li, op, stride)
+                    _seed_frame_one(li, op, stride, 0, 0)
     return o[10:21, :n].copy()

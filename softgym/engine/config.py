@@ -106,6 +106,16 @@ class SimConfig:
         force ``-fluid_drag s^2 (v.n)^2 n`` at its voxel's centre (a face
         moving away takes none). 0: no fluid (0). The seed's voxels weigh
         1e6 kg/m^3, so a fluid of that density with ``C_d = 1`` is 5e5.
+    link_precision : {"double", "single"}
+        Arithmetic of the seed model's link frames and forces. ``"double"``:
+        as the seed's engine, bit-identical from build to build of one
+        instruction set. ``"single"``: those two passes in float (twice the
+        vector lanes; positions, geometry, modes, the world-frame sums and
+        the voxel update stay double), with the rotation-vector formula
+        rewritten so that float does not cancel (docs/PHYSICS.md); faster,
+        different last digits, checked against the seed's engine by
+        ``benchmarks/fidelity_seed.py --link-precision single``. Needs
+        ``model="seed"`` ("double").
     """
 
     voxel_size: float = 0.01
@@ -127,6 +137,7 @@ class SimConfig:
     friction: float = 1.0
     incline: float = 0.0
     fluid_drag: float = 0.0
+    link_precision: Literal["double", "single"] = "double"
 
     def __post_init__(self) -> None:
         def check(name: str, ok: bool, what: str) -> None:
@@ -154,6 +165,11 @@ class SimConfig:
         check("friction", finite("friction") >= 0, ">= 0 (a factor on the materials' friction)")
         check("incline", -60 <= finite("incline") <= 60, "in [-60, 60] degrees")
         check("fluid_drag", finite("fluid_drag") >= 0, ">= 0 kg/m^3")
+        check("link_precision", isinstance(self.link_precision, str) and self.link_precision in ("double", "single"), '"double" or "single"')
+        if self.link_precision == "single" and self.model != "seed":
+            raise InvalidParameterError(
+                f'SimConfig.link_precision "single" needs model "seed", got model {self.model!r}'
+            )
         check("floor", isinstance(self.floor, (bool, int)), "a bool")
         check("self_collision", isinstance(self.self_collision, (bool, int)), "a bool")
         check(

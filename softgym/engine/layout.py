@@ -517,6 +517,13 @@ def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layou
     a["homog"] = a["homog"].astype(np.int8)
     a["link_sa"] = np.ones(a["v1"].shape[0], dtype=np.int8)  # links start in small-angle mode
     a["link_last"] = np.zeros((9, a["v1"].shape[0]))  # see _TRANSPOSED
+    # (11, n_links) float32, for link_precision "single" only: k_axial, k_torsion,
+    # k_bend and the 8 rows of c_seed, rounded once
+    n32 = a["v1"].shape[0] if cfg.link_precision == "single" else 0
+    a["k_seed32"] = np.ascontiguousarray(
+        np.vstack([a["k_axial"][None], a["k_torsion"][None], a["k_bend"][None], a["c_seed"]])[:, :n32],
+        dtype=np.float32,
+    )
     a["axis"] = a["axis"].astype(np.int32)
     a["quat"] = np.zeros((n_vox, 4))
     a["quat"][:, 0] = 1.0
@@ -571,6 +578,7 @@ def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layou
         "model": 0 if cfg.model == "seed" else 1,
         "bond_zeta": float(cfg.bond_damping),
         "fluid_drag": float(cfg.fluid_drag),
+        "link_f32": int(cfg.link_precision == "single"),
     }
     # robots' own voxels in the kernel arrays (None: no objects, all of them)
     own = [np.arange(vox_start[r], body_end[r]) for r in range(n_robots)]

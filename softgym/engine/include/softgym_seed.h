@@ -202,6 +202,224 @@ static void softgym_seed_frames(
     }
 }
 
+/* Single-precision link math (SimConfig.link_precision = "single"): the
+   frames and forces passes in float, 16 lanes of AVX-512 instead of 8 and
+   the divider's float rate, on quantities relative to voxel 1 (positions
+   stay double; the geometry and mode passes stay double). Their float rows
+   take the first n floats of the scratch's double rows (rows 10-21 of the
+   frames, 0-9, 21, 24 of the forces). Reformulated where float would cancel:
+   - the displacements p0 - nom and |p| - nom are taken in double, then rounded;
+   - the rotation vector of a unit quaternion (w, v) is k v with the seed's
+     k = 2 sqrt((2 - 2w) / (1 - w^2)), which is 2 sqrt(2 / (1 + w)) exactly:
+     that form, with no cancellation near w = 1 (the seed's own form loses
+     up to half its digits there in double);
+   - its acos branch (1 - w^2 >= 1 - 0.9988^2) is w <= 0.9988.
+   Links that need the acos branch or have a backward chord are redone in
+   double by _seed_frame_one, as in double precision. */
+static inline float softgym_rotvec_k32(float w)
+{
+    return 2.0f * sqrtf(2.0f / (1.0f + w));
+}
+SOFTGYM_ALWAYS_INLINE void softgym_seed_frames32_impl(
+    const int all_small, Py_ssize_t lo, Py_ssize_t hi, float sa_rad, float w_acos,
+    const double *p0_, const double *p1_, const double *p2_, const double *qw_,
+    const double *n1_, const double *n2_, const double *n3_, const double *nom_,
+    const double *len_, const double *sa_, float *o_P0, float *o_P1, float *o_P2,
+    float *o_a1y, float *o_a1z, float *o_a2x, float *o_a2y, float *o_a2z, float *o_rw,
+    float *o_ry, float *o_rz, float *o_fix)
+{
+    Py_ssize_t li;
+    SOFTGYM_IVDEP
+    for (li = lo; li < hi; li++) {
+        double p0d = p0_[li], nomd = nom_[li];
+        float p0 = (float)p0d, p1 = (float)p1_[li], p2 = (float)p2_[li];
+        float qw = (float)qw_[li], n1 = (float)n1_[li], n2 = (float)n2_[li];
+        float n3 = (float)n3_[li];
+        int is_sa = all_small ? 1 : sa_[li] != 0.0;
+        int fix = 0;
+        int zero = (p0 == 0.0f) & (p1 == 0.0f) & (p2 == 0.0f);
+        float inv_p0 = 1.0f / p0;
+        float yx = p1 * inv_p0, zx = p2 * inv_p0;
+        int small = (yx < sa_rad) & (yx > -sa_rad) & (zx < sa_rad) & (zx > -sa_rad);
+        float ry_s = 0.5f * zx, rz_s = -0.5f * yx;
+        float rw_s = 1.0f + 0.5f * (-ry_s * ry_s - rz_s * rz_s);
+        float ln = sqrtf(p0 * p0 + p1 * p1 + p2 * p2);
+        float lp = ln + p0;
+        float inv_s = 1.0f / sqrtf(2.0f * ln * lp);
+        float ch = lp * inv_s;
+        float ry_l = p2 * inv_s, rz_l = -p1 * inv_s;
+        fix |= (1 - is_sa) & (1 - zero) & (1 - small) & (p0 < -0.5f * ln);
+        float rw = zero ? 1.0f : (small ? rw_s : ch);
+        float ry = zero ? 0.0f : (small ? ry_s : ry_l);
+        float rz = zero ? 0.0f : (small ? rz_s : rz_l);
+        float k1 = softgym_rotvec_k32(rw);
+        fix |= (1 - is_sa) & (1 - zero) & (rw <= w_acos);
+        float a1y = ry * k1, a1z = rz * k1;
+        float tw = rw * qw - ry * n2 - rz * n3;
+        float tx = rw * n1 + ry * n3 - rz * n2;
+        float ty = rw * n2 + ry * qw + rz * n1;
+        float tz = rw * n3 - ry * n1 + rz * qw;
+        float w2 = is_sa ? qw : tw;
+        float k2 = softgym_rotvec_k32(w2);
+        fix |= w2 <= w_acos;
+        float P0_s = (float)(p0d - nomd), P0_l = (float)(len_[li] - nomd);
+        o_P0[li] = is_sa ? P0_s : P0_l;
+        o_P1[li] = is_sa ? p1 : 0.0f;
+        o_P2[li] = is_sa ? p2 : 0.0f;
+        o_a1y[li] = (is_sa | zero) ? 0.0f : a1y;
+        o_a1z[li] = (is_sa | zero) ? 0.0f : a1z;
+        o_a2x[li] = (is_sa ? n1 : tx) * k2;
+        o_a2y[li] = (is_sa ? n2 : ty) * k2;
+        o_a2z[li] = (is_sa ? n3 : tz) * k2;
+        o_rw[li] = is_sa ? 1.0f : rw;
+        o_ry[li] = is_sa ? 0.0f : ry;
+        o_rz[li] = is_sa ? 0.0f : rz;
+        o_fix[li] = fix ? 1.0f : 0.0f;
+    }
+}
+/* the frames pass in float: rows in as softgym_seed_frames, float rows out (f[k]:
+   row 10 + k) */
+static void softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, float sa_rad,
+                                  float w_acos, const double *o, float *const *f)
+{
+    Py_ssize_t blo, bhi, li;
+    const double *sa_ = o + 9 * n;
+    for (blo = lo; blo < hi; blo = bhi) {
+        int all_small = 1;
+        bhi = blo + 64 < hi ? blo + 64 : hi;
+        for (li = blo; li < bhi; li++)
+            all_small &= sa_[li] != 0.0;
+#define SOFTGYM_FRAMES32(s) softgym_seed_frames32_impl( \
+            s, blo, bhi, sa_rad, w_acos, o, o + n, o + 2 * n, o + 3 * n, o + 4 * n, o + 5 * n, \
+            o + 6 * n, o + 7 * n, o + 8 * n, sa_, f[0], f[1], f[2], f[3], f[4], f[5], f[6], \
+            f[7], f[8], f[9], f[10], f[11])
+        if (all_small)
+            SOFTGYM_FRAMES32(1);
+        else
+            SOFTGYM_FRAMES32(0);
+#undef SOFTGYM_FRAMES32
+    }
+}
+
+/* the forces pass in float (softgym_seed_forces's operations): float rows in
+   (in[k]: P0, P1, P2, a1y, a1z, a2x, a2y, a2z, rw, ry, rz), the mode and
+   mode-change rows (double), the link constants in float (k32: k_axial,
+   k_torsion, k_bend, c_seed's 8 rows; stride n), the memory kept in double
+   (holding float values), double rows out for softgym_seed_scatter */
+static void softgym_seed_forces32(
+    Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, float L, float bz, float bzh, float inv_dt,
+    const float *const *in, const double *sa_, const double *chg_, const float *k32,
+    double *link_last, double *const *out)
+{
+    const float *P0_ = in[0], *P1_ = in[1], *P2_ = in[2], *a1y_ = in[3], *a1z_ = in[4];
+    const float *a2x_ = in[5], *a2y_ = in[6], *a2z_ = in[7], *rw_ = in[8], *ry_ = in[9];
+    const float *rz_ = in[10];
+    double *o0 = out[0], *o1 = out[1], *o2 = out[2], *o3 = out[3], *o4 = out[4];
+    double *o5 = out[5], *o6 = out[6], *o7 = out[7], *o8 = out[8], *o9 = out[9];
+    double *o10 = out[10], *o11 = out[11];
+    Py_ssize_t li;
+    SOFTGYM_IVDEP
+    for (li = lo; li < hi; li++) {
+        int sa = sa_[li] != 0.0, changed = chg_[li] != 0.0;
+        float P0 = P0_[li], P1 = P1_[li], P2 = P2_[li];
+        float a1x = 0.0f, a1y = a1y_[li], a1z = a1z_[li];
+        float a2x = a2x_[li], a2y = a2y_[li], a2z = a2z_[li];
+        float rw = rw_[li], ry = ry_[li], rz = rz_[li];
+        float ka = k32[li], kt = k32[n + li], kb = k32[2 * n + li];
+        float b2 = 0.5f * ka * L;
+        float f1x = ka * P0;
+        float f1y = ka * P1 - b2 * (a1z + a2z);
+        float f1z = ka * P2 + b2 * (a1y + a2y);
+        float m1x = kt * (a1x - a2x);
+        float m1y = b2 * P2 + kb * (2.0f * a1y + a2y);
+        float m1z = -b2 * P1 + kb * (2.0f * a1z + a2z);
+        float m2x = -m1x;
+        float m2y = b2 * P2 + kb * (a1y + 2.0f * a2y);
+        float m2z = -b2 * P1 + kb * (a1z + 2.0f * a2z);
+        float l0 = (float)link_last[li], l1 = (float)link_last[n + li];
+        float l2 = (float)link_last[2 * n + li], l3 = (float)link_last[3 * n + li];
+        float l4 = (float)link_last[4 * n + li], l5 = (float)link_last[5 * n + li];
+        float l6 = (float)link_last[6 * n + li], l7 = (float)link_last[7 * n + li];
+        float l8 = (float)link_last[8 * n + li];
+        float vx = (P0 - l0) * inv_dt, vy = (P1 - l1) * inv_dt, vz = (P2 - l2) * inv_dt;
+        float ra1x = (a1x - l3) * inv_dt, ra1y = (a1y - l4) * inv_dt;
+        float ra1z = (a1z - l5) * inv_dt, ra2x = (a2x - l6) * inv_dt;
+        float ra2y = (a2y - l7) * inv_dt, ra2z = (a2z - l8) * inv_dt;
+        float ca = k32[3 * n + li], cb2 = k32[4 * n + li];
+        float ca2 = k32[5 * n + li], cb3 = k32[6 * n + li];
+        float d1x = f1x + bz * (ca * vx);
+        float d1y = f1y + bz * (ca * vy - cb2 * (ra1z + ra2z));
+        float d1z = f1z + bz * (ca * vz + cb2 * (ra1y + ra2y));
+        float e1x = m1x + bzh * (-ca2 * (ra2x - ra1x));
+        float e1y = m1y + bzh * (cb2 * vz + cb3 * (2.0f * ra1y + ra2y));
+        float e1z = m1z + bzh * (-cb2 * vy + cb3 * (2.0f * ra1z + ra2z));
+        ca = k32[7 * n + li];
+        cb2 = k32[8 * n + li];
+        ca2 = k32[9 * n + li];
+        cb3 = k32[10 * n + li];
+        float f2x = -f1x + bz * (-ca * vx);
+        float f2y = -f1y + bz * (-ca * vy + cb2 * (ra1z + ra2z));
+        float f2z = -f1z + bz * (-ca * vz - cb2 * (ra1y + ra2y));
+        float e2x = m2x + bzh * (ca2 * (ra2x - ra1x));
+        float e2y = m2y + bzh * (cb2 * vz + cb3 * (ra1y + 2.0f * ra2y));
+        float e2z = m2z + bzh * (-cb2 * vy + cb3 * (ra1z + 2.0f * ra2z));
+        link_last[li] = changed ? link_last[li] : (double)P0;
+        link_last[n + li] = changed ? link_last[n + li] : (double)P1;
+        link_last[2 * n + li] = changed ? link_last[2 * n + li] : (double)P2;
+        link_last[3 * n + li] = changed ? link_last[3 * n + li] : (double)a1x;
+        link_last[4 * n + li] = changed ? link_last[4 * n + li] : (double)a1y;
+        link_last[5 * n + li] = changed ? link_last[5 * n + li] : (double)a1z;
+        link_last[6 * n + li] = changed ? link_last[6 * n + li] : (double)a2x;
+        link_last[7 * n + li] = changed ? link_last[7 * n + li] : (double)a2y;
+        link_last[8 * n + li] = changed ? link_last[8 * n + li] : (double)a2z;
+        if (!changed) {
+            f1x = d1x;
+            f1y = d1y;
+            f1z = d1z;
+            m1x = e1x;
+            m1y = e1y;
+            m1z = e1z;
+            m2x = e2x;
+            m2y = e2y;
+            m2z = e2z;
+        }
+        float n2q = rw * rw + ry * ry + rz * rz;
+        float r0 = n2q - 2.0f * (ry * ry + rz * rz);
+        float r1 = 2.0f * (rw * rz);
+        float r2 = 2.0f * (rw * ry);
+        float r4 = n2q - 2.0f * (rz * rz);
+        float r5 = 2.0f * (ry * rz);
+        float r8 = n2q - 2.0f * (ry * ry);
+#define SOFTGYM_UNTURN32(x, y, z) do { \
+            float gx_ = r0 * x + r1 * y - r2 * z; \
+            float gy_ = -r1 * x + r4 * y + r5 * z; \
+            float gz_ = r2 * x + r5 * y + r8 * z; \
+            if (!sa) { \
+                x = gx_; \
+                y = gy_; \
+                z = gz_; \
+            } \
+        } while (0)
+        SOFTGYM_UNTURN32(f1x, f1y, f1z);
+        SOFTGYM_UNTURN32(m1x, m1y, m1z);
+        SOFTGYM_UNTURN32(m2x, m2y, m2z);
+        SOFTGYM_UNTURN32(f2x, f2y, f2z);
+#undef SOFTGYM_UNTURN32
+        o0[li] = f1x;
+        o1[li] = f1y;
+        o2[li] = f1z;
+        o3[li] = f2x;
+        o4[li] = f2y;
+        o5[li] = f2z;
+        o6[li] = -m1x;
+        o7[li] = -m1y;
+        o8[li] = -m1z;
+        o9[li] = -m2x;
+        o10[li] = -m2y;
+        o11[li] = -m2z;
+    }
+}
+
 /* The forces pass of _seed_links_along, in C for the vectorising pragma:
    each link's forces and moments in the bond frame from its bond-frame
    quantities (stiffness; the seed's damping from the link's memory of the
