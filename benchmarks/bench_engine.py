@@ -178,6 +178,7 @@ def seed_engine_ratio(oracle_py: str, repeats: int = 3) -> dict:
     walls = []
     ours = []
     corot = []
+    single = []
     # interleaved repeats (seed engine, softgym, seed engine, ...): a background
     # load that comes and goes falls on both engines alike; the medians are compared
     for _ in range(repeats):
@@ -194,6 +195,11 @@ def seed_engine_ratio(oracle_py: str, repeats: int = 3) -> dict:
         t0 = time.perf_counter()
         sim.run(5.0)
         corot.append(time.perf_counter() - t0)
+        sim = Simulation([design.to_body()], SimConfig(self_collision=True, link_precision="single"),
+                         n_threads=1)
+        t0 = time.perf_counter()
+        sim.run(5.0)
+        single.append(time.perf_counter() - t0)
     vsteps = float(design.n_voxels * rollout.steps[0])
     return {
         "seed_engine_voxel_steps_per_s": vsteps / statistics.median(walls),
@@ -204,6 +210,8 @@ def seed_engine_ratio(oracle_py: str, repeats: int = 3) -> dict:
         "repeats": repeats,
         # the corotational preset on the same robot and steps (its own time step is the same)
         "corotational_ratio": statistics.median(walls) / statistics.median(corot),
+        # the seed preset with SimConfig.link_precision="single" (the same steps)
+        "single_ratio": statistics.median(walls) / statistics.median(single),
         "steps": int(rollout.steps[0]),
     }
 
@@ -228,7 +236,8 @@ def main(argv: list[str] | None = None) -> int:
             ap.error("--ratio-only needs --seed-engine")
         m = seed_engine_ratio(args.seed_engine, args.repeats)
         print(f"seed's engine {m['seed_engine_wall_s']:.3f} s, softgym seed preset "
-              f"{m['softgym_wall_s']:.3f} s: {m['ratio']:.2f}x; corotational preset "
+              f"{m['softgym_wall_s']:.3f} s: {m['ratio']:.2f}x; single-precision links "
+              f"{m['single_ratio']:.2f}x; corotational preset "
               f"{m['corotational_ratio']:.2f}x (reference robot, {m['steps']} steps, one "
               f"thread, median of {m['repeats']} interleaved repeats)")
         if args.json:

@@ -20,6 +20,8 @@ each robot alone and the whole set as one batch, on 1 and 2 threads.
     SOFTGYM_KERNEL=baseline python benchmarks/check_bitident.py --compare /tmp/speed_ref.npz
     # the same for the corotational preset's kernel
     python benchmarks/check_bitident.py --model corotational --save /tmp/corot_ref.npz
+    # the same for the seed model's single-precision link math
+    python benchmarks/check_bitident.py --link-precision single --save /tmp/single_ref.npz
 """
 
 from __future__ import annotations
@@ -98,7 +100,8 @@ def state_of(sim: Simulation, robot: int, rollout) -> dict[str, np.ndarray]:
     return out
 
 
-def run_all(seconds: float, quick: bool, vxa: str | None, log=print, model: str = "seed"):
+def run_all(seconds: float, quick: bool, vxa: str | None, log=print, model: str = "seed",
+            link_precision: str = "double"):
     """{key: array} of every case alone (1 and 2 threads) and all in batches."""
     res = {}
     cs = cases(quick, vxa)
@@ -108,7 +111,8 @@ def run_all(seconds: float, quick: bool, vxa: str | None, log=print, model: str 
             # each robot alone
             for name, d, terr, _ in group:
                 t0 = time.perf_counter()
-                sim = Simulation([d], SimConfig(model=model, self_collision=col),
+                sim = Simulation([d], SimConfig(model=model, self_collision=col,
+                                                link_precision=link_precision),
                                  n_threads=threads, terrain=terr)  # fmt: skip
                 ro = sim.run(seconds)
                 for k, v in state_of(sim, 0, ro).items():
@@ -120,7 +124,8 @@ def run_all(seconds: float, quick: bool, vxa: str | None, log=print, model: str 
                         f"{int((sa == 0).sum()):4d} diverged {bool(sim.diverged[0])} "
                         f"({time.perf_counter() - t0:.1f} s)")  # fmt: skip
             # all of them in one batch (per-robot terrains)
-            sim = Simulation([d for _, d, _, _ in group], SimConfig(model=model, self_collision=col),
+            cfg = SimConfig(model=model, self_collision=col, link_precision=link_precision)
+            sim = Simulation([d for _, d, _, _ in group], cfg,
                              n_threads=threads, terrain=[t or Terrain.flat() for _, _, t, _ in group])  # fmt: skip
             ro = sim.run(seconds)
             for r, (name, _, _, _) in enumerate(group):
@@ -139,13 +144,15 @@ def main(argv=None) -> int:
     ap.add_argument("--vxa", default=VXA)
     ap.add_argument("--model", default="seed", choices=("seed", "corotational"),
                     help="preset whose kernel is checked (a reference holds one preset)")
+    ap.add_argument("--link-precision", default="double", choices=("double", "single"),
+                    help="SimConfig.link_precision (a reference holds one)")
     args = ap.parse_args(argv)
     import softgym.engine._core as core
     from softgym.engine import kernel_build
 
     print(f"engine: {core.__file__} (kernel build {kernel_build()})", file=sys.stderr)
     res = run_all(args.seconds, args.quick, args.vxa, log=lambda s: print(s, file=sys.stderr),
-                  model=args.model)
+                  model=args.model, link_precision=args.link_precision)
     # alone vs batch must agree too (the kernel's own promise)
     bad = [k for k in res if k.startswith("batch/") and not k.endswith("/rollout_" + "")
            and k.replace("batch/", "alone/", 1) in res

@@ -122,7 +122,9 @@ cdef struct Batch:
     float64_t* obs           # (n_obs, 4) fixed obstacle voxel centre (m) and its 2 E L (N/m)
     intp_t* obs_rank         # (n_obs,) its index in the seed engine's voxel order
     float64_t* link_last     # (9, n_links) last Pos2, Angle1, Angle2 in the bond frame (state;
-                             #   Simulation.get_state/set_state show it as (n_links, 9))
+                             #   Simulation.get_state/set_state show it as (n_links, 9));
+                             #   NULL with link_f32
+    float* link_last32       # the same in float32 with link_f32 (NULL otherwise)
 
 
 # What robot_aux reports (columns of aux_init / trace_aux).

@@ -347,8 +347,14 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
         b.c_seed = _f(a, "c_seed")
         b.homog = <flag_t*> _p(a, "homog")
         b.link_sa = <flag_t*> _p(a, "link_sa")
-        b.link_last = _f(a, "link_last")
-        b.k_seed32 = <float*> _p(a, "k_seed32") if b.link_f32 else NULL
+        if b.link_f32:  # the single-precision passes' arrays (float32)
+            b.link_last = NULL
+            b.link_last32 = <float*> _p(a, "link_last")
+            b.k_seed32 = <float*> _p(a, "k_seed32")
+        else:
+            b.link_last = _f(a, "link_last")
+            b.link_last32 = NULL
+            b.k_seed32 = NULL
     return 0
 
 

@@ -100,7 +100,7 @@ cdef extern from "softgym_seed.h":
                                const float64_t* o, float* const* f) noexcept nogil
     void softgym_seed_forces32(intp_t lo, intp_t hi, intp_t n, float L, float bz, float bzh,
                                float inv_dt, const float* const* inp, const float64_t* sa_,
-                               const float64_t* chg_, const float* k32, float64_t* link_last,
+                               const float64_t* chg_, const float* k32, float* link_last,
                                float64_t* const* out) noexcept nogil
 
 
@@ -244,7 +244,7 @@ cdef inline void _seed_links_along32(Batch* b, intp_t lo, intp_t end, const int 
     out[11] = o + 24 * n
     softgym_seed_forces32(lo, end, b.n_links, <float> b.L, <float> (0.5 * b.bond_zeta),
                           <float> (0.25 * b.bond_zeta), <float> inv_dt, inp, o + 9 * n,
-                          o + 22 * n, b.k_seed32, b.link_last, out)
+                          o + 22 * n, b.k_seed32, b.link_last32, out)
     softgym_prof_add(4, t0)
     t0 = softgym_prof_tsc()
     softgym_seed_scatter(ax, lo, end, n, b.v1, b.v2, b.rot, o, b.force, b.moment)

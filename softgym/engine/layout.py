@@ -516,7 +516,8 @@ def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layou
     a["c_seed"] = np.ascontiguousarray(np.asarray(a["c_seed"], dtype=np.float64).reshape(-1, 8).T)
     a["homog"] = a["homog"].astype(np.int8)
     a["link_sa"] = np.ones(a["v1"].shape[0], dtype=np.int8)  # links start in small-angle mode
-    a["link_last"] = np.zeros((9, a["v1"].shape[0]))  # see _TRANSPOSED
+    # see _TRANSPOSED; float32 with link_precision "single", whose forces pass keeps float values
+    a["link_last"] = np.zeros((9, a["v1"].shape[0]), dtype=np.float32 if cfg.link_precision == "single" else np.float64)
     # (11, n_links) float32, for link_precision "single" only: k_axial, k_torsion,
     # k_bend and the 8 rows of c_seed, rounded once
     n32 = a["v1"].shape[0] if cfg.link_precision == "single" else 0

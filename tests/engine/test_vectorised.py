@@ -29,6 +29,9 @@ PASSES = {
                            "o, o, o, o, o, o, o, o, o, o, o, o);",
     "softgym_seed_forces": "softgym_seed_forces(0, n, n, 0.01, 0.1, 0.05, 1e4, cin, d, d, d, d, o, "
                            "out);",
+    "softgym_seed_frames32": "softgym_seed_frames32(0, n, n, 0.01f, 0.9988f, d, fo);",
+    "softgym_seed_forces32": "softgym_seed_forces32(0, n, n, 0.01f, 0.1f, 0.05f, 1e4f, fin, d, d, fc, fo[0], "
+                             "out);",
     "softgym_seed_modes": "return (long)softgym_seed_modes(0, n, n, 0.3, 0.99, 0.98, 0.05, 1.3, "
                           "0.055, 1.43, sc, sc, o);",
     "softgym_seed_quats": "softgym_seed_quats(0, n, n, 1e-4, d, d, o);",
@@ -57,7 +60,8 @@ def test_each_seed_pass_vectorises(name, tmp_path):
         '#include "softgym_seed.h"\n'
         '#include "softgym_pairs.h"\n'
         "long run(int ax, Py_ssize_t n, const Py_ssize_t *ip, const double *d, double *o,\n"
-        "         signed char *sc, const double *const *cin, double *const *out)\n"
+        "         signed char *sc, const double *const *cin, double *const *out,\n"
+        "         const float *fc, float *const *fo, const float *const *fin)\n"
         "{\n"
         f"    {PASSES[name]}\n"
         "    return 0;\n"

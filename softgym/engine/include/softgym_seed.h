@@ -304,12 +304,12 @@ static void softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, fl
 /* the forces pass in float (softgym_seed_forces's operations): float rows in
    (in[k]: P0, P1, P2, a1y, a1z, a2x, a2y, a2z, rw, ry, rz), the mode and
    mode-change rows (double), the link constants in float (k32: k_axial,
-   k_torsion, k_bend, c_seed's 8 rows; stride n), the memory kept in double
-   (holding float values), double rows out for softgym_seed_scatter */
+   k_torsion, k_bend, c_seed's 8 rows; stride n) and memory (link_last32),
+   double rows out for softgym_seed_scatter */
 static void softgym_seed_forces32(
     Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, float L, float bz, float bzh, float inv_dt,
     const float *const *in, const double *sa_, const double *chg_, const float *k32,
-    double *link_last, double *const *out)
+    float *link_last, double *const *out)
 {
     const float *P0_ = in[0], *P1_ = in[1], *P2_ = in[2], *a1y_ = in[3], *a1z_ = in[4];
     const float *a2x_ = in[5], *a2y_ = in[6], *a2z_ = in[7], *rw_ = in[8], *ry_ = in[9];
@@ -336,11 +336,11 @@ static void softgym_seed_forces32(
         float m2x = -m1x;
         float m2y = b2 * P2 + kb * (a1y + 2.0f * a2y);
         float m2z = -b2 * P1 + kb * (a1z + 2.0f * a2z);
-        float l0 = (float)link_last[li], l1 = (float)link_last[n + li];
-        float l2 = (float)link_last[2 * n + li], l3 = (float)link_last[3 * n + li];
-        float l4 = (float)link_last[4 * n + li], l5 = (float)link_last[5 * n + li];
-        float l6 = (float)link_last[6 * n + li], l7 = (float)link_last[7 * n + li];
-        float l8 = (float)link_last[8 * n + li];
+        float l0 = link_last[li], l1 = link_last[n + li];
+        float l2 = link_last[2 * n + li], l3 = link_last[3 * n + li];
+        float l4 = link_last[4 * n + li], l5 = link_last[5 * n + li];
+        float l6 = link_last[6 * n + li], l7 = link_last[7 * n + li];
+        float l8 = link_last[8 * n + li];
         float vx = (P0 - l0) * inv_dt, vy = (P1 - l1) * inv_dt, vz = (P2 - l2) * inv_dt;
         float ra1x = (a1x - l3) * inv_dt, ra1y = (a1y - l4) * inv_dt;
         float ra1z = (a1z - l5) * inv_dt, ra2x = (a2x - l6) * inv_dt;
@@ -363,15 +363,15 @@ static void softgym_seed_forces32(
         float e2x = m2x + bzh * (ca2 * (ra2x - ra1x));
         float e2y = m2y + bzh * (cb2 * vz + cb3 * (ra1y + 2.0f * ra2y));
         float e2z = m2z + bzh * (-cb2 * vy + cb3 * (ra1z + 2.0f * ra2z));
-        link_last[li] = changed ? link_last[li] : (double)P0;
-        link_last[n + li] = changed ? link_last[n + li] : (double)P1;
-        link_last[2 * n + li] = changed ? link_last[2 * n + li] : (double)P2;
-        link_last[3 * n + li] = changed ? link_last[3 * n + li] : (double)a1x;
-        link_last[4 * n + li] = changed ? link_last[4 * n + li] : (double)a1y;
-        link_last[5 * n + li] = changed ? link_last[5 * n + li] : (double)a1z;
-        link_last[6 * n + li] = changed ? link_last[6 * n + li] : (double)a2x;
-        link_last[7 * n + li] = changed ? link_last[7 * n + li] : (double)a2y;
-        link_last[8 * n + li] = changed ? link_last[8 * n + li] : (double)a2z;
+        link_last[li] = changed ? l0 : P0;
+        link_last[n + li] = changed ? l1 : P1;
+        link_last[2 * n + li] = changed ? l2 : P2;
+        link_last[3 * n + li] = changed ? l3 : a1x;
+        link_last[4 * n + li] = changed ? l4 : a1y;
+        link_last[5 * n + li] = changed ? l5 : a1z;
+        link_last[6 * n + li] = changed ? l6 : a2x;
+        link_last[7 * n + li] = changed ? l7 : a2y;
+        link_last[8 * n + li] = changed ? l8 : a2z;
         if (!changed) {
             f1x = d1x;
             f1y = d1y;
