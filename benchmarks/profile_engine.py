@@ -185,11 +185,12 @@ def profile_cycles(collisions: bool, seconds: float, n: int, repeats: int,
     return best
 
 
-def print_cycles(p: dict, n: int, collisions: bool) -> None:
+def print_cycles(p: dict, n: int, collisions: bool, precision: str = "double") -> None:
     vs = p["steps"] * p["n_voxels"]
     c = p["counts"]
     total = sum(c[k] for _, k, sub in CYCLE_ROWS if not sub)
-    print(f"seed preset, kernel build {p['build']}, {n}^3 reference robot, self-collision "
+    prec = ", single-precision links" if precision == "single" else ""
+    print(f"seed preset{prec}, kernel build {p['build']}, {n}^3 reference robot, self-collision "
           f"{'on' if collisions else 'off'}, {p['steps']} steps, one thread: the quickest of "
           f"{p['repeats']} runs, {total / vs:.1f} cycles per voxel-step (time-stamp counter at "
           f"{total / p['wall'] / 1e9:.2f} GHz; every run: "
@@ -221,7 +222,7 @@ def main(argv: list[str] | None = None) -> int:
             raise SystemExit("profile_engine: --repeats must be at least 1")
         c = profile_cycles(not args.no_collision, args.seconds, args.size, args.repeats,
                            args.link_precision)
-        print_cycles(c, args.size, not args.no_collision)
+        print_cycles(c, args.size, not args.no_collision, args.link_precision)
         if args.json:
             print(json.dumps(c))
         return 0
@@ -229,7 +230,8 @@ def main(argv: list[str] | None = None) -> int:
                 args.link_precision)
     vs = p["steps"] * p["n_voxels"]
     ls = p["steps"] * p["n_links"]
-    print(f"{p['model']} preset, kernel build {p['kernel_build']}, {args.size}^3 reference "
+    prec = ", single-precision links" if args.link_precision == "single" else ""
+    print(f"{p['model']} preset{prec}, kernel build {p['kernel_build']}, {args.size}^3 reference "
           f"robot, self-collision "
           f"{'on' if p['collisions'] else 'off'}, {p['steps']} steps: "
           f"{p['instructions']:,} instructions, {p['per_voxel_step']:.0f} per voxel-step")
