@@ -86,9 +86,10 @@ cdef extern from "softgym_seed.h":
                              float64_t* o_fix) noexcept nogil
     void softgym_seed_forces(intp_t lo, intp_t hi, intp_t n, float64_t L, float64_t bz,
                              float64_t bzh, float64_t inv_dt, const float64_t* const* inp,
-                             const float64_t* k_axial, const float64_t* k_torsion,
-                             const float64_t* k_bend, const float64_t* c_seed,
-                             float64_t* link_last, float64_t* const* out) noexcept nogil
+                             const float64_t* sa_, const float64_t* chg_,
+                             const float64_t* ka_, const float64_t* kt_, const float64_t* kb_,
+                             const float64_t* cs_, float64_t* link_last,
+                             float64_t* const* out) noexcept nogil
     intp_t softgym_seed_modes(intp_t lo, intp_t hi, intp_t n, float64_t max_ext,
                               float64_t sa_w, float64_t sah_w, float64_t st_in, float64_t ex_in,
                               float64_t st_out, float64_t ex_out, flag_t* link_sa,
@@ -100,7 +101,8 @@ cdef extern from "softgym_seed.h":
                                const float64_t* o, float* const* f) noexcept nogil
     void softgym_seed_forces32(intp_t lo, intp_t hi, intp_t n, float L, float bz, float bzh,
                                float inv_dt, const float* const* inp, const float64_t* sa_,
-                               const float64_t* chg_, const float* k32, float* link_last,
+                               const float64_t* chg_, const float* ka_, const float* kt_,
+                               const float* kb_, const float* cs_, float* link_last,
                                float64_t* const* out) noexcept nogil
 
 
@@ -224,6 +226,7 @@ cdef inline void _seed_links_along32(Batch* b, intp_t lo, intp_t end, const int 
         float* f[12]
         const float* inp[11]
         float64_t* out[12]
+        const float* k32
         unsigned long long t0
     for k in range(12):
         f[k] = _float_row(o, n, ls, 10 + k)
@@ -242,9 +245,11 @@ cdef inline void _seed_links_along32(Batch* b, intp_t lo, intp_t end, const int 
         out[k] = o + k * n
     out[10] = o + 21 * n
     out[11] = o + 24 * n
+    k32 = b.k_seed32
     softgym_seed_forces32(lo, end, b.n_links, <float> b.L, <float> (0.5 * b.bond_zeta),
                           <float> (0.25 * b.bond_zeta), <float> inv_dt, inp, o + 9 * n,
-                          o + 22 * n, b.k_seed32, b.link_last32, out)
+                          o + 22 * n, k32, k32 + b.n_links, k32 + 2 * b.n_links,
+                          k32 + 3 * b.n_links, b.link_last32, out)
     softgym_prof_add(4, t0)
     t0 = softgym_prof_tsc()
     softgym_seed_scatter(ax, lo, end, n, b.v1, b.v2, b.rot, o, b.force, b.moment)
@@ -286,7 +291,7 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
         float64_t* o = b.link_out
         float64_t* force = b.force
         float64_t* moment = b.moment
-        const float64_t* inp[13]
+        const float64_t* inp[11]
         float64_t* out[12]
         unsigned long long t0
     if hi <= lo:
@@ -317,14 +322,12 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
     t0 = softgym_prof_tsc()
     for k in range(11):
         inp[k] = o + (10 + k) * n
-    inp[11] = o + 9 * n
-    inp[12] = o + 22 * n
     for k in range(10):
         out[k] = o + k * n
     out[10] = o + 21 * n
     out[11] = o + 24 * n
-    softgym_seed_forces(lo, end, b.n_links, b.L, bz, bzh, inv_dt, inp, b.k_axial, b.k_torsion,
-                        b.k_bend, b.c_seed, b.link_last, out)
+    softgym_seed_forces(lo, end, b.n_links, b.L, bz, bzh, inv_dt, inp, o + 9 * n, o + 22 * n,
+                        b.k_axial, b.k_torsion, b.k_bend, b.c_seed, b.link_last, out)
     softgym_prof_add(4, t0)
     t0 = softgym_prof_tsc()
     # back to the world (the inverse axis turn, voxel 1's rotation) and the

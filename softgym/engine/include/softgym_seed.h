@@ -111,6 +111,33 @@ static inline long long softgym_rotvec_needs_acos(double w, double thr)
     double sl = 1.0 - w * w;
     return (sl > 0.0) & (sl >= thr);
 }
+/* The large-angle frame rq = (rw, 0, ry, rz) of a link onto its chord p = (p0,
+   p1, p2) (the seed's ToXDirBond of the relative position), in type T (M:
+   the type of its conditions; SQRT: T's square root), every branch computed
+   and one selected, declaring zero (p = 0: the identity), small (transverse
+   ratios under sa_rad: the seed's small-ratio rq, exactly along the chord
+   to first order), back (the chord points backwards, p0 < -|p| / 2, where
+   the seed's discard test may apply: the scalar code redoes the link), rw,
+   ry, rz. Otherwise the half-angle quaternion onto the chord n = p / |p|:
+   (1 + nx, 0, nz, -ny) / sqrt(2 (1 + nx)), i.e. (|p| + p0, 0, p2, -p1) / s
+   with s = sqrt(2 |p| (|p| + p0)): two square roots and one division (the
+   seed's cos(th / 2), sin(th / 2) and 1 / |n_yz| took four and four). */
+#define SOFTGYM_CHORD_FRAME(T, M, SQRT, p0, p1, p2, sa_rad) \
+    M zero = (p0 == (T)0.0) & (p1 == (T)0.0) & (p2 == (T)0.0); \
+    T inv_p0_ = (T)1.0 / p0; \
+    T yx_ = p1 * inv_p0_, zx_ = p2 * inv_p0_; \
+    M small = (yx_ < sa_rad) & (yx_ > -sa_rad) & (zx_ < sa_rad) & (zx_ > -sa_rad); \
+    T ry_s_ = (T)0.5 * zx_, rz_s_ = (T)-0.5 * yx_; \
+    T rw_s_ = (T)1.0 + (T)0.5 * (-ry_s_ * ry_s_ - rz_s_ * rz_s_); \
+    T ln_ = SQRT(p0 * p0 + p1 * p1 + p2 * p2); \
+    T lp_ = ln_ + p0; \
+    T inv_s_ = (T)1.0 / SQRT((T)2.0 * ln_ * lp_); \
+    T ch_ = lp_ * inv_s_; \
+    T ry_l_ = p2 * inv_s_, rz_l_ = -p1 * inv_s_; \
+    M back = (1 - small) & (p0 < (T)-0.5 * ln_); \
+    T rw = zero ? (T)1.0 : (small ? rw_s_ : ch_); \
+    T ry = zero ? (T)0.0 : (small ? ry_s_ : ry_l_); \
+    T rz = zero ? (T)0.0 : (small ? rz_s_ : rz_l_)
 /* the frames pass's rows: geometry and mode in, frame quantities out */
 #define SOFTGYM_FRAME_ROWS \
     const double *p0_, const double *p1_, const double *p2_, const double *qw_, \
@@ -132,28 +159,8 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_frames_impl(
         double n1 = n1_[li], n2 = n2_[li], n3 = n3_[li], nom = nom_[li], cl = len_[li];
         long long is_sa = all_small ? 1 : sa_[li] != 0.0;
         long long fix = 0;
-        /* large angle: rq onto the chord (exactly along it when the
-           transverse ratios are small) */
-        long long zero = (p0 == 0.0) & (p1 == 0.0) & (p2 == 0.0);
-        double inv_p0 = 1.0 / p0;
-        double yx = p1 * inv_p0, zx = p2 * inv_p0;
-        long long small = (yx < sa_rad) & (yx > -sa_rad) & (zx < sa_rad) & (zx > -sa_rad);
-        double ry_s = 0.5 * zx, rz_s = -0.5 * yx;
-        double rw_s = 1.0 + 0.5 * (-ry_s * ry_s - rz_s * rz_s);
-        /* the half-angle quaternion onto the chord n = p / |p|: (1 + nx, 0,
-           nz, -ny) / sqrt(2 (1 + nx)), i.e. (|p| + p0, 0, p2, -p1) / s with
-           s = sqrt(2 |p| (|p| + p0)): two square roots and one division
-           (the seed's cos(th / 2), sin(th / 2) and 1 / |n_yz| took four and
-           four) */
-        double ln = sqrt(p0 * p0 + p1 * p1 + p2 * p2);
-        double lp = ln + p0;
-        double inv_s = 1.0 / sqrt(2.0 * ln * lp);
-        double ch = lp * inv_s;
-        double ry_l = p2 * inv_s, rz_l = -p1 * inv_s;
-        fix |= (1 - is_sa) & (1 - zero) & (1 - small) & (p0 < -0.5 * ln);
-        double rw = zero ? 1.0 : (small ? rw_s : ch);
-        double ry = zero ? 0.0 : (small ? ry_s : ry_l);
-        double rz = zero ? 0.0 : (small ? rz_s : rz_l);
+        SOFTGYM_CHORD_FRAME(double, long long, sqrt, p0, p1, p2, sa_rad);
+        fix |= (1 - is_sa) & (1 - zero) & back;
         double k1 = softgym_rotvec_k_sqrt(rw);
         fix |= (1 - is_sa) & (1 - zero) & softgym_rotvec_needs_acos(rw, thr);
         double a1y = ry * k1, a1z = rz * k1;
@@ -237,21 +244,8 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_frames32_impl(
         float n3 = (float)n3_[li];
         int is_sa = all_small ? 1 : sa_[li] != 0.0;
         int fix = 0;
-        int zero = (p0 == 0.0f) & (p1 == 0.0f) & (p2 == 0.0f);
-        float inv_p0 = 1.0f / p0;
-        float yx = p1 * inv_p0, zx = p2 * inv_p0;
-        int small = (yx < sa_rad) & (yx > -sa_rad) & (zx < sa_rad) & (zx > -sa_rad);
-        float ry_s = 0.5f * zx, rz_s = -0.5f * yx;
-        float rw_s = 1.0f + 0.5f * (-ry_s * ry_s - rz_s * rz_s);
-        float ln = sqrtf(p0 * p0 + p1 * p1 + p2 * p2);
-        float lp = ln + p0;
-        float inv_s = 1.0f / sqrtf(2.0f * ln * lp);
-        float ch = lp * inv_s;
-        float ry_l = p2 * inv_s, rz_l = -p1 * inv_s;
-        fix |= (1 - is_sa) & (1 - zero) & (1 - small) & (p0 < -0.5f * ln);
-        float rw = zero ? 1.0f : (small ? rw_s : ch);
-        float ry = zero ? 0.0f : (small ? ry_s : ry_l);
-        float rz = zero ? 0.0f : (small ? rz_s : rz_l);
+        SOFTGYM_CHORD_FRAME(float, int, sqrtf, p0, p1, p2, sa_rad);
+        fix |= (1 - is_sa) & (1 - zero) & back;
         float k1 = softgym_rotvec_k32(rw);
         fix |= (1 - is_sa) & (1 - zero) & (rw <= w_acos);
         float a1y = ry * k1, a1z = rz * k1;
@@ -301,247 +295,29 @@ static void softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, fl
     }
 }
 
-/* the forces pass in float (softgym_seed_forces's operations): float rows in
-   (in[k]: P0, P1, P2, a1y, a1z, a2x, a2y, a2z, rw, ry, rz), the mode and
-   mode-change rows (double), the link constants in float (k32: k_axial,
-   k_torsion, k_bend, c_seed's 8 rows; stride n) and memory (link_last32),
-   double rows out for softgym_seed_scatter */
-static void softgym_seed_forces32(
-    Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, float L, float bz, float bzh, float inv_dt,
-    const float *const *in, const double *sa_, const double *chg_, const float *k32,
-    float *link_last, double *const *out)
-{
-    const float *P0_ = in[0], *P1_ = in[1], *P2_ = in[2], *a1y_ = in[3], *a1z_ = in[4];
-    const float *a2x_ = in[5], *a2y_ = in[6], *a2z_ = in[7], *rw_ = in[8], *ry_ = in[9];
-    const float *rz_ = in[10];
-    double *o0 = out[0], *o1 = out[1], *o2 = out[2], *o3 = out[3], *o4 = out[4];
-    double *o5 = out[5], *o6 = out[6], *o7 = out[7], *o8 = out[8], *o9 = out[9];
-    double *o10 = out[10], *o11 = out[11];
-    Py_ssize_t li;
-    SOFTGYM_IVDEP
-    for (li = lo; li < hi; li++) {
-        int sa = sa_[li] != 0.0, changed = chg_[li] != 0.0;
-        float P0 = P0_[li], P1 = P1_[li], P2 = P2_[li];
-        float a1x = 0.0f, a1y = a1y_[li], a1z = a1z_[li];
-        float a2x = a2x_[li], a2y = a2y_[li], a2z = a2z_[li];
-        float rw = rw_[li], ry = ry_[li], rz = rz_[li];
-        float ka = k32[li], kt = k32[n + li], kb = k32[2 * n + li];
-        float b2 = 0.5f * ka * L;
-        float f1x = ka * P0;
-        float f1y = ka * P1 - b2 * (a1z + a2z);
-        float f1z = ka * P2 + b2 * (a1y + a2y);
-        float m1x = kt * (a1x - a2x);
-        float m1y = b2 * P2 + kb * (2.0f * a1y + a2y);
-        float m1z = -b2 * P1 + kb * (2.0f * a1z + a2z);
-        float m2x = -m1x;
-        float m2y = b2 * P2 + kb * (a1y + 2.0f * a2y);
-        float m2z = -b2 * P1 + kb * (a1z + 2.0f * a2z);
-        float l0 = link_last[li], l1 = link_last[n + li];
-        float l2 = link_last[2 * n + li], l3 = link_last[3 * n + li];
-        float l4 = link_last[4 * n + li], l5 = link_last[5 * n + li];
-        float l6 = link_last[6 * n + li], l7 = link_last[7 * n + li];
-        float l8 = link_last[8 * n + li];
-        float vx = (P0 - l0) * inv_dt, vy = (P1 - l1) * inv_dt, vz = (P2 - l2) * inv_dt;
-        float ra1x = (a1x - l3) * inv_dt, ra1y = (a1y - l4) * inv_dt;
-        float ra1z = (a1z - l5) * inv_dt, ra2x = (a2x - l6) * inv_dt;
-        float ra2y = (a2y - l7) * inv_dt, ra2z = (a2z - l8) * inv_dt;
-        float ca = k32[3 * n + li], cb2 = k32[4 * n + li];
-        float ca2 = k32[5 * n + li], cb3 = k32[6 * n + li];
-        float d1x = f1x + bz * (ca * vx);
-        float d1y = f1y + bz * (ca * vy - cb2 * (ra1z + ra2z));
-        float d1z = f1z + bz * (ca * vz + cb2 * (ra1y + ra2y));
-        float e1x = m1x + bzh * (-ca2 * (ra2x - ra1x));
-        float e1y = m1y + bzh * (cb2 * vz + cb3 * (2.0f * ra1y + ra2y));
-        float e1z = m1z + bzh * (-cb2 * vy + cb3 * (2.0f * ra1z + ra2z));
-        ca = k32[7 * n + li];
-        cb2 = k32[8 * n + li];
-        ca2 = k32[9 * n + li];
-        cb3 = k32[10 * n + li];
-        float f2x = -f1x + bz * (-ca * vx);
-        float f2y = -f1y + bz * (-ca * vy + cb2 * (ra1z + ra2z));
-        float f2z = -f1z + bz * (-ca * vz - cb2 * (ra1y + ra2y));
-        float e2x = m2x + bzh * (ca2 * (ra2x - ra1x));
-        float e2y = m2y + bzh * (cb2 * vz + cb3 * (ra1y + 2.0f * ra2y));
-        float e2z = m2z + bzh * (-cb2 * vy + cb3 * (ra1z + 2.0f * ra2z));
-        link_last[li] = changed ? l0 : P0;
-        link_last[n + li] = changed ? l1 : P1;
-        link_last[2 * n + li] = changed ? l2 : P2;
-        link_last[3 * n + li] = changed ? l3 : a1x;
-        link_last[4 * n + li] = changed ? l4 : a1y;
-        link_last[5 * n + li] = changed ? l5 : a1z;
-        link_last[6 * n + li] = changed ? l6 : a2x;
-        link_last[7 * n + li] = changed ? l7 : a2y;
-        link_last[8 * n + li] = changed ? l8 : a2z;
-        if (!changed) {
-            f1x = d1x;
-            f1y = d1y;
-            f1z = d1z;
-            m1x = e1x;
-            m1y = e1y;
-            m1z = e1z;
-            m2x = e2x;
-            m2y = e2y;
-            m2z = e2z;
-        }
-        float n2q = rw * rw + ry * ry + rz * rz;
-        float r0 = n2q - 2.0f * (ry * ry + rz * rz);
-        float r1 = 2.0f * (rw * rz);
-        float r2 = 2.0f * (rw * ry);
-        float r4 = n2q - 2.0f * (rz * rz);
-        float r5 = 2.0f * (ry * rz);
-        float r8 = n2q - 2.0f * (ry * ry);
-#define SOFTGYM_UNTURN32(x, y, z) do { \
-            float gx_ = r0 * x + r1 * y - r2 * z; \
-            float gy_ = -r1 * x + r4 * y + r5 * z; \
-            float gz_ = r2 * x + r5 * y + r8 * z; \
-            if (!sa) { \
-                x = gx_; \
-                y = gy_; \
-                z = gz_; \
-            } \
-        } while (0)
-        SOFTGYM_UNTURN32(f1x, f1y, f1z);
-        SOFTGYM_UNTURN32(m1x, m1y, m1z);
-        SOFTGYM_UNTURN32(m2x, m2y, m2z);
-        SOFTGYM_UNTURN32(f2x, f2y, f2z);
-#undef SOFTGYM_UNTURN32
-        o0[li] = f1x;
-        o1[li] = f1y;
-        o2[li] = f1z;
-        o3[li] = f2x;
-        o4[li] = f2y;
-        o5[li] = f2z;
-        o6[li] = -m1x;
-        o7[li] = -m1y;
-        o8[li] = -m1z;
-        o9[li] = -m2x;
-        o10[li] = -m2y;
-        o11[li] = -m2z;
-    }
-}
-
-/* The forces pass of _seed_links_along, in C for the vectorising pragma:
-   each link's forces and moments in the bond frame from its bond-frame
-   quantities (stiffness; the seed's damping from the link's memory of the
-   last step, skipped on a mode-change step), turned back by rq^-1 for a
-   large-angle link, without branches. Outputs what the scatter turns to
-   the world and adds: voxel 1's force, voxel 2's damped force (read only
-   where voxel 2 does not take -F1: two materials, no mode change; the
-   scatter subtracts voxel 1's turned force otherwise), voxel 1's and voxel 2's
-   moments negated (the seed subtracts them; x - y is x + (-y) exactly, and
-   a rotation of -v is exactly minus the rotation of v). Updates the memory
-   unless the mode changed. The same operations as the seed's scalar code. */
-static void softgym_seed_forces(
-    Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double L, double bz, double bzh,
-    double inv_dt, const double *const *in, const double *k_axial,
-    const double *k_torsion, const double *k_bend, const double *c_seed,
-    double *link_last, double *const *out)
-{
-    const double *P0_ = in[0], *P1_ = in[1], *P2_ = in[2], *a1y_ = in[3], *a1z_ = in[4];
-    const double *a2x_ = in[5], *a2y_ = in[6], *a2z_ = in[7], *rw_ = in[8], *ry_ = in[9];
-    const double *rz_ = in[10], *sa_ = in[11], *chg_ = in[12];
-    double *o0 = out[0], *o1 = out[1], *o2 = out[2], *o3 = out[3], *o4 = out[4];
-    double *o5 = out[5], *o6 = out[6], *o7 = out[7], *o8 = out[8], *o9 = out[9];
-    double *o10 = out[10], *o11 = out[11];
-    Py_ssize_t li;
-    SOFTGYM_IVDEP
-    for (li = lo; li < hi; li++) {
-        long long sa = sa_[li] != 0.0, changed = chg_[li] != 0.0;
-        double P0 = P0_[li], P1 = P1_[li], P2 = P2_[li];
-        double a1x = 0.0, a1y = a1y_[li], a1z = a1z_[li];
-        double a2x = a2x_[li], a2y = a2y_[li], a2z = a2z_[li];
-        double rw = rw_[li], ry = ry_[li], rz = rz_[li];
-        double ka = k_axial[li], kt = k_torsion[li], kb = k_bend[li];
-        double b2 = 0.5 * ka * L;
-        double f1x = ka * P0;
-        double f1y = ka * P1 - b2 * (a1z + a2z);
-        double f1z = ka * P2 + b2 * (a1y + a2y);
-        double m1x = kt * (a1x - a2x);
-        double m1y = b2 * P2 + kb * (2.0 * a1y + a2y);
-        double m1z = -b2 * P1 + kb * (2.0 * a1z + a2z);
-        double m2x = -m1x;
-        double m2y = b2 * P2 + kb * (a1y + 2.0 * a2y);
-        double m2z = -b2 * P1 + kb * (a1z + 2.0 * a2z);
-        /* damping: rates from the memory of the last step */
-        double l0 = link_last[li], l1 = link_last[n + li], l2 = link_last[2 * n + li];
-        double l3 = link_last[3 * n + li], l4 = link_last[4 * n + li];
-        double l5 = link_last[5 * n + li], l6 = link_last[6 * n + li];
-        double l7 = link_last[7 * n + li], l8 = link_last[8 * n + li];
-        double vx = (P0 - l0) * inv_dt, vy = (P1 - l1) * inv_dt, vz = (P2 - l2) * inv_dt;
-        double ra1x = (a1x - l3) * inv_dt, ra1y = (a1y - l4) * inv_dt;
-        double ra1z = (a1z - l5) * inv_dt, ra2x = (a2x - l6) * inv_dt;
-        double ra2y = (a2y - l7) * inv_dt, ra2z = (a2z - l8) * inv_dt;
-        double ca = c_seed[li], cb2 = c_seed[n + li];
-        double ca2 = c_seed[2 * n + li], cb3 = c_seed[3 * n + li];
-        double d1x = f1x + bz * (ca * vx);
-        double d1y = f1y + bz * (ca * vy - cb2 * (ra1z + ra2z));
-        double d1z = f1z + bz * (ca * vz + cb2 * (ra1y + ra2y));
-        double e1x = m1x + bzh * (-ca2 * (ra2x - ra1x));
-        double e1y = m1y + bzh * (cb2 * vz + cb3 * (2.0 * ra1y + ra2y));
-        double e1z = m1z + bzh * (-cb2 * vy + cb3 * (2.0 * ra1z + ra2z));
-        ca = c_seed[4 * n + li];
-        cb2 = c_seed[5 * n + li];
-        ca2 = c_seed[6 * n + li];
-        cb3 = c_seed[7 * n + li];
-        double f2x = -f1x + bz * (-ca * vx);
-        double f2y = -f1y + bz * (-ca * vy + cb2 * (ra1z + ra2z));
-        double f2z = -f1z + bz * (-ca * vz - cb2 * (ra1y + ra2y));
-        double e2x = m2x + bzh * (ca2 * (ra2x - ra1x));
-        double e2y = m2y + bzh * (cb2 * vz + cb3 * (ra1y + 2.0 * ra2y));
-        double e2z = m2z + bzh * (-cb2 * vy + cb3 * (ra1z + 2.0 * ra2z));
-        link_last[li] = softgym_pick(changed, l0, P0);
-        link_last[n + li] = softgym_pick(changed, l1, P1);
-        link_last[2 * n + li] = softgym_pick(changed, l2, P2);
-        link_last[3 * n + li] = softgym_pick(changed, l3, a1x);
-        link_last[4 * n + li] = softgym_pick(changed, l4, a1y);
-        link_last[5 * n + li] = softgym_pick(changed, l5, a1z);
-        link_last[6 * n + li] = softgym_pick(changed, l6, a2x);
-        link_last[7 * n + li] = softgym_pick(changed, l7, a2y);
-        link_last[8 * n + li] = softgym_pick(changed, l8, a2z);
-        /* (x, y, z) stays where c holds, else becomes (dx, dy, dz) */
-#define SOFTGYM_KEEP3(c, x, y, z, dx, dy, dz) do { \
-            x = softgym_pick(c, x, dx); \
-            y = softgym_pick(c, y, dy); \
-            z = softgym_pick(c, z, dz); \
-        } while (0)
-        SOFTGYM_KEEP3(changed, f1x, f1y, f1z, d1x, d1y, d1z);
-        SOFTGYM_KEEP3(changed, m1x, m1y, m1z, e1x, e1y, e1z);
-        SOFTGYM_KEEP3(changed, m2x, m2y, m2z, e2x, e2y, e2z);
-        /* large angle: G = RQ^T v rotates by rq^-1 (RQ the matrix of rq,
-           normalised by |rq|^2: the small-ratio rq is not exactly unit) */
-        double n2q = rw * rw + ry * ry + rz * rz;
-        double r0 = n2q - 2.0 * (ry * ry + rz * rz);
-        double r1 = 2.0 * (rw * rz);
-        double r2 = 2.0 * (rw * ry);
-        double r4 = n2q - 2.0 * (rz * rz);
-        double r5 = 2.0 * (ry * rz);
-        double r8 = n2q - 2.0 * (ry * ry);
-#define SOFTGYM_UNTURN(x, y, z) do { \
-            double gx_ = r0 * x + r1 * y - r2 * z; \
-            double gy_ = -r1 * x + r4 * y + r5 * z; \
-            double gz_ = r2 * x + r5 * y + r8 * z; \
-            SOFTGYM_KEEP3(sa, x, y, z, gx_, gy_, gz_); \
-        } while (0)
-        SOFTGYM_UNTURN(f1x, f1y, f1z);
-        SOFTGYM_UNTURN(m1x, m1y, m1z);
-        SOFTGYM_UNTURN(m2x, m2y, m2z);
-        SOFTGYM_UNTURN(f2x, f2y, f2z);
-#undef SOFTGYM_UNTURN
-#undef SOFTGYM_KEEP3
-        o0[li] = f1x;
-        o1[li] = f1y;
-        o2[li] = f1z;
-        o3[li] = f2x;
-        o4[li] = f2y;
-        o5[li] = f2z;
-        o6[li] = -m1x;
-        o7[li] = -m1y;
-        o8[li] = -m1z;
-        o9[li] = -m2x;
-        o10[li] = -m2y;
-        o11[li] = -m2z;
-    }
-}
+/* The forces pass of _seed_links_along (softgym_seed_forces.h, one definition
+   for both precisions): softgym_seed_forces in double, the seed's operations
+   (softgym_pick keeps its selects blends: a select before a store may
+   otherwise become a masked store), softgym_seed_forces32 in float for
+   link_precision "single" (its lanes' conditions 32 bits wide) */
+#define SOFTGYM_FT double
+#define SOFTGYM_FNAME softgym_seed_forces
+#define SOFTGYM_FPICK softgym_pick
+#define SOFTGYM_FMASK long long
+#include "softgym_seed_forces.h"
+#undef SOFTGYM_FT
+#undef SOFTGYM_FNAME
+#undef SOFTGYM_FPICK
+#undef SOFTGYM_FMASK
+#define SOFTGYM_FT float
+#define SOFTGYM_FNAME softgym_seed_forces32
+#define SOFTGYM_FPICK(c, a, b) ((c) ? (a) : (b))
+#define SOFTGYM_FMASK int
+#include "softgym_seed_forces.h"
+#undef SOFTGYM_FT
+#undef SOFTGYM_FNAME
+#undef SOFTGYM_FPICK
+#undef SOFTGYM_FMASK
 
 /* The orientation step of _integrate_seed for voxels lo..hi, in C for the
    vectorising pragma: q + (w dt / 2) x q (w the new angular velocity),
