@@ -51,6 +51,7 @@ cdef float64_t HYSTERESIS = 1.1
 cdef float64_t SMALL_ANGLE_W = cos(0.5 * SMALL_ANGLE_RAD)
 cdef float64_t SMALLISH_ANGLE_W = cos(HYSTERESIS * SMALL_ANGLE_RAD * 0.5)
 cdef float64_t SLTHRESH_ACOS2SQRT = 1.0 - 0.9988 * 0.9988
+cdef float64_t ACOS2SQRT_W = 0.9988  # the same cut on w (1 - w^2 < it: w > 0.9988)
 cdef float64_t DISCARD_ANGLE_RAD = 1.0e-7
 cdef float64_t SA_BOND_BEND_RAD = 0.05
 cdef float64_t SA_BOND_EXT_PERC = 1.30
@@ -124,7 +125,7 @@ def cycle_counts(bint reset=False):
 cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n, bint f32, intp_t ls) noexcept nogil:
     # softgym_seed_frames for one link, with the seed's branches (its acos
     # approximation and the backward-chord rule); f32: into the float rows of
-    # the single-precision passes (_float_rows, ls: the robot's first link)
+    # the single-precision passes (_float_row; ls: the robot's first link)
     cdef:
         float64_t sa_rad = SMALL_ANGLE_RAD
         float64_t th_discard = SEED_PI - DISCARD_ANGLE_RAD
@@ -231,7 +232,7 @@ cdef inline void _seed_links_along32(Batch* b, intp_t lo, intp_t end, const int 
     for k in range(12):
         f[k] = _float_row(o, n, ls, 10 + k)
     t0 = softgym_prof_tsc()
-    softgym_seed_frames32(lo, end, n, <float> SMALL_ANGLE_RAD, <float> 0.9988, o, f)
+    softgym_seed_frames32(lo, end, n, <float> SMALL_ANGLE_RAD, <float> ACOS2SQRT_W, o, f)
     softgym_prof_add(2, t0)
     t0 = softgym_prof_tsc()
     for li in range(lo, end):
@@ -277,6 +278,8 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
     #                        frame (stiffness, the seed's damping from the
     #                        link's memory; rq^-1 for large angles)
     #   softgym_seed_scatter back to the world, scattered in link order
+    # With link_precision "single" the frames and forces run in float
+    # (_seed_links_along32; ls, the robot's first link, places the float rows).
     # The bond frame is voxel 1's frame turned by the proper rotation P that
     # takes the link axis onto +x (the seed's ToXDirBond): (x, y, z) ->
     # (x, y, z), (y, -x, z), (z, y, -x) for ax 0, 1, 2.
@@ -390,7 +393,7 @@ def seed_frames(float64_t[:, ::1] geom, bint scalar=False, bint single=False):
         f[k] = <float*> (op + (10 + k) * stride)
     with nogil:
         if single:
-            softgym_seed_frames32(0, n, stride, <float> SMALL_ANGLE_RAD, <float> 0.9988, op, f)
+            softgym_seed_frames32(0, n, stride, <float> SMALL_ANGLE_RAD, <float> ACOS2SQRT_W, op, f)
             for li in range(n):
                 if f[11][li] != 0.0:
                     _seed_frame_one(li, op, stride, 1, 0)
