@@ -176,9 +176,12 @@ def seed_engine_ratio(oracle_py: str, repeats: int = 3) -> dict:
     design = reference_design()
     text = to_vxa(design)
     walls = []
-    ours = []
-    corot = []
-    single = []
+    # softgym's configurations on the same robot: the seed preset, the corotational
+    # preset, the seed preset with single-precision link math
+    configs = {"seed": SimConfig(self_collision=True),
+               "corotational": SimConfig(self_collision=True, model="corotational"),
+               "single": SimConfig(self_collision=True, link_precision="single")}  # fmt: skip
+    times = {name: [] for name in configs}
     # interleaved repeats (seed engine, softgym, seed engine, ...): a background
     # load that comes and goes falls on both engines alike; the medians are compared
     for _ in range(repeats):
@@ -186,20 +189,14 @@ def seed_engine_ratio(oracle_py: str, repeats: int = 3) -> dict:
         if res.get("hung") or "error" in res:
             raise SystemExit(f"bench_engine: the seed's engine did not finish: {res}")
         walls.append(res["wall_s"])
-        sim = Simulation([design.to_body()], SimConfig(self_collision=True), n_threads=1)
-        t0 = time.perf_counter()
-        rollout = sim.run(5.0)
-        ours.append(time.perf_counter() - t0)
-        sim = Simulation([design.to_body()], SimConfig(self_collision=True, model="corotational"),
-                         n_threads=1)
-        t0 = time.perf_counter()
-        sim.run(5.0)
-        corot.append(time.perf_counter() - t0)
-        sim = Simulation([design.to_body()], SimConfig(self_collision=True, link_precision="single"),
-                         n_threads=1)
-        t0 = time.perf_counter()
-        sim.run(5.0)
-        single.append(time.perf_counter() - t0)
+        for name, cfg in configs.items():
+            sim = Simulation([design.to_body()], cfg, n_threads=1)
+            t0 = time.perf_counter()
+            r = sim.run(5.0)
+            times[name].append(time.perf_counter() - t0)
+            if name == "seed":
+                rollout = r
+    ours, corot, single = times["seed"], times["corotational"], times["single"]
     vsteps = float(design.n_voxels * rollout.steps[0])
     return {
         "seed_engine_voxel_steps_per_s": vsteps / statistics.median(walls),

@@ -516,14 +516,15 @@ def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layou
     a["c_seed"] = np.ascontiguousarray(np.asarray(a["c_seed"], dtype=np.float64).reshape(-1, 8).T)
     a["homog"] = a["homog"].astype(np.int8)
     a["link_sa"] = np.ones(a["v1"].shape[0], dtype=np.int8)  # links start in small-angle mode
+    single = cfg.link_precision == "single"
     # see _TRANSPOSED; float32 with link_precision "single", whose forces pass keeps float values
-    a["link_last"] = np.zeros((9, a["v1"].shape[0]), dtype=np.float32 if cfg.link_precision == "single" else np.float64)
-    # (11, n_links) float32, for link_precision "single" only: k_axial, k_torsion,
-    # k_bend and the 8 rows of c_seed, rounded once
-    n32 = a["v1"].shape[0] if cfg.link_precision == "single" else 0
-    a["k_seed32"] = np.ascontiguousarray(
-        np.vstack([a["k_axial"][None], a["k_torsion"][None], a["k_bend"][None], a["c_seed"]])[:, :n32],
-        dtype=np.float32,
+    a["link_last"] = np.zeros((9, a["v1"].shape[0]), dtype=np.float32 if single else np.float64)
+    # (11, n_links) float32, for link_precision "single" only (else no columns): k_axial,
+    # k_torsion, k_bend and the 8 rows of c_seed, rounded once
+    a["k_seed32"] = (
+        np.ascontiguousarray(np.vstack([a["k_axial"], a["k_torsion"], a["k_bend"], a["c_seed"]]), dtype=np.float32)
+        if single
+        else np.empty((11, 0), dtype=np.float32)
     )
     a["axis"] = a["axis"].astype(np.int32)
     a["quat"] = np.zeros((n_vox, 4))
@@ -579,7 +580,7 @@ def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layou
         "model": 0 if cfg.model == "seed" else 1,
         "bond_zeta": float(cfg.bond_damping),
         "fluid_drag": float(cfg.fluid_drag),
-        "link_f32": int(cfg.link_precision == "single"),
+        "link_f32": int(single),
     }
     # robots' own voxels in the kernel arrays (None: no objects, all of them)
     own = [np.arange(vox_start[r], body_end[r]) for r in range(n_robots)]

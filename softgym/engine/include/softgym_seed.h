@@ -138,6 +138,28 @@ static inline long long softgym_rotvec_needs_acos(double w, double thr)
     T rw = zero ? (T)1.0 : (small ? rw_s_ : ch_); \
     T ry = zero ? (T)0.0 : (small ? ry_s_ : ry_l_); \
     T rz = zero ? (T)0.0 : (small ? rz_s_ : rz_l_)
+/* tq = rq nq in type T, declaring tw, tx, ty, tz: voxel 2's orientation
+   relative to voxel 1 (qw, n1, n2, n3) turned into the large-angle frame rq
+   = (rw, 0, ry, rz) (rq's x part is zero) */
+#define SOFTGYM_TQ(T) \
+    T tw = rw * qw - ry * n2 - rz * n3; \
+    T tx = rw * n1 + ry * n3 - rz * n2; \
+    T ty = rw * n2 + ry * qw + rz * n1; \
+    T tz = rw * n3 - ry * n1 + rz * qw
+/* the end of the block of up to 64 links from blo (before hi), and in
+   *all_small whether every one of them is in small-angle mode (sa_ row): the
+   frames passes then skip the large-angle candidates (a settled or gently
+   actuated body: most blocks) */
+static inline Py_ssize_t softgym_small_block(const double *sa_, Py_ssize_t blo, Py_ssize_t hi,
+                                             int *all_small)
+{
+    Py_ssize_t li, bhi = blo + 64 < hi ? blo + 64 : hi;
+    int all = 1;
+    for (li = blo; li < bhi; li++)
+        all &= sa_[li] != 0.0;
+    *all_small = all;
+    return bhi;
+}
 /* the frames pass's rows: geometry and mode in, frame quantities out */
 #define SOFTGYM_FRAME_ROWS \
     const double *p0_, const double *p1_, const double *p2_, const double *qw_, \
@@ -164,11 +186,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_frames_impl(
         double k1 = softgym_rotvec_k_sqrt(rw);
         fix |= (1 - is_sa) & (1 - zero) & softgym_rotvec_needs_acos(rw, thr);
         double a1y = ry * k1, a1z = rz * k1;
-        /* tq = rq nq (rq's x part is zero) */
-        double tw = rw * qw - ry * n2 - rz * n3;
-        double tx = rw * n1 + ry * n3 - rz * n2;
-        double ty = rw * n2 + ry * qw + rz * n1;
-        double tz = rw * n3 - ry * n1 + rz * qw;
+        SOFTGYM_TQ(double);
         /* voxel 2's rotation vector: k of qw (small angle) or of tw (large),
            one square root and one division for either */
         double w2 = softgym_pick(is_sa, qw, tw);
@@ -194,14 +212,10 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_frames_impl(
 static void softgym_seed_frames(
     Py_ssize_t lo, Py_ssize_t hi, double sa_rad, double thr, SOFTGYM_FRAME_ROWS)
 {
-    /* blocks of links all in small-angle mode (a settled or gently
-       actuated body: most of them) skip the large-angle candidates */
-    Py_ssize_t blo, bhi, li;
+    Py_ssize_t blo, bhi;
+    int all_small;
     for (blo = lo; blo < hi; blo = bhi) {
-        int all_small = 1;
-        bhi = blo + 64 < hi ? blo + 64 : hi;
-        for (li = blo; li < bhi; li++)
-            all_small &= sa_[li] != 0.0;
+        bhi = softgym_small_block(sa_, blo, hi, &all_small);
         if (all_small)
             softgym_seed_frames_impl(1, blo, bhi, sa_rad, thr, SOFTGYM_FRAME_ROW_NAMES);
         else
@@ -249,10 +263,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_frames32_impl(
         float k1 = softgym_rotvec_k32(rw);
         fix |= (1 - is_sa) & (1 - zero) & (rw <= w_acos);
         float a1y = ry * k1, a1z = rz * k1;
-        float tw = rw * qw - ry * n2 - rz * n3;
-        float tx = rw * n1 + ry * n3 - rz * n2;
-        float ty = rw * n2 + ry * qw + rz * n1;
-        float tz = rw * n3 - ry * n1 + rz * qw;
+        SOFTGYM_TQ(float);
         float w2 = is_sa ? qw : tw;
         float k2 = softgym_rotvec_k32(w2);
         fix |= w2 <= w_acos;
@@ -276,13 +287,11 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_frames32_impl(
 static void softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, float sa_rad,
                                   float w_acos, const double *o, float *const *f)
 {
-    Py_ssize_t blo, bhi, li;
+    Py_ssize_t blo, bhi;
+    int all_small;
     const double *sa_ = o + 9 * n;
     for (blo = lo; blo < hi; blo = bhi) {
-        int all_small = 1;
-        bhi = blo + 64 < hi ? blo + 64 : hi;
-        for (li = blo; li < bhi; li++)
-            all_small &= sa_[li] != 0.0;
+        bhi = softgym_small_block(sa_, blo, hi, &all_small);
 #define SOFTGYM_FRAMES32(s) softgym_seed_frames32_impl( \
             s, blo, bhi, sa_rad, w_acos, o, o + n, o + 2 * n, o + 3 * n, o + 4 * n, o + 5 * n, \
             o + 6 * n, o + 7 * n, o + 8 * n, sa_, f[0], f[1], f[2], f[3], f[4], f[5], f[6], \
