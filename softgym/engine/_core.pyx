@@ -246,6 +246,28 @@ KERNEL_ARRAYS = (
 )
 
 
+cpdef intp_t row_stride(intp_t n):
+    """The row stride (in elements) of an array of rows of ``n`` per-link or
+    per-voxel values that a kernel pass reads together, lane by lane: ``n`` rounded
+    up to an odd multiple of 16. Rows of float64 are then an odd multiple of 128
+    bytes apart, rows of float32 of 64: consecutive rows fall in different sets of
+    the core's cache. With rows a multiple of 4096 bytes apart (a batch of 256
+    reference robots has 138,240 links: 270 pages) every row fell in one set of
+    the 8-way L1 and the forces pass, which reads 20 rows at once, ran 2.5x
+    slower (benchmarks/RESULTS.md)."""
+    cdef intp_t s = (n + 15) // 16 * 16
+    if (s // 16) % 2 == 0:
+        s += 16
+    return s
+
+
+def _row_stride_of(cnp.ndarray a, str name):
+    # elements between the rows of a 2-d kernel array whose rows are contiguous
+    if a.ndim != 2 or a.strides[1] != a.itemsize or a.strides[0] % a.itemsize:
+        raise ValueError(f"{name}: each row must be contiguous")
+    return a.strides[0] // a.itemsize
+
+
 cdef inline float64_t* _f(object arrays, str name) except NULL:
     cdef cnp.ndarray a = arrays[name]
     return <float64_t*> cnp.PyArray_DATA(a)
@@ -334,6 +356,7 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.n_links = a["v1"].shape[0]
     b.link_out = NULL  # per thread, set by advance
     b.link_stride = 0
+    b.link_rows = 0
     if a["v1"].shape[0] > 0:
         b.v1 = <intp_t*> _p(a, "v1")
         b.v2 = <intp_t*> _p(a, "v2")
@@ -347,6 +370,11 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
         b.c_seed = _f(a, "c_seed")
         b.homog = <flag_t*> _p(a, "homog")
         b.link_sa = <flag_t*> _p(a, "link_sa")
+        # the rows the forces pass reads with one stride
+        b.link_rows = _row_stride_of(a["link_last"], "link_last")
+        rows_with = "k_seed32" if b.link_f32 else "c_seed"
+        if _row_stride_of(a[rows_with], rows_with) != b.link_rows:
+            raise ValueError(f"{rows_with} and link_last must have one row stride")
         if b.link_f32:  # the single-precision passes' arrays (float32)
             b.link_last = NULL
             b.link_last32 = <float*> _p(a, "link_last")
@@ -458,6 +486,8 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
     for r in range(n):
         stride = max(stride, b.link_start[r + 1] - b.link_start[r])
         vstride = max(vstride, b.vox_start[r + 1] - b.vox_start[r])
+    stride = row_stride(stride)
+    vstride = row_stride(vstride)
     b.link_stride = stride
     b.vox_stride = vstride
     block = N_LINK_OUT * stride + N_VOX_OUT * vstride

@@ -247,10 +247,10 @@ cdef inline void _seed_links_along32(Batch* b, intp_t lo, intp_t end, const int 
     out[10] = o + 21 * n
     out[11] = o + 24 * n
     k32 = b.k_seed32
-    softgym_seed_forces32(lo, end, b.n_links, <float> b.L, <float> (0.5 * b.bond_zeta),
+    softgym_seed_forces32(lo, end, b.link_rows, <float> b.L, <float> (0.5 * b.bond_zeta),
                           <float> (0.25 * b.bond_zeta), <float> inv_dt, inp, o + 9 * n,
-                          o + 22 * n, k32, k32 + b.n_links, k32 + 2 * b.n_links,
-                          k32 + 3 * b.n_links, b.link_last32, out)
+                          o + 22 * n, k32, k32 + b.link_rows, k32 + 2 * b.link_rows,
+                          k32 + 3 * b.link_rows, b.link_last32, out)
     softgym_prof_add(4, t0)
     t0 = softgym_prof_tsc()
     softgym_seed_scatter(ax, lo, end, n, b.v1, b.v2, b.rot, o, b.force, b.moment)
@@ -329,7 +329,7 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
         out[k] = o + k * n
     out[10] = o + 21 * n
     out[11] = o + 24 * n
-    softgym_seed_forces(lo, end, b.n_links, b.L, bz, bzh, inv_dt, inp, o + 9 * n, o + 22 * n,
+    softgym_seed_forces(lo, end, b.link_rows, b.L, bz, bzh, inv_dt, inp, o + 9 * n, o + 22 * n,
                         b.k_axial, b.k_torsion, b.k_bend, b.c_seed, b.link_last, out)
     softgym_prof_add(4, t0)
     t0 = softgym_prof_tsc()

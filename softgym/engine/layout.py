@@ -466,6 +466,19 @@ def _terrain_arrays(terrains: list, cfg: SimConfig) -> dict[str, np.ndarray]:
     return a
 
 
+def _link_rows(rows: np.ndarray) -> np.ndarray:
+    """``rows`` (k, n_links) copied into rows ``_core.row_stride(n_links)`` elements apart.
+
+    A view of shape (k, n_links) whose rows are contiguous: the forces pass reads
+    c_seed, k_seed32 and link_last with one row stride (the kernel checks it), and
+    padded rows keep apart in the cache at every batch size.
+    """
+    k, n = rows.shape
+    out = np.zeros((k, _core.row_stride(n)), dtype=rows.dtype)[:, :n]
+    out[...] = rows
+    return out
+
+
 def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layout:
     """Lay out robots and their terrains (one each, validated) for the kernel.
 
@@ -513,16 +526,16 @@ def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layou
     for name in ("v1", "v2"):
         a[name] = a[name].astype(np.intp)
     # (8, n_links): one row per constant, for the kernel's vector loops
-    a["c_seed"] = np.ascontiguousarray(np.asarray(a["c_seed"], dtype=np.float64).reshape(-1, 8).T)
+    a["c_seed"] = _link_rows(np.asarray(a["c_seed"], dtype=np.float64).reshape(-1, 8).T)
     a["homog"] = a["homog"].astype(np.int8)
     a["link_sa"] = np.ones(a["v1"].shape[0], dtype=np.int8)  # links start in small-angle mode
     single = cfg.link_precision == "single"
     # see _TRANSPOSED; float32 with link_precision "single", whose forces pass keeps float values
-    a["link_last"] = np.zeros((9, a["v1"].shape[0]), dtype=np.float32 if single else np.float64)
+    a["link_last"] = _link_rows(np.zeros((9, a["v1"].shape[0]), dtype=np.float32 if single else np.float64))
     # (11, n_links) float32, for link_precision "single" only (else no columns): k_axial,
     # k_torsion, k_bend and the 8 rows of c_seed, rounded once
     a["k_seed32"] = (
-        np.ascontiguousarray(np.vstack([a["k_axial"], a["k_torsion"], a["k_bend"], a["c_seed"]]), dtype=np.float32)
+        _link_rows(np.vstack([a["k_axial"], a["k_torsion"], a["k_bend"], a["c_seed"]]).astype(np.float32))
         if single
         else np.empty((11, 0), dtype=np.float32)
     )

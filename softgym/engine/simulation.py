@@ -743,7 +743,7 @@ class Simulation:
     def reset(self) -> None:
         """Return every robot to its initial state (t = 0, sinusoidal drive)."""
         for k, v in self._initial.items():
-            self._a[k] = v.copy()
+            self._put(k, v)
         self._t_target = 0.0
         self._contacts.invalidate()
 
@@ -769,10 +769,19 @@ class Simulation:
                 )
         for k in _STATE:
             v = np.asarray(state[k])
-            v = v.T if k in _TRANSPOSED else v
-            self._a[k] = np.array(v, dtype=self._a[k].dtype, order="C", copy=True)
+            self._put(k, v.T if k in _TRANSPOSED else v)
         self._t_target = float(state.get("t_target", 0.0))
         self._state_changed()
+
+    def _put(self, k: str, v: np.ndarray) -> None:
+        # kernel array k becomes a copy of v (cast to its dtype): in place where the
+        # shapes agree, which keeps the array's memory layout (the padded rows of
+        # link_last, layout._link_rows); else (a trace of another capacity) a new array
+        cur = self._a[k]
+        if cur.shape == v.shape:
+            np.copyto(cur, v, casting="unsafe")
+        else:
+            self._a[k] = np.array(v, dtype=cur.dtype, order="C", copy=True)
 
     def _state_view(self, k: str) -> np.ndarray:
         # kernel array k as states show it (a view; see _TRANSPOSED)
