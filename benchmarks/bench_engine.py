@@ -23,6 +23,7 @@ library 1.4-2.1 M) and say so.
     python benchmarks/bench_engine.py            # full table (about 2 minutes)
     python benchmarks/bench_engine.py --quick --json   # < 60 s, last line is JSON
     python benchmarks/bench_engine.py --seed-engine ../shared/oracle/seed_oracle.py
+    python benchmarks/bench_engine.py --scale --repeats 3   # batches of 1 to 1,024, ~10 min
 """
 
 from __future__ import annotations
@@ -117,23 +118,35 @@ def measure_scale(batch: int, threads: int, settle: float = 1.0, seconds: float 
             "diverged": int(np.sum(sim.diverged))}  # fmt: skip
 
 
-def scale_table(log=print) -> list[dict]:
-    """The scale rows: batches of 1 to 1,024 robots on 1 and 2 threads."""
+def scale_table(log=print, repeats: int = 1) -> list[dict]:
+    """The scale rows: batches of 1 to 1,024 robots on 1 and 2 threads.
+
+    Each batch runs ``repeats`` times on 1, then 2 threads, alternating, and keeps
+    each thread count's quickest run: a background load that comes and goes (this
+    VM's timings move by 20 %) falls on both alike and slows, never speeds, a run.
+    """
     rows = []
     for batch in SCALE_BATCHES:
-        for threads in (1, 2):
-            row = measure_scale(batch, threads)
-            rows.append(row)
-            log(f"  scale: batch {batch:5d} threads {threads}: "
-                f"{row['voxel_steps_per_s'] / 1e6:7.2f} M voxel-steps/s, "
-                f"{row['bytes_per_robot'] / 1024:7.1f} KiB/robot ({row['wall_s']:.1f} s)")
+        best = {}
+        for _ in range(max(1, repeats)):
+            for threads in (1, 2):
+                row = measure_scale(batch, threads)
+                log(f"  scale: batch {batch:5d} threads {threads}: "
+                    f"{row['voxel_steps_per_s'] / 1e6:7.2f} M voxel-steps/s, "
+                    f"{row['bytes_per_robot'] / 1024:7.1f} KiB/robot ({row['wall_s']:.1f} s)")
+                row["repeats"] = max(1, repeats)
+                if threads not in best or row["voxel_steps_per_s"] > best[threads]["voxel_steps_per_s"]:
+                    best[threads] = row
+        rows.extend([best[1], best[2]])
     return rows
 
 
 def scale_lines(rows: list[dict]) -> list[str]:
     """Markdown table of :func:`scale_table` with the 2-thread / 1-thread ratio per batch."""
+    reps = rows[0].get("repeats", 1)
     lines = ["", "At scale (seed preset, 6^3 reference robot, self-collision on, in the seed's "
-             "fence; 1 s settled untimed, then 1 s actuated timed):", "",
+             f"fence; 1 s settled untimed, then 1 s actuated timed; the quickest of {reps} "
+             "alternating runs):", "",
              "| batch | M voxel-steps/s, 1 thread | 2 threads | 2 / 1 | KiB per robot | diverged |",
              "|---|---|---|---|---|---|"]  # fmt: skip
     for batch in SCALE_BATCHES:
@@ -225,7 +238,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--scale", action="store_true",
                     help="only the scale table (batches of 1 to 1,024 robots, 1 and 2 threads)")
     ap.add_argument("--repeats", type=int, default=3,
-                    help="interleaved repeats of the ratio measurement (median taken)")
+                    help="interleaved repeats of the ratio measurement (median taken); with "
+                         "--scale, alternating runs of each batch (quickest kept)")
     args = ap.parse_args(argv)
 
     if args.ratio_only:
@@ -241,7 +255,7 @@ def main(argv: list[str] | None = None) -> int:
             print(json.dumps(m))
         return 0
     if args.scale:
-        srows = scale_table(log=lambda m: print(m, file=sys.stderr))
+        srows = scale_table(log=lambda m: print(m, file=sys.stderr), repeats=args.repeats)
         lines = scale_lines(srows)
         print("\n".join(lines))
         if not args.no_append:

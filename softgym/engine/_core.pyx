@@ -40,6 +40,8 @@ from softgym.engine._seed import cycle_counts as seed_cycle_counts
 
 cnp.import_array()
 
+# the robots that the threads of advance step at one time are this many apart
+cdef intp_t ROBOT_SPREAD = 8
 cdef float64_t SEED_2PI_DRIVE = 2.0 * <float64_t> (<float> 3.1415926)  # model 0's drive
 
 
@@ -473,7 +475,7 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
         Batch b
         Batch bt
         intp_t r, n, t
-        intp_t stride = 0, vstride = 0, block
+        intp_t stride = 0, vstride = 0, block, i, m
         float64_t* scratch
     _bind(&b, arrays, settings)
     n = b.n_robots
@@ -492,17 +494,28 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
     b.vox_stride = vstride
     block = N_LINK_OUT * stride + N_VOX_OUT * vstride
     scratch = cache.scratch(max(n_threads * block, 1))
+    # robots in the order 0, 8, 16, ..., then 1, 9, 17, ...: the robots that the
+    # threads step at one time are ROBOT_SPREAD apart, so no two of them write
+    # one cache line (a robot's first and last voxels share lines of every
+    # per-voxel array with its neighbours', and the per-robot counters steps,
+    # col_acc, col_vmax are 8 to a line). In index order the two threads
+    # stepped neighbours and passed those lines back and forth every step: 2
+    # threads ran 1.7x one, against 1.9x for two processes (benchmarks/RESULTS.md).
+    # Each robot's result does not depend on the order.
+    m = (n + ROBOT_SPREAD - 1) // ROBOT_SPREAD
     with nogil, parallel(num_threads=n_threads):
         # dynamic: robots of one batch differ in cost by 10x or more (bone shrinks dt)
-        for r in prange(n, schedule="dynamic", chunksize=1):
-            t = threadid()
-            bt = b
-            # row k of link li sits at link_out[k * stride + li], of voxel i
-            # at vox_out[k * vstride + i]: the thread's block, offset by the
-            # robot's first link and voxel
-            bt.link_out = scratch + t * block - b.link_start[r]
-            bt.vox_out = scratch + t * block + N_LINK_OUT * stride - b.vox_start[r]
-            advance_robot(&bt, r, targets[r], &cache.items[r])
+        for i in prange(ROBOT_SPREAD * m, schedule="dynamic", chunksize=1):
+            r = ROBOT_SPREAD * (i % m) + i // m
+            if r < n:
+                t = threadid()
+                bt = b
+                # row k of link li sits at link_out[k * stride + li], of voxel i
+                # at vox_out[k * vstride + i]: the thread's block, offset by the
+                # robot's first link and voxel
+                bt.link_out = scratch + t * block - b.link_start[r]
+                bt.vox_out = scratch + t * block + N_LINK_OUT * stride - b.vox_start[r]
+                advance_robot(&bt, r, targets[r], &cache.items[r])
 
 
 def compute_energy(dict arrays, dict settings, float64_t[:, ::1] out):

@@ -52,6 +52,24 @@ def test_one_thread_equals_two_threads_bit_for_bit():
         assert np.array_equal(a, b)
 
 
+@pytest.mark.parametrize("n_robots", [1, 7, 8, 9, 17])
+def test_every_robot_steps_once_to_its_target_in_any_batch_size(n_robots):
+    # the threads take the robots 8 apart (0, 8, 16, ..., 1, 9, ...; _core.advance):
+    # each robot of any batch size is stepped exactly to the target, as alone
+    rng = np.random.default_rng(n_robots)
+    bodies = [reference_robot(2)] + [
+        two_material_body(rng.integers(1, 3, size=(2, 2, 2)).astype(np.int32), period=0.2, temp_amplitude=8)
+        for _ in range(n_robots - 1)
+    ]
+    sim = Simulation(bodies, n_threads=2)
+    sim.advance(0.3)
+    assert np.all(sim.time >= 0.3) and np.all(sim.time - sim.dt < 0.3)
+    for r in (0, n_robots // 2, n_robots - 1):
+        alone = Simulation([bodies[r]], n_threads=1)
+        alone.advance(0.3)
+        assert np.array_equal(_final(alone, 0), _final(sim, r)), f"robot {r} differs"
+
+
 def test_openmp_enabled_reports_a_bool():
     assert isinstance(openmp_enabled(), bool)
 
