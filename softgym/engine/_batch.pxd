@@ -110,11 +110,12 @@ cdef struct Batch:
     float64_t* c_torsion     # (n_links,) torsional damping (N m s/rad)
     float64_t* c_bend        # (n_links,) bending damping (N m s/rad)
     # model 0 (seed) only:
-    float64_t* c_seed        # (8, n_links), rows link_rows apart, 2 sqrt(k m) damping constants of voxel 1 then voxel 2:
-                             #   a1 M, b2 FM, a2 I, b3 I (FM = M L / 2, I = M L^2 / 6)
+    float64_t* c_seed        # (8, n_links), rows link_rows apart: 2 sqrt(k m) damping constants
+                             #   of voxel 1 then voxel 2: a1 M, b2 FM, a2 I, b3 I
+                             #   (FM = M L / 2, I = M L^2 / 6)
     flag_t* homog            # (n_links,) 1: both voxels of one material (voxel 2 gets -F1)
-    float* k_seed32          # (11, n_links), rows link_rows apart, float32: k_axial, k_torsion, k_bend, c_seed's 8 rows
-                             #   (link_f32 only; NULL otherwise)
+    float* k_seed32          # (11, n_links), rows link_rows apart, float32: k_axial, k_torsion,
+                             #   k_bend, c_seed's 8 rows (link_f32 only; NULL otherwise)
     flag_t* link_sa          # (n_links,) 1: small-angle mode (state)
     intp_t* seed_rank        # (n_voxels,) the voxel's index in the seed engine's order
     float64_t* col_ref       # (n_voxels, 4) position and size at the last candidate rebuild (state)
@@ -123,9 +124,9 @@ cdef struct Batch:
     intp_t* obs_start        # (n_robots + 1,) model 0: robot r's obstacle voxels [obs_start[r], obs_start[r+1])
     float64_t* obs           # (n_obs, 4) fixed obstacle voxel centre (m) and its 2 E L (N/m)
     intp_t* obs_rank         # (n_obs,) its index in the seed engine's voxel order
-    float64_t* link_last     # (9, n_links), rows link_rows apart: last Pos2, Angle1, Angle2 in the bond frame (state;
-                             #   Simulation.get_state/set_state show it as (n_links, 9));
-                             #   NULL with link_f32
+    float64_t* link_last     # (9, n_links), rows link_rows apart: last Pos2, Angle1, Angle2 in
+                             #   the bond frame (state; Simulation.get_state/set_state show it
+                             #   as (n_links, 9)); NULL with link_f32
     float* link_last32       # the same in float32 with link_f32 (NULL otherwise)
 
 

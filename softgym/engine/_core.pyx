@@ -255,8 +255,8 @@ cpdef intp_t row_stride(intp_t n):
     bytes apart, rows of float32 of 64: consecutive rows fall in different sets of
     the core's cache. With rows a multiple of 4096 bytes apart (a batch of 256
     reference robots has 138,240 links: 270 pages) every row fell in one set of
-    the 8-way L1 and the forces pass, which reads 20 rows at once, ran 2.5x
-    slower (benchmarks/RESULTS.md)."""
+    the 8-way L1 and the forces pass reads 20 rows at once: the batch ran at two
+    thirds of one robot's rate per voxel (benchmarks/RESULTS.md)."""
     cdef intp_t s = (n + 15) // 16 * 16
     if (s // 16) % 2 == 0:
         s += 16
@@ -498,10 +498,10 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
     # threads step at one time are ROBOT_SPREAD apart, so no two of them write
     # one cache line (a robot's first and last voxels share lines of every
     # per-voxel array with its neighbours', and the per-robot counters steps,
-    # col_acc, col_vmax are 8 to a line). In index order the two threads
-    # stepped neighbours and passed those lines back and forth every step: 2
-    # threads ran 1.7x one, against 1.9x for two processes (benchmarks/RESULTS.md).
-    # Each robot's result does not depend on the order.
+    # col_acc, col_vmax are 8 to a line). In index order the two threads often
+    # stepped neighbours and passed those lines back and forth every step: a
+    # batch of 2,048 robots of 3^3 voxels ran no faster on 2 threads than on 1
+    # (benchmarks/RESULTS.md). Each robot's result does not depend on the order.
     m = (n + ROBOT_SPREAD - 1) // ROBOT_SPREAD
     with nogil, parallel(num_threads=n_threads):
         # dynamic: robots of one batch differ in cost by 10x or more (bone shrinks dt)
