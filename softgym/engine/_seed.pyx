@@ -214,6 +214,16 @@ cdef inline void _put(float64_t* o, intp_t n, intp_t ls, intp_t k, intp_t li, fl
         o[k * n + li] = v
 
 
+cdef inline void _forces_rows(float64_t* o, intp_t n, float64_t** out) noexcept nogil:
+    # the scratch rows the forces pass writes and softgym_seed_scatter reads (in
+    # either precision): f1 0-2, f2 3-5, m1 6-8, m2 9, 21, 24
+    cdef intp_t k
+    for k in range(10):
+        out[k] = o + k * n
+    out[10] = o + 21 * n
+    out[11] = o + 24 * n
+
+
 cdef inline void _seed_links_along32(Batch* b, intp_t lo, intp_t end, const int ax,
                                      float64_t inv_dt, intp_t ls) noexcept nogil:
     # _seed_links_along's frames and forces passes in single precision
@@ -242,10 +252,7 @@ cdef inline void _seed_links_along32(Batch* b, intp_t lo, intp_t end, const int 
     t0 = softgym_prof_tsc()
     for k in range(11):
         inp[k] = f[k]
-    for k in range(10):
-        out[k] = o + k * n
-    out[10] = o + 21 * n
-    out[11] = o + 24 * n
+    _forces_rows(o, n, out)
     k32 = b.k_seed32
     softgym_seed_forces32(lo, end, b.link_rows, <float> b.L, <float> (0.5 * b.bond_zeta),
                           <float> (0.25 * b.bond_zeta), <float> inv_dt, inp, o + 9 * n,
@@ -325,10 +332,7 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
     t0 = softgym_prof_tsc()
     for k in range(11):
         inp[k] = o + (10 + k) * n
-    for k in range(10):
-        out[k] = o + k * n
-    out[10] = o + 21 * n
-    out[11] = o + 24 * n
+    _forces_rows(o, n, out)
     softgym_seed_forces(lo, end, b.link_rows, b.L, bz, bzh, inv_dt, inp, o + 9 * n, o + 22 * n,
                         b.k_axial, b.k_torsion, b.k_bend, b.c_seed, b.link_last, out)
     softgym_prof_add(4, t0)
