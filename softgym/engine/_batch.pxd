@@ -113,7 +113,8 @@ cdef struct Batch:
     float64_t* c_seed        # (8, n_links), rows link_rows apart: 2 sqrt(k m) damping constants
                              #   of voxel 1 then voxel 2: a1 M, b2 FM, a2 I, b3 I
                              #   (FM = M L / 2, I = M L^2 / 6)
-    flag_t* homog            # (n_links,) 1: both voxels of one material (voxel 2 gets -F1)
+    flag_t* homog            # (n_links,) 1: voxel 2 gets -F1 (one material, or two with equal
+                             #   damping constants a M, b2 FM: layout._robot_entry)
     float* k_seed32          # (11, n_links), rows link_rows apart, float32: k_axial, k_torsion,
                              #   k_bend, c_seed's 8 rows (link_f32 only; NULL otherwise)
     flag_t* link_sa          # (n_links,) 1: small-angle mode (state)

@@ -368,7 +368,16 @@ def _robot_entry(body: Body, terrain: Any, cfg: SimConfig) -> dict[str, Any]:
         ends += [2.0 * np.sqrt(k_axial * m[v]), 2.0 * np.sqrt(b2 * 0.5 * m[v] * L),
                  2.0 * np.sqrt(k_torsion * inertia[v]), 2.0 * np.sqrt(k_bend * inertia[v])]
     link["c_seed"] = np.stack(ends, axis=1).reshape(-1, 8)
-    link["homog"] = (mat[v1] == mat[v2]).astype(np.int8)
+    # voxel 2 takes exactly -F1 (the scatter subtracts voxel 1's turned force)
+    # where the seed's formulas make it so: one material, or two whose ends
+    # have the same damping constants a M and b2 FM (equal masses: muscles of
+    # one tissue that differ only in CTE). There the seed's own f2 = -f1 + bz
+    # (-a v ...) is exactly minus voxel 1's damped force in IEEE arithmetic;
+    # a build that fuses multiply-adds may fuse the two forms differently
+    # (single-precision links did: 1e-8 relative momentum drift)
+    ends = link["c_seed"]
+    link["homog"] = ((mat[v1] == mat[v2])
+                     | ((ends[:, 0] == ends[:, 4]) & (ends[:, 1] == ends[:, 5]))).astype(np.int8)
     dt = _time_step(k_axial, m, E, v1, v2, cfg)
     crit = 2.0 * np.sqrt(m * E * L)
     origin = np.concatenate([np.broadcast_to(p["origin"], p["idx"].shape) for p in parts])
