@@ -189,11 +189,12 @@ def seed_engine_ratio(oracle_py: str, repeats: int = 3) -> dict:
     design = reference_design()
     text = to_vxa(design)
     walls = []
-    # softgym's configurations on the same robot: the seed preset, the corotational
-    # preset, the seed preset with single-precision link math
+    # softgym's configurations on the same robot: the seed preset (its default
+    # single-precision link math), the corotational preset, the seed preset with
+    # the seed's own double-precision link operations
     configs = {"seed": SimConfig(self_collision=True),
                "corotational": SimConfig(self_collision=True, model="corotational"),
-               "single": SimConfig(self_collision=True, link_precision="single")}  # fmt: skip
+               "double": SimConfig(self_collision=True, link_precision="double")}  # fmt: skip
     times = {name: [] for name in configs}
     # interleaved repeats (seed engine, softgym, seed engine, ...): a background
     # load that comes and goes falls on both engines alike; the medians are compared
@@ -209,7 +210,7 @@ def seed_engine_ratio(oracle_py: str, repeats: int = 3) -> dict:
             times[name].append(time.perf_counter() - t0)
             if name == "seed":
                 rollout = r
-    ours, corot, single = times["seed"], times["corotational"], times["single"]
+    ours, corot, double = times["seed"], times["corotational"], times["double"]
     vsteps = float(design.n_voxels * rollout.steps[0])
     return {
         "seed_engine_voxel_steps_per_s": vsteps / statistics.median(walls),
@@ -220,8 +221,8 @@ def seed_engine_ratio(oracle_py: str, repeats: int = 3) -> dict:
         "repeats": repeats,
         # the corotational preset on the same robot and steps (its own time step is the same)
         "corotational_ratio": statistics.median(walls) / statistics.median(corot),
-        # the seed preset with SimConfig.link_precision="single" (the same steps)
-        "single_ratio": statistics.median(walls) / statistics.median(single),
+        # the seed preset with SimConfig.link_precision="double" (the same steps)
+        "double_ratio": statistics.median(walls) / statistics.median(double),
         "steps": int(rollout.steps[0]),
     }
 
@@ -247,8 +248,8 @@ def main(argv: list[str] | None = None) -> int:
             ap.error("--ratio-only needs --seed-engine")
         m = seed_engine_ratio(args.seed_engine, args.repeats)
         print(f"seed's engine {m['seed_engine_wall_s']:.3f} s, softgym seed preset "
-              f"{m['softgym_wall_s']:.3f} s: {m['ratio']:.2f}x; single-precision links "
-              f"{m['single_ratio']:.2f}x; corotational preset "
+              f"{m['softgym_wall_s']:.3f} s: {m['ratio']:.2f}x; double-precision links "
+              f"{m['double_ratio']:.2f}x; corotational preset "
               f"{m['corotational_ratio']:.2f}x (reference robot, {m['steps']} steps, one "
               f"thread, median of {m['repeats']} interleaved repeats)")
         if args.json:

@@ -20,8 +20,9 @@ each robot alone and the whole set as one batch, on 1 and 2 threads.
     SOFTGYM_KERNEL=baseline python benchmarks/check_bitident.py --compare /tmp/speed_ref.npz
     # the same for the corotational preset's kernel
     python benchmarks/check_bitident.py --model corotational --save /tmp/corot_ref.npz
-    # the same for the seed model's single-precision link math
-    python benchmarks/check_bitident.py --link-precision single --save /tmp/single_ref.npz
+    # the same for the seed model's double-precision link operations (the default
+    # is its single-precision link math)
+    python benchmarks/check_bitident.py --link-precision double --save /tmp/double_ref.npz
 """
 
 from __future__ import annotations
@@ -101,7 +102,7 @@ def state_of(sim: Simulation, robot: int, rollout) -> dict[str, np.ndarray]:
 
 
 def run_all(seconds: float, quick: bool, vxa: str | None, log=print, model: str = "seed",
-            link_precision: str = "double"):
+            link_precision: str | None = None):
     """{key: array} of every case alone (1 and 2 threads) and all in batches."""
     res = {}
     cs = cases(quick, vxa)
@@ -144,7 +145,7 @@ def main(argv=None) -> int:
     ap.add_argument("--vxa", default=VXA)
     ap.add_argument("--model", default="seed", choices=("seed", "corotational"),
                     help="preset whose kernel is checked (a reference holds one preset)")
-    ap.add_argument("--link-precision", default="double", choices=("double", "single"),
+    ap.add_argument("--link-precision", default=None, choices=("double", "single"),
                     help="SimConfig.link_precision (a reference holds one)")
     args = ap.parse_args(argv)
     import softgym.engine._core as core

@@ -24,7 +24,7 @@ oracle's sample steps, as a fraction of the oracle's displacement scale).
     python benchmarks/fidelity_seed.py                      # everything (~30 min on 2 cores)
     python benchmarks/fidelity_seed.py --quick              # 12 cases per set
     python benchmarks/fidelity_seed.py --model corotational # the pre-fidelity step, for the "before" table
-    python benchmarks/fidelity_seed.py --link-precision single  # the seed model's float link math
+    python benchmarks/fidelity_seed.py --link-precision double  # the seed's own double link operations
     python benchmarks/fidelity_seed.py --json               # last line: the figures as JSON
 
 Values under 0.01 voxel lengths are raised to 0.01 before ratios are taken (a
@@ -59,7 +59,7 @@ ORACLE_HALVES = ((1, 2, 3), (4, 5, 6))  # perturbed oracle draws split in two ha
 
 
 # ------------------------------------------------------------------------ micro-cases
-def micro_errors(model: str = "seed", link_precision: str = "double") -> dict[str, dict[str, Any]]:
+def micro_errors(model: str = "seed", link_precision: str | None = None) -> dict[str, dict[str, Any]]:
     """Per micro-case: max |softgym - oracle| over the samples, as a fraction of the
     oracle's displacement scale (its largest range of x, y or z). The oracle prints 6
     significant digits: half a unit of the last one is forgiven."""
@@ -118,7 +118,7 @@ def load_oracle(sets: list[str]) -> tuple[list[Any], dict[tuple[str, str, int], 
 
 
 def run_softgym(cases: list[Any], draws: list[int], model: str, threads: int | None,
-                link_precision: str = "double") -> dict[tuple[str, str, int], float]:
+                link_precision: str | None = None) -> dict[tuple[str, str, int], float]:
     """softgym's value of each case's metric (:data:`METRIC`) for every regime and draw,
     one batch per regime and terrain (fence metrics on the seed's diluted centre of mass)."""
     out = {}
@@ -174,7 +174,7 @@ def compare(cases, oracle, ours, draws, terrain: str = "flat", halves=ORACLE_HAL
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--model", default="seed", choices=["seed", "corotational"])
-    ap.add_argument("--link-precision", default="double", choices=["double", "single"],
+    ap.add_argument("--link-precision", default=None, choices=["double", "single"],
                     help="SimConfig.link_precision of the seed model")
     ap.add_argument("--sets", default="structured,random,fence")
     ap.add_argument("--draws", type=int, default=3, help="perturbed softgym draws per case (>= 3)")
@@ -195,13 +195,14 @@ def main() -> int:
     draws = list(range(1, a.draws + 1))
     halves = tuple(tuple(int(x) for x in h.split(",")) for h in a.halves.split("/"))
     ours = run_softgym(cases, draws, a.model, a.threads, a.link_precision)
-    report = {"model": a.model, "link_precision": a.link_precision, "sets": sets, "draws": draws, "n_cases": len(cases),
+    prec = SimConfig(model=a.model, link_precision=a.link_precision).effective_link_precision
+    report = {"model": a.model, "link_precision": prec, "sets": sets, "draws": draws, "n_cases": len(cases),
               "halves": halves,
               "regimes": compare(cases, oracle, ours, draws, "flat", halves),
               "fence_regimes": compare(cases, oracle, ours, draws, "fence", halves),
               "micro": micro_errors(a.model, a.link_precision)}
     report["wall_s"] = time.perf_counter() - t0
-    print(f"softgym model {a.model!r} (link precision {a.link_precision}) against the seed's engine: {len(cases)} cases "
+    print(f"softgym model {a.model!r} (link precision {prec}) against the seed's engine: {len(cases)} cases "
           f"({', '.join(sets)}), {len(draws)} softgym draws, oracle halves {halves}")
     print(f"{'regime':8s} {'pair':18s} {'n':>4s} {'spearman':>9s} {'med|log10|':>10s} "
           f"{'<=2x':>6s} {'<=3x':>6s} {'moved/still':>11s}")

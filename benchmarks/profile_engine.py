@@ -77,7 +77,7 @@ def demangle(name: str) -> str:
 
 
 def profile(model: str, collisions: bool, seconds: float, n: int, toggle: str,
-            precision: str = "double") -> dict:
+            precision: str | None = None) -> dict:
     """Run the child under callgrind; return totals and per-function counts."""
     if shutil.which("valgrind") is None:
         raise SystemExit("profile_engine: valgrind is not installed (apt-get install valgrind)")
@@ -160,7 +160,7 @@ def _tree_copy(dest: Path) -> None:
 
 
 def profile_cycles(collisions: bool, seconds: float, n: int, repeats: int,
-                   precision: str = "double") -> dict:
+                   precision: str | None = None) -> dict:
     """Build a probed copy of the tree, run it ``repeats`` times; the quickest run's counts."""
     with tempfile.TemporaryDirectory(prefix="softgym-cycles-") as tmp:
         tree = Path(tmp)
@@ -185,11 +185,11 @@ def profile_cycles(collisions: bool, seconds: float, n: int, repeats: int,
     return best
 
 
-def print_cycles(p: dict, n: int, collisions: bool, precision: str = "double") -> None:
+def print_cycles(p: dict, n: int, collisions: bool, precision: str | None = None) -> None:
     vs = p["steps"] * p["n_voxels"]
     c = p["counts"]
     total = sum(c[k] for _, k, sub in CYCLE_ROWS if not sub)
-    prec = ", single-precision links" if precision == "single" else ""
+    prec = ", double-precision links" if precision == "double" else ", single-precision links"
     print(f"seed preset{prec}, kernel build {p['build']}, {n}^3 reference robot, self-collision "
           f"{'on' if collisions else 'off'}, {p['steps']} steps, one thread: the quickest of "
           f"{p['repeats']} runs, {total / vs:.1f} cycles per voxel-step (time-stamp counter at "
@@ -209,7 +209,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--size", type=int, default=6, help="robot edge in voxels")
     ap.add_argument("--toggle", default=TOGGLE, help="callgrind --toggle-collect pattern")
     ap.add_argument("--json", action="store_true", help="print one JSON object as the last line")
-    ap.add_argument("--link-precision", default="double", choices=("double", "single"),
+    ap.add_argument("--link-precision", default=None, choices=("double", "single"),
                     help="SimConfig.link_precision of the seed preset")
     ap.add_argument("--cycles", action="store_true",
                     help="time each pass (a probed build of a copy of the tree; seed preset)")
@@ -230,7 +230,9 @@ def main(argv: list[str] | None = None) -> int:
                 args.link_precision)
     vs = p["steps"] * p["n_voxels"]
     ls = p["steps"] * p["n_links"]
-    prec = ", single-precision links" if args.link_precision == "single" else ""
+    prec = ""
+    if args.model == "seed":
+        prec = ", double-precision links" if args.link_precision == "double" else ", single-precision links"
     print(f"{p['model']} preset{prec}, kernel build {p['kernel_build']}, {args.size}^3 reference "
           f"robot, self-collision "
           f"{'on' if p['collisions'] else 'off'}, {p['steps']} steps: "

@@ -269,7 +269,7 @@ def fence_terrain() -> Terrain:
 
 
 def micro_trace(
-    case: dict[str, Any], model: str = "seed", link_precision: str = "double"
+    case: dict[str, Any], model: str = "seed", link_precision: str | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """The centre of mass softgym computes at the oracle's sample steps of a micro-case.
 

@@ -106,16 +106,18 @@ class SimConfig:
         force ``-fluid_drag s^2 (v.n)^2 n`` at its voxel's centre (a face
         moving away takes none). 0: no fluid (0). The seed's voxels weigh
         1e6 kg/m^3, so a fluid of that density with ``C_d = 1`` is 5e5.
-    link_precision : {"double", "single"}
-        Arithmetic of the seed model's link frames and forces. ``"double"``:
-        as the seed's engine, bit-identical from build to build of one
-        instruction set. ``"single"``: those two passes in float (twice the
-        vector lanes; positions, geometry, modes, the world-frame sums and
-        the voxel update stay double), with the rotation-vector formula
-        rewritten so that float does not cancel (docs/PHYSICS.md); faster,
-        different last digits, checked against the seed's engine by
-        ``benchmarks/fidelity_seed.py --link-precision single``. Needs
-        ``model="seed"`` ("double").
+    link_precision : {"single", "double"} or None
+        Arithmetic of the seed model's link frames and forces. ``"single"``:
+        those two passes in float (twice the vector lanes; positions,
+        geometry, modes, the world-frame sums and the voxel update stay
+        double), with the rotation-vector formula rewritten so that float does
+        not cancel (docs/PHYSICS.md, section 5.8); checked against the seed's
+        engine by ``benchmarks/fidelity_seed.py``. ``"double"``: the seed's
+        engine's own operations in double, as before issue 29 made float the
+        default (bit-identical to earlier runs of the same build); needs
+        ``model="seed"`` when ``"single"`` is asked for. None (the default):
+        ``"single"`` for the seed model, ``"double"`` for the corotational
+        one; :attr:`effective_link_precision` tells which.
     """
 
     voxel_size: float = 0.01
@@ -137,7 +139,7 @@ class SimConfig:
     friction: float = 1.0
     incline: float = 0.0
     fluid_drag: float = 0.0
-    link_precision: Literal["double", "single"] = "double"
+    link_precision: Literal["double", "single"] | None = None
 
     def __post_init__(self) -> None:
         def check(name: str, ok: bool, what: str) -> None:
@@ -165,7 +167,7 @@ class SimConfig:
         check("friction", finite("friction") >= 0, ">= 0 (a factor on the materials' friction)")
         check("incline", -60 <= finite("incline") <= 60, "in [-60, 60] degrees")
         check("fluid_drag", finite("fluid_drag") >= 0, ">= 0 kg/m^3")
-        check("link_precision", isinstance(self.link_precision, str) and self.link_precision in ("double", "single"), '"double" or "single"')
+        check("link_precision", self.link_precision is None or (isinstance(self.link_precision, str) and self.link_precision in ("double", "single")), '"single", "double" or None (the model\'s default)')
         if self.link_precision == "single" and self.model != "seed":
             raise InvalidParameterError(
                 f'SimConfig.link_precision "single" needs model "seed", got model {self.model!r}'
@@ -177,6 +179,16 @@ class SimConfig:
             isinstance(self.collision_exclusion, int) and 1 <= self.collision_exclusion <= 8,
             "an integer in [1, 8]",
         )
+
+    @property
+    def effective_link_precision(self) -> Literal["double", "single"]:
+        """The link math the step uses: ``link_precision``, or the model's default
+        when it is None (``"single"`` for the seed model, ``"double"`` for the
+        corotational one, whose links are always double).
+        """
+        if self.link_precision is not None:
+            return self.link_precision
+        return "single" if self.model == "seed" else "double"
 
     @classmethod
     def seed(cls, **overrides: Any) -> SimConfig:

@@ -538,10 +538,10 @@ def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layou
     a["c_seed"] = _link_rows(np.asarray(a["c_seed"], dtype=np.float64).reshape(-1, 8).T)
     a["homog"] = a["homog"].astype(np.int8)
     a["link_sa"] = np.ones(a["v1"].shape[0], dtype=np.int8)  # links start in small-angle mode
-    single = cfg.link_precision == "single"
-    # see _TRANSPOSED; float32 with link_precision "single", whose forces pass keeps float values
+    single = cfg.effective_link_precision == "single"
+    # see _TRANSPOSED; float32 with single-precision links, whose forces pass keeps float values
     a["link_last"] = _link_rows(np.zeros((9, a["v1"].shape[0]), dtype=np.float32 if single else np.float64))
-    # (11, n_links) float32, for link_precision "single" only (else no columns): k_axial,
+    # (11, n_links) float32, for single-precision links only (else no columns): k_axial,
     # k_torsion, k_bend and the 8 rows of c_seed, rounded once
     a["k_seed32"] = (
         _link_rows(np.vstack([a["k_axial"], a["k_torsion"], a["k_bend"], a["c_seed"]]).astype(np.float32))

@@ -58,12 +58,14 @@ def test_link_rows_are_padded_views_and_state_io_keeps_them(precision):
     assert not np.any(sim.get_state()["link_last"])
 
 
-def test_padding_changes_no_bit():
+@pytest.mark.parametrize("precision", ["double", "single"])
+def test_padding_changes_no_bit(precision):
     # the same robots with their link rows unpadded (contiguous copies, as an older
     # layout had them) and padded step to the same bits
     bodies = [reference_robot(3)] * 3
-    sims = [Simulation(bodies, SimConfig(), n_threads=1) for _ in range(2)]
-    for name in ("link_last", "c_seed"):
+    cfg = SimConfig(link_precision=precision)
+    sims = [Simulation(bodies, cfg, n_threads=1) for _ in range(2)]
+    for name in ("link_last", "c_seed" if precision == "double" else "k_seed32"):
         sims[1]._a[name] = np.ascontiguousarray(sims[1]._a[name])
     for sim in sims:
         sim.advance(0.2)
@@ -71,8 +73,9 @@ def test_padding_changes_no_bit():
         np.testing.assert_array_equal(sims[0].get_state()[key], sims[1].get_state()[key])
 
 
-def test_kernel_refuses_link_rows_of_two_strides():
-    sim = Simulation([reference_robot(2)] * 2, SimConfig(), n_threads=1)
-    sim._a["c_seed"] = np.ascontiguousarray(sim._a["c_seed"])  # link_last stays padded
+@pytest.mark.parametrize(("precision", "name"), [("double", "c_seed"), ("single", "k_seed32")])
+def test_kernel_refuses_link_rows_of_two_strides(precision, name):
+    sim = Simulation([reference_robot(2)] * 2, SimConfig(link_precision=precision), n_threads=1)
+    sim._a[name] = np.ascontiguousarray(sim._a[name])  # link_last stays padded
     with pytest.raises(ValueError, match="one row stride"):
         sim.advance(0.01)

@@ -60,7 +60,7 @@ KWARGS = {
         | st.tuples(st.integers(6, 7), st.floats(5, 8), st.integers(6, 7))
         | st.builds(np.array, st.lists(st.integers(6, 8), min_size=3, max_size=3))
     ),
-    "sim_config": st.sampled_from([None, "default", "single"]),
+    "sim_config": st.sampled_from([None, "default", "double"]),
     "terrain": st.sampled_from([None, "flat", "fence"]),
     "render_mode": st.sampled_from([None, "rgb_array", "human"]),
     "width": st.integers(1, 64) | st.integers(-5, 5) | st.integers(4090, 4100),
@@ -85,7 +85,7 @@ OBJECTS = {
     ("design", "default"): default_walker(),
     ("design", "small"): SMALL,
     ("sim_config", "default"): SimConfig(),
-    ("sim_config", "single"): SimConfig(link_precision="single"),
+    ("sim_config", "double"): SimConfig(link_precision="double"),
     ("terrain", "flat"): Terrain.flat(),
     ("terrain", "fence"): Terrain.fence(),
 }

@@ -40,14 +40,17 @@ def test_check_env_passes_without_warnings(env_id):
     env.close()
 
 
-def test_single_precision_links_pass_the_checker_and_repeat():
-    # SimConfig(link_precision="single") through gym.make: Gymnasium's checker passes
-    # and a seeded episode repeats bit for bit (its own numbers, not the double step's)
+@pytest.mark.parametrize("precision", [None, "double"])
+def test_both_link_precisions_pass_the_checker_and_repeat(precision):
+    # the default (single-precision links) and SimConfig(link_precision="double")
+    # through gym.make: Gymnasium's checker passes and a seeded episode repeats bit for
+    # bit; the two precisions give different numbers
     from softgym.engine import SimConfig
 
-    def rollout():
-        env = gym.make("SoftWalker-Flat-v0", sim_config=SimConfig(link_precision="single"),
-                       episode_seconds=1.2)  # fmt: skip
+    cfg = SimConfig(link_precision=precision)
+
+    def rollout(c):
+        env = gym.make("SoftWalker-Flat-v0", sim_config=c, episode_seconds=1.2)
         obs, _ = env.reset(seed=3)
         env.action_space.seed(3)
         out = [obs]
@@ -56,13 +59,16 @@ def test_single_precision_links_pass_the_checker_and_repeat():
         env.close()
         return np.array(out)
 
-    env = gym.make("SoftWalker-Flat-v0", sim_config=SimConfig(link_precision="single"))
-    assert env.unwrapped.sim.config.link_precision == "single"
+    env = gym.make("SoftWalker-Flat-v0", sim_config=cfg)
+    want = "double" if precision == "double" else "single"
+    assert env.unwrapped.sim.config.effective_link_precision == want
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         check_env(env.unwrapped)
     env.close()
-    assert np.array_equal(rollout(), rollout())
+    assert np.array_equal(rollout(cfg), rollout(cfg))
+    other = SimConfig(link_precision="single" if precision == "double" else "double")
+    assert not np.array_equal(rollout(cfg), rollout(other))
 
 
 def test_make_without_arguments_gives_the_default_walker():
