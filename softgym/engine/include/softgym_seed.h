@@ -241,6 +241,20 @@ static inline float softgym_rotvec_k32(float w)
 {
     return 2.0f * sqrtf(2.0f / (1.0f + w));
 }
+/* k(w) in float for every w >= 0.5: past the seed's acos cut (w <= w_acos)
+   its k = 2 acos(w) / sqrt(1 - w^2) is, with z = (1 - w) / 2 and u = sqrt(z),
+   (2 / sqrt(1 - z)) (asin(u) / u): the square-root branch's k times asin(u) / u,
+   which for z <= 1/4 (w >= 0.5) is single-precision asin's polynomial 1 + z
+   P(z) (Cephes' asinf, good to float rounding). 1 - w is exact there. Below
+   w = 0.5 (rotations past 120 degrees) the link is redone in double. */
+static inline float softgym_rotvec_k32_acos(float w, float w_acos)
+{
+    float z = 0.5f * (1.0f - w);
+    float p = (((4.2163199048e-2f * z + 2.4181311049e-2f) * z + 4.5470025998e-2f) * z
+               + 7.4953002686e-2f) * z + 1.6666752422e-1f;
+    float r = w <= w_acos ? 1.0f + z * p : 1.0f;
+    return softgym_rotvec_k32(w) * r;
+}
 SOFTGYM_ALWAYS_INLINE void softgym_seed_frames32_impl(
     const int all_small, Py_ssize_t lo, Py_ssize_t hi, float sa_rad, float w_acos,
     const double *p0_, const double *p1_, const double *p2_, const double *qw_,
@@ -260,13 +274,13 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_frames32_impl(
         int fix = 0;
         SOFTGYM_CHORD_FRAME(float, int, sqrtf, p0, p1, p2, sa_rad);
         fix |= (1 - is_sa) & (1 - zero) & back;
-        float k1 = softgym_rotvec_k32(rw);
-        fix |= (1 - is_sa) & (1 - zero) & (rw <= w_acos);
+        float k1 = softgym_rotvec_k32_acos(rw, w_acos);
+        fix |= (1 - is_sa) & (1 - zero) & (rw < 0.5f);
         float a1y = ry * k1, a1z = rz * k1;
         SOFTGYM_TQ(float);
         float w2 = is_sa ? qw : tw;
-        float k2 = softgym_rotvec_k32(w2);
-        fix |= w2 <= w_acos;
+        float k2 = softgym_rotvec_k32_acos(w2, w_acos);
+        fix |= w2 < 0.5f;
         float P0_s = (float)(p0d - nomd), P0_l = (float)(len_[li] - nomd);
         o_P0[li] = is_sa ? P0_s : P0_l;
         o_P1[li] = is_sa ? p1 : 0.0f;
