@@ -280,6 +280,7 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
     #   softgym_seed_frames  rows 10-20: displacement P, rotation vectors a1
     #                        (y, z) and a2, the large-angle frame rq; row 21
     #                        marks links whose rotation needs the acos branch
+    #                        (in single precision: turned past 120 degrees)
     #   _seed_frame_one      redoes those links with the seed's branches
     #   softgym_seed_forces  rows 0-9, 21, 24: forces and moments in the bond
     #                        frame (stiffness, the seed's damping from the

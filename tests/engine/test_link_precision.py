@@ -98,6 +98,17 @@ def test_a_tiny_rotation_survives_single_precision(angle, small):
     assert np.linalg.norm(a2) == pytest.approx(angle, rel=1e-5)
 
 
+@pytest.mark.parametrize("angle", [0.1, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0])
+@pytest.mark.parametrize("small", [1.0, 0.0])
+def test_the_acos_branch_in_float_lanes_gives_the_rotation_angle(angle, small):
+    # past ~5.6 degrees the seed's k(w) = 2 acos(w) / sqrt(1 - w^2) (its acos branch):
+    # the float lanes take it as 2 / sqrt(1 - z) times asin's polynomial in z = (1 - w) / 2
+    # up to 120 degrees (2.09 rad), the double fix-up beyond; either way |a2| is the angle
+    geom = np.ascontiguousarray(np.array([_column((1.0, 0.0, 0.0), angle, (1, -2, 0.5), 1.0, small)]).T)
+    a2 = _core.seed_frames(geom, single=True)[5:8, 0]
+    assert np.linalg.norm(a2) == pytest.approx(angle, rel=1e-6)
+
+
 def test_cantilever_and_free_fall_hold_in_single_precision():
     # the closed-form cases of test_closed_form.py, same tolerances
     L, E, P = 0.01, 5e6, 0.015

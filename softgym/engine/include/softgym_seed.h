@@ -223,7 +223,7 @@ static void softgym_seed_frames(
     }
 }
 
-/* Single-precision link math (SimConfig.link_precision = "single"): the
+/* Single-precision link math (the seed model's default link precision): the
    frames and forces passes in float, 16 lanes of AVX-512 instead of 8 and
    the divider's float rate, on quantities relative to voxel 1 (positions
    stay double; the geometry and mode passes stay double). Their float rows
@@ -234,9 +234,10 @@ static void softgym_seed_frames(
      k = 2 sqrt((2 - 2w) / (1 - w^2)), which is 2 sqrt(2 / (1 + w)) exactly:
      that form, with no cancellation near w = 1 (the seed's own form loses
      up to half its digits there in double);
-   - its acos branch (1 - w^2 >= 1 - 0.9988^2) is w <= 0.9988.
-   Links that need the acos branch or have a backward chord are redone in
-   double by _seed_frame_one, as in double precision. */
+   - its acos branch (1 - w^2 >= 1 - 0.9988^2) is w <= 0.9988, computed in the
+     lanes for w >= 0.5 (softgym_rotvec_k32_acos).
+   Links turned past 120 degrees (w < 0.5) or with a backward chord are redone
+   in double by _seed_frame_one, as in double precision. */
 static inline float softgym_rotvec_k32(float w)
 {
     return 2.0f * sqrtf(2.0f / (1.0f + w));
