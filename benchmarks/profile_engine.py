@@ -185,11 +185,21 @@ def profile_cycles(collisions: bool, seconds: float, n: int, repeats: int,
     return best
 
 
+def precision_label(model: str, precision: str | None) -> str:
+    """", single-precision links" / ", double-precision links" for the seed preset (the
+    precision its SimConfig resolves to), "" for the corotational one."""
+    if model != "seed":
+        return ""
+    from softgym.engine import SimConfig
+
+    return f", {SimConfig(model=model, link_precision=precision).effective_link_precision}-precision links"
+
+
 def print_cycles(p: dict, n: int, collisions: bool, precision: str | None = None) -> None:
     vs = p["steps"] * p["n_voxels"]
     c = p["counts"]
     total = sum(c[k] for _, k, sub in CYCLE_ROWS if not sub)
-    prec = ", double-precision links" if precision == "double" else ", single-precision links"
+    prec = precision_label("seed", precision)
     print(f"seed preset{prec}, kernel build {p['build']}, {n}^3 reference robot, self-collision "
           f"{'on' if collisions else 'off'}, {p['steps']} steps, one thread: the quickest of "
           f"{p['repeats']} runs, {total / vs:.1f} cycles per voxel-step (time-stamp counter at "
@@ -230,9 +240,7 @@ def main(argv: list[str] | None = None) -> int:
                 args.link_precision)
     vs = p["steps"] * p["n_voxels"]
     ls = p["steps"] * p["n_links"]
-    prec = ""
-    if args.model == "seed":
-        prec = ", double-precision links" if args.link_precision == "double" else ", single-precision links"
+    prec = precision_label(args.model, args.link_precision)
     print(f"{p['model']} preset{prec}, kernel build {p['kernel_build']}, {args.size}^3 reference "
           f"robot, self-collision "
           f"{'on' if p['collisions'] else 'off'}, {p['steps']} steps: "
