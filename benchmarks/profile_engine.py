@@ -29,6 +29,12 @@ which it prints). It sees what instruction counts miss (a gather or a division c
 more than one instruction):
 
     python benchmarks/profile_engine.py --cycles --repeats 6
+
+``--baseline GITREF`` builds that revision too and runs the two builds alternately (a
+background load that comes and goes then falls on both), printing each pass's change:
+on a shared VM whose runs scatter by 5 %, the way to judge a change of a few per cent:
+
+    python benchmarks/profile_engine.py --cycles --repeats 8 --baseline HEAD
 """
 
 from __future__ import annotations
@@ -159,30 +165,60 @@ def _tree_copy(dest: Path) -> None:
             shutil.copy2(root / rel, dest / rel)
 
 
-def profile_cycles(collisions: bool, seconds: float, n: int, repeats: int,
-                   precision: str | None = None) -> dict:
-    """Build a probed copy of the tree, run it ``repeats`` times; the quickest run's counts."""
-    with tempfile.TemporaryDirectory(prefix="softgym-cycles-") as tmp:
-        tree = Path(tmp)
-        _tree_copy(tree)
-        env = dict(os.environ, SOFTGYM_PROFILE_CYCLES="1")
-        res = subprocess.run([sys.executable, "setup.py", "build_ext", "--inplace"], cwd=tree,
-                             env=env, capture_output=True, text=True, check=False)  # fmt: skip
-        if res.returncode != 0:
-            raise SystemExit(f"profile_engine: the probed build failed:\n{res.stderr[-2000:]}")
-        code = CYCLES_CHILD.format(bench=str(tree / "benchmarks"), n=n, coll=collisions,
-                                   seconds=seconds, prec=precision)  # fmt: skip
-        runs = []
-        for _ in range(repeats):
-            run = run_in_tree(tree, code, "CYCLES", "profile_engine")
-            if run["counts"] is None:
-                raise SystemExit("profile_engine: the run did not load the probed build")
-            runs.append(run)
+def _ref_copy(dest: Path, ref: str) -> None:
+    """The files of git revision ``ref`` (``git archive``), extracted into ``dest``."""
+    root = HERE.parent
+    archive = subprocess.run(["git", "archive", "--format=tar", ref], cwd=root,
+                             capture_output=True, check=False)  # fmt: skip
+    if archive.returncode != 0:
+        raise SystemExit(f"profile_engine: git archive {ref}: {archive.stderr.decode().strip()}")
+    subprocess.run(["tar", "-x", "-C", str(dest)], input=archive.stdout, check=True)
+
+
+def _probed_build(tree: Path) -> None:
+    env = dict(os.environ, SOFTGYM_PROFILE_CYCLES="1")
+    res = subprocess.run([sys.executable, "setup.py", "build_ext", "--inplace"], cwd=tree,
+                         env=env, capture_output=True, text=True, check=False)  # fmt: skip
+    if res.returncode != 0:
+        raise SystemExit(f"profile_engine: the probed build failed:\n{res.stderr[-2000:]}")
+
+
+def _quickest(runs: list[dict], repeats: int) -> dict:
+    """The run with the fewest cycles in all, with every run's total per voxel-step."""
     best = min(runs, key=lambda r: sum(r["counts"][k] for _, k, sub in CYCLE_ROWS if not sub))
     best["repeats"] = repeats
     best["totals"] = sorted(sum(r["counts"][k] for _, k, sub in CYCLE_ROWS if not sub)
                             / (r["steps"] * r["n_voxels"]) for r in runs)  # fmt: skip
     return best
+
+
+def profile_cycles(collisions: bool, seconds: float, n: int, repeats: int,
+                   precision: str | None = None, baseline: str | None = None) -> list[dict]:
+    """Build a probed copy of the tree, run it ``repeats`` times; the quickest run's counts.
+
+    With ``baseline`` (a git revision) a probed build of that revision too, the two
+    run alternately (a load that comes and goes falls on both): [tree, baseline].
+    """
+    with tempfile.TemporaryDirectory(prefix="softgym-cycles-") as tmp:
+        trees = [Path(tmp) / "tree"]
+        trees[0].mkdir()
+        _tree_copy(trees[0])
+        if baseline is not None:
+            trees.append(Path(tmp) / "baseline")
+            trees[1].mkdir()
+            _ref_copy(trees[1], baseline)
+        for tree in trees:
+            _probed_build(tree)
+        runs: list[list[dict]] = [[] for _ in trees]
+        for _ in range(repeats):
+            for tree, out in zip(trees, runs):
+                code = CYCLES_CHILD.format(bench=str(tree / "benchmarks"), n=n, coll=collisions,
+                                           seconds=seconds, prec=precision)  # fmt: skip
+                run = run_in_tree(tree, code, "CYCLES", "profile_engine")
+                if run["counts"] is None:
+                    raise SystemExit("profile_engine: the run did not load the probed build")
+                out.append(run)
+    return [_quickest(r, repeats) for r in runs]
 
 
 def precision_label(model: str, precision: str | None) -> str:
@@ -211,6 +247,23 @@ def print_cycles(p: dict, n: int, collisions: bool, precision: str | None = None
         print(f"{name:40s} {c[key] / vs:18.1f} {100 * c[key] / total:6.1f}%")
 
 
+def print_cycles_against(p: dict, q: dict, baseline: str) -> None:
+    """The tree's cycles per voxel-step (p) beside the baseline's (q), each pass."""
+    vp, vq = p["steps"] * p["n_voxels"], q["steps"] * q["n_voxels"]
+    print(f"against {baseline} (built and run alternately; every run of it: "
+          f"{', '.join(f'{t:.1f}' for t in q['totals'])})")
+    print(f"{'stage / pass':40s} {'this tree':>10s} {baseline[:12]:>12s} {'change':>8s}")
+    rows = [*CYCLE_ROWS, ("total", None, False)]
+    for label, key, sub in rows:
+        if key is None:
+            a = sum(p["counts"][k] for _, k, s in CYCLE_ROWS if not s) / vp
+            b = sum(q["counts"][k] for _, k, s in CYCLE_ROWS if not s) / vq
+        else:
+            a, b = p["counts"][key] / vp, q["counts"][key] / vq
+        name = ("  " + label) if sub else label
+        print(f"{name:40s} {a:10.1f} {b:12.1f} {100 * (a - b) / b if b else 0.0:+7.1f}%")
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", default="seed", choices=("seed", "corotational"))
@@ -224,17 +277,22 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--cycles", action="store_true",
                     help="time each pass (a probed build of a copy of the tree; seed preset)")
     ap.add_argument("--repeats", type=int, default=5, help="--cycles: runs, the quickest kept")
+    ap.add_argument("--baseline", metavar="GITREF", default=None,
+                    help="--cycles: also a probed build of this git revision, run alternately "
+                         "with the tree's, and each pass's change against it")
     args = ap.parse_args(argv)
     if args.cycles:
         if args.model != "seed":
             raise SystemExit("profile_engine: --cycles times the seed preset's passes only")
         if args.repeats < 1:
             raise SystemExit("profile_engine: --repeats must be at least 1")
-        c = profile_cycles(not args.no_collision, args.seconds, args.size, args.repeats,
-                           args.link_precision)
-        print_cycles(c, args.size, not args.no_collision, args.link_precision)
+        got = profile_cycles(not args.no_collision, args.seconds, args.size, args.repeats,
+                             args.link_precision, args.baseline)
+        print_cycles(got[0], args.size, not args.no_collision, args.link_precision)
+        if args.baseline is not None:
+            print_cycles_against(got[0], got[1], args.baseline)
         if args.json:
-            print(json.dumps(c))
+            print(json.dumps(got[0] if args.baseline is None else got))
         return 0
     p = profile(args.model, not args.no_collision, args.seconds, args.size, args.toggle,
                 args.link_precision)
