@@ -85,7 +85,7 @@ def state_of(sim: Simulation, robot: int, rollout) -> dict[str, np.ndarray]:
     out = {}
     for k in ("pos", "vel", "quat", "angvel", "rot", "scale", "col_ref"):
         out[k] = np.array(a[k][vlo:vhi])
-    out["link_sa"] = np.array(a["link_sa"][llo:lhi])
+    out["link_sa"] = np.array(a["link_sa"][llo:lhi], dtype=np.int8)  # as states show it
     last = a["link_last"]
     # (n_links, 9) before the speed work, (9, n_links) after: compared as (n_links, 9)
     out["link_last"] = np.array(last[llo:lhi] if last.shape == (sim.n_links, 9) else last[:, llo:lhi].T)

@@ -4,7 +4,7 @@
 # unless said otherwise; "(n, 3)" means n rows of 3 stored row-major. Units
 # are SI. Types only: no module behind this file.
 
-from softgym.engine._typedefs cimport float64_t, intp_t, step_t, int32, flag_t
+from softgym.engine._typedefs cimport float64_t, intp_t, step_t, int32, flag_t, lane_flag_t
 
 # Status codes returned by the nogil helpers (errors cross nogil as codes).
 cdef enum:
@@ -113,11 +113,12 @@ cdef struct Batch:
     float64_t* c_seed        # (8, n_links), rows link_rows apart: 2 sqrt(k m) damping constants
                              #   of voxel 1 then voxel 2: a1 M, b2 FM, a2 I, b3 I
                              #   (FM = M L / 2, I = M L^2 / 6)
-    flag_t* homog            # (n_links,) 1: voxel 2 gets -F1 (one material, or two with equal
+    lane_flag_t* homog       # (n_links,) int64, 1: voxel 2 gets -F1 (one material, or two with equal
                              #   damping constants a M, b2 FM: layout._robot_entry)
     float* k_seed32          # (11, n_links), rows link_rows apart, float32: k_axial, k_torsion,
                              #   k_bend, c_seed's 8 rows (link_f32 only; NULL otherwise)
-    flag_t* link_sa          # (n_links,) 1: small-angle mode (state)
+    lane_flag_t* link_sa     # (n_links,) int64, 1: small-angle mode (state; int8 in states:
+                             #   simulation._STATE_DTYPE)
     intp_t* seed_rank        # (n_voxels,) the voxel's index in the seed engine's order
     float64_t* col_ref       # (n_voxels, 4) position and size at the last candidate rebuild (state)
     float64_t* col_acc       # (n_robots,) the seed's displacement since that rebuild, in L (state)

@@ -32,7 +32,7 @@ from softgym.engine._record cimport record, robot_aux, robot_energy
 from softgym.engine._prof cimport (softgym_prof_enabled, softgym_prof_tsc, softgym_prof_add,
                                    softgym_prof_get, softgym_prof_reset)
 from softgym.engine._seed cimport links_seed
-from softgym.engine._typedefs cimport float64_t, intp_t, step_t, int32, flag_t
+from softgym.engine._typedefs cimport float64_t, intp_t, step_t, int32, flag_t, lane_flag_t
 
 from softgym.engine._integrate import refresh_rotations  # noqa: F401 (Python API)
 from softgym.engine._seed import seed_frames  # noqa: F401 (Python API, for tests)
@@ -370,8 +370,8 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
         b.c_torsion = _f(a, "c_torsion")
         b.c_bend = _f(a, "c_bend")
         b.c_seed = _f(a, "c_seed")
-        b.homog = <flag_t*> _p(a, "homog")
-        b.link_sa = <flag_t*> _p(a, "link_sa")
+        b.homog = <lane_flag_t*> _p(a, "homog")
+        b.link_sa = <lane_flag_t*> _p(a, "link_sa")
         # the rows the forces pass reads with one stride
         b.link_rows = _row_stride_of(a["link_last"], "link_last")
         rows_with = "k_seed32" if b.link_f32 else "c_seed"

@@ -41,7 +41,7 @@ import numpy as np
 from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_STRAIN, N_LINK_OUT
 from softgym.engine._prof cimport (softgym_prof_enabled, softgym_prof_tsc, softgym_prof_add,
                                    softgym_prof_get, softgym_prof_reset)
-from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t
+from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t, lane_flag_t
 
 cnp.import_array()
 
@@ -71,7 +71,7 @@ cdef inline float64_t _rotvec_k(float64_t w) noexcept nogil:
 
 
 cdef extern from "softgym_seed.h":
-    # the passes of _seed_links_along (C, for the vectorising pragma and one
+    # the passes of links_seed (C, for the vectorising pragma and one
     # copy per link axis; documented in include/softgym_seed.h)
     void softgym_seed_geom(int ax, intp_t lo, intp_t hi, intp_t n, const intp_t* v1,
                            const intp_t* v2, const float64_t* pos, const float64_t* quat,
@@ -93,8 +93,8 @@ cdef extern from "softgym_seed.h":
                              float64_t* const* out) noexcept nogil
     intp_t softgym_seed_modes(intp_t lo, intp_t hi, intp_t n, float64_t max_ext,
                               float64_t sa_w, float64_t sah_w, float64_t st_in, float64_t ex_in,
-                              float64_t st_out, float64_t ex_out, flag_t* link_sa,
-                              const flag_t* homog, float64_t* o) noexcept nogil
+                              float64_t st_out, float64_t ex_out, lane_flag_t* link_sa,
+                              const lane_flag_t* homog, float64_t* o) noexcept nogil
     void softgym_seed_scatter(int ax, intp_t lo, intp_t hi, intp_t n, const intp_t* v1,
                               const intp_t* v2, const float64_t* rot, const float64_t* o,
                               float64_t* force, float64_t* moment) noexcept nogil
@@ -107,7 +107,7 @@ cdef extern from "softgym_seed.h":
                                float64_t* const* out) noexcept nogil
 
 
-#: the passes of _seed_links_along that the cycle probes time, in slot order
+#: the passes of links_seed that the cycle probes time, in slot order
 CYCLE_PASSES = ("geometry", "modes", "frames", "frames_acos", "forces", "scatter")
 
 
@@ -224,9 +224,9 @@ cdef inline void _forces_rows(float64_t* o, intp_t n, float64_t** out) noexcept 
     out[11] = o + 24 * n
 
 
-cdef inline void _seed_links_along32(Batch* b, intp_t lo, intp_t end, const int ax,
-                                     float64_t inv_dt, intp_t ls) noexcept nogil:
-    # _seed_links_along's frames and forces passes in single precision
+cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end, float64_t inv_dt,
+                                       intp_t ls) noexcept nogil:
+    # links_seed's frames and forces passes in single precision
     # (SimConfig.link_precision = "single"; include/softgym_seed.h): float
     # rows 10-21 from the frames, double rows 0-9, 21, 24 from the forces for
     # the scatter. ls: the robot's first link (_float_row)
@@ -259,65 +259,20 @@ cdef inline void _seed_links_along32(Batch* b, intp_t lo, intp_t end, const int 
                           o + 22 * n, k32, k32 + b.link_rows, k32 + 2 * b.link_rows,
                           k32 + 3 * b.link_rows, b.link_last32, out)
     softgym_prof_add(4, t0)
-    t0 = softgym_prof_tsc()
-    softgym_seed_scatter(ax, lo, end, n, b.v1, b.v2, b.rot, o, b.force, b.moment)
-    softgym_prof_add(5, t0)
 
 
-cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
-                                  float64_t inv_dt, intp_t ls) noexcept nogil:
-    # links_seed for its links [lo, hi), all along axis ax (a compile-time
-    # constant once inlined), in passes over the link scratch b.link_out
-    # (profiled: the square roots and divisions of the large-angle frames
-    # dominated the step; one branch-free vector loop does them for many links
-    # at once, the same IEEE operations as the seed's scalar code):
-    #   softgym_seed_geom    rows 0-9: relative position p, orientation (qw, n),
-    #                        nominal length, chord length, transverse ratio
-    #   softgym_seed_modes   the mode (link_sa; row 9 becomes 1.0 small / 0.0
-    #                        large angle), row 22 1.0 on a mode-change step,
-    #                        row 23 1.0 where voxel 2 takes -F1, the strain
-    #                        check (stops at the first strained link)
-    #   softgym_seed_frames  rows 10-20: displacement P, rotation vectors a1
-    #                        (y, z) and a2, the large-angle frame rq; row 21
-    #                        marks links whose rotation needs the acos branch
-    #                        (in single precision: turned past 120 degrees)
-    #   _seed_frame_one      redoes those links with the seed's branches
-    #   softgym_seed_forces  rows 0-9, 21, 24: forces and moments in the bond
-    #                        frame (stiffness, the seed's damping from the
-    #                        link's memory; rq^-1 for large angles)
-    #   softgym_seed_scatter back to the world, scattered in link order
-    # With link_precision "single" the frames and forces run in float
-    # (_seed_links_along32; ls, the robot's first link, places the float rows).
-    # The bond frame is voxel 1's frame turned by the proper rotation P that
-    # takes the link axis onto +x (the seed's ToXDirBond): (x, y, z) ->
-    # (x, y, z), (y, -x, z), (z, y, -x) for ax 0, 1, 2.
+cdef inline void _seed_frames_forces(Batch* b, intp_t lo, intp_t end,
+                                     float64_t inv_dt) noexcept nogil:
+    # links_seed's frames and forces passes in double precision (the seed's
+    # own operations)
     cdef:
-        intp_t li, i, j, k, end
-        float64_t bz = 0.5 * b.bond_zeta
-        float64_t bzh = 0.5 * bz
-        const float64_t* rot = b.rot
-        const intp_t* v1 = b.v1
-        const intp_t* v2 = b.v2
-        intp_t n = b.link_stride  # the scratch's row stride
+        intp_t li, k
+        intp_t n = b.link_stride
         float64_t* o = b.link_out
-        float64_t* force = b.force
-        float64_t* moment = b.moment
+        float64_t bz = 0.5 * b.bond_zeta
         const float64_t* inp[11]
         float64_t* out[12]
         unsigned long long t0
-    if hi <= lo:
-        return STATUS_OK
-    t0 = softgym_prof_tsc()
-    softgym_seed_geom(ax, lo, hi, n, v1, v2, b.pos, b.quat, b.scale, o)
-    softgym_prof_add(0, t0)
-    t0 = softgym_prof_tsc()
-    end = softgym_seed_modes(lo, hi, n, b.max_strain * b.L, SMALL_ANGLE_W, SMALLISH_ANGLE_W,
-                             SA_BOND_BEND_RAD, SA_BOND_EXT_PERC, HYSTERESIS * SA_BOND_BEND_RAD,
-                             HYSTERESIS * SA_BOND_EXT_PERC, b.link_sa, b.homog, o)
-    softgym_prof_add(1, t0)
-    if b.link_f32:
-        _seed_links_along32(b, lo, end, ax, inv_dt, ls)
-        return STATUS_OK if end == hi else STATUS_STRAIN
     t0 = softgym_prof_tsc()
     softgym_seed_frames(lo, end, SMALL_ANGLE_RAD, SLTHRESH_ACOS2SQRT, o, o + n, o + 2 * n,
                         o + 3 * n, o + 4 * n, o + 5 * n, o + 6 * n, o + 7 * n, o + 8 * n,
@@ -334,15 +289,28 @@ cdef inline int _seed_links_along(Batch* b, intp_t lo, intp_t hi, const int ax,
     for k in range(11):
         inp[k] = o + (10 + k) * n
     _forces_rows(o, n, out)
-    softgym_seed_forces(lo, end, b.link_rows, b.L, bz, bzh, inv_dt, inp, o + 9 * n, o + 22 * n,
-                        b.k_axial, b.k_torsion, b.k_bend, b.c_seed, b.link_last, out)
+    softgym_seed_forces(lo, end, b.link_rows, b.L, bz, 0.5 * bz, inv_dt, inp, o + 9 * n,
+                        o + 22 * n, b.k_axial, b.k_torsion, b.k_bend, b.c_seed, b.link_last,
+                        out)
     softgym_prof_add(4, t0)
+
+
+cdef inline intp_t _seed_geom_modes(Batch* b, int ax, intp_t lo, intp_t hi, intp_t n,
+                                   float64_t* o) noexcept nogil:
+    # the geometry and the modes of links lo..hi along axis ax, the modes while
+    # the geometry's rows are in the cache: hi, or the first strained link
+    cdef:
+        intp_t end
+        unsigned long long t0
     t0 = softgym_prof_tsc()
-    # back to the world (the inverse axis turn, voxel 1's rotation) and the
-    # scatter, in link order (the seed's summation order)
-    softgym_seed_scatter(ax, lo, end, n, v1, v2, rot, o, force, moment)
-    softgym_prof_add(5, t0)
-    return STATUS_OK if end == hi else STATUS_STRAIN
+    softgym_seed_geom(ax, lo, hi, n, b.v1, b.v2, b.pos, b.quat, b.scale, o)
+    softgym_prof_add(0, t0)
+    t0 = softgym_prof_tsc()
+    end = softgym_seed_modes(lo, hi, n, b.max_strain * b.L, SMALL_ANGLE_W, SMALLISH_ANGLE_W,
+                             SA_BOND_BEND_RAD, SA_BOND_EXT_PERC, HYSTERESIS * SA_BOND_BEND_RAD,
+                             HYSTERESIS * SA_BOND_EXT_PERC, b.link_sa, b.homog, o)
+    softgym_prof_add(1, t0)
+    return end
 
 
 cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
@@ -351,18 +319,65 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     # Quantities are those of the seed's bond frame (the link axis turned
     # onto +x, voxel 1's orientation removed); rotations back to the world
     # go through voxel 1's rotation matrix. A robot's links are sorted by
-    # axis (x, then y, then z): each run gets a copy with the axis constant.
+    # axis (x, then y, then z); the passes below run over the link scratch
+    # b.link_out (profiled: the square roots and divisions of the large-angle
+    # frames dominated the step; one branch-free vector loop does them for
+    # many links at once, the same IEEE operations as the seed's scalar code):
+    #   softgym_seed_geom    rows 0-9: relative position p, orientation (qw, n),
+    #                        nominal length, chord length, transverse ratio
+    #                        (once per axis: each run gets a copy with the axis
+    #                        constant)
+    #   softgym_seed_modes   the mode (link_sa; row 9 becomes 1.0 small / 0.0
+    #                        large angle), row 22 1.0 on a mode-change step,
+    #                        row 23 1.0 where voxel 2 takes -F1, the strain
+    #                        check (stops at the first strained link)
+    #   softgym_seed_frames  rows 10-20: displacement P, rotation vectors a1
+    #                        (y, z) and a2, the large-angle frame rq; row 21
+    #                        marks links whose rotation needs the acos branch
+    #                        (in single precision: turned past 120 degrees)
+    #   _seed_frame_one      redoes those links with the seed's branches
+    #   softgym_seed_forces  rows 0-9, 21, 24: forces and moments in the bond
+    #                        frame (stiffness, the seed's damping from the
+    #                        link's memory; rq^-1 for large angles)
+    #   softgym_seed_scatter back to the world, scattered in link order (once
+    #                        per axis)
+    # The modes, frames and forces passes need no axis: each runs once over
+    # all the robot's links (one vector loop and one remainder instead of
+    # three). Each link's quantities are its own and the links are visited in
+    # the same order, so the result is the one of running the passes axis by
+    # axis, bit for bit (a strained link stops the step after the links before
+    # it, as the seed's scalar loop does). With link_precision "single" the
+    # frames and forces run in float (_seed_frames_forces32).
+    # The bond frame is voxel 1's frame turned by the proper rotation P that
+    # takes the link axis onto +x (the seed's ToXDirBond): (x, y, z) ->
+    # (x, y, z), (y, -x, z), (z, y, -x) for ax 0, 1, 2.
     cdef:
         intp_t lo = b.link_start[r]
         intp_t hi = b.link_start[r + 1]
-        intp_t nx = b.link_axis_count[3 * r]
-        intp_t ny = b.link_axis_count[3 * r + 1]
+        intp_t ly = lo + b.link_axis_count[3 * r]
+        intp_t lz = ly + b.link_axis_count[3 * r + 1]
+        intp_t n = b.link_stride  # the scratch's row stride
+        intp_t end
         float64_t inv_dt = 1.0 / b.dt[r]
-    if _seed_links_along(b, lo, lo + nx, 0, inv_dt, lo) != STATUS_OK:
-        return STATUS_STRAIN
-    if _seed_links_along(b, lo + nx, lo + nx + ny, 1, inv_dt, lo) != STATUS_OK:
-        return STATUS_STRAIN
-    return _seed_links_along(b, lo + nx + ny, hi, 2, inv_dt, lo)
+        float64_t* o = b.link_out
+        unsigned long long t0
+    if hi <= lo:
+        return STATUS_OK
+    end = _seed_geom_modes(b, 0, lo, ly, n, o)
+    if end == ly:
+        end = _seed_geom_modes(b, 1, ly, lz, n, o)
+        if end == lz:
+            end = _seed_geom_modes(b, 2, lz, hi, n, o)
+    if b.link_f32:
+        _seed_frames_forces32(b, lo, end, inv_dt, lo)
+    else:
+        _seed_frames_forces(b, lo, end, inv_dt)
+    t0 = softgym_prof_tsc()
+    softgym_seed_scatter(0, lo, min(ly, end), n, b.v1, b.v2, b.rot, o, b.force, b.moment)
+    softgym_seed_scatter(1, ly, min(lz, end), n, b.v1, b.v2, b.rot, o, b.force, b.moment)
+    softgym_seed_scatter(2, lz, end, n, b.v1, b.v2, b.rot, o, b.force, b.moment)
+    softgym_prof_add(5, t0)
+    return STATUS_OK if end == hi else STATUS_STRAIN
 
 
 # ---------------------------------------------------------------------------

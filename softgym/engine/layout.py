@@ -536,8 +536,8 @@ def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layou
         a[name] = a[name].astype(np.intp)
     # (8, n_links): one row per constant, for the kernel's vector loops
     a["c_seed"] = _link_rows(np.asarray(a["c_seed"], dtype=np.float64).reshape(-1, 8).T)
-    a["homog"] = a["homog"].astype(np.int8)
-    a["link_sa"] = np.ones(a["v1"].shape[0], dtype=np.int8)  # links start in small-angle mode
+    a["homog"] = a["homog"].astype(np.int64)
+    a["link_sa"] = np.ones(a["v1"].shape[0], dtype=np.int64)  # links start in small-angle mode
     single = cfg.effective_link_precision == "single"
     # see _TRANSPOSED; float32 with single-precision links, whose forces pass keeps float values
     a["link_last"] = _link_rows(np.zeros((9, a["v1"].shape[0]), dtype=np.float32 if single else np.float64))

@@ -89,6 +89,9 @@ _ROBOT_STATE = ("diverged", "diverged_time", "diverged_code", "init_done", "cm_i
 _LINK_STATE = ("link_sa", "link_last")  # the seed model's per-link mode and memory
 # kept as (rows, n_links) for the kernel's vector loops, shown as (n_links, rows) in states
 _TRANSPOSED = ("link_last",)
+# kernel arrays that states show in another dtype: the links' mode is int64 in the kernel
+# (its modes pass reads it in 64-bit vector lanes), a 0/1 flag in states
+_STATE_DTYPE = {"link_sa": np.int8}
 _STATE = (*_VOXEL_STATE, *_ROBOT_STATE, *_LINK_STATE, "steps", "trace_n", "trace_t", "trace_cm",
           "trace_aux")
 
@@ -749,7 +752,8 @@ class Simulation:
 
     def get_state(self) -> dict[str, np.ndarray]:
         """Copy of the full dynamic state (plain arrays, for checkpoints)."""
-        state = {k: self._state_view(k).copy() for k in _STATE}
+        state = {k: np.array(self._state_view(k), dtype=_STATE_DTYPE.get(k), copy=True)
+                 for k in _STATE}
         state["t_target"] = np.array(self._t_target)
         return state
 

@@ -21,7 +21,7 @@
             f(2, __VA_ARGS__); \
     } while (0)
 
-/* The first pass of _seed_links_along: links lo..hi (all along axis ax, a
+/* The first pass of links_seed (_seed.pyx): links lo..hi (all along axis ax, a
    compile-time constant in each copy) measured in the bond frame, without
    branches so the loop vectorises; rows of o (stride n): 0-2 the relative
    position p, 3-6 voxel 2's orientation relative to voxel 1 (q1* q2 = (qw,
@@ -87,7 +87,7 @@ static void softgym_seed_geom(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n
     SOFTGYM_BY_AXIS(ax, softgym_seed_geom_ax, lo, hi, n, v1, v2, pos, quat, scale, o);
 }
 
-/* The second pass of _seed_links_along, in C for one pragma: the bond-frame
+/* The frames pass of links_seed, in C for one pragma: the bond-frame
    quantities of links lo..hi in the mode the first pass gave them, without
    branches so the loop vectorises (the outputs are distinct rows of the
    scratch: no two iterations touch the same element). Every candidate
@@ -319,7 +319,7 @@ static void softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, fl
     }
 }
 
-/* The forces pass of _seed_links_along (softgym_seed_forces.h, one definition
+/* The forces pass of links_seed (softgym_seed_forces.h, one definition
    for both precisions): softgym_seed_forces in double, the seed's operations
    (softgym_pick keeps its selects blends: a select before a store may
    otherwise become a masked store), softgym_seed_forces32 in float for
@@ -377,7 +377,7 @@ static void softgym_seed_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, doubl
     }
 }
 
-/* The first pass of _seed_links_along after the geometry, without branches
+/* The pass of links_seed after the geometry, without branches
    so the loop vectorises: each link's mode, small or large angle, with the
    seed's hysteresis (updates link_sa), from the rows the geometry left
    (p0: row 0, qw: 3, nominal length: 7, chord length: 8, transverse ratio:
@@ -386,12 +386,15 @@ static void softgym_seed_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, doubl
    Then the strain check: returns hi, or the first link whose extension is
    beyond max_ext (NaN included); the links after it keep their old mode
    (old = new xor changed), as in the seed's scalar loop, which stops there.
-   With AVX only (4 lanes, 64-bit compares); else that scalar loop. */
+   With AVX only (4 lanes, 64-bit compares); else that scalar loop. link_sa and
+   homog are 64-bit: with 8-bit flags the loop took 64 links a vector iteration
+   and left up to 63 of each run to its scalar remainder (profiled: 12.3 against
+   5.5 cycles per voxel-step). */
 static Py_ssize_t softgym_seed_modes(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
                                      double max_ext, double sa_w, double sah_w,
                                      double st_in, double ex_in, double st_out,
-                                     double ex_out, signed char *link_sa,
-                                     const signed char *homog, double *o)
+                                     double ex_out, long long *link_sa,
+                                     const long long *homog, double *o)
 {
     Py_ssize_t li;
 #if defined(__AVX__)
@@ -407,7 +410,7 @@ static Py_ssize_t softgym_seed_modes(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
         long long ch = enter | leave;
         long long s2 = sa ^ ch;
         double P0 = softgym_pick(s2, p0 - nom, len - nom);
-        link_sa[li] = (signed char)s2;
+        link_sa[li] = s2;
         o[9 * n + li] = softgym_pick(s2, 1.0, 0.0);
         o[22 * n + li] = softgym_pick(ch, 1.0, 0.0);
         o[23 * n + li] = softgym_pick(ch | (homog[li] != 0), 1.0, 0.0);
@@ -421,7 +424,7 @@ static Py_ssize_t softgym_seed_modes(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
             break;
     }
     for (Py_ssize_t k = li + 1; k < hi; k++)
-        link_sa[k] = (signed char)(link_sa[k] ^ (o[22 * n + k] != 0.0));
+        link_sa[k] = link_sa[k] ^ (o[22 * n + k] != 0.0);
     return li;
 #else
     /* 2 lanes and no 64-bit compare (SSE2): the branchy scalar loop is
@@ -438,7 +441,7 @@ static Py_ssize_t softgym_seed_modes(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
             sa = 0;
             changed = 1;
         }
-        link_sa[li] = (signed char)sa;
+        link_sa[li] = sa;
         o[9 * n + li] = sa ? 1.0 : 0.0;
         o[22 * n + li] = changed ? 1.0 : 0.0;
         o[23 * n + li] = (changed || homog[li]) ? 1.0 : 0.0;
@@ -450,7 +453,7 @@ static Py_ssize_t softgym_seed_modes(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
 #endif
 }
 
-/* The last pass of _seed_links_along: links lo..hi (all along axis ax) back
+/* The last pass of links_seed: links lo..hi (all along axis ax) back
    to the world and scattered, in link order (the seed's summation order).
    Row k of a link's bond-frame output o (rows f1: 0-2, f2: 3-5, m1: 6-8,
    m2: 9, 21, 24) becomes R1 P^T v (P^T the inverse axis turn: (x, y, z) =

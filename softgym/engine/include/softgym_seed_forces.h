@@ -1,4 +1,4 @@
-/* The forces pass of _seed_links_along, one definition for both precisions:
+/* The forces pass of links_seed, one definition for both precisions:
    softgym_seed.h includes this file twice, with SOFTGYM_FT (the arithmetic's
    type: double, or float for SimConfig.link_precision = "single"),
    SOFTGYM_FNAME (the function's name), SOFTGYM_FPICK (c ? a : b in that
