@@ -8,7 +8,7 @@ from libc.math cimport sqrt
 from libc.stdint cimport int64_t
 
 from softgym.engine._batch cimport Batch
-from softgym.engine._typedefs cimport float64_t, intp_t, int32
+from softgym.engine._typedefs cimport float64_t, intp_t, int32, lane_flag_t
 
 
 # Self-collision candidates of one robot, rebuilt inside _core.advance_robot (scratch
@@ -38,7 +38,8 @@ cdef struct Contacts:
                              #   voxels' x, y, z and size
     intp_t* sur_idx          # (2, n_voxels_r) scratch: their voxel indices, then their
                              #   ranks in the seed's order
-    unsigned char* hit       # (n_voxels_r,) scratch: 1 where a pair is a candidate
+    lane_flag_t* hit         # (n_voxels_r,) scratch: 1 where a pair is a candidate (64-bit:
+                             #   softgym_pair_hits' vector lanes)
 
 
 # The spatial hash of the candidate lists (_contact.pyx, _hash_*): points in

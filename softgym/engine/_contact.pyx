@@ -19,7 +19,7 @@ from libc.stdlib cimport malloc, realloc, qsort
 from libc.string cimport memcpy, memset
 
 from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_MEMORY
-from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t
+from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t, lane_flag_t
 
 # ---------------------------------------------------------------------------
 # The spatial hash (SpatialHash, _contact.pxd): points binned in cubic cells
@@ -210,7 +210,7 @@ cdef inline int _alloc_lists(Contacts* c, intp_t n) noexcept nogil:
         c.ref = <float64_t*> malloc(3 * n * sizeof(float64_t))
         c.sur = <float64_t*> malloc(4 * n * sizeof(float64_t))
         c.sur_idx = <intp_t*> malloc(2 * n * sizeof(intp_t))
-        c.hit = <unsigned char*> malloc(n * sizeof(unsigned char))
+        c.hit = <lane_flag_t*> malloc(n * sizeof(lane_flag_t))
         if c.cells == NULL or c.row == NULL or c.ref == NULL or c.sur == NULL \
                 or c.sur_idx == NULL or c.hit == NULL:
             return STATUS_MEMORY
@@ -223,7 +223,7 @@ cdef extern from "softgym_pairs.h":
     void softgym_pair_hits(int seed_rule, intp_t a, intp_t n, const float64_t* x,
                            const float64_t* y, const float64_t* z, const float64_t* s,
                            const intp_t* rank, float64_t lim2,
-                           unsigned char* hit) noexcept nogil
+                           lane_flag_t* hit) noexcept nogil
 
 
 # robots with at most this many surface voxels get the all-pairs test

@@ -15,12 +15,14 @@
    in each copy): the pair is kept unless d2 >= lim2 (9 L^2) or d2 >= act^2,
    act twice the size of the pair's first voxel in the seed's order; else
    unless d2 >= lim2 (the horizon squared). The same expressions and
-   comparisons as the hash's scalar test (a NaN distance is kept, as there). */
+   comparisons as the hash's scalar test (a NaN distance is kept, as there).
+   hit is 64-bit: with 8-bit flags the loop took 64 voxels a vector iteration,
+   and the rows of a small robot (shorter than 64) ran in its scalar remainder. */
 SOFTGYM_ALWAYS_INLINE void softgym_pair_hits_impl(const int seed_rule, Py_ssize_t a,
                                                   Py_ssize_t n, const double *x,
                                                   const double *y, const double *z,
                                                   const double *s, const Py_ssize_t *rank,
-                                                  double lim2, unsigned char *hit)
+                                                  double lim2, long long *hit)
 {
     const double xa = x[a], ya = y[a], za = z[a], sa = s[a];
     const Py_ssize_t ra = rank[a];
@@ -36,12 +38,12 @@ SOFTGYM_ALWAYS_INLINE void softgym_pair_hits_impl(const int seed_rule, Py_ssize_
             double act = 2.0 * (ra < rank[k] ? sa : s[k]);
             out |= d2 >= act * act;
         }
-        hit[k] = (unsigned char)(out == 0);
+        hit[k] = out == 0;
     }
 }
 static void softgym_pair_hits(int seed_rule, Py_ssize_t a, Py_ssize_t n, const double *x,
                               const double *y, const double *z, const double *s,
-                              const Py_ssize_t *rank, double lim2, unsigned char *hit)
+                              const Py_ssize_t *rank, double lim2, long long *hit)
 {
     if (seed_rule)
         softgym_pair_hits_impl(1, a, n, x, y, z, s, rank, lim2, hit);
