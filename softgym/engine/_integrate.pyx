@@ -100,13 +100,11 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
         float64_t dt = b.dt[r]
         float64_t m, h, pen, cg, d2, mx, my, mz
         float64_t c[3]
-        float64_t wx, wy, wz, qw, qx, qy, qz, nq
         float64_t f[3]
         float64_t n[3]
         float64_t* pos = b.pos
         float64_t* vel = b.vel
         float64_t* av = b.angvel
-        float64_t* qq
         float64_t g = b.gravity
         int32 has_floor = b.floor[r]
         int32 has_fluid = b.fluid_drag > 0.0
@@ -154,49 +152,42 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
         pos[3 * i + 1] += vel[3 * i + 1] * dt
         pos[3 * i + 2] += vel[3 * i + 2] * dt
         if not (fabs(pos[3 * i]) + fabs(pos[3 * i + 1]) + fabs(pos[3 * i + 2]) < RUNAWAY):
+            _orient(b, vs, i, dt, 0)  # the voxels before it were stepped
             clear_robot(b, r)
             return STATUS_NONFINITE
         if ref != NULL:
             d2 = _drift2(pos, ref, i, vs, c)
             if d2 > dmax2[0]:
                 dmax2[0] = d2
-        # rotation: w += M dt / I, global damping, q += 0.5 dt (0, w) q
+        # rotation: w += M dt / I, global damping; q += 0.5 dt (0, w) q after
+        # the loop (_orient: no voxel's update reads another's orientation)
         _spin(b, i, dt, mx, my, mz)
-        wx = av[3 * i] * 0.5 * dt
-        wy = av[3 * i + 1] * 0.5 * dt
-        wz = av[3 * i + 2] * 0.5 * dt
-        qq = b.quat + 4 * i
-        qw = qq[0] - wx * qq[1] - wy * qq[2] - wz * qq[3]
-        qx = qq[1] + wx * qq[0] + wy * qq[3] - wz * qq[2]
-        qy = qq[2] + wy * qq[0] + wz * qq[1] - wx * qq[3]
-        qz = qq[3] + wz * qq[0] + wx * qq[2] - wy * qq[1]
-        # renormalise: |q|^2 = 1 + O((w dt)^2), so one Newton step of 1/sqrt
-        # from 1 is exact to rounding
-        nq = 1.5 - 0.5 * (qw * qw + qx * qx + qy * qy + qz * qz)
-        qq[0] = qw * nq
-        qq[1] = qx * nq
-        qq[2] = qy * nq
-        qq[3] = qz * nq
-        _rotation_matrix(qq, b.rot + 9 * i)
+    _orient(b, vs, b.vox_start[r + 1], dt, 0)
     return STATUS_OK
 
 
-cdef extern from "softgym_seed.h":
-    # the seed's orientation step (C, for the vectorising pragma; documented in
-    # include/softgym_seed.h)
+cdef extern from "softgym_orient.h":
+    # the voxels' orientation step of both models (C, for the vectorising pragma;
+    # documented in include/softgym_orient.h)
     void softgym_seed_quats(intp_t lo, intp_t hi, intp_t n, float64_t dt, const float64_t* av,
                             const float64_t* quat, float64_t* q_out) noexcept nogil
+    void softgym_corot_quats(intp_t lo, intp_t hi, intp_t n, float64_t dt, const float64_t* av,
+                             const float64_t* quat, float64_t* q_out) noexcept nogil
 
 
-cdef inline void _seed_orient(Batch* b, intp_t lo, intp_t hi, float64_t dt) noexcept nogil:
-    # the orientation step of integrate_seed for voxels lo..hi (fixed voxels
-    # keep theirs): new quaternions, then their rotation matrices
+cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int seed) noexcept nogil:
+    # the orientation step of voxels lo..hi (fixed voxels keep theirs): new
+    # quaternions (the seed's exact renormalisation, or the corotational
+    # model's Newton step), then their rotation matrices
     cdef:
         intp_t i
         intp_t n = b.vox_stride  # the scratch's row stride
         float64_t* qo = b.vox_out
         float64_t* qq
-    softgym_seed_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
+    if seed:
+        softgym_seed_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
+    else:
+        softgym_corot_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
     for i in range(lo, hi):
         if b.fixed[i]:
             continue
@@ -212,7 +203,7 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
                         float64_t* dmax2) noexcept nogil:
     # Model 0's voxel update (the seed's EulerStep): as integrate_corotational, with the
     # seed's floor and exact quaternion renormalisation snapped to the identity
-    # at w >= 1 (_seed_orient, after the loop: no voxel's update reads
+    # at w >= 1 (_orient, after the loop: no voxel's update reads
     # another's orientation). Terrain boxes use the common surface contact.
     cdef:
         intp_t i, k
@@ -264,7 +255,7 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
         pos[3 * i + 1] += vel[3 * i + 1] * dt
         pos[3 * i + 2] += vel[3 * i + 2] * dt
         if not (fabs(pos[3 * i]) + fabs(pos[3 * i + 1]) + fabs(pos[3 * i + 2]) < RUNAWAY):
-            _seed_orient(b, vs, i, dt)  # the voxels before it were stepped
+            _orient(b, vs, i, dt, 1)  # the voxels before it were stepped
             clear_robot(b, r)
             return STATUS_NONFINITE
         if ref != NULL:
@@ -272,7 +263,7 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
             if d2 > dmax2[0]:
                 dmax2[0] = d2
         _spin(b, i, dt, mx, my, mz)
-    _seed_orient(b, vs, b.vox_start[r + 1], dt)
+    _orient(b, vs, b.vox_start[r + 1], dt, 1)
     return STATUS_OK
 
 

@@ -343,40 +343,6 @@ static void softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, fl
 #undef SOFTGYM_FPICK
 #undef SOFTGYM_FMASK
 
-/* The orientation step of _integrate_seed for voxels lo..hi, in C for the
-   vectorising pragma: q + (w dt / 2) x q (w the new angular velocity),
-   renormalised exactly (the seed's square root and division), snapped to
-   the identity at w >= 1, into the scratch rows q_out (4, n_voxels). The
-   same IEEE operations as the scalar seed code; the square root and the
-   division of one voxel no longer wait on the previous voxel's. */
-static void softgym_seed_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,
-                               const double *av, const double *quat, double *q_out)
-{
-    Py_ssize_t i;
-    SOFTGYM_IVDEP
-    for (i = lo; i < hi; i++) {
-        double wx = av[3 * i] * 0.5 * dt;
-        double wy = av[3 * i + 1] * 0.5 * dt;
-        double wz = av[3 * i + 2] * 0.5 * dt;
-        double q0 = quat[4 * i], q1 = quat[4 * i + 1], q2 = quat[4 * i + 2], q3 = quat[4 * i + 3];
-        double qw = q0 - wx * q1 - wy * q2 - wz * q3;
-        double qx = q1 + wx * q0 + wy * q3 - wz * q2;
-        double qy = q2 + wy * q0 + wz * q1 - wx * q3;
-        double qz = q3 + wz * q0 + wx * q2 - wy * q1;
-        double nq = sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
-        double inv = 1.0 / nq;
-        double nw = nq != 0.0 ? qw * inv : qw;
-        double nx = nq != 0.0 ? qx * inv : qx;
-        double ny = nq != 0.0 ? qy * inv : qy;
-        double nz = nq != 0.0 ? qz * inv : qz;
-        long long one = nw >= 1.0;
-        q_out[i] = one ? 1.0 : nw;
-        q_out[n + i] = one ? 0.0 : nx;
-        q_out[2 * n + i] = one ? 0.0 : ny;
-        q_out[3 * n + i] = one ? 0.0 : nz;
-    }
-}
-
 /* The pass of links_seed after the geometry, without branches
    so the loop vectorises: each link's mode, small or large angle, with the
    seed's hysteresis (updates link_sa), from the rows the geometry left
