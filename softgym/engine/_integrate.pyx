@@ -20,6 +20,8 @@ cdef float64_t RUNAWAY = 1.0e6  # |coordinate| (m) beyond which a robot diverged
 cdef extern from "softgym_simd.h":
     # R = the rotation matrix of the unit quaternion q = (w, x, y, z), row-major
     void _rotation_matrix "softgym_quat_matrix" (const float64_t* q, float64_t* R) noexcept nogil
+    void _quat_matrix "softgym_quat_matrix_wxyz" (float64_t w, float64_t x, float64_t y,
+                                                  float64_t z, float64_t* R) noexcept nogil
 
 
 cdef inline void _fluid_drag(Batch* b, intp_t i, float64_t* f) noexcept nogil:
@@ -184,6 +186,7 @@ cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int
         intp_t n = b.vox_stride  # the scratch's row stride
         float64_t* qo = b.vox_out
         float64_t* qq
+        float64_t w, x, y, z
     if seed:
         softgym_seed_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
     else:
@@ -191,12 +194,16 @@ cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int
     for i in range(lo, hi):
         if b.fixed[i]:
             continue
+        w = qo[i]
+        x = qo[n + i]
+        y = qo[2 * n + i]
+        z = qo[3 * n + i]
         qq = b.quat + 4 * i
-        qq[0] = qo[i]
-        qq[1] = qo[n + i]
-        qq[2] = qo[2 * n + i]
-        qq[3] = qo[3 * n + i]
-        _rotation_matrix(qq, b.rot + 9 * i)
+        qq[0] = w
+        qq[1] = x
+        qq[2] = y
+        qq[3] = z
+        _quat_matrix(w, x, y, z, b.rot + 9 * i)  # from registers, not the stores just made
 
 
 cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,

@@ -4,7 +4,8 @@ A refactor that keeps every bit can still stop GCC from vectorising a loop:
 the geometry pass once ran scalar for a whole session (twice its cycles)
 because its quaternion reached the matrix formula as a pointer plus an
 offset, which GCC 12 found "not suitable for gather load". Each pass of
-``include/softgym_seed.h`` and ``include/softgym_pairs.h`` is compiled here
+``include/softgym_seed.h``, ``include/softgym_orient.h`` and ``include/softgym_pairs.h``
+is compiled here
 alone, with the flags of the x86-64-v3 kernel build (setup.py), and GCC's
 vectorisation report must name a vectorised loop in it. Skipped where the
 compiler is not GCC or cannot target x86-64-v3.
@@ -33,9 +34,10 @@ PASSES = {
     "softgym_seed_forces32": "softgym_seed_forces32(0, n, n, 0.01f, 0.1f, 0.05f, 1e4f, fin, d, d, fc, fc, "
                              "fc, fc, fo[0], out);",
     "softgym_seed_modes": "return (long)softgym_seed_modes(0, n, n, 0.3, 0.99, 0.98, 0.05, 1.3, "
-                          "0.055, 1.43, sc, sc, o);",
+                          "0.055, 1.43, lf, lf, o);",
     "softgym_seed_quats": "softgym_seed_quats(0, n, n, 1e-4, d, d, o);",
-    "softgym_pair_hits": "softgym_pair_hits(ax, 0, n, d, d, d, d, ip, 1e-4, (unsigned char *)sc);",
+    "softgym_corot_quats": "softgym_corot_quats(0, n, n, 1e-4, d, d, o);",
+    "softgym_pair_hits": "softgym_pair_hits(ax, 0, n, d, d, d, d, ip, 1e-4, lf);",
 }
 
 
@@ -58,9 +60,10 @@ def test_each_seed_pass_vectorises(name, tmp_path):
         "#include <stddef.h>\n"
         "typedef long Py_ssize_t;\n"  # Python.h's, which Cython includes first
         '#include "softgym_seed.h"\n'
+        '#include "softgym_orient.h"\n'
         '#include "softgym_pairs.h"\n'
         "long run(int ax, Py_ssize_t n, const Py_ssize_t *ip, const double *d, double *o,\n"
-        "         signed char *sc, const double *const *cin, double *const *out,\n"
+        "         long long *lf, const double *const *cin, double *const *out,\n"
         "         const float *fc, float *const *fo, const float *const *fin)\n"
         "{\n"
         f"    {PASSES[name]}\n"
@@ -72,6 +75,8 @@ def test_each_seed_pass_vectorises(name, tmp_path):
     if res.returncode != 0 and "x86-64-v3" in res.stderr:
         pytest.skip("the compiler cannot target x86-64-v3")
     assert res.returncode == 0, res.stderr
+    assert "implicit declaration" not in res.stderr, res.stderr  # the pass is where we look
     vectorised = [line for line in res.stderr.splitlines()
-                  if "loop vectorized" in line and ("softgym_seed" in line or "softgym_pairs.h" in line)]  # fmt: skip
+                  if "loop vectorized" in line
+                  and any(h in line for h in ("softgym_seed", "softgym_orient.h", "softgym_pairs.h"))]  # fmt: skip
     assert vectorised, f"{name}: GCC vectorised no loop:\n{res.stderr[-2000:]}"
