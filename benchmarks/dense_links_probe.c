@@ -40,20 +40,17 @@ static double urand(void) { return rand() / (double)RAND_MAX - 0.5; }
 static Py_ssize_t stride_of(int n) { return (n + 15) / 16 * 16 + 16; }
 
 /* the geometry of slots [0, hi) along axis ax: voxel 1 in cell c, voxel 2 in c + s;
-   rows of o as softgym_seed_geom_ax's (P: the packed rows, 8 of NC) */
+   the engine's arithmetic (SOFTGYM_SEED_GEOM_LINK) into rows of o as softgym_seed_geom_ax's
+   (P: the packed rows, 8 of NC) */
 SOFTGYM_ALWAYS_INLINE void geom_dense_ax(const int ax, Py_ssize_t s, Py_ssize_t hi,
                                          Py_ssize_t n, const double *P, double *o)
 {
-    const int a0 = ax, a1 = ax == 1 ? 0 : 1, a2 = ax == 2 ? 0 : 2;
-    const double s1 = ax == 1 ? -1.0 : 1.0, s2 = ax == 2 ? -1.0 : 1.0;
-    const double w00 = a0 == 0, w01 = a0 == 1, w02 = a0 == 2;
-    const double w10 = a1 == 0 ? s1 : 0.0, w11 = a1 == 1 ? s1 : 0.0, w12 = a1 == 2 ? s1 : 0.0;
-    const double w20 = a2 == 0 ? s2 : 0.0, w21 = a2 == 1 ? s2 : 0.0, w22 = a2 == 2 ? s2 : 0.0;
+    SOFTGYM_SEED_GEOM_AXIS(ax);
+    SOFTGYM_SEED_GEOM_OUT(o, n);
     const double *__restrict__ px = P, *__restrict__ py = P + NC, *__restrict__ pz = P + 2 * NC;
     const double *__restrict__ qw_ = P + 3 * NC, *__restrict__ qx_ = P + 4 * NC;
     const double *__restrict__ qy_ = P + 5 * NC, *__restrict__ qz_ = P + 6 * NC;
     const double *__restrict__ sc = P + 7 * NC;
-    double *__restrict__ O = o;
     Py_ssize_t c;
     SOFTGYM_IVDEP
     for (c = 0; c < hi; c++) {
@@ -61,25 +58,7 @@ SOFTGYM_ALWAYS_INLINE void geom_dense_ax(const int ax, Py_ssize_t s, Py_ssize_t 
         double dx = px[j] - px[i], dy = py[j] - py[i], dz = pz[j] - pz[i];
         double w = qw_[i], x = qx_[i], y = qy_[i], z = qz_[i];
         double wj = qw_[j], xj = qx_[j], yj = qy_[j], zj = qz_[j];
-        double R[9];
-        softgym_quat_matrix_wxyz(w, x, y, z, R);
-        double p0 = (((R[a0] * dx) + (R[3 + a0] * dy)) + (R[6 + a0] * dz));
-        double p1 = (s1 * (((R[a1] * dx) + (R[3 + a1] * dy)) + (R[6 + a1] * dz)));
-        double p2 = (s2 * (((R[a2] * dx) + (R[3 + a2] * dy)) + (R[6 + a2] * dz)));
-        double qw = ((((w * wj) + (x * xj)) + (y * yj)) + (z * zj));
-        double qx = ((((w * xj) - (x * wj)) - (y * zj)) + (z * yj));
-        double qy = ((((w * yj) + (x * zj)) - (y * wj)) - (z * xj));
-        double qz = ((((w * zj) - (x * yj)) + (y * xj)) - (z * wj));
-        O[c] = p0;
-        O[n + c] = p1;
-        O[2 * n + c] = p2;
-        O[3 * n + c] = qw;
-        O[4 * n + c] = (((qx * w00) + (qy * w01)) + (qz * w02));
-        O[5 * n + c] = (((qx * w10) + (qy * w11)) + (qz * w12));
-        O[6 * n + c] = (((qx * w20) + (qy * w21)) + (qz * w22));
-        O[7 * n + c] = (0.5 * (sc[i] + sc[j]));
-        O[8 * n + c] = sqrt((((dx * dx) + (dy * dy)) + (dz * dz)));
-        O[9 * n + c] = ((fabs(p2) + fabs(p1)) / p0);
+        SOFTGYM_SEED_GEOM_LINK(c, dx, dy, dz, w, x, y, z, wj, xj, yj, zj, sc[i], sc[j]);
     }
 }
 

@@ -10,55 +10,63 @@
 #include <math.h>
 #include "softgym_simd.h"
 
-/* q + (w dt / 2) x q for voxel i, declaring qw, qx, qy, qz (and q0..q3, its old value) */
-#define SOFTGYM_QUAT_STEP(av, quat, i, dt) \
-    double wx = av[3 * i] * 0.5 * dt; \
-    double wy = av[3 * i + 1] * 0.5 * dt; \
-    double wz = av[3 * i + 2] * 0.5 * dt; \
-    double q0 = quat[4 * i], q1 = quat[4 * i + 1], q2 = quat[4 * i + 2], q3 = quat[4 * i + 3]; \
-    double qw = q0 - wx * q1 - wy * q2 - wz * q3; \
-    double qx = q1 + wx * q0 + wy * q3 - wz * q2; \
-    double qy = q2 + wy * q0 + wz * q1 - wx * q3; \
-    double qz = q3 + wz * q0 + wx * q2 - wy * q1
-
-/* model 0 (the seed's): renormalised exactly (the seed's square root and division),
-   snapped to the identity at w >= 1 */
+/* voxels lo..hi: q + (w dt / 2) x q, then (seed, a compile-time constant in each copy)
+   the seed's exact renormalisation (its square root and division) snapped to the
+   identity at w >= 1, or the corotational model's one Newton step of 1 / sqrt from 1
+   (|q|^2 is 1 + O((w dt)^2), so the step is exact to rounding) */
+SOFTGYM_ALWAYS_INLINE void softgym_quats_impl(const int seed, Py_ssize_t lo, Py_ssize_t hi,
+                                              Py_ssize_t n, double dt, const double *av,
+                                              const double *quat, double *q_out)
+{
+    Py_ssize_t i;
+    SOFTGYM_IVDEP
+    for (i = lo; i < hi; i++) {
+        double wx = av[3 * i] * 0.5 * dt;
+        double wy = av[3 * i + 1] * 0.5 * dt;
+        double wz = av[3 * i + 2] * 0.5 * dt;
+        double q0 = quat[4 * i], q1 = quat[4 * i + 1], q2 = quat[4 * i + 2], q3 = quat[4 * i + 3];
+        double qw = q0 - wx * q1 - wy * q2 - wz * q3;
+        double qx = q1 + wx * q0 + wy * q3 - wz * q2;
+        double qy = q2 + wy * q0 + wz * q1 - wx * q3;
+        double qz = q3 + wz * q0 + wx * q2 - wy * q1;
+        double nw, nx, ny, nz;
+        if (seed) {
+            double nq = sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
+            double inv = 1.0 / nq;
+            long long one;
+            nw = nq != 0.0 ? qw * inv : qw;
+            nx = nq != 0.0 ? qx * inv : qx;
+            ny = nq != 0.0 ? qy * inv : qy;
+            nz = nq != 0.0 ? qz * inv : qz;
+            one = nw >= 1.0;
+            nw = one ? 1.0 : nw;
+            nx = one ? 0.0 : nx;
+            ny = one ? 0.0 : ny;
+            nz = one ? 0.0 : nz;
+        } else {
+            double nq = 1.5 - 0.5 * (qw * qw + qx * qx + qy * qy + qz * qz);
+            nw = qw * nq;
+            nx = qx * nq;
+            ny = qy * nq;
+            nz = qz * nq;
+        }
+        q_out[i] = nw;
+        q_out[n + i] = nx;
+        q_out[2 * n + i] = ny;
+        q_out[3 * n + i] = nz;
+    }
+}
+/* model 0 (the seed's) */
 static void softgym_seed_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,
                                const double *av, const double *quat, double *q_out)
 {
-    Py_ssize_t i;
-    SOFTGYM_IVDEP
-    for (i = lo; i < hi; i++) {
-        SOFTGYM_QUAT_STEP(av, quat, i, dt);
-        double nq = sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
-        double inv = 1.0 / nq;
-        double nw = nq != 0.0 ? qw * inv : qw;
-        double nx = nq != 0.0 ? qx * inv : qx;
-        double ny = nq != 0.0 ? qy * inv : qy;
-        double nz = nq != 0.0 ? qz * inv : qz;
-        long long one = nw >= 1.0;
-        q_out[i] = one ? 1.0 : nw;
-        q_out[n + i] = one ? 0.0 : nx;
-        q_out[2 * n + i] = one ? 0.0 : ny;
-        q_out[3 * n + i] = one ? 0.0 : nz;
-    }
+    softgym_quats_impl(1, lo, hi, n, dt, av, quat, q_out);
 }
-
-/* model 1 (corotational): renormalised by one Newton step of 1 / sqrt from 1 (|q|^2 is
-   1 + O((w dt)^2), so the step is exact to rounding) */
+/* model 1 (corotational) */
 static void softgym_corot_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,
                                 const double *av, const double *quat, double *q_out)
 {
-    Py_ssize_t i;
-    SOFTGYM_IVDEP
-    for (i = lo; i < hi; i++) {
-        SOFTGYM_QUAT_STEP(av, quat, i, dt);
-        double nq = 1.5 - 0.5 * (qw * qw + qx * qx + qy * qy + qz * qz);
-        q_out[i] = qw * nq;
-        q_out[n + i] = qx * nq;
-        q_out[2 * n + i] = qy * nq;
-        q_out[3 * n + i] = qz * nq;
-    }
+    softgym_quats_impl(0, lo, hi, n, dt, av, quat, q_out);
 }
 
 #endif  /* SOFTGYM_ORIENT_H */

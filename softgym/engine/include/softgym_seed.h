@@ -33,22 +33,56 @@
    Voxel 1's rotation matrix is computed in the lanes from its quaternion
    (softgym_quat_matrix, as the voxel update stores it): the same bits as
    the stored matrix, and 9 fewer gathered loads a link. */
+/* the axis constants of the geometry of links along ax: the components a0, a1, a2 of
+   the bond frame's axes in voxel 1's frame and their signs s1, s2; W (w00..w22) */
+#define SOFTGYM_SEED_GEOM_AXIS(ax) \
+    const int a0 = (ax), a1 = (ax) == 1 ? 0 : 1, a2 = (ax) == 2 ? 0 : 2; \
+    const double s1 = (ax) == 1 ? -1.0 : 1.0, s2 = (ax) == 2 ? -1.0 : 1.0; \
+    /* n = W (qx, qy, qz): W's rows one-hot (x 1 + y 0 + z 0 = x exactly) */ \
+    const double w00 = a0 == 0, w01 = a0 == 1, w02 = a0 == 2; \
+    const double w10 = a1 == 0 ? s1 : 0.0, w11 = a1 == 1 ? s1 : 0.0, w12 = a1 == 2 ? s1 : 0.0; \
+    const double w20 = a2 == 0 ? s2 : 0.0, w21 = a2 == 1 ? s2 : 0.0, w22 = a2 == 2 ? s2 : 0.0
+/* the geometry's output rows 0-9 of the scratch o (row stride n) */
+#define SOFTGYM_SEED_GEOM_OUT(o, n) \
+    double *__restrict__ o_p0 = (o), *__restrict__ o_p1 = (o) + (n); \
+    double *__restrict__ o_p2 = (o) + 2 * (n), *__restrict__ o_qw = (o) + 3 * (n); \
+    double *__restrict__ o_n1 = (o) + 4 * (n), *__restrict__ o_n2 = (o) + 5 * (n); \
+    double *__restrict__ o_n3 = (o) + 6 * (n), *__restrict__ o_nom = (o) + 7 * (n); \
+    double *__restrict__ o_len = (o) + 8 * (n), *__restrict__ o_st = (o) + 9 * (n)
+/* one link's geometry into column li of those rows, from voxel 2's position relative
+   to voxel 1's (dx, dy, dz), their orientations (w, x, y, z), (wj, xj, yj, zj) and
+   sizes si, sj (the axis constants and output rows in scope); the engine's pass
+   below and benchmarks/dense_links_probe.c share it */
+#define SOFTGYM_SEED_GEOM_LINK(li, dx, dy, dz, w, x, y, z, wj, xj, yj, zj, si, sj) do { \
+        double geo_R[9]; \
+        softgym_quat_matrix_wxyz(w, x, y, z, geo_R); \
+        /* relative position in voxel 1's frame (column a of its rotation . d) */ \
+        double geo_p0 = (((geo_R[a0] * (dx)) + (geo_R[3 + a0] * (dy))) + (geo_R[6 + a0] * (dz))); \
+        double geo_p1 = (s1 * (((geo_R[a1] * (dx)) + (geo_R[3 + a1] * (dy))) + (geo_R[6 + a1] * (dz)))); \
+        double geo_p2 = (s2 * (((geo_R[a2] * (dx)) + (geo_R[3 + a2] * (dy))) + (geo_R[6 + a2] * (dz)))); \
+        double geo_qw = (((((w) * (wj)) + ((x) * (xj))) + ((y) * (yj))) + ((z) * (zj))); \
+        double geo_qx = (((((w) * (xj)) - ((x) * (wj))) - ((y) * (zj))) + ((z) * (yj))); \
+        double geo_qy = (((((w) * (yj)) + ((x) * (zj))) - ((y) * (wj))) - ((z) * (xj))); \
+        double geo_qz = (((((w) * (zj)) - ((x) * (yj))) + ((y) * (xj))) - ((z) * (wj))); \
+        o_p0[li] = geo_p0; \
+        o_p1[li] = geo_p1; \
+        o_p2[li] = geo_p2; \
+        o_qw[li] = geo_qw; \
+        o_n1[li] = (((geo_qx * w00) + (geo_qy * w01)) + (geo_qz * w02)); \
+        o_n2[li] = (((geo_qx * w10) + (geo_qy * w11)) + (geo_qz * w12)); \
+        o_n3[li] = (((geo_qx * w20) + (geo_qy * w21)) + (geo_qz * w22)); \
+        o_nom[li] = (0.5 * ((si) + (sj))); \
+        o_len[li] = sqrt(((((dx) * (dx)) + ((dy) * (dy))) + ((dz) * (dz)))); \
+        o_st[li] = ((fabs(geo_p2) + fabs(geo_p1)) / geo_p0); \
+    } while (0)
 SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
                                                 Py_ssize_t n, const Py_ssize_t *v1,
                                                 const Py_ssize_t *v2, const double *pos,
                                                 const double *quat, const double *scale,
                                                 double *o)
 {
-    const int a0 = ax, a1 = ax == 1 ? 0 : 1, a2 = ax == 2 ? 0 : 2;
-    const double s1 = ax == 1 ? -1.0 : 1.0, s2 = ax == 2 ? -1.0 : 1.0;
-    /* n = W (qx, qy, qz): W's rows one-hot (x 1 + y 0 + z 0 = x exactly) */
-    const double w00 = a0 == 0, w01 = a0 == 1, w02 = a0 == 2;
-    const double w10 = a1 == 0 ? s1 : 0.0, w11 = a1 == 1 ? s1 : 0.0, w12 = a1 == 2 ? s1 : 0.0;
-    const double w20 = a2 == 0 ? s2 : 0.0, w21 = a2 == 1 ? s2 : 0.0, w22 = a2 == 2 ? s2 : 0.0;
-    double *__restrict__ o_p0 = o, *__restrict__ o_p1 = o + n, *__restrict__ o_p2 = o + 2 * n;
-    double *__restrict__ o_qw = o + 3 * n, *__restrict__ o_n1 = o + 4 * n, *__restrict__ o_n2 = o + 5 * n;
-    double *__restrict__ o_n3 = o + 6 * n, *__restrict__ o_nom = o + 7 * n, *__restrict__ o_len = o + 8 * n;
-    double *__restrict__ o_st = o + 9 * n;
+    SOFTGYM_SEED_GEOM_AXIS(ax);
+    SOFTGYM_SEED_GEOM_OUT(o, n);
     Py_ssize_t li;
     SOFTGYM_IVDEP
     for (li = lo; li < hi; li++) {
@@ -58,26 +92,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
         double dz = pos[3 * j + 2] - pos[3 * i + 2];
         double w = quat[4 * i], x = quat[4 * i + 1], y = quat[4 * i + 2], z = quat[4 * i + 3];
         double wj = quat[4 * j], xj = quat[4 * j + 1], yj = quat[4 * j + 2], zj = quat[4 * j + 3];
-        double R[9];
-        softgym_quat_matrix_wxyz(w, x, y, z, R);
-        /* relative position in voxel 1's frame (column a of its rotation . d) */
-        double p0 = (((R[a0] * dx) + (R[3 + a0] * dy)) + (R[6 + a0] * dz));
-        double p1 = (s1 * (((R[a1] * dx) + (R[3 + a1] * dy)) + (R[6 + a1] * dz)));
-        double p2 = (s2 * (((R[a2] * dx) + (R[3 + a2] * dy)) + (R[6 + a2] * dz)));
-        double qw = ((((w * wj) + (x * xj)) + (y * yj)) + (z * zj));
-        double qx = ((((w * xj) - (x * wj)) - (y * zj)) + (z * yj));
-        double qy = ((((w * yj) + (x * zj)) - (y * wj)) - (z * xj));
-        double qz = ((((w * zj) - (x * yj)) + (y * xj)) - (z * wj));
-        o_p0[li] = p0;
-        o_p1[li] = p1;
-        o_p2[li] = p2;
-        o_qw[li] = qw;
-        o_n1[li] = (((qx * w00) + (qy * w01)) + (qz * w02));
-        o_n2[li] = (((qx * w10) + (qy * w11)) + (qz * w12));
-        o_n3[li] = (((qx * w20) + (qy * w21)) + (qz * w22));
-        o_nom[li] = (0.5 * (scale[i] + scale[j]));
-        o_len[li] = sqrt((((dx * dx) + (dy * dy)) + (dz * dz)));
-        o_st[li] = ((fabs(p2) + fabs(p1)) / p0);
+        SOFTGYM_SEED_GEOM_LINK(li, dx, dy, dz, w, x, y, z, wj, xj, yj, zj, scale[i], scale[j]);
     }
 }
 static void softgym_seed_geom(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
