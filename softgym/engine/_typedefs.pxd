@@ -6,4 +6,5 @@ ctypedef Py_ssize_t intp_t     # indices and counts into the flat batch arrays
 ctypedef int64_t step_t        # step counters
 ctypedef int32_t int32         # small integer codes (link axis, flags)
 ctypedef int8_t flag_t         # booleans stored in arrays
-ctypedef int64_t lane_flag_t   # booleans read in 64-bit vector lanes (a link's mode)
+ctypedef int64_t lane_flag_t   # booleans read in 64-bit vector lanes (links' mode and material flags,
+                               # the all-pairs hits): 8-bit ones sized those loops for 64 lanes
