@@ -183,12 +183,16 @@ def _probed_build(tree: Path) -> None:
         raise SystemExit(f"profile_engine: the probed build failed:\n{res.stderr[-2000:]}")
 
 
+def _total(counts: dict) -> int:
+    """A run's cycles in all: the sum of its stages (the passes are inside "links")."""
+    return sum(counts[k] for _, k, sub in CYCLE_ROWS if not sub)
+
+
 def _quickest(runs: list[dict], repeats: int) -> dict:
     """The run with the fewest cycles in all, with every run's total per voxel-step."""
-    best = min(runs, key=lambda r: sum(r["counts"][k] for _, k, sub in CYCLE_ROWS if not sub))
+    best = min(runs, key=lambda r: _total(r["counts"]))
     best["repeats"] = repeats
-    best["totals"] = sorted(sum(r["counts"][k] for _, k, sub in CYCLE_ROWS if not sub)
-                            / (r["steps"] * r["n_voxels"]) for r in runs)  # fmt: skip
+    best["totals"] = sorted(_total(r["counts"]) / (r["steps"] * r["n_voxels"]) for r in runs)
     return best
 
 
@@ -234,7 +238,7 @@ def precision_label(model: str, precision: str | None) -> str:
 def print_cycles(p: dict, n: int, collisions: bool, precision: str | None = None) -> None:
     vs = p["steps"] * p["n_voxels"]
     c = p["counts"]
-    total = sum(c[k] for _, k, sub in CYCLE_ROWS if not sub)
+    total = _total(c)
     prec = precision_label("seed", precision)
     print(f"seed preset{prec}, kernel build {p['build']}, {n}^3 reference robot, self-collision "
           f"{'on' if collisions else 'off'}, {p['steps']} steps, one thread: the quickest of "
@@ -253,11 +257,9 @@ def print_cycles_against(p: dict, q: dict, baseline: str) -> None:
     print(f"against {baseline} (built and run alternately; every run of it: "
           f"{', '.join(f'{t:.1f}' for t in q['totals'])})")
     print(f"{'stage / pass':40s} {'this tree':>10s} {baseline[:12]:>12s} {'change':>8s}")
-    rows = [*CYCLE_ROWS, ("total", None, False)]
-    for label, key, sub in rows:
+    for label, key, sub in [*CYCLE_ROWS, ("total", None, False)]:
         if key is None:
-            a = sum(p["counts"][k] for _, k, s in CYCLE_ROWS if not s) / vp
-            b = sum(q["counts"][k] for _, k, s in CYCLE_ROWS if not s) / vq
+            a, b = _total(p["counts"]) / vp, _total(q["counts"]) / vq
         else:
             a, b = p["counts"][key] / vp, q["counts"][key] / vq
         name = ("  " + label) if sub else label

@@ -41,7 +41,7 @@ import numpy as np
 from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_STRAIN, N_LINK_OUT
 from softgym.engine._prof cimport (softgym_prof_enabled, softgym_prof_tsc, softgym_prof_add,
                                    softgym_prof_get, softgym_prof_reset)
-from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t, lane_flag_t
+from softgym.engine._typedefs cimport float64_t, intp_t, lane_flag_t
 
 cnp.import_array()
 
@@ -354,28 +354,30 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     cdef:
         intp_t lo = b.link_start[r]
         intp_t hi = b.link_start[r + 1]
-        intp_t ly = lo + b.link_axis_count[3 * r]
-        intp_t lz = ly + b.link_axis_count[3 * r + 1]
+        intp_t run[4]  # the x, y and z links are run[ax] .. run[ax + 1]
         intp_t n = b.link_stride  # the scratch's row stride
-        intp_t end
+        intp_t end = hi
+        int ax
         float64_t inv_dt = 1.0 / b.dt[r]
         float64_t* o = b.link_out
         unsigned long long t0
     if hi <= lo:
         return STATUS_OK
-    end = _seed_geom_modes(b, 0, lo, ly, n, o)
-    if end == ly:
-        end = _seed_geom_modes(b, 1, ly, lz, n, o)
-        if end == lz:
-            end = _seed_geom_modes(b, 2, lz, hi, n, o)
+    run[0] = lo
+    for ax in range(3):
+        run[ax + 1] = run[ax] + b.link_axis_count[3 * r + ax] if ax < 2 else hi
+    for ax in range(3):
+        end = _seed_geom_modes(b, ax, run[ax], run[ax + 1], n, o)
+        if end < run[ax + 1]:
+            break  # a strained link: the links after it stay as they were
     if b.link_f32:
         _seed_frames_forces32(b, lo, end, inv_dt, lo)
     else:
         _seed_frames_forces(b, lo, end, inv_dt)
     t0 = softgym_prof_tsc()
-    softgym_seed_scatter(0, lo, min(ly, end), n, b.v1, b.v2, b.rot, o, b.force, b.moment)
-    softgym_seed_scatter(1, ly, min(lz, end), n, b.v1, b.v2, b.rot, o, b.force, b.moment)
-    softgym_seed_scatter(2, lz, end, n, b.v1, b.v2, b.rot, o, b.force, b.moment)
+    for ax in range(3):
+        softgym_seed_scatter(ax, run[ax], min(run[ax + 1], end), n, b.v1, b.v2, b.rot, o,
+                             b.force, b.moment)
     softgym_prof_add(5, t0)
     return STATUS_OK if end == hi else STATUS_STRAIN
 
