@@ -76,8 +76,9 @@ cdef extern from "softgym_seed.h":
     void softgym_seed_geom(int ax, intp_t lo, intp_t hi, intp_t n, const intp_t* v1,
                            const intp_t* v2, const float64_t* pos, const float64_t* quat,
                            const float64_t* scale, float64_t* o) noexcept nogil
-    void softgym_seed_frames(intp_t lo, intp_t hi, float64_t sa_rad, float64_t thr,
-                             const float64_t* p0_, const float64_t* p1_, const float64_t* p2_,
+    # (the two frames passes return whether any link needs _seed_frame_one)
+    int softgym_seed_frames(intp_t lo, intp_t hi, float64_t sa_rad, float64_t thr,
+                            const float64_t* p0_, const float64_t* p1_, const float64_t* p2_,
                              const float64_t* qw_, const float64_t* n1_, const float64_t* n2_,
                              const float64_t* n3_, const float64_t* nom_, const float64_t* len_,
                              const float64_t* sa_, float64_t* o_P0, float64_t* o_P1,
@@ -98,8 +99,8 @@ cdef extern from "softgym_seed.h":
     void softgym_seed_scatter(int ax, intp_t lo, intp_t hi, intp_t n, const intp_t* v1,
                               const intp_t* v2, const float64_t* rot, const float64_t* o,
                               float64_t* force, float64_t* moment) noexcept nogil
-    void softgym_seed_frames32(intp_t lo, intp_t hi, intp_t n, float sa_rad, float w_acos,
-                               const float64_t* o, float* const* f) noexcept nogil
+    int softgym_seed_frames32(intp_t lo, intp_t hi, intp_t n, float sa_rad, float w_acos,
+                              const float64_t* o, float* const* f) noexcept nogil
     void softgym_seed_forces32(intp_t lo, intp_t hi, intp_t n, float L, float bz, float bzh,
                                float inv_dt, const float* const* inp, const float64_t* sa_,
                                const float64_t* chg_, const float* ka_, const float* kt_,
@@ -232,6 +233,7 @@ cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end, float64_
     # the scatter. ls: the robot's first link (_float_row)
     cdef:
         intp_t li, k
+        int fix
         intp_t n = b.link_stride
         float64_t* o = b.link_out
         float* f[12]
@@ -242,12 +244,13 @@ cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end, float64_
     for k in range(12):
         f[k] = _float_row(o, n, ls, 10 + k)
     t0 = softgym_prof_tsc()
-    softgym_seed_frames32(lo, end, n, <float> SMALL_ANGLE_RAD, <float> ACOS2SQRT_W, o, f)
+    fix = softgym_seed_frames32(lo, end, n, <float> SMALL_ANGLE_RAD, <float> ACOS2SQRT_W, o, f)
     softgym_prof_add(2, t0)
     t0 = softgym_prof_tsc()
-    for li in range(lo, end):
-        if f[11][li] != 0.0:
-            _seed_frame_one(li, o, n, 1, ls)
+    if fix:  # rare: links turned past 120 degrees, or a backward chord
+        for li in range(lo, end):
+            if f[11][li] != 0.0:
+                _seed_frame_one(li, o, n, 1, ls)
     softgym_prof_add(3, t0)
     t0 = softgym_prof_tsc()
     for k in range(11):
@@ -267,6 +270,7 @@ cdef inline void _seed_frames_forces(Batch* b, intp_t lo, intp_t end,
     # own operations)
     cdef:
         intp_t li, k
+        int fix
         intp_t n = b.link_stride
         float64_t* o = b.link_out
         float64_t bz = 0.5 * b.bond_zeta
@@ -274,16 +278,17 @@ cdef inline void _seed_frames_forces(Batch* b, intp_t lo, intp_t end,
         float64_t* out[12]
         unsigned long long t0
     t0 = softgym_prof_tsc()
-    softgym_seed_frames(lo, end, SMALL_ANGLE_RAD, SLTHRESH_ACOS2SQRT, o, o + n, o + 2 * n,
-                        o + 3 * n, o + 4 * n, o + 5 * n, o + 6 * n, o + 7 * n, o + 8 * n,
-                        o + 9 * n, o + 10 * n, o + 11 * n, o + 12 * n, o + 13 * n, o + 14 * n,
-                        o + 15 * n, o + 16 * n, o + 17 * n, o + 18 * n, o + 19 * n, o + 20 * n,
-                        o + 21 * n)
+    fix = softgym_seed_frames(lo, end, SMALL_ANGLE_RAD, SLTHRESH_ACOS2SQRT, o, o + n, o + 2 * n,
+                              o + 3 * n, o + 4 * n, o + 5 * n, o + 6 * n, o + 7 * n, o + 8 * n,
+                              o + 9 * n, o + 10 * n, o + 11 * n, o + 12 * n, o + 13 * n,
+                              o + 14 * n, o + 15 * n, o + 16 * n, o + 17 * n, o + 18 * n,
+                              o + 19 * n, o + 20 * n, o + 21 * n)
     softgym_prof_add(2, t0)
     t0 = softgym_prof_tsc()
-    for li in range(lo, end):
-        if o[21 * n + li] != 0.0:
-            _seed_frame_one(li, o, n, 0, 0)
+    if fix:  # links whose rotation needs the seed's acos branch
+        for li in range(lo, end):
+            if o[21 * n + li] != 0.0:
+                _seed_frame_one(li, o, n, 0, 0)
     softgym_prof_add(3, t0)
     t0 = softgym_prof_tsc()
     for k in range(11):

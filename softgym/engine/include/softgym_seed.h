@@ -185,11 +185,12 @@ static inline Py_ssize_t softgym_small_block(const double *sa_, Py_ssize_t blo, 
     double *o_rz, double *o_fix
 #define SOFTGYM_FRAME_ROW_NAMES p0_, p1_, p2_, qw_, n1_, n2_, n3_, nom_, len_, sa_, o_P0, \
     o_P1, o_P2, o_a1y, o_a1z, o_a2x, o_a2y, o_a2z, o_rw, o_ry, o_rz, o_fix
-SOFTGYM_ALWAYS_INLINE void softgym_seed_frames_impl(
+SOFTGYM_ALWAYS_INLINE long long softgym_seed_frames_impl(
     const int all_small, Py_ssize_t lo, Py_ssize_t hi, double sa_rad, double thr,
     SOFTGYM_FRAME_ROWS)
 {
     Py_ssize_t li;
+    long long any_fix = 0;
     SOFTGYM_IVDEP
     for (li = lo; li < hi; li++) {
         double p0 = p0_[li], p1 = p1_[li], p2 = p2_[li], qw = qw_[li];
@@ -222,20 +223,25 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_frames_impl(
         o_ry[li] = softgym_pick(is_sa, 0.0, ry);
         o_rz[li] = softgym_pick(is_sa, 0.0, rz);
         o_fix[li] = softgym_pick(fix, 1.0, 0.0);
+        any_fix |= fix;
     }
+    return any_fix;
 }
-static void softgym_seed_frames(
+/* returns whether any link got fix = 1 (else the caller need not look) */
+static int softgym_seed_frames(
     Py_ssize_t lo, Py_ssize_t hi, double sa_rad, double thr, SOFTGYM_FRAME_ROWS)
 {
     Py_ssize_t blo, bhi;
     int all_small;
+    long long any_fix = 0;
     for (blo = lo; blo < hi; blo = bhi) {
         bhi = softgym_small_block(sa_, blo, hi, &all_small);
         if (all_small)
-            softgym_seed_frames_impl(1, blo, bhi, sa_rad, thr, SOFTGYM_FRAME_ROW_NAMES);
+            any_fix |= softgym_seed_frames_impl(1, blo, bhi, sa_rad, thr, SOFTGYM_FRAME_ROW_NAMES);
         else
-            softgym_seed_frames_impl(0, blo, bhi, sa_rad, thr, SOFTGYM_FRAME_ROW_NAMES);
+            any_fix |= softgym_seed_frames_impl(0, blo, bhi, sa_rad, thr, SOFTGYM_FRAME_ROW_NAMES);
     }
+    return any_fix != 0;
 }
 
 /* Single-precision link math (the seed model's default link precision): the
@@ -271,7 +277,7 @@ static inline float softgym_rotvec_k32_acos(float w, float w_acos)
     float r = w <= w_acos ? 1.0f + z * p : 1.0f;
     return softgym_rotvec_k32(w) * r;
 }
-SOFTGYM_ALWAYS_INLINE void softgym_seed_frames32_impl(
+SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_impl(
     const int all_small, Py_ssize_t lo, Py_ssize_t hi, float sa_rad, float w_acos,
     const double *p0_, const double *p1_, const double *p2_, const double *qw_,
     const double *n1_, const double *n2_, const double *n3_, const double *nom_,
@@ -280,6 +286,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_frames32_impl(
     float *o_ry, float *o_rz, float *o_fix)
 {
     Py_ssize_t li;
+    int any_fix = 0;
     SOFTGYM_IVDEP
     for (li = lo; li < hi; li++) {
         double p0d = p0_[li], nomd = nom_[li];
@@ -310,19 +317,21 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_frames32_impl(
         o_ry[li] = is_sa ? 0.0f : ry;
         o_rz[li] = is_sa ? 0.0f : rz;
         o_fix[li] = fix ? 1.0f : 0.0f;
+        any_fix |= fix;
     }
+    return any_fix;
 }
 /* the frames pass in float: rows in as softgym_seed_frames, float rows out (f[k]:
-   row 10 + k) */
-static void softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, float sa_rad,
-                                  float w_acos, const double *o, float *const *f)
+   row 10 + k); returns whether any link got fix = 1 */
+static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, float sa_rad,
+                                 float w_acos, const double *o, float *const *f)
 {
     Py_ssize_t blo, bhi;
-    int all_small;
+    int all_small, any_fix = 0;
     const double *sa_ = o + 9 * n;
     for (blo = lo; blo < hi; blo = bhi) {
         bhi = softgym_small_block(sa_, blo, hi, &all_small);
-#define SOFTGYM_FRAMES32(s) softgym_seed_frames32_impl( \
+#define SOFTGYM_FRAMES32(s) any_fix |= softgym_seed_frames32_impl( \
             s, blo, bhi, sa_rad, w_acos, o, o + n, o + 2 * n, o + 3 * n, o + 4 * n, o + 5 * n, \
             o + 6 * n, o + 7 * n, o + 8 * n, sa_, f[0], f[1], f[2], f[3], f[4], f[5], f[6], \
             f[7], f[8], f[9], f[10], f[11])
@@ -332,6 +341,7 @@ static void softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, fl
             SOFTGYM_FRAMES32(0);
 #undef SOFTGYM_FRAMES32
     }
+    return any_fix != 0;
 }
 
 /* The forces pass of links_seed (softgym_seed_forces.h, one definition
