@@ -100,7 +100,7 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
     cdef:
         intp_t i, k
         float64_t dt = b.dt[r]
-        float64_t m, h, pen, cg, d2, mx, my, mz
+        float64_t m, h, pen, cg, d2, mx, my, mz, vx, vy, vz, px, py, pz
         float64_t c[3]
         float64_t f[3]
         float64_t n[3]
@@ -147,13 +147,19 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
             if pen > 0.0:
                 surface_contact(b, i, n[0], n[1], n[2], pen, dt, f)
         h = dt * b.inv_mass[i]
-        vel[3 * i] += f[0] * h
-        vel[3 * i + 1] += f[1] * h
-        vel[3 * i + 2] += f[2] * h
-        pos[3 * i] += vel[3 * i] * dt
-        pos[3 * i + 1] += vel[3 * i + 1] * dt
-        pos[3 * i + 2] += vel[3 * i + 2] * dt
-        if not (fabs(pos[3 * i]) + fabs(pos[3 * i + 1]) + fabs(pos[3 * i + 2]) < RUNAWAY):
+        vx = vel[3 * i] + f[0] * h  # in locals, as integrate_seed
+        vy = vel[3 * i + 1] + f[1] * h
+        vz = vel[3 * i + 2] + f[2] * h
+        vel[3 * i] = vx
+        vel[3 * i + 1] = vy
+        vel[3 * i + 2] = vz
+        px = pos[3 * i] + vx * dt
+        py = pos[3 * i + 1] + vy * dt
+        pz = pos[3 * i + 2] + vz * dt
+        pos[3 * i] = px
+        pos[3 * i + 1] = py
+        pos[3 * i + 2] = pz
+        if not (fabs(px) + fabs(py) + fabs(pz) < RUNAWAY):
             _orient(b, vs, i, dt, 0)  # the voxels before it were stepped
             clear_robot(b, r)
             return STATUS_NONFINITE
