@@ -74,3 +74,60 @@ def test_sigint_stops_a_long_advance_within_a_fraction_of_a_second():
         timer.cancel()
     assert time.perf_counter() - t0 < 2.0  # 0.3 s + at most a chunk (about 0.1 s), with slack
     assert 0.0 < sim.time.max() < 60.0
+
+
+def _many():
+    rng = np.random.default_rng(11)
+    bodies = []
+    for k in range(10):
+        grid = rng.integers(1, 3, size=(3, 3, 2)).astype(np.int32)
+        bodies.append(two_material_body(grid, cte=0.02, period=0.2 + 0.02 * k, temp_amplitude=10))
+    return bodies
+
+
+@pytest.mark.parametrize("threads", [1, 2])
+def test_a_large_batch_advances_group_by_group_to_the_same_bits(threads):
+    # 10 robots of 18 voxels; 400 voxel-steps a thread a call would give each robot
+    # a few steps: with min_visit_steps = 50 the batch goes in groups of 4 robots a
+    # thread, each to the end before the next
+    cfg = SimConfig(self_collision=True)
+    one = Simulation(_many(), cfg, n_threads=threads)
+    one.chunk_voxel_steps = BIG
+    one.advance_to(0.6)
+    grouped = Simulation(_many(), cfg, n_threads=threads)
+    grouped.chunk_voxel_steps = 400
+    grouped.min_visit_steps = 50
+    calls, spread = [], []
+
+    def seen(t):
+        calls.append(t)
+        spread.append(float(grouped.time.max() - grouped.time.min()))
+
+    grouped.advance_to(0.6, progress=seen)
+    assert calls == sorted(calls) and calls[-1] == 0.6
+    assert max(spread) > 0.5  # one group at 0.6 s while another had not started
+    a, b = _state(one), _state(grouped)
+    for k in a:
+        np.testing.assert_array_equal(a[k], b[k], err_msg=k)
+    np.testing.assert_array_equal(one.rollout().cm, grouped.rollout().cm)
+
+
+def test_an_interrupted_group_by_group_advance_goes_on_to_the_same_state():
+    ref = Simulation(_many(), n_threads=1)
+    ref.advance_to(0.6)
+    sim = Simulation(_many(), n_threads=1)
+    sim.chunk_voxel_steps = 400
+    sim.min_visit_steps = 50
+
+    def stop(t):
+        if sim.time.max() >= 0.6:  # the first group is done, the others are not
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        sim.advance_to(0.6, progress=stop)
+    assert sim.time.min() < 0.6
+    sim.advance_to(0.6)
+    a, b = _state(ref), _state(sim)
+    for k in a:
+        np.testing.assert_array_equal(a[k], b[k], err_msg=k)
+    np.testing.assert_array_equal(ref.rollout().cm, sim.rollout().cm)
