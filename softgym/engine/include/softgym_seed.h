@@ -53,28 +53,108 @@
    to voxel 1's (dx, dy, dz), their orientations (w, x, y, z), (wj, xj, yj, zj) and
    sizes si, sj (the axis constants and output rows in scope); the engine's pass
    below and benchmarks/dense_links_probe.c share it */
-#define SOFTGYM_SEED_GEOM_LINK(li, dx, dy, dz, w, x, y, z, wj, xj, yj, zj, si, sj) do { \
-        double geo_R[9]; \
-        softgym_quat_matrix_wxyz(w, x, y, z, geo_R); \
+#define SOFTGYM_SEED_GEOM_LINK(li, dx, dy, dz, w, x, y, z, wj, xj, yj, zj, si, sj) \
+    SOFTGYM_SEED_GEOM_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, li, dx, dy, dz, w, x, y, z, \
+                             wj, xj, yj, zj, si, sj)
+#define SOFTGYM_PUT1(row, li, v) ((row)[li] = (v))
+/* the same for any arithmetic type T (double, or a vector of doubles: then links li ..
+   li + lanes - 1 at once, SQRT and FABS T's square root and absolute value, PUT(row,
+   li, v) storing v at row + li) */
+#define SOFTGYM_SEED_GEOM_LINK_T(T, SQRT, FABS, PUT, li, dx, dy, dz, w, x, y, z, wj, xj, yj, \
+                                 zj, si, sj) do { \
+        T geo_R[9]; \
+        SOFTGYM_QUAT_MATRIX(w, x, y, z, geo_R); \
         /* relative position in voxel 1's frame (column a of its rotation . d) */ \
-        double geo_p0 = (((geo_R[a0] * (dx)) + (geo_R[3 + a0] * (dy))) + (geo_R[6 + a0] * (dz))); \
-        double geo_p1 = (s1 * (((geo_R[a1] * (dx)) + (geo_R[3 + a1] * (dy))) + (geo_R[6 + a1] * (dz)))); \
-        double geo_p2 = (s2 * (((geo_R[a2] * (dx)) + (geo_R[3 + a2] * (dy))) + (geo_R[6 + a2] * (dz)))); \
-        double geo_qw = (((((w) * (wj)) + ((x) * (xj))) + ((y) * (yj))) + ((z) * (zj))); \
-        double geo_qx = (((((w) * (xj)) - ((x) * (wj))) - ((y) * (zj))) + ((z) * (yj))); \
-        double geo_qy = (((((w) * (yj)) + ((x) * (zj))) - ((y) * (wj))) - ((z) * (xj))); \
-        double geo_qz = (((((w) * (zj)) - ((x) * (yj))) + ((y) * (xj))) - ((z) * (wj))); \
-        o_p0[li] = geo_p0; \
-        o_p1[li] = geo_p1; \
-        o_p2[li] = geo_p2; \
-        o_qw[li] = geo_qw; \
-        o_n1[li] = (((geo_qx * w00) + (geo_qy * w01)) + (geo_qz * w02)); \
-        o_n2[li] = (((geo_qx * w10) + (geo_qy * w11)) + (geo_qz * w12)); \
-        o_n3[li] = (((geo_qx * w20) + (geo_qy * w21)) + (geo_qz * w22)); \
-        o_nom[li] = (0.5 * ((si) + (sj))); \
-        o_len[li] = sqrt(((((dx) * (dx)) + ((dy) * (dy))) + ((dz) * (dz)))); \
-        o_st[li] = ((fabs(geo_p2) + fabs(geo_p1)) / geo_p0); \
+        T geo_p0 = (((geo_R[a0] * (dx)) + (geo_R[3 + a0] * (dy))) + (geo_R[6 + a0] * (dz))); \
+        T geo_p1 = (s1 * (((geo_R[a1] * (dx)) + (geo_R[3 + a1] * (dy))) + (geo_R[6 + a1] * (dz)))); \
+        T geo_p2 = (s2 * (((geo_R[a2] * (dx)) + (geo_R[3 + a2] * (dy))) + (geo_R[6 + a2] * (dz)))); \
+        T geo_qw = (((((w) * (wj)) + ((x) * (xj))) + ((y) * (yj))) + ((z) * (zj))); \
+        T geo_qx = (((((w) * (xj)) - ((x) * (wj))) - ((y) * (zj))) + ((z) * (yj))); \
+        T geo_qy = (((((w) * (yj)) + ((x) * (zj))) - ((y) * (wj))) - ((z) * (xj))); \
+        T geo_qz = (((((w) * (zj)) - ((x) * (yj))) + ((y) * (xj))) - ((z) * (wj))); \
+        PUT(o_p0, li, geo_p0); \
+        PUT(o_p1, li, geo_p1); \
+        PUT(o_p2, li, geo_p2); \
+        PUT(o_qw, li, geo_qw); \
+        PUT(o_n1, li, (((geo_qx * w00) + (geo_qy * w01)) + (geo_qz * w02))); \
+        PUT(o_n2, li, (((geo_qx * w10) + (geo_qy * w11)) + (geo_qz * w12))); \
+        PUT(o_n3, li, (((geo_qx * w20) + (geo_qy * w21)) + (geo_qz * w22))); \
+        PUT(o_nom, li, (0.5 * ((si) + (sj)))); \
+        PUT(o_len, li, SQRT(((((dx) * (dx)) + ((dy) * (dy))) + ((dz) * (dz))))); \
+        PUT(o_st, li, ((FABS(geo_p2) + FABS(geo_p1)) / geo_p0)); \
     } while (0)
+#if defined(__AVX__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+/* The geometry's loads in vector code of our own. GCC's vectoriser loaded the 16
+   numbers a link reads from its two voxels one by one, and with 16 indices per 8 links
+   it parked them in vector registers and spilled (objdump: about 34 instructions a link
+   before any arithmetic). Here each voxel's quaternion is two 16-byte loads and its
+   position one (x, y) load and z, turned into rows of 4 links by unpacks
+   (SOFTGYM_GATHER_PAIRS), 8 links with AVX-512; the arithmetic is
+   SOFTGYM_SEED_GEOM_LINK_T's, lane by lane: the same bits. */
+#if defined(__AVX512F__)
+#define SOFTGYM_GEOM_LANES 8
+typedef double softgym_gvd __attribute__((vector_size(64)));
+#define SOFTGYM_GSQRT(v) ((softgym_gvd)_mm512_sqrt_pd((__m512d)(v)))
+#else
+#define SOFTGYM_GEOM_LANES 4
+typedef double softgym_gvd __attribute__((vector_size(32)));
+#define SOFTGYM_GSQRT(v) ((softgym_gvd)_mm256_sqrt_pd((__m256d)(v)))
+#endif
+typedef long long softgym_gvi __attribute__((vector_size(sizeof(softgym_gvd))));
+static inline softgym_gvd softgym_gabs(softgym_gvd v)
+{
+    softgym_gvi bits;
+    memcpy(&bits, &v, sizeof bits);
+    bits &= 0x7fffffffffffffffLL;
+    memcpy(&v, &bits, sizeof v);
+    return v;
+}
+#define SOFTGYM_GPUT(row, li, v) do { \
+        softgym_gvd v_ = (v); \
+        memcpy((row) + (li), &v_, sizeof v_); \
+    } while (0)
+/* the elements k and k + 1 of the rows of 4 voxels at pa..pd as two rows of 4 lanes */
+#define SOFTGYM_GATHER_PAIRS(pa, pb, pc, pd, k, lo_, hi_) do { \
+        __m256d ac_ = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd((pa) + (k))), \
+                                           _mm_loadu_pd((pc) + (k)), 1); \
+        __m256d bd_ = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd((pb) + (k))), \
+                                           _mm_loadu_pd((pd) + (k)), 1); \
+        lo_ = _mm256_unpacklo_pd(ac_, bd_); \
+        hi_ = _mm256_unpackhi_pd(ac_, bd_); \
+    } while (0)
+/* voxels idx[0..3]: position (x, y, z), quaternion (w, qx, qy, qz) and size as rows of 4 */
+static inline void softgym_gather4(const Py_ssize_t *idx, const double *pos, const double *quat,
+                                   const double *scale, __m256d *r)
+{
+    const double *pa = pos + 3 * idx[0], *pb = pos + 3 * idx[1];
+    const double *pc = pos + 3 * idx[2], *pd = pos + 3 * idx[3];
+    const double *qa = quat + 4 * idx[0], *qb = quat + 4 * idx[1];
+    const double *qc = quat + 4 * idx[2], *qd = quat + 4 * idx[3];
+    SOFTGYM_GATHER_PAIRS(pa, pb, pc, pd, 0, r[0], r[1]);
+    r[2] = _mm256_set_pd(pd[2], pc[2], pb[2], pa[2]);
+    SOFTGYM_GATHER_PAIRS(qa, qb, qc, qd, 0, r[3], r[4]);
+    SOFTGYM_GATHER_PAIRS(qa, qb, qc, qd, 2, r[5], r[6]);
+    r[7] = _mm256_set_pd(scale[idx[3]], scale[idx[2]], scale[idx[1]], scale[idx[0]]);
+}
+/* the same for SOFTGYM_GEOM_LANES voxels, as vectors */
+static inline void softgym_gather(const Py_ssize_t *idx, const double *pos, const double *quat,
+                                  const double *scale, softgym_gvd *r)
+{
+    __m256d a[8];
+    int k;
+    softgym_gather4(idx, pos, quat, scale, a);
+#if SOFTGYM_GEOM_LANES == 8
+    __m256d b[8];
+    softgym_gather4(idx + 4, pos, quat, scale, b);
+    for (k = 0; k < 8; k++)
+        r[k] = (softgym_gvd)_mm512_insertf64x4(_mm512_castpd256_pd512(a[k]), b[k], 1);
+#else
+    for (k = 0; k < 8; k++)
+        r[k] = (softgym_gvd)a[k];
+#endif
+}
+#endif
 SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
                                                 Py_ssize_t n, const Py_ssize_t *v1,
                                                 const Py_ssize_t *v2, const double *pos,
@@ -83,9 +163,20 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
 {
     SOFTGYM_SEED_GEOM_AXIS(ax);
     SOFTGYM_SEED_GEOM_OUT(o, n);
-    Py_ssize_t li;
-    SOFTGYM_IVDEP
-    for (li = lo; li < hi; li++) {
+    Py_ssize_t li = lo;
+#if defined(SOFTGYM_GEOM_LANES)
+    for (; li + SOFTGYM_GEOM_LANES <= hi; li += SOFTGYM_GEOM_LANES) {
+        softgym_gvd gi[8], gj[8];
+        softgym_gather(v1 + li, pos, quat, scale, gi);
+        softgym_gather(v2 + li, pos, quat, scale, gj);
+        softgym_gvd dx = gj[0] - gi[0], dy = gj[1] - gi[1], dz = gj[2] - gi[2];
+        SOFTGYM_SEED_GEOM_LINK_T(softgym_gvd, SOFTGYM_GSQRT, softgym_gabs, SOFTGYM_GPUT, li, dx,
+                                 dy, dz, gi[3], gi[4], gi[5], gi[6], gj[3], gj[4], gj[5], gj[6],
+                                 gi[7], gj[7]);
+    }
+#endif
+    /* the rest (and every link without AVX): the compiler's vectoriser */
+    for (; li < hi; li++) {
         Py_ssize_t i = v1[li], j = v2[li];
         double dx = pos[3 * j] - pos[3 * i];
         double dy = pos[3 * j + 1] - pos[3 * i + 1];

@@ -31,17 +31,22 @@ static inline double softgym_pick(long long c, double a, double b)
    The geometry passes the values it has loaded: given the pointer form inside
    its loop, GCC 12 found the loads "not suitable for gather" and ran the loop
    scalar (twice the cycles; check with -fopt-info-vec-missed) */
+/* the formula itself, for any arithmetic type of w, x, y, z and the elements of R
+   (doubles, or the seed geometry's vectors of doubles: the same operations lane by lane) */
+#define SOFTGYM_QUAT_MATRIX(w, x, y, z, R) do { \
+        (R)[0] = 1.0 - 2.0 * ((y) * (y) + (z) * (z)); \
+        (R)[1] = 2.0 * ((x) * (y) - (w) * (z)); \
+        (R)[2] = 2.0 * ((x) * (z) + (w) * (y)); \
+        (R)[3] = 2.0 * ((x) * (y) + (w) * (z)); \
+        (R)[4] = 1.0 - 2.0 * ((x) * (x) + (z) * (z)); \
+        (R)[5] = 2.0 * ((y) * (z) - (w) * (x)); \
+        (R)[6] = 2.0 * ((x) * (z) - (w) * (y)); \
+        (R)[7] = 2.0 * ((y) * (z) + (w) * (x)); \
+        (R)[8] = 1.0 - 2.0 * ((x) * (x) + (y) * (y)); \
+    } while (0)
 static inline void softgym_quat_matrix_wxyz(double w, double x, double y, double z, double *R)
 {
-    R[0] = 1.0 - 2.0 * (y * y + z * z);
-    R[1] = 2.0 * (x * y - w * z);
-    R[2] = 2.0 * (x * z + w * y);
-    R[3] = 2.0 * (x * y + w * z);
-    R[4] = 1.0 - 2.0 * (x * x + z * z);
-    R[5] = 2.0 * (y * z - w * x);
-    R[6] = 2.0 * (x * z - w * y);
-    R[7] = 2.0 * (y * z + w * x);
-    R[8] = 1.0 - 2.0 * (x * x + y * y);
+    SOFTGYM_QUAT_MATRIX(w, x, y, z, R);
 }
 static inline void softgym_quat_matrix(const double *q, double *R)
 {
