@@ -60,7 +60,7 @@ def test_each_seed_pass_vectorises(name, tmp_path):
         pytest.skip("the vectorisation report is GCC's")
     src = tmp_path / "pass.c"
     # the geometry's loop is vectorised by hand with AVX (its remainder is the compiler's)
-    hand = ("#ifndef SOFTGYM_GEOM_LANES\n#error the hand-vectorised geometry is not compiled in\n"
+    hand = ("#ifndef SOFTGYM_VLANES\n#error the hand-vectorised geometry is not compiled in\n"
             "#endif\n") if name == "softgym_seed_geom" else ""  # fmt: skip
     src.write_text(
         "#include <stddef.h>\n"

@@ -83,8 +83,7 @@
         PUT(o_len, li, SQRT(((((dx) * (dx)) + ((dy) * (dy))) + ((dz) * (dz))))); \
         PUT(o_st, li, ((FABS(geo_p2) + FABS(geo_p1)) / geo_p0)); \
     } while (0)
-#if defined(__AVX__) && (defined(__GNUC__) || defined(__clang__))
-#include <immintrin.h>
+#if defined(SOFTGYM_VLANES)
 /* The geometry's loads in vector code of our own. GCC's vectoriser loaded the 16
    numbers a link reads from its two voxels one by one, and with 16 indices per 8 links
    it parked them in vector registers and spilled (objdump: about 34 instructions a link
@@ -92,40 +91,9 @@
    position one (x, y) load and z, turned into rows of 4 links by unpacks
    (SOFTGYM_GATHER_PAIRS), 8 links with AVX-512; the arithmetic is
    SOFTGYM_SEED_GEOM_LINK_T's, lane by lane: the same bits. */
-#if defined(__AVX512F__)
-#define SOFTGYM_GEOM_LANES 8
-typedef double softgym_gvd __attribute__((vector_size(64)));
-#define SOFTGYM_GSQRT(v) ((softgym_gvd)_mm512_sqrt_pd((__m512d)(v)))
-#else
-#define SOFTGYM_GEOM_LANES 4
-typedef double softgym_gvd __attribute__((vector_size(32)));
-#define SOFTGYM_GSQRT(v) ((softgym_gvd)_mm256_sqrt_pd((__m256d)(v)))
-#endif
-typedef long long softgym_gvi __attribute__((vector_size(sizeof(softgym_gvd))));
-static inline softgym_gvd softgym_gabs(softgym_gvd v)
-{
-    softgym_gvi bits;
-    memcpy(&bits, &v, sizeof bits);
-    bits &= 0x7fffffffffffffffLL;
-    memcpy(&v, &bits, sizeof v);
-    return v;
-}
-#define SOFTGYM_GPUT(row, li, v) do { \
-        softgym_gvd v_ = (v); \
-        memcpy((row) + (li), &v_, sizeof v_); \
-    } while (0)
-/* the elements k and k + 1 of the rows of 4 voxels at pa..pd as two rows of 4 lanes */
-#define SOFTGYM_GATHER_PAIRS(pa, pb, pc, pd, k, lo_, hi_) do { \
-        __m256d ac_ = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd((pa) + (k))), \
-                                           _mm_loadu_pd((pc) + (k)), 1); \
-        __m256d bd_ = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd((pb) + (k))), \
-                                           _mm_loadu_pd((pd) + (k)), 1); \
-        lo_ = _mm256_unpacklo_pd(ac_, bd_); \
-        hi_ = _mm256_unpackhi_pd(ac_, bd_); \
-    } while (0)
 /* voxels idx[0..3]: position (x, y, z), quaternion (w, qx, qy, qz) and size as rows of 4 */
-static inline void softgym_gather4(const Py_ssize_t *idx, const double *pos, const double *quat,
-                                   const double *scale, __m256d *r)
+static inline void softgym_seed_gather4(const Py_ssize_t *idx, const double *pos,
+                                        const double *quat, const double *scale, __m256d *r)
 {
     const double *pa = pos + 3 * idx[0], *pb = pos + 3 * idx[1];
     const double *pc = pos + 3 * idx[2], *pd = pos + 3 * idx[3];
@@ -137,21 +105,18 @@ static inline void softgym_gather4(const Py_ssize_t *idx, const double *pos, con
     SOFTGYM_GATHER_PAIRS(qa, qb, qc, qd, 2, r[5], r[6]);
     r[7] = _mm256_set_pd(scale[idx[3]], scale[idx[2]], scale[idx[1]], scale[idx[0]]);
 }
-/* the same for SOFTGYM_GEOM_LANES voxels, as vectors */
-static inline void softgym_gather(const Py_ssize_t *idx, const double *pos, const double *quat,
-                                  const double *scale, softgym_gvd *r)
+/* the same for SOFTGYM_VLANES voxels, as vectors */
+static inline void softgym_seed_gather(const Py_ssize_t *idx, const double *pos,
+                                       const double *quat, const double *scale, softgym_vd *r)
 {
     __m256d a[8];
-    int k;
-    softgym_gather4(idx, pos, quat, scale, a);
-#if SOFTGYM_GEOM_LANES == 8
+    softgym_seed_gather4(idx, pos, quat, scale, a);
+#if SOFTGYM_VLANES == 8
     __m256d b[8];
-    softgym_gather4(idx + 4, pos, quat, scale, b);
-    for (k = 0; k < 8; k++)
-        r[k] = (softgym_gvd)_mm512_insertf64x4(_mm512_castpd256_pd512(a[k]), b[k], 1);
+    softgym_seed_gather4(idx + 4, pos, quat, scale, b);
+    SOFTGYM_VJOIN(r, a, b, 8);
 #else
-    for (k = 0; k < 8; k++)
-        r[k] = (softgym_gvd)a[k];
+    SOFTGYM_VJOIN(r, a, a, 8);
 #endif
 }
 #endif
@@ -164,13 +129,13 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
     SOFTGYM_SEED_GEOM_AXIS(ax);
     SOFTGYM_SEED_GEOM_OUT(o, n);
     Py_ssize_t li = lo;
-#if defined(SOFTGYM_GEOM_LANES)
-    for (; li + SOFTGYM_GEOM_LANES <= hi; li += SOFTGYM_GEOM_LANES) {
-        softgym_gvd gi[8], gj[8];
-        softgym_gather(v1 + li, pos, quat, scale, gi);
-        softgym_gather(v2 + li, pos, quat, scale, gj);
-        softgym_gvd dx = gj[0] - gi[0], dy = gj[1] - gi[1], dz = gj[2] - gi[2];
-        SOFTGYM_SEED_GEOM_LINK_T(softgym_gvd, SOFTGYM_GSQRT, softgym_gabs, SOFTGYM_GPUT, li, dx,
+#if defined(SOFTGYM_VLANES)
+    for (; li + SOFTGYM_VLANES <= hi; li += SOFTGYM_VLANES) {
+        softgym_vd gi[8], gj[8];
+        softgym_seed_gather(v1 + li, pos, quat, scale, gi);
+        softgym_seed_gather(v2 + li, pos, quat, scale, gj);
+        softgym_vd dx = gj[0] - gi[0], dy = gj[1] - gi[1], dz = gj[2] - gi[2];
+        SOFTGYM_SEED_GEOM_LINK_T(softgym_vd, SOFTGYM_VSQRT, softgym_vabs, SOFTGYM_VPUT, li, dx,
                                  dy, dz, gi[3], gi[4], gi[5], gi[6], gj[3], gj[4], gj[5], gj[6],
                                  gi[7], gj[7]);
     }

@@ -52,6 +52,62 @@ static inline void softgym_quat_matrix(const double *q, double *R)
 {
     softgym_quat_matrix_wxyz(q[0], q[1], q[2], q[3], R);
 }
+/* Vector code of our own for the link passes' loads (softgym_seed.h, softgym_corot.h):
+   GCC's vectoriser loads a gathered number at a time, and with two voxels' indices per
+   lane it parks them in vector registers and spills. With AVX, softgym_vd is a vector of
+   SOFTGYM_VLANES doubles (8 with AVX-512, else 4) that GCC's arithmetic operators act on
+   lane by lane, so a pass's formula, written once as a macro over its type, runs on
+   doubles and on these vectors with the same operations. */
+#if defined(__AVX__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+#if defined(__AVX512F__)
+#define SOFTGYM_VLANES 8
+typedef double softgym_vd __attribute__((vector_size(64)));
+#define SOFTGYM_VSQRT(v) ((softgym_vd)_mm512_sqrt_pd((__m512d)(v)))
+#else
+#define SOFTGYM_VLANES 4
+typedef double softgym_vd __attribute__((vector_size(32)));
+#define SOFTGYM_VSQRT(v) ((softgym_vd)_mm256_sqrt_pd((__m256d)(v)))
+#endif
+typedef long long softgym_vi __attribute__((vector_size(sizeof(softgym_vd))));
+/* |v| lane by lane (the sign bit cleared, as fabs) */
+static inline softgym_vd softgym_vabs(softgym_vd v)
+{
+    softgym_vi bits;
+    memcpy(&bits, &v, sizeof bits);
+    bits &= 0x7fffffffffffffffLL;
+    memcpy(&v, &bits, sizeof v);
+    return v;
+}
+/* v stored at row + li (lanes li ..) */
+#define SOFTGYM_VPUT(row, li, v) do { \
+        softgym_vd v_ = (v); \
+        memcpy((row) + (li), &v_, sizeof v_); \
+    } while (0)
+/* elements k and k + 1 of 4 voxels' rows at pa..pd as two rows of 4 lanes (lo_: k, hi_: k + 1) */
+#define SOFTGYM_GATHER_PAIRS(pa, pb, pc, pd, k, lo_, hi_) do { \
+        __m256d ac_ = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd((pa) + (k))), \
+                                           _mm_loadu_pd((pc) + (k)), 1); \
+        __m256d bd_ = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd((pb) + (k))), \
+                                           _mm_loadu_pd((pd) + (k)), 1); \
+        lo_ = _mm256_unpacklo_pd(ac_, bd_); \
+        hi_ = _mm256_unpackhi_pd(ac_, bd_); \
+    } while (0)
+/* rows of 4 lanes a[0..m) (links 0-3) and b[0..m) (links 4-7) as m rows of softgym_vd (with
+   4 lanes, b is not read) */
+#if SOFTGYM_VLANES == 8
+#define SOFTGYM_VJOIN(r, a, b, m) do { \
+        for (int k_ = 0; k_ < (m); k_++) \
+            (r)[k_] = (softgym_vd)_mm512_insertf64x4(_mm512_castpd256_pd512((a)[k_]), (b)[k_], 1); \
+    } while (0)
+#else
+#define SOFTGYM_VJOIN(r, a, b, m) do { \
+        for (int k_ = 0; k_ < (m); k_++) \
+            (r)[k_] = (softgym_vd)(a)[k_]; \
+    } while (0)
+#endif
+#endif
+
 #if defined(_MSC_VER)
 #define SOFTGYM_ALWAYS_INLINE static __forceinline
 #else
