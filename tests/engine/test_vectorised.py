@@ -10,7 +10,8 @@ alone, with the flags of the x86-64-v3 kernel build (setup.py), and GCC's
 vectorisation report must name a vectorised loop in it. The geometry pass is
 vectorised by hand where the build has AVX (its loads; the arithmetic is the
 scalar formula's macro on vectors): there the hand path must be compiled in, and
-a harness checks it against the formula link by link, bit for bit. Skipped where
+a harness checks it against the formula link by link, bit for bit; so does one
+for the corotational link kernel (include/softgym_corot.h). Skipped where
 the compiler is not GCC or cannot target x86-64-v3.
 """
 
@@ -143,22 +144,97 @@ int main(void)
 """
 
 
-@pytest.mark.parametrize("level", ["x86-64-v3", "x86-64-v4"])
-def test_hand_vectorised_geometry_is_the_formula_bit_for_bit(level, tmp_path):
+COROT_HARNESS = r"""
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+typedef long Py_ssize_t;
+#include "softgym_corot.h"
+/* links of random voxels along each axis through softgym_corot_links (the hand-vectorised
+   loop and its remainder) against SOFTGYM_COROT_LINK_T on doubles, one link at a time */
+static double urand(void) { return rand() / (double)RAND_MAX - 0.5; }
+enum { NV = 200, N = 203 };  /* N: not a multiple of the lanes */
+static double pos[3 * NV], vel[3 * NV], av[3 * NV], rot[9 * NV], sc[NV];
+static double ka[N], ca[N], kb[N], cb[N], kt[N], ct[N], o[10 * N], r[10 * N];
+static Py_ssize_t v1[N], v2[N];
+SOFTGYM_ALWAYS_INLINE long check_ax(const int ax)
+{
+    const int p = (ax + 1) % 3, q = (ax + 2) % 3;
+    const double inv_L = 100.0;
+    softgym_corot_links(ax, 0, N, N, inv_L, v1, v2, pos, vel, av, rot, sc, ka, ca, kb, cb, kt,
+                        ct, o);
+    double *o_ext = r, *o_fx = r + N, *o_fy = r + 2 * N, *o_fz = r + 3 * N, *o_m1x = r + 4 * N;
+    double *o_m1y = r + 5 * N, *o_m1z = r + 6 * N, *o_m2x = r + 7 * N, *o_m2y = r + 8 * N;
+    double *o_m2z = r + 9 * N;
+    for (Py_ssize_t li = 0; li < N; li++) {
+        Py_ssize_t i = v1[li], j = v2[li];
+        SOFTGYM_COROT_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, li, ax, p, q, inv_L,
+                             pos[3 * j] - pos[3 * i], pos[3 * j + 1] - pos[3 * i + 1],
+                             pos[3 * j + 2] - pos[3 * i + 2], vel[3 * j] - vel[3 * i],
+                             vel[3 * j + 1] - vel[3 * i + 1], vel[3 * j + 2] - vel[3 * i + 2],
+                             sc[i], sc[j], (rot + 9 * i), (rot + 9 * j), av[3 * i],
+                             av[3 * i + 1], av[3 * i + 2], av[3 * j], av[3 * j + 1],
+                             av[3 * j + 2], ka[li], ca[li], kb[li], cb[li], kt[li], ct[li]);
+    }
+    long bad = 0;
+    for (Py_ssize_t k = 0; k < 10 * N; k++)
+        bad += memcmp(o + k, r + k, sizeof(double)) != 0;
+    return bad;
+}
+int main(void)
+{
+    for (int i = 0; i < NV; i++) {
+        double q[4], s = 0.0;
+        for (int k = 0; k < 4; k++) { q[k] = urand(); s += q[k] * q[k]; }
+        for (int k = 0; k < 4; k++) q[k] /= sqrt(s);
+        softgym_quat_matrix(q, rot + 9 * i);
+        for (int k = 0; k < 3; k++) {
+            pos[3 * i + k] = 0.01 * (i % 7 + urand());
+            vel[3 * i + k] = urand();
+            av[3 * i + k] = 10.0 * urand();
+        }
+        sc[i] = 0.01 * (1.0 + 0.1 * urand());
+    }
+    for (int li = 0; li < N; li++) {
+        v1[li] = rand() % NV;
+        v2[li] = (v1[li] + 1 + rand() % (NV - 1)) % NV;
+        ka[li] = 1e4 * (1.0 + urand()), ca[li] = 1.0 + urand(), kb[li] = 0.1 * (1.0 + urand());
+        cb[li] = 1e-4 * (1.0 + urand()), kt[li] = 0.05 * (1.0 + urand());
+        ct[li] = 1e-5 * (1.0 + urand());
+    }
+    printf("%ld\n", check_ax(0) + check_ax(1) + check_ax(2));
+    return 0;
+}
+"""
+
+
+def _run_harness(level, text, tmp_path):
+    """Compile ``text`` with the kernel build's flags for ``level`` and run it: its output."""
     cc = _gcc()
     if cc is None:
         pytest.skip("built with GCC's flags")
     cpu = Path("/proc/cpuinfo").read_text() if Path("/proc/cpuinfo").exists() else ""
     if ("avx512f" if level == "x86-64-v4" else "avx2") not in cpu:
         pytest.skip(f"this CPU cannot run {level}")
-    src = tmp_path / "geom.c"
-    src.write_text(HARNESS)
-    exe = tmp_path / "geom"
+    src = tmp_path / "harness.c"
+    src.write_text(text)
+    exe = tmp_path / "harness"
     flags = [f if not f.startswith("-march") else f"-march={level}" for f in FLAGS[:-1]]
     res = subprocess.run([cc, *flags, f"-I{INCLUDE}", str(src), "-o", str(exe), "-lm"],
                          capture_output=True, text=True)  # fmt: skip
     if res.returncode != 0 and level in res.stderr:
         pytest.skip(f"the compiler cannot target {level}")
     assert res.returncode == 0, res.stderr
-    out = subprocess.run([str(exe)], capture_output=True, text=True, check=True).stdout
-    assert out.strip() == "0", f"{out.strip()} of {3 * 10 * 203} geometry values differ"
+    return subprocess.run([str(exe)], capture_output=True, text=True, check=True).stdout.strip()
+
+
+@pytest.mark.parametrize("level", ["x86-64-v3", "x86-64-v4"])
+def test_hand_vectorised_corotational_kernel_is_the_formula_bit_for_bit(level, tmp_path):
+    out = _run_harness(level, COROT_HARNESS, tmp_path)
+    assert out == "0", f"{out} of {3 * 10 * 203} link outputs differ"
+
+
+@pytest.mark.parametrize("level", ["x86-64-v3", "x86-64-v4"])
+def test_hand_vectorised_geometry_is_the_formula_bit_for_bit(level, tmp_path):
+    out = _run_harness(level, HARNESS, tmp_path)
+    assert out == "0", f"{out} of {3 * 10 * 203} geometry values differ"

@@ -10,16 +10,6 @@
 #include <math.h>
 #include "softgym_simd.h"
 
-/* f(a, ...) with the link axis a = ax as a compile-time constant: one copy of an
-   always-inline pass per axis */
-#define SOFTGYM_BY_AXIS(ax, f, ...) do { \
-        if ((ax) == 0) \
-            f(0, __VA_ARGS__); \
-        else if ((ax) == 1) \
-            f(1, __VA_ARGS__); \
-        else \
-            f(2, __VA_ARGS__); \
-    } while (0)
 
 /* The first pass of links_seed (_seed.pyx): links lo..hi (all along axis ax, a
    compile-time constant in each copy) measured in the bond frame, without
@@ -56,7 +46,6 @@
 #define SOFTGYM_SEED_GEOM_LINK(li, dx, dy, dz, w, x, y, z, wj, xj, yj, zj, si, sj) \
     SOFTGYM_SEED_GEOM_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, li, dx, dy, dz, w, x, y, z, \
                              wj, xj, yj, zj, si, sj)
-#define SOFTGYM_PUT1(row, li, v) ((row)[li] = (v))
 /* the same for any arithmetic type T (double, or a vector of doubles: then links li ..
    li + lanes - 1 at once, SQRT and FABS T's square root and absolute value, PUT(row,
    li, v) storing v at row + li) */

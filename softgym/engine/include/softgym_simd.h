@@ -70,6 +70,23 @@ typedef double softgym_vd __attribute__((vector_size(32)));
 #define SOFTGYM_VSQRT(v) ((softgym_vd)_mm256_sqrt_pd((__m256d)(v)))
 #endif
 typedef long long softgym_vi __attribute__((vector_size(sizeof(softgym_vd))));
+/* 4 lanes whatever the build (a pass with many rows live at once: with AVX-512 these
+   take the 32 vector registers at half width, where 8 lanes spilled) */
+typedef double softgym_v4 __attribute__((vector_size(32)));
+typedef long long softgym_v4i __attribute__((vector_size(32)));
+#define SOFTGYM_V4SQRT(v) ((softgym_v4)_mm256_sqrt_pd((__m256d)(v)))
+static inline softgym_v4 softgym_v4abs(softgym_v4 v)
+{
+    softgym_v4i bits;
+    memcpy(&bits, &v, sizeof bits);
+    bits &= 0x7fffffffffffffffLL;
+    memcpy(&v, &bits, sizeof v);
+    return v;
+}
+#define SOFTGYM_V4PUT(row, li, v) do { \
+        softgym_v4 v4_ = (v); \
+        memcpy((row) + (li), &v4_, sizeof v4_); \
+    } while (0)
 /* |v| lane by lane (the sign bit cleared, as fabs) */
 static inline softgym_vd softgym_vabs(softgym_vd v)
 {
@@ -107,6 +124,19 @@ static inline softgym_vd softgym_vabs(softgym_vd v)
     } while (0)
 #endif
 #endif
+
+/* f(a, ...) with the link axis a = ax as a compile-time constant: one copy of an
+   always-inline pass per axis */
+#define SOFTGYM_BY_AXIS(ax, f, ...) do { \
+        if ((ax) == 0) \
+            f(0, __VA_ARGS__); \
+        else if ((ax) == 1) \
+            f(1, __VA_ARGS__); \
+        else \
+            f(2, __VA_ARGS__); \
+    } while (0)
+/* v stored at row[li] (a pass's formula macro on doubles; SOFTGYM_VPUT on vectors) */
+#define SOFTGYM_PUT1(row, li, v) ((row)[li] = (v))
 
 #if defined(_MSC_VER)
 #define SOFTGYM_ALWAYS_INLINE static __forceinline

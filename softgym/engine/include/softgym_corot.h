@@ -1,0 +1,212 @@
+/* The corotational model's link kernel (softgym/engine/_corotational.pyx calls it; the
+   physics is described there and in docs/PHYSICS.md). Per link, branch-free: the axial
+   extension and force, the bending and twist of the two voxels relative to the link's
+   frame, their damping, and the force on voxel 2 (voxel 1 takes minus it) and the two
+   voxels' moments, into rows of the scratch. Py_ssize_t comes from Python.h, which
+   Cython includes first. */
+#ifndef SOFTGYM_COROT_H
+#define SOFTGYM_COROT_H
+
+#include <math.h>
+#include "softgym_simd.h"
+
+/* One link's kernel in type T (double, or softgym_vd for SOFTGYM_VLANES links at once:
+   SQRT, FABS T's square root and absolute value, PUT(row, li, v) storing v at row + li),
+   from voxel 2's position and velocity relative to voxel 1's (d, dv), the voxels' sizes
+   si, sj, rotation matrices R1, R2 (row-major: R1[3 r + c]), angular velocities w1, w2
+   and the link's constants. (ax, p, q) is a cyclic permutation of (0, 1, 2), ax the
+   link's lattice axis; inv_L = 1 / the nominal voxel size. Rows out: ext |axial
+   extension|, f the force on voxel 2, m1, m2 the moments on voxels 1 and 2. */
+#define SOFTGYM_COROT_LINK_T(T, SQRT, FABS, PUT, li, ax, p, q, inv_L, dx, dy, dz, dvx, dvy, \
+                             dvz, si, sj, R1, R2, w1x_, w1y_, w1z_, w2x_, w2y_, w2z_, k_ax, \
+                             c_ax, k_b, c_b, k_t, c_t) do { \
+        T ell = SQRT((((dx) * (dx)) + ((dy) * (dy))) + ((dz) * (dz))); \
+        T e = ell - (0.5 * ((si) + (sj))); \
+        PUT(o_ext, li, FABS(e));  /* NaN stays NaN: the caller's check catches it */ \
+        /* axial force on voxel 2 along the chord u = d / |d| (elastic + damping) */ \
+        T inv_l = 1.0 / ell; \
+        T edot = ((((dx) * (dvx)) + ((dy) * (dvy))) + ((dz) * (dvz))) * inv_l; \
+        T fa = (((k_ax) * e) + ((c_ax) * edot)) * inv_l; \
+        T ax_x = (-fa) * (dx), ax_y = (-fa) * (dy), ax_z = (-fa) * (dz); \
+        /* the link's lattice axis in each voxel (column ax of its rotation) and the \
+           link's frame axis r, their bisector */ \
+        T a1x = (R1)[ax], a1y = (R1)[3 + (ax)], a1z = (R1)[6 + (ax)]; \
+        T a2x = (R2)[ax], a2y = (R2)[3 + (ax)], a2z = (R2)[6 + (ax)]; \
+        T rx = a1x + a2x, ry = a1y + a2y, rz = a1z + a2z; \
+        /* 1 / |a1 + a2| by one Newton step from 1/2 (|a1 + a2|^2 = 4 - |a1 - a2|^2 is \
+           near 4): relative error 0.14 % at 0.5 rad of relative bending */ \
+        T inv_r = 0.5 * (1.5 - (0.125 * (((rx * rx) + (ry * ry)) + (rz * rz)))); \
+        rx = rx * inv_r; \
+        ry = ry * inv_r; \
+        rz = rz * inv_r; \
+        /* transverse offset of voxel 2 as an angle on the nominal length, c = r x d / L \
+           (the seed's Pos2.y / L: stiffness does not grow when actuated voxels shrink) */ \
+        T cx = ((ry * (dz)) - (rz * (dy))) * (inv_L); \
+        T cy = ((rz * (dx)) - (rx * (dz))) * (inv_L); \
+        T cz = ((rx * (dy)) - (ry * (dx))) * (inv_L); \
+        /* bending of each voxel relative to the link, b_i = r x a_i - c; as r bisects a1 \
+           and a2, r x a2 = -(r x a1) = h = inv_r (a1 x a2), so b1 = -h - c, b2 = h - c */ \
+        T hx = ((a1y * a2z) - (a1z * a2y)) * inv_r; \
+        T hy = ((a1z * a2x) - (a1x * a2z)) * inv_r; \
+        T hz = ((a1x * a2y) - (a1y * a2x)) * inv_r; \
+        /* twist of voxel 2 relative to voxel 1 about the link: with y, z the voxels' \
+           two other lattice axes, sin(twist) = (z1 . y2 - y1 . z2) / 2 */ \
+        T tw = 0.5 * (((((((R1)[q] * (R2)[p]) + ((R1)[3 + (q)] * (R2)[3 + (p)])) \
+                         + ((R1)[6 + (q)] * (R2)[6 + (p)])) - ((R1)[p] * (R2)[q])) \
+                       - ((R1)[3 + (p)] * (R2)[3 + (q)])) - ((R1)[6 + (p)] * (R2)[6 + (q)])); \
+        /* rates: transverse angle (wc = r x dv / L), the voxels' angular velocities \
+           across the link (w_i minus its part along r) and twist */ \
+        T wcx = ((ry * (dvz)) - (rz * (dvy))) * (inv_L); \
+        T wcy = ((rz * (dvx)) - (rx * (dvz))) * (inv_L); \
+        T wcz = ((rx * (dvy)) - (ry * (dvx))) * (inv_L); \
+        T w1x = (w1x_), w1y = (w1y_), w1z = (w1z_); \
+        T uw = ((rx * w1x) + (ry * w1y)) + (rz * w1z); \
+        w1x = w1x - (uw * rx); \
+        w1y = w1y - (uw * ry); \
+        w1z = w1z - (uw * rz); \
+        T twdot = -uw; \
+        T w2x = (w2x_), w2y = (w2y_), w2z = (w2z_); \
+        uw = ((rx * w2x) + (ry * w2y)) + (rz * w2z); \
+        w2x = w2x - (uw * rx); \
+        w2y = w2y - (uw * ry); \
+        w2z = w2z - (uw * rz); \
+        twdot = twdot + uw; \
+        /* bending moments: elastic -k_b (2 b1 + b2) = k_b (h + 3 c) on voxel 1, \
+           -k_b (b1 + 2 b2) = k_b (3 c - h) on voxel 2; damping the same form with the \
+           bending rates (w_i - wc) */ \
+        T kb_ = (k_b), cb_ = (c_b); \
+        T n1x = (kb_ * (hx + (3.0 * cx))) - (cb_ * (((2.0 * w1x) + w2x) - (3.0 * wcx))); \
+        T n1y = (kb_ * (hy + (3.0 * cy))) - (cb_ * (((2.0 * w1y) + w2y) - (3.0 * wcy))); \
+        T n1z = (kb_ * (hz + (3.0 * cz))) - (cb_ * (((2.0 * w1z) + w2z) - (3.0 * wcz))); \
+        T n2x = (kb_ * ((3.0 * cx) - hx)) - (cb_ * ((w1x + (2.0 * w2x)) - (3.0 * wcx))); \
+        T n2y = (kb_ * ((3.0 * cy) - hy)) - (cb_ * ((w1y + (2.0 * w2y)) - (3.0 * wcy))); \
+        T n2z = (kb_ * ((3.0 * cz) - hz)) - (cb_ * ((w1z + (2.0 * w2z)) - (3.0 * wcz))); \
+        /* force on voxel 2: axial plus the shear that balances the bending moments \
+           over the nominal length */ \
+        T sx = n1x + n2x, sy = n1y + n2y, sz = n1z + n2z; \
+        PUT(o_fx, li, ax_x + (((ry * sz) - (rz * sy)) * (inv_L))); \
+        PUT(o_fy, li, ax_y + (((rz * sx) - (rx * sz)) * (inv_L))); \
+        PUT(o_fz, li, ax_z + (((rx * sy) - (ry * sx)) * (inv_L))); \
+        /* torsion, equal and opposite along r */ \
+        T tor = ((k_t) * tw) + ((c_t) * twdot); \
+        PUT(o_m1x, li, n1x + (tor * rx)); \
+        PUT(o_m1y, li, n1y + (tor * ry)); \
+        PUT(o_m1z, li, n1z + (tor * rz)); \
+        PUT(o_m2x, li, n2x - (tor * rx)); \
+        PUT(o_m2y, li, n2y - (tor * ry)); \
+        PUT(o_m2z, li, n2z - (tor * rz)); \
+    } while (0)
+
+#if defined(SOFTGYM_VLANES)
+/* rows a..d (4 doubles each) transposed: r0 = the a..d's element 0, ..., r3 element 3 */
+#define SOFTGYM_TRANSPOSE4(a, b, c, d, r0, r1, r2, r3) do { \
+        __m256d t0_ = _mm256_unpacklo_pd(a, b), t1_ = _mm256_unpackhi_pd(a, b); \
+        __m256d t2_ = _mm256_unpacklo_pd(c, d), t3_ = _mm256_unpackhi_pd(c, d); \
+        r0 = _mm256_permute2f128_pd(t0_, t2_, 0x20); \
+        r1 = _mm256_permute2f128_pd(t1_, t3_, 0x20); \
+        r2 = _mm256_permute2f128_pd(t0_, t2_, 0x31); \
+        r3 = _mm256_permute2f128_pd(t1_, t3_, 0x31); \
+    } while (0)
+/* voxels idx[0..3] as rows of 4: position 0-2, velocity 3-5, angular velocity 6-8,
+   rotation matrix 9-17 (row-major), size 18. GCC's vectoriser loaded these 19 numbers a
+   voxel one by one; here pairs of 16-byte loads and unpacks, and the matrix as two
+   32-byte loads a voxel turned into rows by a 4 x 4 transpose */
+static inline void softgym_corot_gather4(const Py_ssize_t *idx, const double *pos,
+                                         const double *vel, const double *av,
+                                         const double *rot, const double *scale, __m256d *r)
+{
+    const double *a = pos + 3 * idx[0], *b = pos + 3 * idx[1];
+    const double *c = pos + 3 * idx[2], *d = pos + 3 * idx[3];
+    SOFTGYM_GATHER_PAIRS(a, b, c, d, 0, r[0], r[1]);
+    r[2] = _mm256_set_pd(d[2], c[2], b[2], a[2]);
+    a = vel + 3 * idx[0], b = vel + 3 * idx[1], c = vel + 3 * idx[2], d = vel + 3 * idx[3];
+    SOFTGYM_GATHER_PAIRS(a, b, c, d, 0, r[3], r[4]);
+    r[5] = _mm256_set_pd(d[2], c[2], b[2], a[2]);
+    a = av + 3 * idx[0], b = av + 3 * idx[1], c = av + 3 * idx[2], d = av + 3 * idx[3];
+    SOFTGYM_GATHER_PAIRS(a, b, c, d, 0, r[6], r[7]);
+    r[8] = _mm256_set_pd(d[2], c[2], b[2], a[2]);
+    a = rot + 9 * idx[0], b = rot + 9 * idx[1], c = rot + 9 * idx[2], d = rot + 9 * idx[3];
+    SOFTGYM_TRANSPOSE4(_mm256_loadu_pd(a), _mm256_loadu_pd(b), _mm256_loadu_pd(c),
+                       _mm256_loadu_pd(d), r[9], r[10], r[11], r[12]);
+    SOFTGYM_TRANSPOSE4(_mm256_loadu_pd(a + 4), _mm256_loadu_pd(b + 4), _mm256_loadu_pd(c + 4),
+                       _mm256_loadu_pd(d + 4), r[13], r[14], r[15], r[16]);
+    r[17] = _mm256_set_pd(d[8], c[8], b[8], a[8]);
+    r[18] = _mm256_set_pd(scale[idx[3]], scale[idx[2]], scale[idx[1]], scale[idx[0]]);
+}
+/* n consecutive values of a row from li, as 4 lanes */
+static inline softgym_v4 softgym_v4load(const double *row, Py_ssize_t li)
+{
+    softgym_v4 v;
+    memcpy(&v, row + li, sizeof v);
+    return v;
+}
+#endif
+
+/* links lo..hi, all along axis ax (a compile-time constant in each copy), into the
+   rows of the scratch o (stride n): 0 |axial extension|, 1-3 the force on voxel 2,
+   4-6 voxel 1's moment, 7-9 voxel 2's */
+SOFTGYM_ALWAYS_INLINE void softgym_corot_links_ax(
+    const int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double inv_L,
+    const Py_ssize_t *__restrict__ v1, const Py_ssize_t *__restrict__ v2,
+    const double *__restrict__ pos, const double *__restrict__ vel,
+    const double *__restrict__ av, const double *__restrict__ rot,
+    const double *__restrict__ scale, const double *__restrict__ k_axial,
+    const double *__restrict__ c_axial, const double *__restrict__ k_bend,
+    const double *__restrict__ c_bend, const double *__restrict__ k_torsion,
+    const double *__restrict__ c_torsion, double *o)
+{
+    const int p = (ax + 1) % 3, q = (ax + 2) % 3;
+    double *__restrict__ o_ext = o, *__restrict__ o_fx = o + n, *__restrict__ o_fy = o + 2 * n;
+    double *__restrict__ o_fz = o + 3 * n, *__restrict__ o_m1x = o + 4 * n;
+    double *__restrict__ o_m1y = o + 5 * n, *__restrict__ o_m1z = o + 6 * n;
+    double *__restrict__ o_m2x = o + 7 * n, *__restrict__ o_m2y = o + 8 * n;
+    double *__restrict__ o_m2z = o + 9 * n;
+    Py_ssize_t li = lo;
+#if defined(SOFTGYM_VLANES)
+    /* 4 links a vector also with AVX-512: 8 spilled (38 rows live; measured 5 % slower) */
+    for (; li + 4 <= hi; li += 4) {
+        __m256d gi[19], gj[19];
+        softgym_corot_gather4(v1 + li, pos, vel, av, rot, scale, gi);
+        softgym_corot_gather4(v2 + li, pos, vel, av, rot, scale, gj);
+        softgym_v4 dx = gj[0] - gi[0], dy = gj[1] - gi[1], dz = gj[2] - gi[2];
+        softgym_v4 dvx = gj[3] - gi[3], dvy = gj[4] - gi[4], dvz = gj[5] - gi[5];
+        SOFTGYM_COROT_LINK_T(softgym_v4, SOFTGYM_V4SQRT, softgym_v4abs, SOFTGYM_V4PUT, li, ax, p,
+                             q, inv_L, dx, dy, dz, dvx, dvy, dvz, (softgym_v4)gi[18],
+                             (softgym_v4)gj[18], ((softgym_v4 *)gi + 9), ((softgym_v4 *)gj + 9),
+                             (softgym_v4)gi[6], (softgym_v4)gi[7], (softgym_v4)gi[8],
+                             (softgym_v4)gj[6], (softgym_v4)gj[7], (softgym_v4)gj[8],
+                             softgym_v4load(k_axial, li), softgym_v4load(c_axial, li),
+                             softgym_v4load(k_bend, li), softgym_v4load(c_bend, li),
+                             softgym_v4load(k_torsion, li), softgym_v4load(c_torsion, li));
+    }
+#endif
+    /* the rest (and every link without AVX): the compiler's vectoriser */
+    SOFTGYM_IVDEP
+    for (; li < hi; li++) {
+        Py_ssize_t i = v1[li], j = v2[li];
+        double dx = pos[3 * j] - pos[3 * i];
+        double dy = pos[3 * j + 1] - pos[3 * i + 1];
+        double dz = pos[3 * j + 2] - pos[3 * i + 2];
+        double dvx = vel[3 * j] - vel[3 * i];
+        double dvy = vel[3 * j + 1] - vel[3 * i + 1];
+        double dvz = vel[3 * j + 2] - vel[3 * i + 2];
+        SOFTGYM_COROT_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, li, ax, p, q, inv_L, dx, dy, dz,
+                             dvx, dvy, dvz, scale[i], scale[j], (rot + 9 * i), (rot + 9 * j),
+                             av[3 * i], av[3 * i + 1], av[3 * i + 2], av[3 * j], av[3 * j + 1],
+                             av[3 * j + 2], k_axial[li], c_axial[li], k_bend[li], c_bend[li],
+                             k_torsion[li], c_torsion[li]);
+    }
+}
+static void softgym_corot_links(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
+                                double inv_L, const Py_ssize_t *v1, const Py_ssize_t *v2,
+                                const double *pos, const double *vel, const double *av,
+                                const double *rot, const double *scale, const double *k_axial,
+                                const double *c_axial, const double *k_bend,
+                                const double *c_bend, const double *k_torsion,
+                                const double *c_torsion, double *o)
+{
+    SOFTGYM_BY_AXIS(ax, softgym_corot_links_ax, lo, hi, n, inv_L, v1, v2, pos, vel, av, rot,
+                    scale, k_axial, c_axial, k_bend, c_bend, k_torsion, c_torsion, o);
+}
+
+#endif  /* SOFTGYM_COROT_H */
