@@ -90,6 +90,42 @@ def test_each_seed_pass_vectorises(name, tmp_path):
     assert vectorised or hand, f"{name}: GCC vectorised no loop:\n{res.stderr[-2000:]}"
 
 
+# the hand-vectorised passes' loops on doubles: the rest of a run, and every link of the
+# portable build (no AVX), where GCC must still vectorise them
+FALLBACKS = {
+    "softgym_seed_geom": PASSES["softgym_seed_geom"],
+    "softgym_corot_links": "softgym_corot_links(ax, 0, n, n, 100.0, ip, ip, d, d, d, d, d, d, d, "
+                           "d, d, d, d, o);",
+}
+
+
+@pytest.mark.parametrize("name", sorted(FALLBACKS))
+def test_the_portable_build_vectorises_the_hand_vectorised_passes_loops(name, tmp_path):
+    cc = _gcc()
+    if cc is None:
+        pytest.skip("the vectorisation report is GCC's")
+    src = tmp_path / "pass.c"
+    src.write_text(
+        "#include <stddef.h>\n"
+        "typedef long Py_ssize_t;\n"
+        '#include "softgym_seed.h"\n'
+        '#include "softgym_corot.h"\n'
+        "#ifdef SOFTGYM_VLANES\n#error the portable build has no hand-vectorised loop\n#endif\n"
+        "long run(int ax, Py_ssize_t n, const Py_ssize_t *ip, const double *d, double *o)\n"
+        "{\n"
+        f"    {FALLBACKS[name]}\n"
+        "    return 0;\n"
+        "}\n"
+    )
+    flags = [f if not f.startswith("-march") else "-march=x86-64" for f in FLAGS]
+    res = subprocess.run([cc, *flags, f"-I{INCLUDE}", "-c", str(src), "-o", str(tmp_path / "pass.o")],
+                         capture_output=True, text=True)  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    vectorised = [line for line in res.stderr.splitlines()
+                  if "loop vectorized" in line and ("softgym_seed.h" in line or "softgym_corot.h" in line)]  # fmt: skip
+    assert vectorised, f"{name}: GCC vectorised no loop in the portable build:\n{res.stderr[-2000:]}"
+
+
 HARNESS = r"""
 #include <stdio.h>
 #include <stdlib.h>

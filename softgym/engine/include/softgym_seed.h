@@ -130,6 +130,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
     }
 #endif
     /* the rest (and every link without AVX): the compiler's vectoriser */
+    SOFTGYM_IVDEP
     for (; li < hi; li++) {
         Py_ssize_t i = v1[li], j = v2[li];
         double dx = pos[3 * j] - pos[3 * i];
