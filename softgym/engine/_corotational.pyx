@@ -57,38 +57,24 @@ cdef extern from "softgym_corot.h":
                              const float64_t* c_axial, const float64_t* k_bend,
                              const float64_t* c_bend, const float64_t* k_torsion,
                              const float64_t* c_torsion, float64_t* o) noexcept nogil
+    # the strain check and the scatter in link order: hi, or the first strained link
+    intp_t softgym_corot_scatter(intp_t lo, intp_t hi, intp_t n, float64_t max_ext,
+                                 const intp_t* v1, const intp_t* v2, const float64_t* o,
+                                 float64_t* force, float64_t* moment) noexcept nogil
 
 
 cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi, int ax) noexcept nogil:
     # Links lo..hi along axis `ax`: the vectorised kernel, then the strain
     # check and the scatter of forces and moments in link order.
     cdef:
-        intp_t li, i, j
         intp_t n = b.link_stride  # the scratch's row stride
-        float64_t max_ext = b.max_strain * b.L
         float64_t* o = b.link_out
-        float64_t* force = b.force
-        float64_t* moment = b.moment
     if hi <= lo:
         return STATUS_OK
     softgym_corot_links(ax, lo, hi, n, 1.0 / b.L, b.v1, b.v2, b.pos, b.vel, b.angvel, b.rot,
                         b.scale, b.k_axial, b.c_axial, b.k_bend, b.c_bend, b.k_torsion,
                         b.c_torsion, o)
-    for li in range(lo, hi):
-        if not (o[li] <= max_ext):
-            return STATUS_STRAIN  # also catches NaN
-        i = b.v1[li]
-        j = b.v2[li]
-        force[4 * j] += o[n + li]
-        force[4 * j + 1] += o[2 * n + li]
-        force[4 * j + 2] += o[3 * n + li]
-        force[4 * i] -= o[n + li]
-        force[4 * i + 1] -= o[2 * n + li]
-        force[4 * i + 2] -= o[3 * n + li]
-        moment[4 * i] += o[4 * n + li]
-        moment[4 * i + 1] += o[5 * n + li]
-        moment[4 * i + 2] += o[6 * n + li]
-        moment[4 * j] += o[7 * n + li]
-        moment[4 * j + 1] += o[8 * n + li]
-        moment[4 * j + 2] += o[9 * n + li]
+    if softgym_corot_scatter(lo, hi, n, b.max_strain * b.L, b.v1, b.v2, o, b.force,
+                             b.moment) < hi:
+        return STATUS_STRAIN  # also for NaN
     return STATUS_OK

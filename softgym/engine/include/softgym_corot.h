@@ -209,4 +209,70 @@ static void softgym_corot_links(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t
                     scale, k_axial, c_axial, k_bend, c_bend, k_torsion, c_torsion, o);
 }
 
+/* The strain check and the scatter of links lo..hi in link order, from the kernel's rows
+   of o (stride n): voxel 2 takes the force f and voxel 1 minus it, each voxel its moment.
+   Returns hi, or the first link whose |axial extension| is beyond max_ext (NaN
+   included); the links before it are scattered. With AVX each link's three components
+   are added to the voxel's whole row of 4 (lane 3 is padding, never read): the same
+   additions, in the same order, per component. Where a link's voxel 1 is the last link's
+   voxel 2 (runs along the lattice's fastest axis) its rows come from registers instead
+   of a load that would wait on the store just made. */
+static Py_ssize_t softgym_corot_scatter(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
+                                        double max_ext, const Py_ssize_t *v1,
+                                        const Py_ssize_t *v2, const double *o, double *force,
+                                        double *moment)
+{
+    Py_ssize_t li;
+#if defined(SOFTGYM_VLANES)
+    softgym_v4 cf = {0.0, 0.0, 0.0, 0.0}, cm = cf;
+    Py_ssize_t pj = -1;
+#endif
+    for (li = lo; li < hi; li++) {
+        if (!(o[li] <= max_ext))
+            return li;
+        Py_ssize_t i = v1[li], j = v2[li];
+        double fx = o[n + li], fy = o[2 * n + li], fz = o[3 * n + li];
+#if defined(SOFTGYM_VLANES)
+        softgym_v4 f = {fx, fy, fz, 0.0};
+        softgym_v4 m1 = {o[4 * n + li], o[5 * n + li], o[6 * n + li], 0.0};
+        softgym_v4 m2 = {o[7 * n + li], o[8 * n + li], o[9 * n + li], 0.0};
+        softgym_v4 fi, mi, fj, mj;
+        if (i == pj) {
+            fi = cf;
+            mi = cm;
+        } else {
+            memcpy(&fi, force + 4 * i, sizeof fi);
+            memcpy(&mi, moment + 4 * i, sizeof mi);
+        }
+        memcpy(&fj, force + 4 * j, sizeof fj);
+        memcpy(&mj, moment + 4 * j, sizeof mj);
+        fj += f;
+        fi -= f;
+        mi += m1;
+        mj += m2;
+        memcpy(force + 4 * j, &fj, sizeof fj);
+        memcpy(force + 4 * i, &fi, sizeof fi);
+        memcpy(moment + 4 * i, &mi, sizeof mi);
+        memcpy(moment + 4 * j, &mj, sizeof mj);
+        cf = fj;
+        cm = mj;
+        pj = j;
+#else
+        force[4 * j] += fx;
+        force[4 * j + 1] += fy;
+        force[4 * j + 2] += fz;
+        force[4 * i] -= fx;
+        force[4 * i + 1] -= fy;
+        force[4 * i + 2] -= fz;
+        moment[4 * i] += o[4 * n + li];
+        moment[4 * i + 1] += o[5 * n + li];
+        moment[4 * i + 2] += o[6 * n + li];
+        moment[4 * j] += o[7 * n + li];
+        moment[4 * j + 1] += o[8 * n + li];
+        moment[4 * j + 2] += o[9 * n + li];
+#endif
+    }
+    return hi;
+}
+
 #endif  /* SOFTGYM_COROT_H */
