@@ -78,6 +78,26 @@ cdef inline float64_t _drift2(const float64_t* pos, const float64_t* ref, intp_t
             + (pos[3 * i + 2] - ref[k + 2] - c[2]) ** 2)
 
 
+cdef inline float64_t _translate(float64_t* v, float64_t* p, const float64_t* f, float64_t h,
+                                 float64_t dt) noexcept nogil:
+    # one voxel's symplectic Euler step of translation: v += f h, then p += v dt
+    # (h = dt / m); returns |p_x| + |p_y| + |p_z| for the runaway check. The new
+    # values are kept in locals: the stores to v may alias p for the compiler,
+    # which otherwise reloaded each velocity just stored (a store-to-load wait)
+    cdef float64_t vx = v[0] + f[0] * h, vy = v[1] + f[1] * h, vz = v[2] + f[2] * h
+    cdef float64_t px, py, pz
+    v[0] = vx
+    v[1] = vy
+    v[2] = vz
+    px = p[0] + vx * dt
+    py = p[1] + vy * dt
+    pz = p[2] + vz * dt
+    p[0] = px
+    p[1] = py
+    p[2] = pz
+    return fabs(px) + fabs(py) + fabs(pz)
+
+
 cdef inline void _spin(Batch* b, intp_t i, float64_t dt, float64_t mx, float64_t my,
                        float64_t mz) noexcept nogil:
     # angular velocity: w += M dt / I, then the global damping factor
@@ -100,7 +120,7 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
     cdef:
         intp_t i, k
         float64_t dt = b.dt[r]
-        float64_t m, h, pen, cg, d2, mx, my, mz, vx, vy, vz, px, py, pz
+        float64_t m, pen, cg, d2, mx, my, mz
         float64_t c[3]
         float64_t f[3]
         float64_t n[3]
@@ -146,20 +166,7 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
             pen = box_penetration(b.boxes + 6 * k, pos + 3 * i, 0.5 * b.scale[i], n)
             if pen > 0.0:
                 surface_contact(b, i, n[0], n[1], n[2], pen, dt, f)
-        h = dt * b.inv_mass[i]
-        vx = vel[3 * i] + f[0] * h  # in locals, as integrate_seed
-        vy = vel[3 * i + 1] + f[1] * h
-        vz = vel[3 * i + 2] + f[2] * h
-        vel[3 * i] = vx
-        vel[3 * i + 1] = vy
-        vel[3 * i + 2] = vz
-        px = pos[3 * i] + vx * dt
-        py = pos[3 * i + 1] + vy * dt
-        pz = pos[3 * i + 2] + vz * dt
-        pos[3 * i] = px
-        pos[3 * i + 1] = py
-        pos[3 * i + 2] = pz
-        if not (fabs(px) + fabs(py) + fabs(pz) < RUNAWAY):
+        if not (_translate(vel + 3 * i, pos + 3 * i, f, dt * b.inv_mass[i], dt) < RUNAWAY):
             _orient(b, vs, i, dt, 0)  # the voxels before it were stepped
             clear_robot(b, r)
             return STATUS_NONFINITE
@@ -221,7 +228,7 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
     cdef:
         intp_t i, k
         float64_t dt = b.dt[r]
-        float64_t h, pen, cg, d2, mx, my, mz, vx, vy, vz, px, py, pz
+        float64_t pen, cg, d2, mx, my, mz
         float64_t c[3]
         float64_t f[3]
         float64_t n[3]
@@ -260,22 +267,7 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
                 surface_contact(b, i, n[0], n[1], n[2], pen, dt, f)
         if has_floor:
             seed_floor(b, i, dt, f)
-        h = dt * b.inv_mass[i]
-        # in locals: the stores to vel may alias pos for the compiler, which
-        # otherwise reloads each velocity just stored (a store-to-load wait)
-        vx = vel[3 * i] + f[0] * h
-        vy = vel[3 * i + 1] + f[1] * h
-        vz = vel[3 * i + 2] + f[2] * h
-        vel[3 * i] = vx
-        vel[3 * i + 1] = vy
-        vel[3 * i + 2] = vz
-        px = pos[3 * i] + vx * dt
-        py = pos[3 * i + 1] + vy * dt
-        pz = pos[3 * i + 2] + vz * dt
-        pos[3 * i] = px
-        pos[3 * i + 1] = py
-        pos[3 * i + 2] = pz
-        if not (fabs(px) + fabs(py) + fabs(pz) < RUNAWAY):
+        if not (_translate(vel + 3 * i, pos + 3 * i, f, dt * b.inv_mass[i], dt) < RUNAWAY):
             _orient(b, vs, i, dt, 1)  # the voxels before it were stepped
             clear_robot(b, r)
             return STATUS_NONFINITE

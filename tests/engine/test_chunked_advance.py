@@ -21,8 +21,13 @@ def _bodies():
     return [reference_robot(4), two_material_body(grid, cte=0.02, period=0.3, temp_amplitude=10)]
 
 
-def _state(sim):
-    return sim.get_state()
+def _assert_same(a_sim, b_sim, rollouts=True):
+    # every state array, and (rollouts) the centre-of-mass traces, equal bit for bit
+    a, b = a_sim.get_state(), b_sim.get_state()
+    for k in a:
+        np.testing.assert_array_equal(a[k], b[k], err_msg=k)
+    if rollouts:
+        np.testing.assert_array_equal(a_sim.rollout().cm, b_sim.rollout().cm)
 
 
 @pytest.mark.parametrize("model", ["seed", "corotational"])
@@ -36,29 +41,7 @@ def test_chunked_advance_is_bit_identical_to_one_call(model):
     calls = []
     chunked.advance_to(1.3, progress=calls.append)
     assert len(calls) > 50 and calls == sorted(calls) and calls[-1] == 1.3
-    a, b = _state(one), _state(chunked)
-    for k in a:
-        np.testing.assert_array_equal(a[k], b[k], err_msg=k)
-    np.testing.assert_array_equal(one.rollout().cm, chunked.rollout().cm)
-
-
-def test_an_interrupted_advance_goes_on_to_the_same_state():
-    ref = Simulation(_bodies(), n_threads=1)
-    ref.advance_to(1.0)
-    sim = Simulation(_bodies(), n_threads=1)
-    sim.chunk_voxel_steps = 2000
-
-    def stop(t):
-        if t > 0.4:
-            raise KeyboardInterrupt
-
-    with pytest.raises(KeyboardInterrupt):
-        sim.advance_to(1.0, progress=stop)
-    assert 0.4 < sim.time.max() < 1.0  # left at the end of a chunk
-    sim.advance_to(1.0)
-    a, b = _state(ref), _state(sim)
-    for k in a:
-        np.testing.assert_array_equal(a[k], b[k], err_msg=k)
+    _assert_same(one, chunked)
 
 
 @pytest.mark.skipif(os.name != "posix", reason="needs POSIX signals")
@@ -106,28 +89,30 @@ def test_a_large_batch_advances_group_by_group_to_the_same_bits(threads):
     grouped.advance_to(0.6, progress=seen)
     assert calls == sorted(calls) and calls[-1] == 0.6
     assert max(spread) > 0.5  # one group at 0.6 s while another had not started
-    a, b = _state(one), _state(grouped)
-    for k in a:
-        np.testing.assert_array_equal(a[k], b[k], err_msg=k)
-    np.testing.assert_array_equal(one.rollout().cm, grouped.rollout().cm)
+    _assert_same(one, grouped)
 
 
-def test_an_interrupted_group_by_group_advance_goes_on_to_the_same_state():
-    ref = Simulation(_many(), n_threads=1)
-    ref.advance_to(0.6)
-    sim = Simulation(_many(), n_threads=1)
-    sim.chunk_voxel_steps = 400
-    sim.min_visit_steps = 50
+@pytest.mark.parametrize("grouped", [False, True])
+def test_an_interrupted_advance_goes_on_to_the_same_state(grouped):
+    # a batch in chunks, stopped past 0.4 s; or in groups, stopped when the first group
+    # is done and the others are not: a later call ends where one call would have
+    bodies, end = (_many, 0.6) if grouped else (_bodies, 1.0)
+    ref = Simulation(bodies(), n_threads=1)
+    ref.advance_to(end)
+    sim = Simulation(bodies(), n_threads=1)
+    sim.chunk_voxel_steps = 400 if grouped else 2000
+    if grouped:
+        sim.min_visit_steps = 50
 
     def stop(t):
-        if sim.time.max() >= 0.6:  # the first group is done, the others are not
+        if (sim.time.max() >= end) if grouped else (t > 0.4):
             raise KeyboardInterrupt
 
     with pytest.raises(KeyboardInterrupt):
-        sim.advance_to(0.6, progress=stop)
-    assert sim.time.min() < 0.6
-    sim.advance_to(0.6)
-    a, b = _state(ref), _state(sim)
-    for k in a:
-        np.testing.assert_array_equal(a[k], b[k], err_msg=k)
-    np.testing.assert_array_equal(ref.rollout().cm, sim.rollout().cm)
+        sim.advance_to(end, progress=stop)
+    if grouped:
+        assert sim.time.min() < end
+    else:
+        assert 0.4 < sim.time.max() < 1.0  # left at the end of a chunk
+    sim.advance_to(end)
+    _assert_same(ref, sim, rollouts=grouped)

@@ -54,40 +54,48 @@ def _gcc():
     return cc if is_gcc else None
 
 
-@pytest.mark.parametrize("name", sorted(PASSES))
-def test_each_seed_pass_vectorises(name, tmp_path):
+HEADERS = ("softgym_seed.h", "softgym_orient.h", "softgym_pairs.h", "softgym_corot.h")
+REPORTED = (*HEADERS, "softgym_seed_forces.h")  # included by softgym_seed.h
+
+
+def _compile_pass(call, march, guard, tmp_path):
+    """GCC's vectorisation report (stderr) of ``call`` compiled alone, with the kernel
+    build's flags for ``march``, after the headers and the preprocessor lines ``guard``."""
     cc = _gcc()
     if cc is None:
         pytest.skip("the vectorisation report is GCC's")
     src = tmp_path / "pass.c"
-    # the geometry's loop is vectorised by hand with AVX (its remainder is the compiler's)
-    hand = ("#ifndef SOFTGYM_VLANES\n#error the hand-vectorised geometry is not compiled in\n"
-            "#endif\n") if name == "softgym_seed_geom" else ""  # fmt: skip
     src.write_text(
         "#include <stddef.h>\n"
         "typedef long Py_ssize_t;\n"  # Python.h's, which Cython includes first
-        '#include "softgym_seed.h"\n'
-        '#include "softgym_orient.h"\n'
-        '#include "softgym_pairs.h"\n'
-        f"{hand}"
-        "long run(int ax, Py_ssize_t n, const Py_ssize_t *ip, const double *d, double *o,\n"
+        + "".join(f'#include "{h}"\n' for h in HEADERS)
+        + guard
+        + "long run(int ax, Py_ssize_t n, const Py_ssize_t *ip, const double *d, double *o,\n"
         "         long long *lf, const double *const *cin, double *const *out,\n"
         "         const float *fc, float *const *fo, const float *const *fin)\n"
         "{\n"
-        f"    {PASSES[name]}\n"
+        f"    {call}\n"
         "    return 0;\n"
         "}\n"
     )
-    res = subprocess.run([cc, *FLAGS, f"-I{INCLUDE}", "-c", str(src), "-o", str(tmp_path / "pass.o")],
+    flags = [f if not f.startswith("-march") else f"-march={march}" for f in FLAGS]
+    res = subprocess.run([cc, *flags, f"-I{INCLUDE}", "-c", str(src), "-o", str(tmp_path / "pass.o")],
                          capture_output=True, text=True)  # fmt: skip
-    if res.returncode != 0 and "x86-64-v3" in res.stderr:
-        pytest.skip("the compiler cannot target x86-64-v3")
+    if res.returncode != 0 and march in res.stderr:
+        pytest.skip(f"the compiler cannot target {march}")
     assert res.returncode == 0, res.stderr
     assert "implicit declaration" not in res.stderr, res.stderr  # the pass is where we look
-    vectorised = [line for line in res.stderr.splitlines()
-                  if "loop vectorized" in line
-                  and any(h in line for h in ("softgym_seed", "softgym_orient.h", "softgym_pairs.h"))]  # fmt: skip
-    assert vectorised or hand, f"{name}: GCC vectorised no loop:\n{res.stderr[-2000:]}"
+    return [line for line in res.stderr.splitlines()
+            if "loop vectorized" in line and any(h in line for h in REPORTED)]  # fmt: skip
+
+
+@pytest.mark.parametrize("name", sorted(PASSES))
+def test_each_seed_pass_vectorises(name, tmp_path):
+    # the geometry's loop is vectorised by hand with AVX (its remainder is the compiler's)
+    hand = ("#ifndef SOFTGYM_VLANES\n#error the hand-vectorised geometry is not compiled in\n"
+            "#endif\n") if name == "softgym_seed_geom" else ""  # fmt: skip
+    vectorised = _compile_pass(PASSES[name], "x86-64-v3", hand, tmp_path)
+    assert vectorised or hand, f"{name}: GCC vectorised no loop"
 
 
 # the hand-vectorised passes' loops on doubles: the rest of a run, and every link of the
@@ -101,29 +109,9 @@ FALLBACKS = {
 
 @pytest.mark.parametrize("name", sorted(FALLBACKS))
 def test_the_portable_build_vectorises_the_hand_vectorised_passes_loops(name, tmp_path):
-    cc = _gcc()
-    if cc is None:
-        pytest.skip("the vectorisation report is GCC's")
-    src = tmp_path / "pass.c"
-    src.write_text(
-        "#include <stddef.h>\n"
-        "typedef long Py_ssize_t;\n"
-        '#include "softgym_seed.h"\n'
-        '#include "softgym_corot.h"\n'
-        "#ifdef SOFTGYM_VLANES\n#error the portable build has no hand-vectorised loop\n#endif\n"
-        "long run(int ax, Py_ssize_t n, const Py_ssize_t *ip, const double *d, double *o)\n"
-        "{\n"
-        f"    {FALLBACKS[name]}\n"
-        "    return 0;\n"
-        "}\n"
-    )
-    flags = [f if not f.startswith("-march") else "-march=x86-64" for f in FLAGS]
-    res = subprocess.run([cc, *flags, f"-I{INCLUDE}", "-c", str(src), "-o", str(tmp_path / "pass.o")],
-                         capture_output=True, text=True)  # fmt: skip
-    assert res.returncode == 0, res.stderr
-    vectorised = [line for line in res.stderr.splitlines()
-                  if "loop vectorized" in line and ("softgym_seed.h" in line or "softgym_corot.h" in line)]  # fmt: skip
-    assert vectorised, f"{name}: GCC vectorised no loop in the portable build:\n{res.stderr[-2000:]}"
+    guard = "#ifdef SOFTGYM_VLANES\n#error the portable build has no hand-vectorised loop\n#endif\n"
+    vectorised = _compile_pass(FALLBACKS[name], "x86-64", guard, tmp_path)
+    assert vectorised, f"{name}: GCC vectorised no loop in the portable build"
 
 
 HARNESS = r"""

@@ -184,12 +184,8 @@ SOFTGYM_ALWAYS_INLINE void softgym_corot_links_ax(
     SOFTGYM_IVDEP
     for (; li < hi; li++) {
         Py_ssize_t i = v1[li], j = v2[li];
-        double dx = pos[3 * j] - pos[3 * i];
-        double dy = pos[3 * j + 1] - pos[3 * i + 1];
-        double dz = pos[3 * j + 2] - pos[3 * i + 2];
-        double dvx = vel[3 * j] - vel[3 * i];
-        double dvy = vel[3 * j + 1] - vel[3 * i + 1];
-        double dvz = vel[3 * j + 2] - vel[3 * i + 2];
+        SOFTGYM_DIFF3(pos, i, j, dx, dy, dz);
+        SOFTGYM_DIFF3(vel, i, j, dvx, dvy, dvz);
         SOFTGYM_COROT_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, li, ax, p, q, inv_L, dx, dy, dz,
                              dvx, dvy, dvz, scale[i], scale[j], (rot + 9 * i), (rot + 9 * j),
                              av[3 * i], av[3 * i + 1], av[3 * i + 2], av[3 * j], av[3 * j + 1],

@@ -133,9 +133,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
     SOFTGYM_IVDEP
     for (; li < hi; li++) {
         Py_ssize_t i = v1[li], j = v2[li];
-        double dx = pos[3 * j] - pos[3 * i];
-        double dy = pos[3 * j + 1] - pos[3 * i + 1];
-        double dz = pos[3 * j + 2] - pos[3 * i + 2];
+        SOFTGYM_DIFF3(pos, i, j, dx, dy, dz);
         double w = quat[4 * i], x = quat[4 * i + 1], y = quat[4 * i + 2], z = quat[4 * i + 3];
         double wj = quat[4 * j], xj = quat[4 * j + 1], yj = quat[4 * j + 2], zj = quat[4 * j + 3];
         SOFTGYM_SEED_GEOM_LINK(li, dx, dy, dz, w, x, y, z, wj, xj, yj, zj, scale[i], scale[j]);

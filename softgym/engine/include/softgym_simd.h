@@ -75,32 +75,26 @@ typedef long long softgym_vi __attribute__((vector_size(sizeof(softgym_vd))));
 typedef double softgym_v4 __attribute__((vector_size(32)));
 typedef long long softgym_v4i __attribute__((vector_size(32)));
 #define SOFTGYM_V4SQRT(v) ((softgym_v4)_mm256_sqrt_pd((__m256d)(v)))
-static inline softgym_v4 softgym_v4abs(softgym_v4 v)
-{
-    softgym_v4i bits;
-    memcpy(&bits, &v, sizeof bits);
-    bits &= 0x7fffffffffffffffLL;
-    memcpy(&v, &bits, sizeof v);
-    return v;
-}
-#define SOFTGYM_V4PUT(row, li, v) do { \
-        softgym_v4 v4_ = (v); \
-        memcpy((row) + (li), &v4_, sizeof v4_); \
-    } while (0)
-/* |v| lane by lane (the sign bit cleared, as fabs) */
-static inline softgym_vd softgym_vabs(softgym_vd v)
-{
-    softgym_vi bits;
-    memcpy(&bits, &v, sizeof bits);
-    bits &= 0x7fffffffffffffffLL;
-    memcpy(&v, &bits, sizeof v);
-    return v;
-}
-/* v stored at row + li (lanes li ..) */
-#define SOFTGYM_VPUT(row, li, v) do { \
-        softgym_vd v_ = (v); \
+/* name(v): |v| lane by lane for the vector type VT (its integer twin VI): the sign bit
+   cleared, as fabs */
+#define SOFTGYM_DEFINE_VABS(name, VT, VI) \
+    static inline VT name(VT v) \
+    { \
+        VI bits; \
+        memcpy(&bits, &v, sizeof bits); \
+        bits &= 0x7fffffffffffffffLL; \
+        memcpy(&v, &bits, sizeof v); \
+        return v; \
+    }
+SOFTGYM_DEFINE_VABS(softgym_vabs, softgym_vd, softgym_vi)
+SOFTGYM_DEFINE_VABS(softgym_v4abs, softgym_v4, softgym_v4i)
+/* v (of type VT) stored at row + li (lanes li ..) */
+#define SOFTGYM_VTPUT(VT, row, li, v) do { \
+        VT v_ = (v); \
         memcpy((row) + (li), &v_, sizeof v_); \
     } while (0)
+#define SOFTGYM_VPUT(row, li, v) SOFTGYM_VTPUT(softgym_vd, row, li, v)
+#define SOFTGYM_V4PUT(row, li, v) SOFTGYM_VTPUT(softgym_v4, row, li, v)
 /* elements k and k + 1 of 4 voxels' rows at pa..pd as two rows of 4 lanes (lo_: k, hi_: k + 1) */
 #define SOFTGYM_GATHER_PAIRS(pa, pb, pc, pd, k, lo_, hi_) do { \
         __m256d ac_ = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd((pa) + (k))), \
@@ -135,6 +129,10 @@ static inline softgym_vd softgym_vabs(softgym_vd v)
         else \
             f(2, __VA_ARGS__); \
     } while (0)
+/* voxel j's row of 3 in a (rows of 3 doubles) minus voxel i's, declared as doubles dx, dy, dz */
+#define SOFTGYM_DIFF3(a, i, j, dx, dy, dz) \
+    double dx = (a)[3 * (j)] - (a)[3 * (i)], dy = (a)[3 * (j) + 1] - (a)[3 * (i) + 1]; \
+    double dz = (a)[3 * (j) + 2] - (a)[3 * (i) + 2]
 /* v stored at row[li] (a pass's formula macro on doubles; SOFTGYM_VPUT on vectors) */
 #define SOFTGYM_PUT1(row, li, v) ((row)[li] = (v))
 
