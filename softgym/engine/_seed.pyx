@@ -79,13 +79,13 @@ cdef extern from "softgym_seed.h":
     # (the two frames passes return whether any link needs _seed_frame_one)
     int softgym_seed_frames(intp_t lo, intp_t hi, float64_t sa_rad, float64_t thr,
                             const float64_t* p0_, const float64_t* p1_, const float64_t* p2_,
-                             const float64_t* qw_, const float64_t* n1_, const float64_t* n2_,
-                             const float64_t* n3_, const float64_t* nom_, const float64_t* len_,
-                             const float64_t* sa_, float64_t* o_P0, float64_t* o_P1,
-                             float64_t* o_P2, float64_t* o_a1y, float64_t* o_a1z,
-                             float64_t* o_a2x, float64_t* o_a2y, float64_t* o_a2z,
-                             float64_t* o_rw, float64_t* o_ry, float64_t* o_rz,
-                             float64_t* o_fix) noexcept nogil
+                            const float64_t* qw_, const float64_t* n1_, const float64_t* n2_,
+                            const float64_t* n3_, const float64_t* nom_, const float64_t* len_,
+                            const float64_t* sa_, float64_t* o_P0, float64_t* o_P1,
+                            float64_t* o_P2, float64_t* o_a1y, float64_t* o_a1z,
+                            float64_t* o_a2x, float64_t* o_a2y, float64_t* o_a2z,
+                            float64_t* o_rw, float64_t* o_ry, float64_t* o_rz,
+                            float64_t* o_fix) noexcept nogil
     void softgym_seed_forces(intp_t lo, intp_t hi, intp_t n, float64_t L, float64_t bz,
                              float64_t bzh, float64_t inv_dt, const float64_t* const* inp,
                              const float64_t* sa_, const float64_t* chg_,

@@ -676,6 +676,7 @@ class Simulation:
             # simulated seconds per chunk = work per chunk / the group's voxel-steps per second
             rate = float(rates[g0:g1].sum())
             chunk = budget / max(rate, 1e-300)
+            last = g == len(groups) - 1
             t = start
             while True:
                 t_prev, t = t, min(time, t + chunk)
@@ -688,14 +689,11 @@ class Simulation:
                 _core.advance(a, self._settings, targets, threads, self._contacts)
                 # back in Python: a pending SIGINT raises KeyboardInterrupt here
                 done += rate * (t - t_prev)
-                last = g == len(groups) - 1
                 if last:
                     self._t_target = t  # every robot has reached t
                 if progress is not None:
-                    if len(groups) == 1 or (last and t >= time):
-                        progress(t)
-                    else:
-                        progress(start + (time - start) * (min(done / work, 1.0) if work > 0 else 1.0))
+                    whole = len(groups) == 1 or (last and t >= time) or work <= 0
+                    progress(t if whole else start + (time - start) * min(done / work, 1.0))
                 if t >= time:
                     break
         if self.config.on_divergence == "raise":

@@ -98,15 +98,6 @@
     } while (0)
 
 #if defined(SOFTGYM_VLANES)
-/* rows a..d (4 doubles each) transposed: r0 = the a..d's element 0, ..., r3 element 3 */
-#define SOFTGYM_TRANSPOSE4(a, b, c, d, r0, r1, r2, r3) do { \
-        __m256d t0_ = _mm256_unpacklo_pd(a, b), t1_ = _mm256_unpackhi_pd(a, b); \
-        __m256d t2_ = _mm256_unpacklo_pd(c, d), t3_ = _mm256_unpackhi_pd(c, d); \
-        r0 = _mm256_permute2f128_pd(t0_, t2_, 0x20); \
-        r1 = _mm256_permute2f128_pd(t1_, t3_, 0x20); \
-        r2 = _mm256_permute2f128_pd(t0_, t2_, 0x31); \
-        r3 = _mm256_permute2f128_pd(t1_, t3_, 0x31); \
-    } while (0)
 /* voxels idx[0..3] as rows of 4: position 0-2, velocity 3-5, angular velocity 6-8,
    rotation matrix 9-17 (row-major), size 18. GCC's vectoriser loaded these 19 numbers a
    voxel one by one; here pairs of 16-byte loads and unpacks, and the matrix as two
@@ -132,13 +123,6 @@ static inline void softgym_corot_gather4(const Py_ssize_t *idx, const double *po
                        _mm256_loadu_pd(d + 4), r[13], r[14], r[15], r[16]);
     r[17] = _mm256_set_pd(d[8], c[8], b[8], a[8]);
     r[18] = _mm256_set_pd(scale[idx[3]], scale[idx[2]], scale[idx[1]], scale[idx[0]]);
-}
-/* n consecutive values of a row from li, as 4 lanes */
-static inline softgym_v4 softgym_v4load(const double *row, Py_ssize_t li)
-{
-    softgym_v4 v;
-    memcpy(&v, row + li, sizeof v);
-    return v;
 }
 #endif
 

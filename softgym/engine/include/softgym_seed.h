@@ -10,7 +10,6 @@
 #include <math.h>
 #include "softgym_simd.h"
 
-
 /* The first pass of links_seed (_seed.pyx): links lo..hi (all along axis ax, a
    compile-time constant in each copy) measured in the bond frame, without
    branches so the loop vectorises; rows of o (stride n): 0-2 the relative

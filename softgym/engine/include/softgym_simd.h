@@ -104,6 +104,22 @@ SOFTGYM_DEFINE_VABS(softgym_v4abs, softgym_v4, softgym_v4i)
         lo_ = _mm256_unpacklo_pd(ac_, bd_); \
         hi_ = _mm256_unpackhi_pd(ac_, bd_); \
     } while (0)
+/* rows a..d (4 doubles each) transposed: r0 = the a..d's element 0, ..., r3 element 3 */
+#define SOFTGYM_TRANSPOSE4(a, b, c, d, r0, r1, r2, r3) do { \
+        __m256d t0_ = _mm256_unpacklo_pd(a, b), t1_ = _mm256_unpackhi_pd(a, b); \
+        __m256d t2_ = _mm256_unpacklo_pd(c, d), t3_ = _mm256_unpackhi_pd(c, d); \
+        r0 = _mm256_permute2f128_pd(t0_, t2_, 0x20); \
+        r1 = _mm256_permute2f128_pd(t1_, t3_, 0x20); \
+        r2 = _mm256_permute2f128_pd(t0_, t2_, 0x31); \
+        r3 = _mm256_permute2f128_pd(t1_, t3_, 0x31); \
+    } while (0)
+/* 4 consecutive values of a row from li, as 4 lanes */
+static inline softgym_v4 softgym_v4load(const double *row, Py_ssize_t li)
+{
+    softgym_v4 v;
+    memcpy(&v, row + li, sizeof v);
+    return v;
+}
 /* rows of 4 lanes a[0..m) (links 0-3) and b[0..m) (links 4-7) as m rows of softgym_vd (with
    4 lanes, b is not read) */
 #if SOFTGYM_VLANES == 8
