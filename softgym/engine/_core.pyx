@@ -96,17 +96,6 @@ cdef inline float64_t _actuate(Batch* b, intp_t r) noexcept nogil:
     return smax
 
 
-cdef inline float64_t _max_speed(Batch* b, intp_t r) noexcept nogil:
-    # the fastest voxel speed of robot r (m/s)
-    cdef intp_t i
-    cdef float64_t v2, m = 0.0
-    for i in range(b.vox_start[r], b.vox_start[r + 1]):
-        v2 = b.vel[3 * i] * b.vel[3 * i] + b.vel[3 * i + 1] * b.vel[3 * i + 1] + b.vel[3 * i + 2] * b.vel[3 * i + 2]
-        if v2 > m:
-            m = v2
-    return sqrt(m)
-
-
 #: the stages of the seed model's step that the cycle probes time, in slot order
 CYCLE_STAGES = ("contacts", "links", "collide", "integrate", "drive_record")
 
@@ -165,9 +154,7 @@ cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
             b.diverged_code[r] = status
             b.diverged_time[r] = b.steps[r] * b.dt[r]
             break
-        if b.self_collision:
-            b.col_vmax[r] = _max_speed(b, r)
-        smax = _actuate(b, r)
+        smax = _actuate(b, r)  # (integrate_seed set col_vmax)
         b.steps[r] += 1
         record(b, r)
         softgym_prof_add(4, t0)

@@ -7,7 +7,7 @@
 #                           since the last collision-list rebuild
 #   integrate_seed          model 0 (the seed's EulerStep)
 
-from libc.math cimport fabs
+from libc.math cimport fabs, sqrt
 from libc.string cimport memset
 
 from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_NONFINITE
@@ -22,6 +22,8 @@ cdef extern from "softgym_simd.h":
     void _rotation_matrix "softgym_quat_matrix" (const float64_t* q, float64_t* R) noexcept nogil
     void _quat_matrix "softgym_quat_matrix_wxyz" (float64_t w, float64_t x, float64_t y,
                                                   float64_t z, float64_t* R) noexcept nogil
+    # |v|^2 with the same bits in every build that inlines it
+    float64_t speed_squared "softgym_speed2" (float64_t vx, float64_t vy, float64_t vz) noexcept nogil
 
 
 cdef inline void _fluid_drag(Batch* b, intp_t i, float64_t* f) noexcept nogil:
@@ -225,6 +227,8 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
     # seed's floor and exact quaternion renormalisation snapped to the identity
     # at w >= 1 (_orient, after the loop: no voxel's update reads
     # another's orientation). Terrain boxes use the common surface contact.
+    # With self-collision, also OUT: b.col_vmax[r], the fastest voxel's new speed
+    # (the seed's collision schedule), from the velocities as they are computed.
     cdef:
         intp_t i, k
         float64_t dt = b.dt[r]
@@ -240,6 +244,8 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
         intp_t k0 = b.box_start[r]
         intp_t k1 = b.box_start[r + 1]
         intp_t vs = b.vox_start[r]
+        float64_t vmax2 = 0.0
+        int32 track_speed = b.self_collision
     dmax2[0] = 0.0
     c[0] = 0.0
     c[1] = 0.0
@@ -275,8 +281,14 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
             d2 = _drift2(pos, ref, i, vs, c)
             if d2 > dmax2[0]:
                 dmax2[0] = d2
+        if track_speed:
+            d2 = speed_squared(vel[3 * i], vel[3 * i + 1], vel[3 * i + 2])
+            if d2 > vmax2:
+                vmax2 = d2
         _spin(b, i, dt, mx, my, mz)
     _orient(b, vs, b.vox_start[r + 1], dt, 1)
+    if track_speed:
+        b.col_vmax[r] = sqrt(vmax2)
     return STATUS_OK
 
 

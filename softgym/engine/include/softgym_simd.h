@@ -12,6 +12,7 @@
 #else
 #define SOFTGYM_IVDEP
 #endif
+#include <math.h>
 #include <string.h>
 /* c ? a : b on the bits: compilers keep it a blend (a select before a
    store may otherwise become a masked store, slow on some cores) */
@@ -24,6 +25,19 @@ static inline double softgym_pick(long long c, double a, double b)
     ua = (ua & m) | (ub & ~m);
     memcpy(&r, &ua, sizeof r);
     return r;
+}
+/* |v|^2 of a voxel's velocity, for the seed's collision schedule (the fastest voxel's
+   speed). Where the build fuses multiply-adds, the fusion is written out: the value
+   is the same wherever the expression is inlined, (vy vy, then + vx vx and + vz vz
+   fused), the form GCC chose in the separate loop over the velocities that this
+   replaced, so the schedule keeps its bits */
+static inline double softgym_speed2(double vx, double vy, double vz)
+{
+#if defined(__FMA__)
+    return fma(vz, vz, fma(vx, vx, vy * vy));
+#else
+    return vx * vx + vy * vy + vz * vz;
+#endif
 }
 /* R = the rotation matrix of the unit quaternion q = (w, x, y, z), row-major: the
    one formula of the engine (the voxel update stores it, the seed geometry
