@@ -80,6 +80,15 @@ cdef inline float64_t _actuate(Batch* b, intp_t r) noexcept nogil:
     s = sin(w)
     c = cos(w)
     amp = b.temp_amp[r]
+    if seed and b.model == 0:
+        # the seed step does not use smax: the same sizes without branches, a
+        # loop the compiler vectorises (a voxel without expansion, cte 0, or a size
+        # outside [min_scale L, L] keeps its size)
+        for i in range(vs, ve):
+            f = b.cte[i] * amp * (s * b.cos_phase[i] + c * b.sin_phase[i])
+            new = L * (1.0 + f)
+            b.scale[i] = new if (new >= lo) & (new <= L) & (b.cte[i] != 0.0) else b.scale[i]
+        return smax
     for i in range(vs, ve):
         if b.cte[i] == 0.0:
             continue
