@@ -12,7 +12,7 @@ from libc.string cimport memset
 
 from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_NONFINITE
 from softgym.engine._contact cimport surface_contact, box_penetration, seed_floor
-from softgym.engine._typedefs cimport float64_t, intp_t, int32
+from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t
 
 cdef float64_t RUNAWAY = 1.0e6  # |coordinate| (m) beyond which a robot diverged
 
@@ -20,8 +20,6 @@ cdef float64_t RUNAWAY = 1.0e6  # |coordinate| (m) beyond which a robot diverged
 cdef extern from "softgym_simd.h":
     # R = the rotation matrix of the unit quaternion q = (w, x, y, z), row-major
     void _rotation_matrix "softgym_quat_matrix" (const float64_t* q, float64_t* R) noexcept nogil
-    void _quat_matrix "softgym_quat_matrix_wxyz" (float64_t w, float64_t x, float64_t y,
-                                                  float64_t z, float64_t* R) noexcept nogil
     # |v|^2 with the same bits in every build that inlines it
     float64_t speed_squared "softgym_speed2" (float64_t vx, float64_t vy, float64_t vz) noexcept nogil
 
@@ -190,6 +188,8 @@ cdef extern from "softgym_orient.h":
                             const float64_t* quat, float64_t* q_out) noexcept nogil
     void softgym_corot_quats(intp_t lo, intp_t hi, intp_t n, float64_t dt, const float64_t* av,
                              const float64_t* quat, float64_t* q_out) noexcept nogil
+    void softgym_orient_store(intp_t lo, intp_t hi, intp_t n, const float64_t* q_out,
+                              const flag_t* fixed, float64_t* quat, float64_t* rot) noexcept nogil
 
 
 cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int seed) noexcept nogil:
@@ -197,28 +197,13 @@ cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int
     # quaternions (the seed's exact renormalisation, or the corotational
     # model's Newton step), then their rotation matrices
     cdef:
-        intp_t i
         intp_t n = b.vox_stride  # the scratch's row stride
         float64_t* qo = b.vox_out
-        float64_t* qq
-        float64_t w, x, y, z
     if seed:
         softgym_seed_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
     else:
         softgym_corot_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
-    for i in range(lo, hi):
-        if b.fixed[i]:
-            continue
-        w = qo[i]
-        x = qo[n + i]
-        y = qo[2 * n + i]
-        z = qo[3 * n + i]
-        qq = b.quat + 4 * i
-        qq[0] = w
-        qq[1] = x
-        qq[2] = y
-        qq[3] = z
-        _quat_matrix(w, x, y, z, b.rot + 9 * i)  # from registers, not the stores just made
+    softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat, b.rot)
 
 
 cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,

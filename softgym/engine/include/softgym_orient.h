@@ -69,4 +69,29 @@ static void softgym_corot_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, doub
     softgym_quats_impl(0, lo, hi, n, dt, av, quat, q_out);
 }
 
+/* voxels lo..hi but the fixed: the new quaternions from the rows q_out into quat, and their
+   rotation matrices into rot (softgym_quat_matrix_wxyz, from registers). Scalar stores: GCC
+   packed each matrix into a 512-bit register with seven shuffles and stored it across
+   two cache lines (a voxel's matrix is 72 bytes), and on an Intel Xeon the loop waited on
+   that (perf annotate) */
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((optimize("no-tree-slp-vectorize")))
+#endif
+static void softgym_orient_store(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const double *q_out,
+                                 const signed char *fixed, double *quat, double *rot)
+{
+    Py_ssize_t i;
+    for (i = lo; i < hi; i++) {
+        if (fixed[i])
+            continue;
+        double w = q_out[i], x = q_out[n + i], y = q_out[2 * n + i], z = q_out[3 * n + i];
+        double *qq = quat + 4 * i;
+        qq[0] = w;
+        qq[1] = x;
+        qq[2] = y;
+        qq[3] = z;
+        softgym_quat_matrix_wxyz(w, x, y, z, rot + 9 * i);
+    }
+}
+
 #endif  /* SOFTGYM_ORIENT_H */
