@@ -18,6 +18,7 @@
 from cython.parallel cimport prange, parallel, threadid
 from libc.math cimport sin, cos, sqrt, fabs, M_PI
 from libc.stdlib cimport calloc, realloc, free
+from libc.stdint cimport uintptr_t
 
 cimport numpy as cnp
 import numpy as np
@@ -439,15 +440,19 @@ cdef class ContactCache:
         free(self.link_scratch)
 
     cdef float64_t* scratch(self, intp_t size) except NULL:
-        # at least `size` doubles of scratch (contents undefined)
+        # at least `size` doubles of scratch (contents undefined), starting on a
+        # 64-byte boundary: the passes' rows start on cache lines (their strides are
+        # multiples of 16 doubles), so a 512-bit load or store of a row never spans
+        # two lines. malloc gives 16 bytes, and on an Intel Xeon every vector access
+        # to the rows was split (benchmarks/RESULTS.md)
         cdef float64_t* p
         if size > self.link_scratch_size:
-            p = <float64_t*> realloc(self.link_scratch, size * sizeof(float64_t))
+            p = <float64_t*> realloc(self.link_scratch, (size + 8) * sizeof(float64_t))
             if p == NULL:
                 raise MemoryError("no memory for the kernels' scratch")
             self.link_scratch = p
             self.link_scratch_size = size
-        return self.link_scratch
+        return <float64_t*> ((<uintptr_t> self.link_scratch + 63) & ~(<uintptr_t> 63))
 
 
 def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, ContactCache cache):
