@@ -488,6 +488,28 @@ def _link_rows(rows: np.ndarray) -> np.ndarray:
     return out
 
 
+CACHE_LINE = 64  # bytes
+
+
+def _line_aligned(x: np.ndarray) -> np.ndarray:
+    """``x`` itself if it starts on a cache line, else a copy that does, with its strides.
+
+    A view of padded rows (:func:`_link_rows`) keeps its row stride. The kernel's
+    vector loops read and write its arrays 32 or 64 bytes at a time from their
+    starts (a robot's first link and voxel, for the first robot of a batch): where an
+    array starts 16 bytes into a line (NumPy's default), many of those accesses span
+    two lines, which an Intel Xeon pays for (``benchmarks/RESULTS.md``).
+    """
+    if x.ctypes.data % CACHE_LINE == 0 or x.size == 0:
+        return x
+    span = x.strides[0] * x.shape[0] if x.ndim else x.itemsize
+    buf = np.zeros(span + CACHE_LINE, dtype=np.uint8)
+    out = np.ndarray(x.shape, x.dtype, buffer=buf, offset=(-buf.ctypes.data) % CACHE_LINE,
+                     strides=x.strides)
+    out[...] = x
+    return out
+
+
 def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layout:
     """Lay out robots and their terrains (one each, validated) for the kernel.
 
@@ -589,6 +611,8 @@ def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layou
     missing = [k for k in _core.KERNEL_ARRAYS if k not in a]
     if missing:  # the kernel's declared contract (_core.KERNEL_ARRAYS)
         raise RuntimeError(f"softgym engine: arrays {missing} missing for the kernel")
+    for name in _core.KERNEL_ARRAYS:
+        a[name] = _line_aligned(a[name])
     settings = {
         "n_robots": n_robots,
         "L": L,

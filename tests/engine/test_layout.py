@@ -54,3 +54,24 @@ def test_build_layout_is_pure():
         assert np.array_equal(g, b.grid) and np.array_equal(o, b.origin)
     for k in first.arrays:
         assert first.arrays[k].tobytes() == second.arrays[k].tobytes(), k
+
+
+@pytest.mark.parametrize("precision", ["single", "double"])
+def test_kernel_arrays_start_on_cache_lines_and_keep_their_row_stride(precision):
+    # the kernel's vector loops access its arrays 32 or 64 bytes at a time from their
+    # starts: every array begins on a 64-byte line; padded link rows keep their stride
+    bodies, terrains = _batch()
+    cfg = SimConfig(self_collision=True, link_precision=precision)
+    a = build_layout(bodies, terrains, cfg).arrays
+    for name in _core.KERNEL_ARRAYS:
+        if a[name].size:
+            assert a[name].ctypes.data % 64 == 0, name
+    n = a["v1"].shape[0]
+    for name in ("c_seed", "link_last", "k_seed32"):
+        x = a[name]
+        if x.size:
+            assert x.shape[1] == n and x.strides == (_core.row_stride(n) * x.itemsize, x.itemsize)
+    # the copies hold the layout's values: links start in small-angle mode, quaternions
+    # at the identity, each robot's first voxel where its body put it
+    assert np.all(a["link_sa"] == 1) and np.all(a["quat"][:, 0] == 1.0)
+    assert np.all(a["link_last"] == 0.0) and np.all(a["scale"] == cfg.voxel_size)
