@@ -8,6 +8,7 @@
 #define SOFTGYM_SEED_H
 
 #include <math.h>
+#include <stdint.h>
 #include "softgym_simd.h"
 
 /* The first pass of links_seed (_seed.pyx): links lo..hi (all along axis ax, a
@@ -108,16 +109,47 @@ static inline void softgym_seed_gather(const Py_ssize_t *idx, const double *pos,
 #endif
 }
 #endif
+/* links lo..hi by the formula on doubles, in a loop the compiler vectorises */
+SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_scalar(const int ax, Py_ssize_t lo, Py_ssize_t hi,
+                                                    Py_ssize_t n, const Py_ssize_t *v1,
+                                                    const Py_ssize_t *v2, const double *pos,
+                                                    const double *quat, const double *scale,
+                                                    double *o)
+{
+    SOFTGYM_SEED_GEOM_AXIS(ax);
+    SOFTGYM_SEED_GEOM_OUT(o, n);
+    Py_ssize_t li;
+    SOFTGYM_IVDEP
+    for (li = lo; li < hi; li++) {
+        Py_ssize_t i = v1[li], j = v2[li];
+        SOFTGYM_DIFF3(pos, i, j, dx, dy, dz);
+        double w = quat[4 * i], x = quat[4 * i + 1], y = quat[4 * i + 2], z = quat[4 * i + 3];
+        double wj = quat[4 * j], xj = quat[4 * j + 1], yj = quat[4 * j + 2], zj = quat[4 * j + 3];
+        SOFTGYM_SEED_GEOM_LINK(li, dx, dy, dz, w, x, y, z, wj, xj, yj, zj, scale[i], scale[j]);
+    }
+}
 SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
                                                 Py_ssize_t n, const Py_ssize_t *v1,
                                                 const Py_ssize_t *v2, const double *pos,
                                                 const double *quat, const double *scale,
                                                 double *o)
 {
-    SOFTGYM_SEED_GEOM_AXIS(ax);
-    SOFTGYM_SEED_GEOM_OUT(o, n);
     Py_ssize_t li = lo;
 #if defined(SOFTGYM_VLANES)
+    SOFTGYM_SEED_GEOM_AXIS(ax);
+    SOFTGYM_SEED_GEOM_OUT(o, n);
+    /* the links before the first whose output rows start a cache line go through
+       softgym_seed_geom_scalar, so that no vector store spans two lines: the rows start
+       on lines, but a run of links along y starts mid-line (after 180 x links in the
+       reference robot), and its stores that spanned lines cost 3.5 % of the step on an
+       Intel Xeon */
+    Py_ssize_t al = lo;
+    while (al < hi && ((uintptr_t)(o + al) & 63) != 0)
+        al++;
+    if (al + SOFTGYM_VLANES <= hi) {
+        softgym_seed_geom_scalar(ax, lo, al, n, v1, v2, pos, quat, scale, o);
+        li = al;
+    }
     for (; li + SOFTGYM_VLANES <= hi; li += SOFTGYM_VLANES) {
         softgym_vd gi[8], gj[8];
         softgym_seed_gather(v1 + li, pos, quat, scale, gi);
@@ -129,14 +161,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
     }
 #endif
     /* the rest (and every link without AVX): the compiler's vectoriser */
-    SOFTGYM_IVDEP
-    for (; li < hi; li++) {
-        Py_ssize_t i = v1[li], j = v2[li];
-        SOFTGYM_DIFF3(pos, i, j, dx, dy, dz);
-        double w = quat[4 * i], x = quat[4 * i + 1], y = quat[4 * i + 2], z = quat[4 * i + 3];
-        double wj = quat[4 * j], xj = quat[4 * j + 1], yj = quat[4 * j + 2], zj = quat[4 * j + 3];
-        SOFTGYM_SEED_GEOM_LINK(li, dx, dy, dz, w, x, y, z, wj, xj, yj, zj, scale[i], scale[j]);
-    }
+    softgym_seed_geom_scalar(ax, li, hi, n, v1, v2, pos, quat, scale, o);
 }
 static void softgym_seed_geom(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
                               const Py_ssize_t *v1, const Py_ssize_t *v2, const double *pos,
