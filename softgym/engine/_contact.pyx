@@ -271,7 +271,7 @@ cdef inline int _voxel_pairs_all(Batch* b, intp_t r, Contacts* c, const float64_
         intp_t vs = b.vox_start[r]
         intp_t ve = b.vox_start[r + 1]
         intp_t cap = ve - vs
-        intp_t i, j, a, k, ns = 0, n_row
+        intp_t i, j, a, k, e, e_end, ns = 0, n_row
         float64_t L = b.L
         float64_t lim2
         float64_t* X = c.sur
@@ -296,10 +296,17 @@ cdef inline int _voxel_pairs_all(Batch* b, intp_t r, Contacts* c, const float64_
         softgym_pair_hits(seed_rule, a, ns, X, Y, Z, S, RK, lim2, c.hit)
         i = c.sur_idx[a]
         n_row = 0
+        # the hits come in increasing j (sur_idx is in voxel order) and i's exclusion
+        # row is sorted: one walk along it (e) instead of a binary search per hit,
+        # whose branches the predictor could not learn
+        e = b.excl_start[i]
+        e_end = b.excl_start[i + 1]
         for k in range(a + 1, ns):
             if c.hit[k]:
                 j = c.sur_idx[k]
-                if _excluded(b, i, j):
+                while e < e_end and b.excl_idx[e] < j:
+                    e += 1
+                if e < e_end and b.excl_idx[e] == j:
                     continue
                 c.row[n_row] = j
                 n_row += 1
