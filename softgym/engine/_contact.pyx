@@ -220,7 +220,7 @@ cdef inline int _alloc_lists(Contacts* c, intp_t n) noexcept nogil:
 cdef extern from "softgym_pairs.h":
     # the all-pairs test of one surface voxel against the later ones (C, for
     # the vectorising pragma; documented in include/softgym_pairs.h)
-    void softgym_pair_hits(int seed_rule, intp_t a, intp_t n, const float64_t* x,
+    intp_t softgym_pair_hits(int seed_rule, intp_t a, intp_t n, const float64_t* x,
                            const float64_t* y, const float64_t* z, const float64_t* s,
                            const intp_t* rank, float64_t lim2,
                            lane_flag_t* hit) noexcept nogil
@@ -271,7 +271,7 @@ cdef inline int _voxel_pairs_all(Batch* b, intp_t r, Contacts* c, const float64_
         intp_t vs = b.vox_start[r]
         intp_t ve = b.vox_start[r + 1]
         intp_t cap = ve - vs
-        intp_t i, j, a, k, e, e_end, ns = 0, n_row
+        intp_t i, j, a, k, e, e_end, last, ns = 0, n_row
         float64_t L = b.L
         float64_t lim2
         float64_t* X = c.sur
@@ -293,15 +293,16 @@ cdef inline int _voxel_pairs_all(Batch* b, intp_t r, Contacts* c, const float64_
         ns += 1
     lim2 = 9.0 * L * L if seed_rule else horizon * horizon
     for a in range(ns):
-        softgym_pair_hits(seed_rule, a, ns, X, Y, Z, S, RK, lim2, c.hit)
+        last = softgym_pair_hits(seed_rule, a, ns, X, Y, Z, S, RK, lim2, c.hit)
         i = c.sur_idx[a]
         n_row = 0
         # the hits come in increasing j (sur_idx is in voxel order) and i's exclusion
         # row is sorted: one walk along it (e) instead of a binary search per hit,
-        # whose branches the predictor could not learn
+        # whose branches the predictor could not learn; the walk over the flags ends
+        # at the last hit
         e = b.excl_start[i]
         e_end = b.excl_start[i + 1]
-        for k in range(a + 1, ns):
+        for k in range(a + 1, last + 1):
             if c.hit[k]:
                 j = c.sur_idx[k]
                 while e < e_end and b.excl_idx[e] < j:

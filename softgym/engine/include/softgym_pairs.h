@@ -17,8 +17,10 @@
    unless d2 >= lim2 (the horizon squared). The same expressions and
    comparisons as the hash's scalar test (a NaN distance is kept, as there).
    hit is 64-bit: with 8-bit flags the loop took 64 voxels a vector iteration,
-   and the rows of a small robot (shorter than 64) ran in its scalar remainder. */
-SOFTGYM_ALWAYS_INLINE void softgym_pair_hits_impl(const int seed_rule, Py_ssize_t a,
+   and the rows of a small robot (shorter than 64) ran in its scalar remainder.
+   Returns the last b with hit[b] = 1 (a if none): the caller's walk over the flags
+   stops there. */
+SOFTGYM_ALWAYS_INLINE Py_ssize_t softgym_pair_hits_impl(const int seed_rule, Py_ssize_t a,
                                                   Py_ssize_t n, const double *x,
                                                   const double *y, const double *z,
                                                   const double *s, const Py_ssize_t *rank,
@@ -27,6 +29,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_pair_hits_impl(const int seed_rule, Py_ssize_
     const double xa = x[a], ya = y[a], za = z[a], sa = s[a];
     const Py_ssize_t ra = rank[a];
     Py_ssize_t k;
+    long long last = a;
     SOFTGYM_IVDEP
     for (k = a + 1; k < n; k++) {
         double dx = x[k] - xa;
@@ -39,16 +42,18 @@ SOFTGYM_ALWAYS_INLINE void softgym_pair_hits_impl(const int seed_rule, Py_ssize_
             out |= d2 >= act * act;
         }
         hit[k] = out == 0;
+        last = out == 0 ? k : last;
     }
+    return last;
 }
-static void softgym_pair_hits(int seed_rule, Py_ssize_t a, Py_ssize_t n, const double *x,
-                              const double *y, const double *z, const double *s,
-                              const Py_ssize_t *rank, double lim2, long long *hit)
+static Py_ssize_t softgym_pair_hits(int seed_rule, Py_ssize_t a, Py_ssize_t n,
+                                    const double *x, const double *y, const double *z,
+                                    const double *s, const Py_ssize_t *rank, double lim2,
+                                    long long *hit)
 {
     if (seed_rule)
-        softgym_pair_hits_impl(1, a, n, x, y, z, s, rank, lim2, hit);
-    else
-        softgym_pair_hits_impl(0, a, n, x, y, z, s, rank, lim2, hit);
+        return softgym_pair_hits_impl(1, a, n, x, y, z, s, rank, lim2, hit);
+    return softgym_pair_hits_impl(0, a, n, x, y, z, s, rank, lim2, hit);
 }
 
 #endif  /* SOFTGYM_PAIRS_H */
