@@ -48,7 +48,8 @@ cdef float64_t SEED_2PI_DRIVE = 2.0 * <float64_t> (<float> 3.1415926)  # model 0
 
 cdef inline float64_t _actuate(Batch* b, intp_t r) noexcept nogil:
     # OUT: b.scale of robot r's voxels at the robot's current time.
-    # Returns the largest size written this step (0 if none).
+    # Returns the largest size written this step (0 if none; always 0 for the
+    # seed's step with the seed's actuation, which does not use it).
     cdef:
         intp_t i
         intp_t vs = b.vox_start[r]
@@ -130,7 +131,7 @@ cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
     # (softgym_prof_*: cycle probes, empty in a normal build)
     cdef:
         int status = STATUS_OK
-        float64_t smax = 0.0, dmax2 = 0.0
+        float64_t dmax2 = 0.0
         unsigned long long t0
     while b.steps[r] < target:
         t0 = softgym_prof_tsc()
@@ -164,7 +165,9 @@ cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
             b.diverged_code[r] = status
             b.diverged_time[r] = b.steps[r] * b.dt[r]
             break
-        smax = _actuate(b, r)  # (integrate_seed set col_vmax)
+        # the sizes of the next step (their largest is for the corotational loop);
+        # integrate_seed has set col_vmax for the next step's schedule
+        _actuate(b, r)
         b.steps[r] += 1
         record(b, r)
         softgym_prof_add(4, t0)

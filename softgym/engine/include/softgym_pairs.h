@@ -21,10 +21,11 @@
    Returns the last b with hit[b] = 1 (a if none): the caller's walk over the flags
    stops there. */
 SOFTGYM_ALWAYS_INLINE Py_ssize_t softgym_pair_hits_impl(const int seed_rule, Py_ssize_t a,
-                                                  Py_ssize_t n, const double *x,
-                                                  const double *y, const double *z,
-                                                  const double *s, const Py_ssize_t *rank,
-                                                  double lim2, long long *hit)
+                                                        Py_ssize_t n, const double *x,
+                                                        const double *y, const double *z,
+                                                        const double *s,
+                                                        const Py_ssize_t *rank, double lim2,
+                                                        long long *hit)
 {
     const double xa = x[a], ya = y[a], za = z[a], sa = s[a];
     const Py_ssize_t ra = rank[a];
