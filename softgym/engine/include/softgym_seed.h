@@ -615,7 +615,11 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
         double w[3];
 #endif
         const double *q = o + li;
-        int neg2 = q[23 * n] != 0.0;
+        /* row 23 holds exactly 1.0 or 0.0 (the modes pass): its bits, one integer test
+           (a double's != 0.0 is two branches, for NaN) */
+        unsigned long long neg2_bits;
+        memcpy(&neg2_bits, q + 23 * n, sizeof neg2_bits);
+        int neg2 = neg2_bits != 0;
         double *fi = force + 4 * i, *fj = force + 4 * j;
         double *mi = moment + 4 * i, *mj = moment + 4 * j;
 #if defined(SOFTGYM_SCATTER_V4)
