@@ -46,6 +46,13 @@ cdef intp_t ROBOT_SPREAD = 8
 cdef float64_t SEED_2PI_DRIVE = 2.0 * <float64_t> (<float> 3.1415926)  # model 0's drive
 
 
+cdef inline float64_t _driven_size(const Batch* b, intp_t i, float64_t L, float64_t amp,
+                                   float64_t s, float64_t c) noexcept nogil:
+    # voxel i's size under the sinusoidal drive (s, c: sine and cosine of its phase
+    # angle at this time; amp: the robot's temperature amplitude), before the limits
+    return L * (1.0 + b.cte[i] * amp * (s * b.cos_phase[i] + c * b.sin_phase[i]))
+
+
 cdef inline float64_t _actuate(Batch* b, intp_t r) noexcept nogil:
     # OUT: b.scale of robot r's voxels at the robot's current time.
     # Returns the largest size written this step (0 if none; always 0 for the
@@ -57,7 +64,7 @@ cdef inline float64_t _actuate(Batch* b, intp_t r) noexcept nogil:
         float64_t t = b.steps[r] * b.dt[r]
         float64_t L = b.L
         float64_t lo = b.min_scale * L
-        float64_t f, new, s, c, amp, w
+        float64_t new, s, c, amp, w
         float64_t smax = 0.0
         int32 seed = b.actuation_mode == 0
     if b.use_temp[r]:
@@ -87,15 +94,13 @@ cdef inline float64_t _actuate(Batch* b, intp_t r) noexcept nogil:
         # loop the compiler vectorises (a voxel without expansion, cte 0, or a size
         # outside [min_scale L, L] keeps its size)
         for i in range(vs, ve):
-            f = b.cte[i] * amp * (s * b.cos_phase[i] + c * b.sin_phase[i])
-            new = L * (1.0 + f)
+            new = _driven_size(b, i, L, amp, s, c)
             b.scale[i] = new if (new >= lo) & (new <= L) & (b.cte[i] != 0.0) else b.scale[i]
         return smax
     for i in range(vs, ve):
         if b.cte[i] == 0.0:
             continue
-        f = b.cte[i] * amp * (s * b.cos_phase[i] + c * b.sin_phase[i])
-        new = L * (1.0 + f)
+        new = _driven_size(b, i, L, amp, s, c)
         if seed:
             # the seed's engine: outside [min_scale L, L] the previous size is kept
             if new >= lo and new <= L:

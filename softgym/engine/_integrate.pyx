@@ -217,7 +217,7 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
     cdef:
         intp_t i, k
         float64_t dt = b.dt[r]
-        float64_t pen, cg, d2, mx, my, mz
+        float64_t pen, cg, d2, v2, mx, my, mz
         float64_t c[3]
         float64_t f[3]
         float64_t n[3]
@@ -267,9 +267,9 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
             if d2 > dmax2[0]:
                 dmax2[0] = d2
         if track_speed:
-            d2 = speed_squared(vel[3 * i], vel[3 * i + 1], vel[3 * i + 2])
-            if d2 > vmax2:
-                vmax2 = d2
+            v2 = speed_squared(vel[3 * i], vel[3 * i + 1], vel[3 * i + 2])
+            if v2 > vmax2:
+                vmax2 = v2
         _spin(b, i, dt, mx, my, mz)
     _orient(b, vs, b.vox_start[r + 1], dt, 1)
     if track_speed:
