@@ -226,6 +226,14 @@ int main(int argc, char **argv)
         bd[ax][23 * nd + c] = neg2;
         valid[ax][c] = 1.0;
     }
+    /* the same rows as the engine's forces pass leaves them for its scatter: per chunk of
+       SOFTGYM_CHUNK_LINKS links, 12 rows SOFTGYM_CHUNK_STRIDE apart */
+    Py_ssize_t nch = (nl + SOFTGYM_CHUNK_LINKS - 1) / SOFTGYM_CHUNK_LINKS;
+    double *bc = zalloc(nch * SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE, 8);
+    for (Py_ssize_t li = 0; li < nl; li++)
+        for (int k = 0; k < 12; k++)
+            bc[(li / SOFTGYM_CHUNK_LINKS) * SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE
+               + k * SOFTGYM_CHUNK_STRIDE + li % SOFTGYM_CHUNK_LINKS] = bo[rows[k] * ne + li];
     double *fa = zalloc(4 * nv, 8), *ma = zalloc(4 * nv, 8);
     double *fb = zalloc(4 * NC, 8), *mb = zalloc(4 * NC, 8);
     unsigned long long best[6];
@@ -241,8 +249,16 @@ int main(int argc, char **argv)
         memset(fa, 0, 4 * nv * 8);
         memset(ma, 0, 4 * nv * 8);
         t0 = __rdtsc();
-        for (int ax = 0; ax < 3; ax++)
-            softgym_seed_scatter(ax, start[ax], start[ax + 1], ne, v1, v2, rot, bo, fa, ma);
+        for (Py_ssize_t ch = 0; ch < nch; ch++) {
+            Py_ssize_t c0 = ch * SOFTGYM_CHUNK_LINKS, c1 = c0 + SOFTGYM_CHUNK_LINKS;
+            const double *chunk = bc + ch * SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE - c0;
+            for (int ax = 0; ax < 3; ax++) {
+                Py_ssize_t a0 = start[ax] > c0 ? start[ax] : c0;
+                Py_ssize_t a1 = start[ax + 1] < c1 ? start[ax + 1] : c1;
+                if (a0 < a1)
+                    softgym_seed_scatter(ax, a0, a1, v1, v2, rot, chunk, bo + 23 * ne, fa, ma);
+            }
+        }
         t = __rdtsc() - t0;
         best[1] = t < best[1] ? t : best[1];
         t0 = __rdtsc();

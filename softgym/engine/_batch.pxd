@@ -100,6 +100,9 @@ cdef struct Batch:
     float64_t* link_out      # scratch of the link kernels (each names its rows): row k of link li
                              #   at link_out[k * link_stride + li], li among the robot's links
     intp_t link_stride       # its row stride (the most links of one robot)
+    float64_t* chunk_out     # scratch of the seed model's forces pass: SOFTGYM_CHUNK_ROWS rows,
+                             #   SOFTGYM_CHUNK_STRIDE apart, for one chunk of links from its
+                             #   first (include/softgym_seed.h, _seed.links_seed)
     intp_t* v1               # (n_links,) voxel on the negative side
     intp_t* v2               # (n_links,) voxel on the positive side
     int32* axis              # (n_links,) 0, 1, 2 for x, y, z

@@ -32,7 +32,7 @@ from softgym.engine._integrate cimport integrate_corotational, integrate_seed, c
 from softgym.engine._record cimport record, robot_aux, robot_energy
 from softgym.engine._prof cimport (softgym_prof_enabled, softgym_prof_tsc, softgym_prof_add,
                                    softgym_prof_get, softgym_prof_reset)
-from softgym.engine._seed cimport links_seed
+from softgym.engine._seed cimport links_seed, SOFTGYM_CHUNK_STRIDE, SOFTGYM_CHUNK_ROWS
 from softgym.engine._typedefs cimport float64_t, intp_t, step_t, int32, flag_t, lane_flag_t
 
 from softgym.engine._integrate import refresh_rotations  # noqa: F401 (Python API)
@@ -330,6 +330,7 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.rot = _f(a, "rot")
     b.force = _f(a, "force")
     b.vox_out = NULL  # per thread, set by advance
+    b.chunk_out = NULL
     b.vox_stride = 0
     b.moment = _f(a, "moment")
     b.ext_force = _f(a, "ext_force")
@@ -501,7 +502,7 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
     vstride = row_stride(vstride)
     b.link_stride = stride
     b.vox_stride = vstride
-    block = N_LINK_OUT * stride + N_VOX_OUT * vstride
+    block = N_LINK_OUT * stride + N_VOX_OUT * vstride + SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE
     scratch = cache.scratch(max(n_threads * block, 1))
     # robots in the order 0, 8, 16, ..., then 1, 9, 17, ...: the robots that the
     # threads step at one time are ROBOT_SPREAD apart, so no two of them write
@@ -524,6 +525,7 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
                 # robot's first link and voxel
                 bt.link_out = scratch + t * block - b.link_start[r]
                 bt.vox_out = scratch + t * block + N_LINK_OUT * stride - b.vox_start[r]
+                bt.chunk_out = scratch + t * block + N_LINK_OUT * stride + N_VOX_OUT * vstride
                 advance_robot(&bt, r, targets[r], &cache.items[r])
 
 

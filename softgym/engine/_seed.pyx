@@ -96,8 +96,8 @@ cdef extern from "softgym_seed.h":
                               float64_t sa_w, float64_t sah_w, float64_t st_in, float64_t ex_in,
                               float64_t st_out, float64_t ex_out, lane_flag_t* link_sa,
                               const lane_flag_t* homog, float64_t* o) noexcept nogil
-    void softgym_seed_scatter(int ax, intp_t lo, intp_t hi, intp_t n, const intp_t* v1,
-                              const intp_t* v2, const float64_t* rot, const float64_t* o,
+    void softgym_seed_scatter(int ax, intp_t lo, intp_t hi, const intp_t* v1, const intp_t* v2,
+                              const float64_t* rot, const float64_t* o, const float64_t* neg2_row,
                               float64_t* force, float64_t* moment) noexcept nogil
     int softgym_seed_frames32(intp_t lo, intp_t hi, intp_t n, float sa_rad, float w_acos,
                               const float64_t* o, float* const* f) noexcept nogil
@@ -215,22 +215,21 @@ cdef inline void _put(float64_t* o, intp_t n, intp_t ls, intp_t k, intp_t li, fl
         o[k * n + li] = v
 
 
-cdef inline void _forces_rows(float64_t* o, intp_t n, float64_t** out) noexcept nogil:
-    # the scratch rows the forces pass writes and softgym_seed_scatter reads (in
-    # either precision): f1 0-2, f2 3-5, m1 6-8, m2 9, 21, 24
+cdef inline void _forces_rows(Batch* b, intp_t c0, float64_t** out) noexcept nogil:
+    # the rows the forces pass writes and softgym_seed_scatter reads (in either
+    # precision) for the chunk of links from c0: f1 0-2, f2 3-5, m1 6-8, m2 9-11 of
+    # b.chunk_out, indexed by link
     cdef intp_t k
-    for k in range(10):
-        out[k] = o + k * n
-    out[10] = o + 21 * n
-    out[11] = o + 24 * n
+    for k in range(SOFTGYM_CHUNK_ROWS):
+        out[k] = b.chunk_out + k * SOFTGYM_CHUNK_STRIDE - c0
 
 
 cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end, float64_t inv_dt,
                                        intp_t ls) noexcept nogil:
     # links_seed's frames and forces passes in single precision
     # (SimConfig.link_precision = "single"; include/softgym_seed.h): float
-    # rows 10-21 from the frames, double rows 0-9, 21, 24 from the forces for
-    # the scatter. ls: the robot's first link (_float_row)
+    # rows 10-21 from the frames, double rows of b.chunk_out from the forces for
+    # the scatter (links lo..end: one chunk). ls: the robot's first link (_float_row)
     cdef:
         intp_t li, k
         int fix
@@ -255,7 +254,7 @@ cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end, float64_
     t0 = softgym_prof_tsc()
     for k in range(11):
         inp[k] = f[k]
-    _forces_rows(o, n, out)
+    _forces_rows(b, lo, out)
     k32 = b.k_seed32
     softgym_seed_forces32(lo, end, b.link_rows, <float> b.L, <float> (0.5 * b.bond_zeta),
                           <float> (0.25 * b.bond_zeta), <float> inv_dt, inp, o + 9 * n,
@@ -293,7 +292,7 @@ cdef inline void _seed_frames_forces(Batch* b, intp_t lo, intp_t end,
     t0 = softgym_prof_tsc()
     for k in range(11):
         inp[k] = o + (10 + k) * n
-    _forces_rows(o, n, out)
+    _forces_rows(b, lo, out)
     softgym_seed_forces(lo, end, b.link_rows, b.L, bz, 0.5 * bz, inv_dt, inp, o + 9 * n,
                         o + 22 * n, b.k_axial, b.k_torsion, b.k_bend, b.c_seed, b.link_last,
                         out)
@@ -341,17 +340,22 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     #                        marks links whose rotation needs the acos branch
     #                        (in single precision: turned past 120 degrees)
     #   _seed_frame_one      redoes those links with the seed's branches
-    #   softgym_seed_forces  rows 0-9, 21, 24: forces and moments in the bond
-    #                        frame (stiffness, the seed's damping from the
-    #                        link's memory; rq^-1 for large angles)
+    #   softgym_seed_forces  forces and moments in the bond frame (stiffness, the
+    #                        seed's damping from the link's memory; rq^-1 for
+    #                        large angles) into the 12 rows of b.chunk_out
     #   softgym_seed_scatter back to the world, scattered in link order (once
     #                        per axis)
-    # The modes, frames and forces passes need no axis: each runs once over
-    # all the robot's links (one vector loop and one remainder instead of
-    # three). Each link's quantities are its own and the links are visited in
-    # the same order, so the result is the one of running the passes axis by
-    # axis, bit for bit (a strained link stops the step after the links before
-    # it, as the seed's scalar loop does). With link_precision "single" the
+    # The passes run over one chunk of SOFTGYM_CHUNK_LINKS links at a time (128),
+    # all of them before the next chunk: a chunk's scratch rows stay in the L1
+    # cache from the geometry to the scatter (the whole robot's 25 rows, 108 KB
+    # for the reference robot, did not), and the forces pass's rows, one chunk's,
+    # are a compile-time stride apart (include/softgym_seed.h). The geometry and
+    # the scatter split a chunk at the axis runs; the modes, frames and forces
+    # passes need no axis. Each link's quantities are its own and the links are
+    # scattered in the same order, so the result is the one of running each pass
+    # over all the links, bit for bit (a strained link stops the step after the
+    # links before it, as the seed's scalar loop does; 3.0 % on an Intel Xeon,
+    # benchmarks/RESULTS.md). With link_precision "single" the
     # frames and forces run in float (_seed_frames_forces32).
     # The bond frame is voxel 1's frame turned by the proper rotation P that
     # takes the link axis onto +x (the seed's ToXDirBond): (x, y, z) ->
@@ -361,7 +365,7 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
         intp_t hi = b.link_start[r + 1]
         intp_t run[4]  # the x, y and z links are run[ax] .. run[ax + 1]
         intp_t n = b.link_stride  # the scratch's row stride
-        intp_t end = hi
+        intp_t c0, c1, a0, a1, end
         int ax
         float64_t inv_dt = 1.0 / b.dt[r]
         float64_t* o = b.link_out
@@ -371,20 +375,34 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     run[0] = lo
     for ax in range(3):
         run[ax + 1] = run[ax] + b.link_axis_count[3 * r + ax] if ax < 2 else hi
-    for ax in range(3):
-        end = _seed_geom_modes(b, ax, run[ax], run[ax + 1], n, o)
-        if end < run[ax + 1]:
-            break  # a strained link: the links after it stay as they were
-    if b.link_f32:
-        _seed_frames_forces32(b, lo, end, inv_dt, lo)
-    else:
-        _seed_frames_forces(b, lo, end, inv_dt)
-    t0 = softgym_prof_tsc()
-    for ax in range(3):
-        softgym_seed_scatter(ax, run[ax], min(run[ax + 1], end), n, b.v1, b.v2, b.rot, o,
-                             b.force, b.moment)
-    softgym_prof_add(5, t0)
-    return STATUS_OK if end == hi else STATUS_STRAIN
+    c0 = lo
+    while c0 < hi:
+        c1 = min(c0 + SOFTGYM_CHUNK_LINKS, hi)
+        end = c1
+        for ax in range(3):
+            a0 = max(c0, run[ax])
+            a1 = min(c1, run[ax + 1])
+            if a0 < a1:
+                end = _seed_geom_modes(b, ax, a0, a1, n, o)
+                if end < a1:
+                    break  # a strained link: the links after it stay as they were
+                end = c1
+        if b.link_f32:
+            _seed_frames_forces32(b, c0, end, inv_dt, lo)
+        else:
+            _seed_frames_forces(b, c0, end, inv_dt)
+        t0 = softgym_prof_tsc()
+        for ax in range(3):
+            a0 = max(c0, run[ax])
+            a1 = min(end, run[ax + 1])
+            if a0 < a1:
+                softgym_seed_scatter(ax, a0, a1, b.v1, b.v2, b.rot,
+                                     b.chunk_out - c0, o + 23 * n, b.force, b.moment)
+        softgym_prof_add(5, t0)
+        if end < c1:
+            return STATUS_STRAIN
+        c0 = c1
+    return STATUS_OK
 
 
 # ---------------------------------------------------------------------------

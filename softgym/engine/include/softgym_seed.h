@@ -11,6 +11,16 @@
 #include <stdint.h>
 #include "softgym_simd.h"
 
+/* links_seed (_seed.pyx) runs its passes over chunks of SOFTGYM_CHUNK_LINKS links (a
+   multiple of 16: a chunk's rows of the scratch start on cache lines), and the forces
+   pass leaves a chunk's forces and moments in 12 rows of their own, SOFTGYM_CHUNK_STRIDE
+   doubles apart (a compile-time constant: the scatter addresses all 12 from one pointer,
+   where a run-time stride took a register per row and spilled; 8 more than the chunk, so
+   that consecutive rows start on different cache sets) */
+#define SOFTGYM_CHUNK_LINKS 128
+#define SOFTGYM_CHUNK_STRIDE (SOFTGYM_CHUNK_LINKS + 8)
+#define SOFTGYM_CHUNK_ROWS 12
+
 /* The first pass of links_seed (_seed.pyx): links lo..hi (all along axis ax, a
    compile-time constant in each copy) measured in the bond frame, without
    branches so the loop vectorises; rows of o (stride n): 0-2 the relative
@@ -315,9 +325,9 @@ static int softgym_seed_frames(
 /* Single-precision link math (the seed model's default link precision): the
    frames and forces passes in float, 16 lanes of AVX-512 instead of 8 and
    the divider's float rate, on quantities relative to voxel 1 (positions
-   stay double; the geometry and mode passes stay double). Their float rows
-   take the first n floats of the scratch's double rows (rows 10-21 of the
-   frames, 0-9, 21, 24 of the forces). Reformulated where float would cancel:
+   stay double; the geometry and mode passes stay double). The frames' float rows
+   take the first floats of the scratch's double rows 10-21; the forces pass
+   leaves doubles for the scatter. Reformulated where float would cancel:
    - the displacements p0 - nom and |p| - nom are taken in double, then rounded;
    - the rotation vector of a unit quaternion (w, v) is k v with the seed's
      k = 2 sqrt((2 - 2w) / (1 - w^2)), which is 2 sqrt(2 / (1 + w)) exactly:
@@ -512,10 +522,10 @@ static Py_ssize_t softgym_seed_modes(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
 #endif
 }
 
-/* The last pass of links_seed: links lo..hi (all along axis ax) back
+/* The last pass of links_seed: links lo..hi (all along axis ax, in one chunk) back
    to the world and scattered, in link order (the seed's summation order).
-   Row k of a link's bond-frame output o (rows f1: 0-2, f2: 3-5, m1: 6-8,
-   m2: 9, 21, 24) becomes R1 P^T v (P^T the inverse axis turn: (x, y, z) =
+   Row k of a link's bond-frame output o (the chunk's rows, SOFTGYM_CHUNK_STRIDE apart:
+   f1: 0-2, f2: 3-5, m1: 6-8, m2: 9-11) becomes R1 P^T v (P^T the inverse axis turn: (x, y, z) =
    (v0, v1, v2), (-v1, v0, v2), (-v2, v1, v0) for ax 0, 1, 2; R1 voxel 1's
    rotation, row-major) and is added to force / moment of voxel 1 or 2.
    Component c of R1 P^T v is R[3c] x + R[3c+1] y + R[3c+2] z, evaluated in
@@ -577,11 +587,12 @@ typedef long long softgym_v4i __attribute__((vector_size(32)));
         } \
     } while (0)
 SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
-                                                   Py_ssize_t n, const Py_ssize_t *v1,
-                                                   const Py_ssize_t *v2, const double *rot,
-                                                   const double *o, double *force,
+                                                   const Py_ssize_t *v1, const Py_ssize_t *v2,
+                                                   const double *rot, const double *o,
+                                                   const double *neg2_row, double *force,
                                                    double *moment)
 {
+    const Py_ssize_t n = SOFTGYM_CHUNK_STRIDE;
     Py_ssize_t li;
 #if defined(SOFTGYM_SCATTER_V4)
     /* voxel 2's rows after the last link, kept in registers: where a link's
@@ -615,10 +626,10 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
         double w[3];
 #endif
         const double *q = o + li;
-        /* row 23 holds exactly 1.0 or 0.0 (the modes pass): its bits, one integer test
-           (a double's != 0.0 is two branches, for NaN) */
+        /* neg2_row (row 23 of the scratch) holds exactly 1.0 or 0.0 (the modes pass): its
+           bits, one integer test (a double's != 0.0 is two branches, for NaN) */
         unsigned long long neg2_bits;
-        memcpy(&neg2_bits, q + 23 * n, sizeof neg2_bits);
+        memcpy(&neg2_bits, neg2_row + li, sizeof neg2_bits);
         int neg2 = neg2_bits != 0;
         double *fi = force + 4 * i, *fj = force + 4 * j;
         double *mi = moment + 4 * i, *mj = moment + 4 * j;
@@ -638,17 +649,17 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
             SOFTGYM_SCATTER_TURN(fi, q[0], q[n], q[2 * n]);
             SOFTGYM_SCATTER_F2(q[3 * n], q[4 * n], q[5 * n]);
             SOFTGYM_SCATTER_TURN(mi, q[6 * n], q[7 * n], q[8 * n]);
-            SOFTGYM_SCATTER_TURN(mj, q[9 * n], q[21 * n], q[24 * n]);
+            SOFTGYM_SCATTER_TURN(mj, q[9 * n], q[10 * n], q[11 * n]);
         } else if (ax == 1) {
             SOFTGYM_SCATTER_TURN(fi, SOFTGYM_NEG1(q[n]), q[0], q[2 * n]);
             SOFTGYM_SCATTER_F2(SOFTGYM_NEG1(q[4 * n]), q[3 * n], q[5 * n]);
             SOFTGYM_SCATTER_TURN(mi, SOFTGYM_NEG1(q[7 * n]), q[6 * n], q[8 * n]);
-            SOFTGYM_SCATTER_TURN(mj, SOFTGYM_NEG1(q[21 * n]), q[9 * n], q[24 * n]);
+            SOFTGYM_SCATTER_TURN(mj, SOFTGYM_NEG1(q[10 * n]), q[9 * n], q[11 * n]);
         } else {
             SOFTGYM_SCATTER_TURN(fi, SOFTGYM_NEG1(q[2 * n]), q[n], q[0]);
             SOFTGYM_SCATTER_F2(SOFTGYM_NEG1(q[5 * n]), q[4 * n], q[3 * n]);
             SOFTGYM_SCATTER_TURN(mi, SOFTGYM_NEG1(q[8 * n]), q[7 * n], q[6 * n]);
-            SOFTGYM_SCATTER_TURN(mj, SOFTGYM_NEG1(q[24 * n]), q[21 * n], q[9 * n]);
+            SOFTGYM_SCATTER_TURN(mj, SOFTGYM_NEG1(q[11 * n]), q[10 * n], q[9 * n]);
         }
 #if defined(SOFTGYM_SCATTER_V4)
         memcpy(fi, &fi_v, sizeof fi_v);
@@ -668,11 +679,12 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
 #undef SOFTGYM_SCATTER_V4
 #undef SOFTGYM_NEG1
 
-static void softgym_seed_scatter(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
-                                 const Py_ssize_t *v1, const Py_ssize_t *v2, const double *rot,
-                                 const double *o, double *force, double *moment)
+static void softgym_seed_scatter(int ax, Py_ssize_t lo, Py_ssize_t hi, const Py_ssize_t *v1,
+                                 const Py_ssize_t *v2, const double *rot, const double *o,
+                                 const double *neg2_row, double *force, double *moment)
 {
-    SOFTGYM_BY_AXIS(ax, softgym_seed_scatter_ax, lo, hi, n, v1, v2, rot, o, force, moment);
+    SOFTGYM_BY_AXIS(ax, softgym_seed_scatter_ax, lo, hi, v1, v2, rot, o, neg2_row, force,
+                    moment);
 }
 
 #endif  /* SOFTGYM_SEED_H */
