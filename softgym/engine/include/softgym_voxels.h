@@ -1,0 +1,214 @@
+/* The seed model's voxel update (softgym/engine/_integrate.pyx, integrate_seed) for 8
+   voxels at once, in the lanes of AVX-512: the same IEEE operations as the scalar loop,
+   lane by lane, each expression written in the scalar code's shape (so the build fuses
+   the same multiply-adds), the seed's floor with every branch computed and one selected.
+   The voxels' records (position, velocity, angular velocity and external force: 3
+   doubles each; force and moment: rows of 4) are turned into rows of 8 lanes and back
+   by two-source permutes. Only for the common block: no fixed voxel, no fluid, no
+   terrain box; a block where a voxel runs away is left to the scalar loop untouched
+   (nothing is stored before the check), which then stops where the seed's loop stops.
+   Py_ssize_t comes from Python.h, which Cython includes first. */
+#ifndef SOFTGYM_VOXELS_H
+#define SOFTGYM_VOXELS_H
+
+#include <math.h>
+#include <string.h>
+#include "softgym_simd.h"
+
+#if defined(__AVX512F__) && (defined(__GNUC__) || defined(__clang__))
+#define SOFTGYM_VOXELS8 1
+typedef double softgym_v8 __attribute__((vector_size(64)));
+
+/* 8 voxels' records of 3 (a[0..23]) as rows x, y, z */
+static inline void softgym_v8_load3(const double *a, softgym_v8 *x, softgym_v8 *y,
+                                    softgym_v8 *z)
+{
+    __m512d p0 = _mm512_loadu_pd(a), p1 = _mm512_loadu_pd(a + 8), p2 = _mm512_loadu_pd(a + 16);
+    /* element e of the 24 is voxel e / 3, component e % 3 */
+    const __m512i ix0 = _mm512_set_epi64(0, 0, 15, 12, 9, 6, 3, 0);
+    const __m512i iy0 = _mm512_set_epi64(0, 0, 8 + 8, 13, 10, 7, 4, 1);
+    const __m512i iz0 = _mm512_set_epi64(0, 0, 8 + 9, 14, 11, 8, 5, 2);
+    const __m512i ix1 = _mm512_set_epi64(8 + 5, 8 + 2, 5, 4, 3, 2, 1, 0);
+    const __m512i iy1 = _mm512_set_epi64(8 + 6, 8 + 3, 8 + 0, 4, 3, 2, 1, 0);
+    const __m512i iz1 = _mm512_set_epi64(8 + 7, 8 + 4, 8 + 1, 4, 3, 2, 1, 0);
+    /* x: 0 3 6 9 12 15 | 18 21; y: 1 4 7 10 13 | 16 19 22; z: 2 5 8 11 14 | 17 20 23 */
+    *x = (softgym_v8)_mm512_permutex2var_pd(_mm512_permutex2var_pd(p0, ix0, p1), ix1, p2);
+    *y = (softgym_v8)_mm512_permutex2var_pd(_mm512_permutex2var_pd(p0, iy0, p1), iy1, p2);
+    *z = (softgym_v8)_mm512_permutex2var_pd(_mm512_permutex2var_pd(p0, iz0, p1), iz1, p2);
+}
+/* rows x, y, z back into 8 records of 3 at a[0..23] */
+static inline void softgym_v8_store3(double *a, softgym_v8 x, softgym_v8 y, softgym_v8 z)
+{
+    /* out0 = x0 y0 z0 x1 y1 z1 x2 y2; out1 = z2 x3 y3 z3 x4 y4 z4 x5;
+       out2 = y5 z5 x6 y6 z6 x7 y7 z7 */
+    /* t0 = x0 y0 _ x1 y1 _ x2 y2, then z0, z1 into its gaps; the same for out1, out2 */
+    __m512d t0 = _mm512_permutex2var_pd(
+        (__m512d)x, _mm512_set_epi64(8 + 2, 2, 0, 8 + 1, 1, 0, 8 + 0, 0), (__m512d)y);
+    __m512d o0 = _mm512_permutex2var_pd(t0, _mm512_set_epi64(7, 6, 8 + 1, 4, 3, 8 + 0, 1, 0),
+                                        (__m512d)z);
+    __m512d t1 = _mm512_permutex2var_pd((__m512d)x, _mm512_set_epi64(5, 0, 8 + 4, 4, 0, 8 + 3, 3, 0),
+                                        (__m512d)y);
+    __m512d o1 = _mm512_permutex2var_pd(t1, _mm512_set_epi64(7, 8 + 4, 5, 4, 8 + 3, 2, 1, 8 + 2),
+                                        (__m512d)z);
+    __m512d t2 = _mm512_permutex2var_pd((__m512d)x, _mm512_set_epi64(0, 8 + 7, 7, 0, 8 + 6, 6, 0, 8 + 5),
+                                        (__m512d)y);
+    __m512d o2 = _mm512_permutex2var_pd(t2, _mm512_set_epi64(8 + 7, 6, 5, 8 + 6, 3, 2, 8 + 5, 0),
+                                        (__m512d)z);
+    _mm512_storeu_pd(a, o0);
+    _mm512_storeu_pd(a + 8, o1);
+    _mm512_storeu_pd(a + 16, o2);
+}
+/* 8 voxels' rows of 4 (a[0..31]) as rows x, y, z (lane 3 of each record dropped) */
+static inline void softgym_v8_load4(const double *a, softgym_v8 *x, softgym_v8 *y,
+                                    softgym_v8 *z)
+{
+    __m512d p0 = _mm512_loadu_pd(a), p1 = _mm512_loadu_pd(a + 8);
+    __m512d p2 = _mm512_loadu_pd(a + 16), p3 = _mm512_loadu_pd(a + 24);
+    /* from p0, p1: x0 x1 x2 x3 y0 y1 y2 y3; z0 z1 z2 z3 _ */
+    const __m512i ixy = _mm512_set_epi64(8 + 5, 8 + 1, 5, 1, 8 + 4, 8 + 0, 4, 0);
+    const __m512i iz = _mm512_set_epi64(0, 0, 0, 0, 8 + 6, 8 + 2, 6, 2);
+    __m512d a01 = _mm512_permutex2var_pd(p0, ixy, p1), a23 = _mm512_permutex2var_pd(p2, ixy, p3);
+    __m512d z01 = _mm512_permutex2var_pd(p0, iz, p1), z23 = _mm512_permutex2var_pd(p2, iz, p3);
+    const __m512i lo = _mm512_set_epi64(8 + 3, 8 + 2, 8 + 1, 8 + 0, 3, 2, 1, 0);
+    const __m512i hi = _mm512_set_epi64(8 + 7, 8 + 6, 8 + 5, 8 + 4, 7, 6, 5, 4);
+    *x = (softgym_v8)_mm512_permutex2var_pd(a01, lo, a23);
+    *y = (softgym_v8)_mm512_permutex2var_pd(a01, hi, a23);
+    *z = (softgym_v8)_mm512_permutex2var_pd(z01, lo, z23);
+}
+static inline softgym_v8 softgym_v8_load(const double *a)
+{
+    softgym_v8 v;
+    memcpy(&v, a, sizeof v);
+    return v;
+}
+#define SOFTGYM_V8_PICK(m, a, b) ((softgym_v8)_mm512_mask_blend_pd((m), (__m512d)(b), (__m512d)(a)))
+#define SOFTGYM_V8_LT(a, b) _mm512_cmp_pd_mask((__m512d)(a), (__m512d)(b), _CMP_LT_OQ)
+#define SOFTGYM_V8_LE(a, b) _mm512_cmp_pd_mask((__m512d)(a), (__m512d)(b), _CMP_LE_OQ)
+#define SOFTGYM_V8_GT(a, b) _mm512_cmp_pd_mask((__m512d)(a), (__m512d)(b), _CMP_GT_OQ)
+#define SOFTGYM_V8_EQ(a, b) _mm512_cmp_pd_mask((__m512d)(a), (__m512d)(b), _CMP_EQ_OQ)
+
+/* voxels i..i+7 of a robot whose first voxel is vs (i > vs): returns 1 when they were
+   stepped (and *dmax, *vmax2 raised to their largest drift and speed squared), 0 when
+   nothing was written (a fixed voxel in the block, or a runaway one) */
+static int softgym_seed_voxels8(
+    Py_ssize_t i, Py_ssize_t vs, double dt, double g, int has_floor, double *pos,
+    double *vel, double *av, double *force, double *moment, const double *ext,
+    const double *c_global, const double *mass, const double *inv_mass,
+    const double *inv_inertia, const double *rot_damp, const double *scale,
+    const double *k_floor, const double *c_floor, const double *mu_s, const double *mu_k,
+    const signed char *fixed, const double *ref, const double *c, int track_speed,
+    double runaway, double *dmax, double *vmax2)
+{
+    long long fx;
+    memcpy(&fx, fixed + i, sizeof fx);
+    if (fx != 0)
+        return 0;
+    softgym_v8 v0, v1, v2, p0, p1, p2, F0, F1, F2, M0, M1, M2, E0, E1, E2;
+    softgym_v8_load3(vel + 3 * i, &v0, &v1, &v2);
+    softgym_v8_load3(pos + 3 * i, &p0, &p1, &p2);
+    softgym_v8_load3(ext + 3 * i, &E0, &E1, &E2);
+    softgym_v8_load4(force + 4 * i, &F0, &F1, &F2);
+    softgym_v8_load4(moment + 4 * i, &M0, &M1, &M2);
+    softgym_v8 cg = softgym_v8_load(c_global + i), m = softgym_v8_load(mass + i);
+    softgym_v8 f0 = (((-cg) * v0) + F0) + E0;
+    softgym_v8 f1 = (((-cg) * v1) + F1) + E1;
+    softgym_v8 f2 = ((((-cg) * v2) + F2) + (m * g)) + E2;
+    if (has_floor) {
+        softgym_v8 sc = softgym_v8_load(scale + i);
+        softgym_v8 pen = (0.5 * sc) - p2;
+        __mmask8 contact = ~SOFTGYM_V8_LE(pen, _mm512_setzero_pd()) & 0xFF;
+        if (contact) {
+            softgym_v8 n = softgym_v8_load(k_floor + i) * pen;
+            softgym_v8 fd = softgym_v8_load(mu_k + i) * n;
+            __mmask8 still = SOFTGYM_V8_EQ(v0, _mm512_setzero_pd()) & SOFTGYM_V8_EQ(v1, _mm512_setzero_pd());
+            __mmask8 stat = 0;
+            if (contact & still) {  /* (the square root and the divisions only where needed) */
+                softgym_v8 sf = (softgym_v8)_mm512_sqrt_pd((__m512d)((f0 * f0) + (f1 * f1)));
+                stat = SOFTGYM_V8_LT(sf, (softgym_v8_load(mu_s + i) * n));
+            }
+            __mmask8 moving = contact & ~still, slide = 0, stop = 0;
+            if (moving) {
+                softgym_v8 vsp = (softgym_v8)_mm512_sqrt_pd((__m512d)((v0 * v0) + (v1 * v1)));
+                __mmask8 kin = SOFTGYM_V8_LT((fd * dt), (m * vsp));
+                slide = moving & kin;          /* kinetic friction */
+                stop = moving & ~kin;          /* friction stops it: v_xy = 0 */
+                if (slide) {
+                    softgym_v8 f0k = f0 - ((fd * v0) / vsp);
+                    softgym_v8 f1k = f1 - ((fd * v1) / vsp);
+                    f0 = SOFTGYM_V8_PICK(slide, f0k, f0);
+                    f1 = SOFTGYM_V8_PICK(slide, f1k, f1);
+                }
+            }
+            __mmask8 stick = (contact & still & stat) | stop;
+            v0 = SOFTGYM_V8_PICK(stop, (softgym_v8){0}, v0);
+            v1 = SOFTGYM_V8_PICK(stop, (softgym_v8){0}, v1);
+            softgym_v8 f2c = f2 + (n - (softgym_v8_load(c_floor + i) * v2));
+            f2 = SOFTGYM_V8_PICK(contact, f2c, f2);
+            f0 = SOFTGYM_V8_PICK(stick, (softgym_v8){0}, f0);
+            f1 = SOFTGYM_V8_PICK(stick, (softgym_v8){0}, f1);
+        }
+    }
+    softgym_v8 h = dt * softgym_v8_load(inv_mass + i);
+    softgym_v8 vx = v0 + (f0 * h), vy = v1 + (f1 * h), vz = v2 + (f2 * h);
+    softgym_v8 px = p0 + (vx * dt), py = p1 + (vy * dt), pz = p2 + (vz * dt);
+    softgym_v8 run = (softgym_vabs(px) + softgym_vabs(py)) + softgym_vabs(pz);
+    if ((SOFTGYM_V8_LT(run, _mm512_set1_pd(runaway)) & 0xFF) != 0xFF)
+        return 0;
+    /* the block is stepped: from here on, stores */
+    softgym_v8_store3(vel + 3 * i, vx, vy, vz);
+    softgym_v8_store3(pos + 3 * i, px, py, pz);
+    memset(force + 4 * i, 0, 32 * sizeof(double));
+    memset(moment + 4 * i, 0, 32 * sizeof(double));
+    if (ref != NULL) {
+        softgym_v8 r0, r1, r2;
+        softgym_v8_load3(ref + 3 * (i - vs), &r0, &r1, &r2);
+        softgym_v8 d0 = (px - r0) - c[0], d1 = (py - r1) - c[1], d2 = (pz - r2) - c[2];
+        softgym_v8 dd = ((d0 * d0) + (d1 * d1)) + (d2 * d2);
+        double t[8], best = *dmax;
+        memcpy(t, &dd, sizeof t);
+        for (int k = 0; k < 8; k++)
+            if (t[k] > best)
+                best = t[k];
+        *dmax = best;
+    }
+    if (track_speed) {
+#if defined(__FMA__)
+        softgym_v8 s2 = (softgym_v8)_mm512_fmadd_pd(
+            (__m512d)vz, (__m512d)vz,
+            _mm512_fmadd_pd((__m512d)vx, (__m512d)vx, _mm512_mul_pd((__m512d)vy, (__m512d)vy)));
+#else
+        softgym_v8 s2 = vx * vx + vy * vy + vz * vz;
+#endif
+        double t[8], best = *vmax2;
+        memcpy(t, &s2, sizeof t);
+        for (int k = 0; k < 8; k++)
+            if (t[k] > best)
+                best = t[k];
+        *vmax2 = best;
+    }
+    softgym_v8 w0, w1, w2;
+    softgym_v8_load3(av + 3 * i, &w0, &w1, &w2);
+    softgym_v8 hi = dt * softgym_v8_load(inv_inertia + i), rd = softgym_v8_load(rot_damp + i);
+    w0 = (w0 + (M0 * hi)) * rd;
+    w1 = (w1 + (M1 * hi)) * rd;
+    w2 = (w2 + (M2 * hi)) * rd;
+    softgym_v8_store3(av + 3 * i, w0, w1, w2);
+    return 1;
+}
+#else
+#define SOFTGYM_VOXELS8 0
+/* (without AVX-512 the scalar loop steps every voxel) */
+static int softgym_seed_voxels8(
+    Py_ssize_t i, Py_ssize_t vs, double dt, double g, int has_floor, double *pos,
+    double *vel, double *av, double *force, double *moment, const double *ext,
+    const double *c_global, const double *mass, const double *inv_mass,
+    const double *inv_inertia, const double *rot_damp, const double *scale,
+    const double *k_floor, const double *c_floor, const double *mu_s, const double *mu_k,
+    const signed char *fixed, const double *ref, const double *c, int track_speed,
+    double runaway, double *dmax, double *vmax2)
+{
+    return 0;
+}
+#endif
+
+#endif  /* SOFTGYM_VOXELS_H */
