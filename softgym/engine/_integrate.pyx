@@ -267,8 +267,10 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
                 lo += 8
                 continue
             hi = lo + 8
-        else:
+        elif vec and lo == vs:
             hi = lo + 1
+        else:
+            hi = ve  # the rest (every voxel without the lanes)
         for i in range(lo, hi):
             if b.fixed[i]:
                 for k in range(3):

@@ -40,7 +40,9 @@ for model in ("seed", "corotational"):
     out.update({f"{model}/{k}": v for k, v in sim.get_state().items()})
 # the seed voxel update's corner cases (with AVX-512 it steps 8 voxels at a time and leaves
 # a block to its scalar loop): fixed voxels inside a block, a voxel that runs away in its
-# first step (diverged_code 2), and the seed's fence (terrain boxes: the scalar loop)
+# first step (diverged_code 2), the seed's fence as its wall voxels (the lanes) and as
+# boxes with surface contact (the scalar loop)
+import dataclasses
 from softgym.terrain import Terrain
 fixed = np.zeros((3, 3, 3), dtype=bool)
 fixed[1, 1, 0] = fixed[2, 0, 1] = True
@@ -57,9 +59,11 @@ sim.set_state(state)
 sim.run(0.2)
 out.update({f"corners/{k}": v for k, v in sim.get_state().items()})
 fence = Terrain.fence(inner=10, center=(3, 3))
-sim = Simulation([walker], SimConfig(self_collision=True), n_threads=1, terrain=fence)
-sim.run(0.2)
-out.update({f"fence/{k}": v for k, v in sim.get_state().items()})
+for name, terrain in (("fence", fence),
+                      ("boxes", dataclasses.replace(fence, box_contact="surface"))):
+    sim = Simulation([walker], SimConfig(self_collision=True), n_threads=1, terrain=terrain)
+    sim.run(0.2)
+    out.update({f"{name}/{k}": v for k, v in sim.get_state().items()})
 np.savez(sys.argv[1], **out)
 print(kernel_build())
 """
