@@ -1,4 +1,4 @@
-"""Wall time of the seed preset in two or more checkouts, alternating: which build is faster.
+"""Wall time of a preset in two or more checkouts, alternating: which build is faster.
 
 On a shared VM the same build's time moves by 20 % from run to run, more than most
 single kernel changes; a median of a few runs of each build in turn does not
@@ -15,6 +15,7 @@ Each tree must be a checkout whose extensions are built in place
 ``benchmarks/`` import the installed (editable) checkout instead.
 
     python benchmarks/compare_builds.py /tmp/before . --rounds 10
+    python benchmarks/compare_builds.py /tmp/before . --model corotational
 """
 
 from __future__ import annotations
@@ -36,18 +37,21 @@ from softgym.engine import SimConfig, Simulation
 design = reference_design()
 best = float("inf")
 for _ in range({runs}):
-    sim = Simulation([design.to_body()], SimConfig(self_collision=True), n_threads=1)
+    sim = Simulation([design.to_body()], SimConfig(self_collision=True, model={model!r}),
+                     n_threads=1)
     t0 = time.perf_counter()
     sim.run({seconds})
     best = min(best, time.perf_counter() - t0)
-print("RESULT " + json.dumps({{"best": best, "module": softgym.__file__}}))
+print("RESULT " + json.dumps({{"best": best, "module": softgym.__file__, "model": sim.config.model}}))
 """
 
 
-def run_once(tree: Path, runs: int, seconds: float) -> float:
+def run_once(tree: Path, runs: int, seconds: float, model: str = "seed") -> float:
     """The quickest of ``runs`` runs of the reference robot with the softgym of ``tree`` (s)."""
-    code = CHILD.format(bench=str(tree / "benchmarks"), runs=runs, seconds=seconds)
+    code = CHILD.format(bench=str(tree / "benchmarks"), runs=runs, seconds=seconds, model=model)
     out = run_in_tree(tree, code, "RESULT", "compare_builds", env={"OMP_NUM_THREADS": "1"})
+    if out["model"] != model:
+        raise SystemExit(f"compare_builds: the run in {tree} stepped {out['model']!r}, not {model!r}")
     return float(out["best"])
 
 
@@ -57,6 +61,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--rounds", type=int, default=10, help="turns of every build")
     ap.add_argument("--runs", type=int, default=3, help="runs per turn, the quickest kept")
     ap.add_argument("--seconds", type=float, default=5.0, help="simulated time per run")
+    ap.add_argument("--model", choices=("seed", "corotational"), default="seed",
+                    help="the preset (SimConfig.model) to time")
     ap.add_argument("--json", action="store_true", help="print one JSON object as the last line")
     args = ap.parse_args(argv)
     trees = [Path(t).resolve() for t in args.trees]
@@ -66,7 +72,7 @@ def main(argv: list[str] | None = None) -> int:
         ap.error("--rounds and --runs must be >= 1, --seconds > 0")
     times: list[list[float]] = [[] for _ in trees]
     for k in range(args.rounds):
-        row = [run_once(t, args.runs, args.seconds) for t in trees]
+        row = [run_once(t, args.runs, args.seconds, args.model) for t in trees]
         for col, t in zip(times, row):
             col.append(t)
         print(f"round {k + 1:3d}: " + "  ".join(f"{t:.4f} s" for t in row), flush=True)
@@ -80,7 +86,7 @@ def main(argv: list[str] | None = None) -> int:
               f"speed-up vs the first: {base_min / lo:.3f}x (minima), {base_med / med:.3f}x (medians)")
     if args.json:
         print(json.dumps({"rounds": args.rounds, "runs": args.runs, "seconds": args.seconds,
-                          "builds": summary}))  # fmt: skip
+                          "model": args.model, "builds": summary}))  # fmt: skip
     return 0
 
 

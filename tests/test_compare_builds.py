@@ -30,6 +30,15 @@ def test_two_turns_of_the_same_tree_report_minima_medians_and_ratios():
     assert sum(line.startswith("round") for line in res.stdout.splitlines()) == 2
 
 
+def test_the_corotational_preset_is_timed_on_request():
+    res = _compare(ROOT, ROOT, "--rounds", 1, "--runs", 1, "--seconds", 0.02, "--model",
+                   "corotational", "--json")  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    assert json.loads(res.stdout.strip().splitlines()[-1])["model"] == "corotational"
+    bad = _compare(ROOT, ROOT, "--rounds", 1, "--model", "stiff")
+    assert bad.returncode == 2 and "--model" in bad.stderr
+
+
 def test_a_tree_without_softgym_is_refused_with_the_reason(tmp_path):
     # softgym would come from the installed checkout, not from the tree asked for
     (tmp_path / "benchmarks").mkdir()

@@ -110,6 +110,32 @@ cdef inline void _spin(Batch* b, intp_t i, float64_t dt, float64_t mx, float64_t
     av[3 * i + 2] = (av[3 * i + 2] + mz * h) * rd
 
 
+cdef extern from "softgym_voxels.h":
+    # the seed's voxel update for 8 voxels in vector lanes (AVX-512 builds: SOFTGYM_VOXELS8
+    # is 1); 1: stepped, 0: nothing written (a fixed or runaway voxel among them: the
+    # scalar loop steps them). Documented in include/softgym_voxels.h
+    int SOFTGYM_VOXELS8
+    int seed_voxels8 "softgym_seed_voxels8" (
+        intp_t i, intp_t vs, float64_t dt, float64_t g, int has_floor, float64_t* pos,
+        float64_t* vel, float64_t* av, float64_t* force, float64_t* moment,
+        const float64_t* ext, const float64_t* c_global, const float64_t* mass,
+        const float64_t* inv_mass, const float64_t* inv_inertia, const float64_t* rot_damp,
+        const float64_t* scale, const float64_t* k_floor, const float64_t* c_floor,
+        const float64_t* mu_s, const float64_t* mu_k, const flag_t* fixed,
+        const float64_t* ref, const float64_t* c, int track_speed, float64_t runaway,
+        float64_t* dmax, float64_t* vmax2) noexcept nogil
+    # the same for the corotational model's update (its floor the common surface contact)
+    int corot_voxels8 "softgym_corot_voxels8" (
+        intp_t i, intp_t vs, float64_t dt, float64_t g, int has_floor, float64_t* pos,
+        float64_t* vel, float64_t* av, float64_t* force, float64_t* moment,
+        const float64_t* ext, const float64_t* c_global, const float64_t* mass,
+        const float64_t* inv_mass, const float64_t* inv_inertia, const float64_t* rot_damp,
+        const float64_t* scale, const float64_t* k_floor, const float64_t* c_floor,
+        const float64_t* mu_s, const float64_t* mu_k, const flag_t* fixed,
+        const float64_t* ref, const float64_t* c, float64_t runaway,
+        float64_t* dmax) noexcept nogil
+
+
 cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
                                 float64_t* dmax2) noexcept nogil:
     # IN: force, moment. OUT: pos, vel, quat, angvel, rot (symplectic Euler).
@@ -133,50 +159,74 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
         intp_t k0 = b.box_start[r]
         intp_t k1 = b.box_start[r + 1]
         intp_t vs = b.vox_start[r]
+        float64_t dmax = 0.0
+        intp_t lo, hi
+        intp_t ve = b.vox_start[r + 1]
+        bint vec
     dmax2[0] = 0.0
     c[0] = 0.0
     c[1] = 0.0
     c[2] = 0.0
-    for i in range(b.vox_start[r], b.vox_start[r + 1]):
-        if b.fixed[i]:
-            vel[3 * i] = 0.0
-            vel[3 * i + 1] = 0.0
-            vel[3 * i + 2] = 0.0
-            av[3 * i] = 0.0
-            av[3 * i + 1] = 0.0
-            av[3 * i + 2] = 0.0
-            _clear(b, i)
-            continue
-        m = b.mass[i]
-        cg = b.c_global[i]
-        f[0] = b.force[4 * i] + b.ext_force[3 * i] - cg * vel[3 * i]
-        f[1] = b.force[4 * i + 1] + b.ext_force[3 * i + 1] - cg * vel[3 * i + 1]
-        f[2] = b.force[4 * i + 2] + b.ext_force[3 * i + 2] - cg * vel[3 * i + 2] + m * g
-        mx = b.moment[4 * i]
-        my = b.moment[4 * i + 1]
-        mz = b.moment[4 * i + 2]
-        _clear(b, i)  # the scratch is zero again for the next step
-        if has_fluid:
-            _fluid_drag(b, i, f)
-        if has_floor:
-            pen = 0.5 * b.scale[i] - pos[3 * i + 2]
-            if pen > 0.0:
-                surface_contact(b, i, 0.0, 0.0, 1.0, pen, dt, f)
-        for k in range(k0, k1):
-            pen = box_penetration(b.boxes + 6 * k, pos + 3 * i, 0.5 * b.scale[i], n)
-            if pen > 0.0:
-                surface_contact(b, i, n[0], n[1], n[2], pen, dt, f)
-        if not (_translate(vel + 3 * i, pos + 3 * i, f, dt * b.inv_mass[i], dt) < RUNAWAY):
-            _orient(b, vs, i, dt, 0)  # the voxels before it were stepped
-            clear_robot(b, r)
-            return STATUS_NONFINITE
-        if ref != NULL:
-            d2 = _drift2(pos, ref, i, vs, c)
-            if d2 > dmax2[0]:
-                dmax2[0] = d2
-        # rotation: w += M dt / I, global damping; q += 0.5 dt (0, w) q after
-        # the loop (_orient: no voxel's update reads another's orientation)
-        _spin(b, i, dt, mx, my, mz)
+    # blocks of 8 voxels after the first in vector lanes where the build and the robot
+    # allow (as integrate_seed)
+    vec = SOFTGYM_VOXELS8 and not has_fluid and k0 == k1
+    lo = vs
+    while lo < ve:
+        if vec and lo > vs and lo + 8 <= ve:
+            if corot_voxels8(lo, vs, dt, g, has_floor, pos, vel, av, b.force, b.moment,
+                             b.ext_force, b.c_global, b.mass, b.inv_mass, b.inv_inertia,
+                             b.rot_damp, b.scale, b.k_floor, b.c_floor, b.mu_s, b.mu_k, b.fixed,
+                             ref, c, RUNAWAY, &dmax):
+                lo += 8
+                continue
+            hi = lo + 8
+        elif vec and lo == vs:
+            hi = lo + 1
+        else:
+            hi = ve  # the rest (every voxel without the lanes)
+        for i in range(lo, hi):
+            if b.fixed[i]:
+                vel[3 * i] = 0.0
+                vel[3 * i + 1] = 0.0
+                vel[3 * i + 2] = 0.0
+                av[3 * i] = 0.0
+                av[3 * i + 1] = 0.0
+                av[3 * i + 2] = 0.0
+                _clear(b, i)
+                continue
+            m = b.mass[i]
+            cg = b.c_global[i]
+            f[0] = b.force[4 * i] + b.ext_force[3 * i] - cg * vel[3 * i]
+            f[1] = b.force[4 * i + 1] + b.ext_force[3 * i + 1] - cg * vel[3 * i + 1]
+            f[2] = b.force[4 * i + 2] + b.ext_force[3 * i + 2] - cg * vel[3 * i + 2] + m * g
+            mx = b.moment[4 * i]
+            my = b.moment[4 * i + 1]
+            mz = b.moment[4 * i + 2]
+            _clear(b, i)  # the scratch is zero again for the next step
+            if has_fluid:
+                _fluid_drag(b, i, f)
+            if has_floor:
+                pen = 0.5 * b.scale[i] - pos[3 * i + 2]
+                if pen > 0.0:
+                    surface_contact(b, i, 0.0, 0.0, 1.0, pen, dt, f)
+            for k in range(k0, k1):
+                pen = box_penetration(b.boxes + 6 * k, pos + 3 * i, 0.5 * b.scale[i], n)
+                if pen > 0.0:
+                    surface_contact(b, i, n[0], n[1], n[2], pen, dt, f)
+            if not (_translate(vel + 3 * i, pos + 3 * i, f, dt * b.inv_mass[i], dt) < RUNAWAY):
+                dmax2[0] = dmax
+                _orient(b, vs, i, dt, 0)  # the voxels before it were stepped
+                clear_robot(b, r)
+                return STATUS_NONFINITE
+            if ref != NULL:
+                d2 = _drift2(pos, ref, i, vs, c)
+                if d2 > dmax:
+                    dmax = d2
+            # rotation: w += M dt / I, global damping; q += 0.5 dt (0, w) q after
+            # the loop (_orient: no voxel's update reads another's orientation)
+            _spin(b, i, dt, mx, my, mz)
+        lo = hi
+    dmax2[0] = dmax
     _orient(b, vs, b.vox_start[r + 1], dt, 0)
     return STATUS_OK
 
@@ -204,22 +254,6 @@ cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int
     else:
         softgym_corot_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
     softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat, b.rot)
-
-
-cdef extern from "softgym_voxels.h":
-    # the seed's voxel update for 8 voxels in vector lanes (AVX-512 builds: SOFTGYM_VOXELS8
-    # is 1); 1: stepped, 0: nothing written (a fixed or runaway voxel among them: the
-    # scalar loop steps them). Documented in include/softgym_voxels.h
-    int SOFTGYM_VOXELS8
-    int seed_voxels8 "softgym_seed_voxels8" (
-        intp_t i, intp_t vs, float64_t dt, float64_t g, int has_floor, float64_t* pos,
-        float64_t* vel, float64_t* av, float64_t* force, float64_t* moment,
-        const float64_t* ext, const float64_t* c_global, const float64_t* mass,
-        const float64_t* inv_mass, const float64_t* inv_inertia, const float64_t* rot_damp,
-        const float64_t* scale, const float64_t* k_floor, const float64_t* c_floor,
-        const float64_t* mu_s, const float64_t* mu_k, const flag_t* fixed,
-        const float64_t* ref, const float64_t* c, int track_speed, float64_t runaway,
-        float64_t* dmax, float64_t* vmax2) noexcept nogil
 
 
 cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,

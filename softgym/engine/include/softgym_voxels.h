@@ -195,6 +195,119 @@ static int softgym_seed_voxels8(
     softgym_v8_store3(av + 3 * i, w0, w1, w2);
     return 1;
 }
+
+/* voxels i..i+7 of the corotational model's update (integrate_corotational: its floor is
+   the common surface contact with the normal (0, 0, 1), applied before any box), as
+   softgym_seed_voxels8 (no speed to track) */
+static int softgym_corot_voxels8(
+    Py_ssize_t i, Py_ssize_t vs, double dt, double g, int has_floor, double *pos,
+    double *vel, double *av, double *force, double *moment, const double *ext,
+    const double *c_global, const double *mass, const double *inv_mass,
+    const double *inv_inertia, const double *rot_damp, const double *scale,
+    const double *k_floor, const double *c_floor, const double *mu_s, const double *mu_k,
+    const signed char *fixed, const double *ref, const double *c, double runaway,
+    double *dmax)
+{
+    long long fx;
+    memcpy(&fx, fixed + i, sizeof fx);
+    if (fx != 0)
+        return 0;
+    softgym_v8 v0, v1, v2, p0, p1, p2, F0, F1, F2, M0, M1, M2, E0, E1, E2;
+    softgym_v8_load3(vel + 3 * i, &v0, &v1, &v2);
+    softgym_v8_load3(pos + 3 * i, &p0, &p1, &p2);
+    softgym_v8_load3(ext + 3 * i, &E0, &E1, &E2);
+    softgym_v8_load4(force + 4 * i, &F0, &F1, &F2);
+    softgym_v8_load4(moment + 4 * i, &M0, &M1, &M2);
+    softgym_v8 cg = softgym_v8_load(c_global + i), m = softgym_v8_load(mass + i);
+    softgym_v8 f0 = (F0 + E0) - (cg * v0);
+    softgym_v8 f1 = (F1 + E1) - (cg * v1);
+    softgym_v8 f2 = ((F2 + E2) - (cg * v2)) + (m * g);
+    if (has_floor) {
+        softgym_v8 pen = (0.5 * softgym_v8_load(scale + i)) - p2;
+        __mmask8 contact = SOFTGYM_V8_GT(pen, _mm512_setzero_pd());
+        if (contact) {
+            /* surface_contact with n = (0, 0, 1), every product as the scalar code's */
+            const softgym_v8 nx = {0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0};
+            const softgym_v8 ny = nx;
+            const softgym_v8 nz = {1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0};
+            softgym_v8 vn = ((v0 * nx) + (v1 * ny)) + (v2 * nz);
+            softgym_v8 fn = (softgym_v8_load(k_floor + i) * pen) - (softgym_v8_load(c_floor + i) * vn);
+            contact &= ~SOFTGYM_V8_LE(fn, _mm512_setzero_pd());
+            if (contact) {
+                softgym_v8 g0 = f0 + (fn * nx), g1 = f1 + (fn * ny), g2 = f2 + (fn * nz);
+                softgym_v8 vtx = v0 - (vn * nx), vty = v1 - (vn * ny), vtz = v2 - (vn * nz);
+                softgym_v8 ftn = ((g0 * nx) + (g1 * ny)) + (g2 * nz);
+                softgym_v8 ftx = g0 - (ftn * nx), fty = g1 - (ftn * ny), ftz = g2 - (ftn * nz);
+                __mmask8 rest = SOFTGYM_V8_EQ(vtx, _mm512_setzero_pd())
+                                & SOFTGYM_V8_EQ(vty, _mm512_setzero_pd())
+                                & SOFTGYM_V8_EQ(vtz, _mm512_setzero_pd());
+                softgym_v8 ms = softgym_v8_load(mu_s + i) * fn;
+                __mmask8 hold = rest & SOFTGYM_V8_LE(((ftx * ftx) + (fty * fty)) + (ftz * ftz),
+                                                     (ms * ms));
+                __mmask8 moving = ~rest & 0xFF, stop = 0, slide = 0;
+                softgym_v8 s0 = g0, s1 = g1, s2 = g2;
+                if (moving & contact) {
+                    softgym_v8 vt = (softgym_v8)_mm512_sqrt_pd(
+                        (__m512d)(((vtx * vtx) + (vty * vty)) + (vtz * vtz)));
+                    softgym_v8 fk = softgym_v8_load(mu_k + i) * fn;
+                    __mmask8 ge = _mm512_cmp_pd_mask((__m512d)(fk * dt), (__m512d)(m * vt),
+                                                     _CMP_GE_OQ);
+                    stop = moving & ge;
+                    slide = moving & ~ge;
+                    if (slide & contact) {
+                        softgym_v8 fkv = fk / vt;
+                        s0 = g0 - (fkv * vtx);
+                        s1 = g1 - (fkv * vty);
+                        s2 = g2 - (fkv * vtz);
+                    }
+                }
+                /* hold, stop: f - ft; slide: f - fk vt / |vt|; rest without hold: f */
+                __mmask8 minus_ft = contact & (hold | stop);
+                __mmask8 sl = contact & slide;
+                softgym_v8 h0 = SOFTGYM_V8_PICK(minus_ft, g0 - ftx, SOFTGYM_V8_PICK(sl, s0, g0));
+                softgym_v8 h1 = SOFTGYM_V8_PICK(minus_ft, g1 - fty, SOFTGYM_V8_PICK(sl, s1, g1));
+                softgym_v8 h2 = SOFTGYM_V8_PICK(minus_ft, g2 - ftz, SOFTGYM_V8_PICK(sl, s2, g2));
+                f0 = SOFTGYM_V8_PICK(contact, h0, f0);
+                f1 = SOFTGYM_V8_PICK(contact, h1, f1);
+                f2 = SOFTGYM_V8_PICK(contact, h2, f2);
+                __mmask8 st = contact & stop;
+                v0 = SOFTGYM_V8_PICK(st, v0 - vtx, v0);
+                v1 = SOFTGYM_V8_PICK(st, v1 - vty, v1);
+                v2 = SOFTGYM_V8_PICK(st, v2 - vtz, v2);
+            }
+        }
+    }
+    softgym_v8 h = dt * softgym_v8_load(inv_mass + i);
+    softgym_v8 vx = v0 + (f0 * h), vy = v1 + (f1 * h), vz = v2 + (f2 * h);
+    softgym_v8 px = p0 + (vx * dt), py = p1 + (vy * dt), pz = p2 + (vz * dt);
+    softgym_v8 run = (softgym_vabs(px) + softgym_vabs(py)) + softgym_vabs(pz);
+    if ((SOFTGYM_V8_LT(run, _mm512_set1_pd(runaway)) & 0xFF) != 0xFF)
+        return 0;
+    softgym_v8_store3(vel + 3 * i, vx, vy, vz);
+    softgym_v8_store3(pos + 3 * i, px, py, pz);
+    memset(force + 4 * i, 0, 32 * sizeof(double));
+    memset(moment + 4 * i, 0, 32 * sizeof(double));
+    if (ref != NULL) {
+        softgym_v8 r0, r1, r2;
+        softgym_v8_load3(ref + 3 * (i - vs), &r0, &r1, &r2);
+        softgym_v8 d0 = (px - r0) - c[0], d1 = (py - r1) - c[1], d2 = (pz - r2) - c[2];
+        softgym_v8 dd = ((d0 * d0) + (d1 * d1)) + (d2 * d2);
+        double t[8], best = *dmax;
+        memcpy(t, &dd, sizeof t);
+        for (int k = 0; k < 8; k++)
+            if (t[k] > best)
+                best = t[k];
+        *dmax = best;
+    }
+    softgym_v8 w0, w1, w2;
+    softgym_v8_load3(av + 3 * i, &w0, &w1, &w2);
+    softgym_v8 hi = dt * softgym_v8_load(inv_inertia + i), rd = softgym_v8_load(rot_damp + i);
+    w0 = (w0 + (M0 * hi)) * rd;
+    w1 = (w1 + (M1 * hi)) * rd;
+    w2 = (w2 + (M2 * hi)) * rd;
+    softgym_v8_store3(av + 3 * i, w0, w1, w2);
+    return 1;
+}
 #else
 #define SOFTGYM_VOXELS8 0
 /* (without AVX-512 the scalar loop steps every voxel) */
@@ -206,6 +319,17 @@ static int softgym_seed_voxels8(
     const double *k_floor, const double *c_floor, const double *mu_s, const double *mu_k,
     const signed char *fixed, const double *ref, const double *c, int track_speed,
     double runaway, double *dmax, double *vmax2)
+{
+    return 0;
+}
+static int softgym_corot_voxels8(
+    Py_ssize_t i, Py_ssize_t vs, double dt, double g, int has_floor, double *pos,
+    double *vel, double *av, double *force, double *moment, const double *ext,
+    const double *c_global, const double *mass, const double *inv_mass,
+    const double *inv_inertia, const double *rot_damp, const double *scale,
+    const double *k_floor, const double *c_floor, const double *mu_s, const double *mu_k,
+    const signed char *fixed, const double *ref, const double *c, double runaway,
+    double *dmax)
 {
     return 0;
 }
