@@ -78,6 +78,11 @@ cdef inline float64_t _drift2(const float64_t* pos, const float64_t* ref, intp_t
             + (pos[3 * i + 2] - ref[k + 2] - c[2]) ** 2)
 
 
+cdef inline float64_t _raise(float64_t best, float64_t v) noexcept nogil:
+    # best raised to v (a NaN v never: the running maxima of the voxel updates)
+    return v if v > best else best
+
+
 cdef inline float64_t _translate(float64_t* v, float64_t* p, const float64_t* f, float64_t h,
                                  float64_t dt) noexcept nogil:
     # one voxel's symplectic Euler step of translation: v += f h, then p += v dt
@@ -111,29 +116,71 @@ cdef inline void _spin(Batch* b, intp_t i, float64_t dt, float64_t mx, float64_t
 
 
 cdef extern from "softgym_voxels.h":
-    # the seed's voxel update for 8 voxels in vector lanes (AVX-512 builds: SOFTGYM_VOXELS8
-    # is 1); 1: stepped, 0: nothing written (a fixed or runaway voxel among them: the
-    # scalar loop steps them). Documented in include/softgym_voxels.h
+    # both models' voxel updates for 8 voxels in vector lanes (AVX-512 builds:
+    # SOFTGYM_VOXELS8 is 1); 1: stepped, 0: nothing written (a fixed or runaway voxel
+    # among them: the scalar loop steps them). Documented in include/softgym_voxels.h
     int SOFTGYM_VOXELS8
-    int seed_voxels8 "softgym_seed_voxels8" (
-        intp_t i, intp_t vs, float64_t dt, float64_t g, int has_floor, float64_t* pos,
-        float64_t* vel, float64_t* av, float64_t* force, float64_t* moment,
-        const float64_t* ext, const float64_t* c_global, const float64_t* mass,
-        const float64_t* inv_mass, const float64_t* inv_inertia, const float64_t* rot_damp,
-        const float64_t* scale, const float64_t* k_floor, const float64_t* c_floor,
-        const float64_t* mu_s, const float64_t* mu_k, const flag_t* fixed,
-        const float64_t* ref, const float64_t* c, int track_speed, float64_t runaway,
-        float64_t* dmax, float64_t* vmax2) noexcept nogil
-    # the same for the corotational model's update (its floor the common surface contact)
-    int corot_voxels8 "softgym_corot_voxels8" (
-        intp_t i, intp_t vs, float64_t dt, float64_t g, int has_floor, float64_t* pos,
-        float64_t* vel, float64_t* av, float64_t* force, float64_t* moment,
-        const float64_t* ext, const float64_t* c_global, const float64_t* mass,
-        const float64_t* inv_mass, const float64_t* inv_inertia, const float64_t* rot_damp,
-        const float64_t* scale, const float64_t* k_floor, const float64_t* c_floor,
-        const float64_t* mu_s, const float64_t* mu_k, const flag_t* fixed,
-        const float64_t* ref, const float64_t* c, float64_t runaway,
-        float64_t* dmax) noexcept nogil
+    int softgym_seed_voxels8(...) noexcept nogil
+    int softgym_corot_voxels8(...) noexcept nogil
+
+
+# their signature (SOFTGYM_VOXELS8_PARAMS)
+ctypedef int (*voxels8_t)(
+    intp_t i, intp_t vs, float64_t dt, float64_t g, int has_floor, float64_t* pos,
+    float64_t* vel, float64_t* av, float64_t* force, float64_t* moment,
+    const float64_t* ext, const float64_t* c_global, const float64_t* mass,
+    const float64_t* inv_mass, const float64_t* inv_inertia, const float64_t* rot_damp,
+    const float64_t* scale, const float64_t* k_floor, const float64_t* c_floor,
+    const float64_t* mu_s, const float64_t* mu_k, const flag_t* fixed,
+    const float64_t* ref, const float64_t* c, int track_speed, float64_t runaway,
+    float64_t* dmax, float64_t* vmax2) noexcept nogil
+
+
+cdef inline intp_t _scalar_run(Batch* b, intp_t r, intp_t* lo, int seed, const float64_t* ref,
+                               const float64_t* c, float64_t* dmax,
+                               float64_t* vmax2) noexcept nogil:
+    # The voxel updates' schedule from voxel lo[0] on: blocks of 8 after the robot's first
+    # voxel (which sets c) go to the vector lanes while they take them (where the build
+    # has them and the robot has no fluid and no terrain box; lo[0] moves past each
+    # block stepped); returns the end of the run the scalar loop must do from lo[0]: the
+    # first voxel, a block the lanes left (a fixed or runaway voxel), or the rest
+    cdef:
+        intp_t vs = b.vox_start[r], ve = b.vox_start[r + 1]
+        voxels8_t step8 = <voxels8_t> softgym_seed_voxels8 if seed else <voxels8_t> softgym_corot_voxels8
+    if not SOFTGYM_VOXELS8 or b.fluid_drag > 0.0 or b.box_start[r] != b.box_start[r + 1]:
+        return ve
+    if lo[0] == vs:
+        return vs + 1
+    while lo[0] + 8 <= ve:
+        if not step8(lo[0], vs, b.dt[r], b.gravity, b.floor[r], b.pos, b.vel, b.angvel, b.force,
+                     b.moment, b.ext_force, b.c_global, b.mass, b.inv_mass, b.inv_inertia,
+                     b.rot_damp, b.scale, b.k_floor, b.c_floor, b.mu_s, b.mu_k, b.fixed, ref,
+                     c, b.self_collision and seed, RUNAWAY, dmax, vmax2):
+            return lo[0] + 8
+        lo[0] += 8
+    return ve
+
+
+cdef inline void _box_contacts(Batch* b, intp_t i, intp_t k0, intp_t k1, float64_t dt,
+                               float64_t* f) noexcept nogil:
+    # voxel i against the robot's terrain boxes k0..k1 (the common surface contact)
+    cdef intp_t k
+    cdef float64_t pen
+    cdef float64_t n[3]
+    for k in range(k0, k1):
+        pen = box_penetration(b.boxes + 6 * k, b.pos + 3 * i, 0.5 * b.scale[i], n)
+        if pen > 0.0:
+            surface_contact(b, i, n[0], n[1], n[2], pen, dt, f)
+
+
+cdef inline int _ran_away(Batch* b, intp_t r, intp_t i, float64_t dt, const int seed,
+                          float64_t dmax, float64_t* dmax2) noexcept nogil:
+    # voxel i ran away: the voxels before it were stepped; their orientations, the
+    # robot's force scratch cleared, STATUS_NONFINITE
+    dmax2[0] = dmax
+    _orient(b, b.vox_start[r], i, dt, seed)
+    clear_robot(b, r)
+    return STATUS_NONFINITE
 
 
 cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
@@ -149,7 +196,6 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
         float64_t m, pen, cg, d2, mx, my, mz
         float64_t c[3]
         float64_t f[3]
-        float64_t n[3]
         float64_t* pos = b.pos
         float64_t* vel = b.vel
         float64_t* av = b.angvel
@@ -159,31 +205,16 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
         intp_t k0 = b.box_start[r]
         intp_t k1 = b.box_start[r + 1]
         intp_t vs = b.vox_start[r]
-        float64_t dmax = 0.0
+        float64_t dmax = 0.0, vmax2 = 0.0  # (vmax2: not tracked by this model)
         intp_t lo, hi
         intp_t ve = b.vox_start[r + 1]
-        bint vec
     dmax2[0] = 0.0
     c[0] = 0.0
     c[1] = 0.0
     c[2] = 0.0
-    # blocks of 8 voxels after the first in vector lanes where the build and the robot
-    # allow (as integrate_seed)
-    vec = SOFTGYM_VOXELS8 and not has_fluid and k0 == k1
-    lo = vs
+    lo = vs  # (blocks of 8 voxels in vector lanes where they can: _scalar_run)
     while lo < ve:
-        if vec and lo > vs and lo + 8 <= ve:
-            if corot_voxels8(lo, vs, dt, g, has_floor, pos, vel, av, b.force, b.moment,
-                             b.ext_force, b.c_global, b.mass, b.inv_mass, b.inv_inertia,
-                             b.rot_damp, b.scale, b.k_floor, b.c_floor, b.mu_s, b.mu_k, b.fixed,
-                             ref, c, RUNAWAY, &dmax):
-                lo += 8
-                continue
-            hi = lo + 8
-        elif vec and lo == vs:
-            hi = lo + 1
-        else:
-            hi = ve  # the rest (every voxel without the lanes)
+        hi = _scalar_run(b, r, &lo, 0, ref, c, &dmax, &vmax2)
         for i in range(lo, hi):
             if b.fixed[i]:
                 vel[3 * i] = 0.0
@@ -209,19 +240,11 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
                 pen = 0.5 * b.scale[i] - pos[3 * i + 2]
                 if pen > 0.0:
                     surface_contact(b, i, 0.0, 0.0, 1.0, pen, dt, f)
-            for k in range(k0, k1):
-                pen = box_penetration(b.boxes + 6 * k, pos + 3 * i, 0.5 * b.scale[i], n)
-                if pen > 0.0:
-                    surface_contact(b, i, n[0], n[1], n[2], pen, dt, f)
+            _box_contacts(b, i, k0, k1, dt, f)
             if not (_translate(vel + 3 * i, pos + 3 * i, f, dt * b.inv_mass[i], dt) < RUNAWAY):
-                dmax2[0] = dmax
-                _orient(b, vs, i, dt, 0)  # the voxels before it were stepped
-                clear_robot(b, r)
-                return STATUS_NONFINITE
+                return _ran_away(b, r, i, dt, 0, dmax, dmax2)
             if ref != NULL:
-                d2 = _drift2(pos, ref, i, vs, c)
-                if d2 > dmax:
-                    dmax = d2
+                dmax = _raise(dmax, _drift2(pos, ref, i, vs, c))
             # rotation: w += M dt / I, global damping; q += 0.5 dt (0, w) q after
             # the loop (_orient: no voxel's update reads another's orientation)
             _spin(b, i, dt, mx, my, mz)
@@ -270,7 +293,6 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
         float64_t pen, cg, d2, v2, mx, my, mz
         float64_t c[3]
         float64_t f[3]
-        float64_t n[3]
         float64_t* pos = b.pos
         float64_t* vel = b.vel
         float64_t* av = b.angvel
@@ -283,28 +305,13 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
         int32 track_speed = b.self_collision
         intp_t lo, hi
         intp_t ve = b.vox_start[r + 1]
-        bint vec
     dmax2[0] = 0.0
     c[0] = 0.0
     c[1] = 0.0
     c[2] = 0.0
-    # blocks of 8 voxels after the first (which sets c) in vector lanes where the
-    # build and the robot allow (no fluid, no terrain box), else one voxel at a time
-    vec = SOFTGYM_VOXELS8 and not has_fluid and k0 == k1
-    lo = vs
+    lo = vs  # (blocks of 8 voxels in vector lanes where they can: _scalar_run)
     while lo < ve:
-        if vec and lo > vs and lo + 8 <= ve:
-            if seed_voxels8(lo, vs, dt, b.gravity, has_floor, pos, vel, av, b.force, b.moment,
-                            b.ext_force, b.c_global, b.mass, b.inv_mass, b.inv_inertia,
-                            b.rot_damp, b.scale, b.k_floor, b.c_floor, b.mu_s, b.mu_k, b.fixed,
-                            ref, c, track_speed, RUNAWAY, &dmax, &vmax2):
-                lo += 8
-                continue
-            hi = lo + 8
-        elif vec and lo == vs:
-            hi = lo + 1
-        else:
-            hi = ve  # the rest (every voxel without the lanes)
+        hi = _scalar_run(b, r, &lo, 1, ref, c, &dmax, &vmax2)
         for i in range(lo, hi):
             if b.fixed[i]:
                 for k in range(3):
@@ -323,21 +330,13 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
             _clear(b, i)
             if has_fluid:
                 _fluid_drag(b, i, f)
-            for k in range(k0, k1):
-                pen = box_penetration(b.boxes + 6 * k, pos + 3 * i, 0.5 * b.scale[i], n)
-                if pen > 0.0:
-                    surface_contact(b, i, n[0], n[1], n[2], pen, dt, f)
+            _box_contacts(b, i, k0, k1, dt, f)
             if has_floor:
                 seed_floor(b, i, dt, f)
             if not (_translate(vel + 3 * i, pos + 3 * i, f, dt * b.inv_mass[i], dt) < RUNAWAY):
-                dmax2[0] = dmax
-                _orient(b, vs, i, dt, 1)  # the voxels before it were stepped
-                clear_robot(b, r)
-                return STATUS_NONFINITE
+                return _ran_away(b, r, i, dt, 1, dmax, dmax2)
             if ref != NULL:
-                d2 = _drift2(pos, ref, i, vs, c)
-                if d2 > dmax:
-                    dmax = d2
+                dmax = _raise(dmax, _drift2(pos, ref, i, vs, c))
             if track_speed:
                 v2 = speed_squared(vel[3 * i], vel[3 * i + 1], vel[3 * i + 2])
                 if v2 > vmax2:

@@ -15,6 +15,20 @@
 #include <string.h>
 #include "softgym_simd.h"
 
+/* the arguments of softgym_seed_voxels8 and softgym_corot_voxels8: voxels i..i+7 of a
+   robot whose first voxel is vs (i > vs), the robot's time step, gravity and floor flag,
+   the state and per-voxel constants (the Batch's arrays), the drift reference (ref and
+   the first voxel's displacement c; ref NULL: none), whether to track the fastest speed,
+   the runaway bound, and the running maxima of drift and speed squared (raised) */
+#define SOFTGYM_VOXELS8_PARAMS \
+    Py_ssize_t i, Py_ssize_t vs, double dt, double g, int has_floor, double *pos, \
+    double *vel, double *av, double *force, double *moment, const double *ext, \
+    const double *c_global, const double *mass, const double *inv_mass, \
+    const double *inv_inertia, const double *rot_damp, const double *scale, \
+    const double *k_floor, const double *c_floor, const double *mu_s, const double *mu_k, \
+    const signed char *fixed, const double *ref, const double *c, int track_speed, \
+    double runaway, double *dmax, double *vmax2
+
 #if defined(__AVX512F__) && (defined(__GNUC__) || defined(__clang__))
 #define SOFTGYM_VOXELS8 1
 typedef double softgym_v8 __attribute__((vector_size(64)));
@@ -87,29 +101,90 @@ static inline softgym_v8 softgym_v8_load(const double *a)
 #define SOFTGYM_V8_GT(a, b) _mm512_cmp_pd_mask((__m512d)(a), (__m512d)(b), _CMP_GT_OQ)
 #define SOFTGYM_V8_EQ(a, b) _mm512_cmp_pd_mask((__m512d)(a), (__m512d)(b), _CMP_EQ_OQ)
 
-/* voxels i..i+7 of a robot whose first voxel is vs (i > vs): returns 1 when they were
-   stepped (and *dmax, *vmax2 raised to their largest drift and speed squared), 0 when
-   nothing was written (a fixed voxel in the block, or a runaway one) */
-static int softgym_seed_voxels8(
-    Py_ssize_t i, Py_ssize_t vs, double dt, double g, int has_floor, double *pos,
-    double *vel, double *av, double *force, double *moment, const double *ext,
-    const double *c_global, const double *mass, const double *inv_mass,
-    const double *inv_inertia, const double *rot_damp, const double *scale,
-    const double *k_floor, const double *c_floor, const double *mu_s, const double *mu_k,
-    const signed char *fixed, const double *ref, const double *c, int track_speed,
-    double runaway, double *dmax, double *vmax2)
+#define SOFTGYM_VOXELS8_ARGS i, vs, dt, g, has_floor, pos, vel, av, force, moment, ext, \
+    c_global, mass, inv_mass, inv_inertia, rot_damp, scale, k_floor, c_floor, mu_s, mu_k, \
+    fixed, ref, c, track_speed, runaway, dmax, vmax2
+
+/* the block's records as rows: velocity, position, external force, force, moment; 0 when
+   a voxel of the block is fixed (the scalar loop's case) */
+#define SOFTGYM_VOXELS8_LOAD \
+    long long fx_; \
+    memcpy(&fx_, fixed + i, sizeof fx_); \
+    if (fx_ != 0) \
+        return 0; \
+    softgym_v8 v0, v1, v2, p0, p1, p2, F0, F1, F2, M0, M1, M2, E0, E1, E2; \
+    softgym_v8_load3(vel + 3 * i, &v0, &v1, &v2); \
+    softgym_v8_load3(pos + 3 * i, &p0, &p1, &p2); \
+    softgym_v8_load3(ext + 3 * i, &E0, &E1, &E2); \
+    softgym_v8_load4(force + 4 * i, &F0, &F1, &F2); \
+    softgym_v8_load4(moment + 4 * i, &M0, &M1, &M2); \
+    softgym_v8 cg = softgym_v8_load(c_global + i), m = softgym_v8_load(mass + i)
+
+/* the largest lane of v above *best, as the scalar loop's "if v > best" (NaN never) */
+static inline void softgym_v8_raise_max(softgym_v8 v, double *best)
 {
-    long long fx;
-    memcpy(&fx, fixed + i, sizeof fx);
-    if (fx != 0)
+    double t[8], b = *best;
+    memcpy(t, &v, sizeof t);
+    for (int k = 0; k < 8; k++)
+        if (t[k] > b)
+            b = t[k];
+    *best = b;
+}
+
+/* both models' step after the forces (f) and the floor (v possibly stopped): the
+   translation, the runaway check (0 and nothing stored when a voxel ran away), the
+   stores, the drift and speed maxima, the angular velocity; returns 1 */
+static inline int softgym_v8_finish(SOFTGYM_VOXELS8_PARAMS, softgym_v8 v0, softgym_v8 v1,
+                                    softgym_v8 v2, softgym_v8 p0, softgym_v8 p1, softgym_v8 p2,
+                                    softgym_v8 f0, softgym_v8 f1, softgym_v8 f2, softgym_v8 M0,
+                                    softgym_v8 M1, softgym_v8 M2)
+{
+    softgym_v8 h = dt * softgym_v8_load(inv_mass + i);
+    softgym_v8 vx = v0 + (f0 * h), vy = v1 + (f1 * h), vz = v2 + (f2 * h);
+    softgym_v8 px = p0 + (vx * dt), py = p1 + (vy * dt), pz = p2 + (vz * dt);
+    softgym_v8 run = (softgym_vabs(px) + softgym_vabs(py)) + softgym_vabs(pz);
+    if ((SOFTGYM_V8_LT(run, _mm512_set1_pd(runaway)) & 0xFF) != 0xFF)
         return 0;
-    softgym_v8 v0, v1, v2, p0, p1, p2, F0, F1, F2, M0, M1, M2, E0, E1, E2;
-    softgym_v8_load3(vel + 3 * i, &v0, &v1, &v2);
-    softgym_v8_load3(pos + 3 * i, &p0, &p1, &p2);
-    softgym_v8_load3(ext + 3 * i, &E0, &E1, &E2);
-    softgym_v8_load4(force + 4 * i, &F0, &F1, &F2);
-    softgym_v8_load4(moment + 4 * i, &M0, &M1, &M2);
-    softgym_v8 cg = softgym_v8_load(c_global + i), m = softgym_v8_load(mass + i);
+    /* the block is stepped: from here on, stores */
+    softgym_v8_store3(vel + 3 * i, vx, vy, vz);
+    softgym_v8_store3(pos + 3 * i, px, py, pz);
+    memset(force + 4 * i, 0, 32 * sizeof(double));
+    memset(moment + 4 * i, 0, 32 * sizeof(double));
+    if (ref != NULL) {
+        softgym_v8 r0, r1, r2;
+        softgym_v8_load3(ref + 3 * (i - vs), &r0, &r1, &r2);
+        softgym_v8 d0 = (px - r0) - c[0], d1 = (py - r1) - c[1], d2 = (pz - r2) - c[2];
+        softgym_v8_raise_max(((d0 * d0) + (d1 * d1)) + (d2 * d2), dmax);
+    }
+    if (track_speed) {
+#if defined(__FMA__)
+        /* softgym_speed2's fused form */
+        softgym_v8 s2 = (softgym_v8)_mm512_fmadd_pd(
+            (__m512d)vz, (__m512d)vz,
+            _mm512_fmadd_pd((__m512d)vx, (__m512d)vx, _mm512_mul_pd((__m512d)vy, (__m512d)vy)));
+#else
+        softgym_v8 s2 = vx * vx + vy * vy + vz * vz;
+#endif
+        softgym_v8_raise_max(s2, vmax2);
+    }
+    softgym_v8 w0, w1, w2;
+    softgym_v8_load3(av + 3 * i, &w0, &w1, &w2);
+    softgym_v8 hi = dt * softgym_v8_load(inv_inertia + i), rd = softgym_v8_load(rot_damp + i);
+    w0 = (w0 + (M0 * hi)) * rd;
+    w1 = (w1 + (M1 * hi)) * rd;
+    w2 = (w2 + (M2 * hi)) * rd;
+    softgym_v8_store3(av + 3 * i, w0, w1, w2);
+    return 1;
+}
+#define SOFTGYM_VOXELS8_FINISH \
+    return softgym_v8_finish(SOFTGYM_VOXELS8_ARGS, v0, v1, v2, p0, p1, p2, f0, f1, f2, M0, \
+                             M1, M2)
+
+/* model 0 (integrate_seed): 1 when voxels i..i+7 were stepped, 0 when nothing was
+   written (a fixed voxel in the block, or a runaway one) */
+static int softgym_seed_voxels8(SOFTGYM_VOXELS8_PARAMS)
+{
+    SOFTGYM_VOXELS8_LOAD;
     softgym_v8 f0 = (((-cg) * v0) + F0) + E0;
     softgym_v8 f1 = (((-cg) * v1) + F1) + E1;
     softgym_v8 f2 = ((((-cg) * v2) + F2) + (m * g)) + E2;
@@ -148,77 +223,14 @@ static int softgym_seed_voxels8(
             f1 = SOFTGYM_V8_PICK(stick, (softgym_v8){0}, f1);
         }
     }
-    softgym_v8 h = dt * softgym_v8_load(inv_mass + i);
-    softgym_v8 vx = v0 + (f0 * h), vy = v1 + (f1 * h), vz = v2 + (f2 * h);
-    softgym_v8 px = p0 + (vx * dt), py = p1 + (vy * dt), pz = p2 + (vz * dt);
-    softgym_v8 run = (softgym_vabs(px) + softgym_vabs(py)) + softgym_vabs(pz);
-    if ((SOFTGYM_V8_LT(run, _mm512_set1_pd(runaway)) & 0xFF) != 0xFF)
-        return 0;
-    /* the block is stepped: from here on, stores */
-    softgym_v8_store3(vel + 3 * i, vx, vy, vz);
-    softgym_v8_store3(pos + 3 * i, px, py, pz);
-    memset(force + 4 * i, 0, 32 * sizeof(double));
-    memset(moment + 4 * i, 0, 32 * sizeof(double));
-    if (ref != NULL) {
-        softgym_v8 r0, r1, r2;
-        softgym_v8_load3(ref + 3 * (i - vs), &r0, &r1, &r2);
-        softgym_v8 d0 = (px - r0) - c[0], d1 = (py - r1) - c[1], d2 = (pz - r2) - c[2];
-        softgym_v8 dd = ((d0 * d0) + (d1 * d1)) + (d2 * d2);
-        double t[8], best = *dmax;
-        memcpy(t, &dd, sizeof t);
-        for (int k = 0; k < 8; k++)
-            if (t[k] > best)
-                best = t[k];
-        *dmax = best;
-    }
-    if (track_speed) {
-#if defined(__FMA__)
-        softgym_v8 s2 = (softgym_v8)_mm512_fmadd_pd(
-            (__m512d)vz, (__m512d)vz,
-            _mm512_fmadd_pd((__m512d)vx, (__m512d)vx, _mm512_mul_pd((__m512d)vy, (__m512d)vy)));
-#else
-        softgym_v8 s2 = vx * vx + vy * vy + vz * vz;
-#endif
-        double t[8], best = *vmax2;
-        memcpy(t, &s2, sizeof t);
-        for (int k = 0; k < 8; k++)
-            if (t[k] > best)
-                best = t[k];
-        *vmax2 = best;
-    }
-    softgym_v8 w0, w1, w2;
-    softgym_v8_load3(av + 3 * i, &w0, &w1, &w2);
-    softgym_v8 hi = dt * softgym_v8_load(inv_inertia + i), rd = softgym_v8_load(rot_damp + i);
-    w0 = (w0 + (M0 * hi)) * rd;
-    w1 = (w1 + (M1 * hi)) * rd;
-    w2 = (w2 + (M2 * hi)) * rd;
-    softgym_v8_store3(av + 3 * i, w0, w1, w2);
-    return 1;
+    SOFTGYM_VOXELS8_FINISH;
 }
 
-/* voxels i..i+7 of the corotational model's update (integrate_corotational: its floor is
-   the common surface contact with the normal (0, 0, 1), applied before any box), as
-   softgym_seed_voxels8 (no speed to track) */
-static int softgym_corot_voxels8(
-    Py_ssize_t i, Py_ssize_t vs, double dt, double g, int has_floor, double *pos,
-    double *vel, double *av, double *force, double *moment, const double *ext,
-    const double *c_global, const double *mass, const double *inv_mass,
-    const double *inv_inertia, const double *rot_damp, const double *scale,
-    const double *k_floor, const double *c_floor, const double *mu_s, const double *mu_k,
-    const signed char *fixed, const double *ref, const double *c, double runaway,
-    double *dmax)
+/* model 1 (integrate_corotational: its floor is the common surface contact with the
+   normal (0, 0, 1), applied before any box), as softgym_seed_voxels8 */
+static int softgym_corot_voxels8(SOFTGYM_VOXELS8_PARAMS)
 {
-    long long fx;
-    memcpy(&fx, fixed + i, sizeof fx);
-    if (fx != 0)
-        return 0;
-    softgym_v8 v0, v1, v2, p0, p1, p2, F0, F1, F2, M0, M1, M2, E0, E1, E2;
-    softgym_v8_load3(vel + 3 * i, &v0, &v1, &v2);
-    softgym_v8_load3(pos + 3 * i, &p0, &p1, &p2);
-    softgym_v8_load3(ext + 3 * i, &E0, &E1, &E2);
-    softgym_v8_load4(force + 4 * i, &F0, &F1, &F2);
-    softgym_v8_load4(moment + 4 * i, &M0, &M1, &M2);
-    softgym_v8 cg = softgym_v8_load(c_global + i), m = softgym_v8_load(mass + i);
+    SOFTGYM_VOXELS8_LOAD;
     softgym_v8 f0 = (F0 + E0) - (cg * v0);
     softgym_v8 f1 = (F1 + E1) - (cg * v1);
     softgym_v8 f2 = ((F2 + E2) - (cg * v2)) + (m * g);
@@ -277,62 +289,13 @@ static int softgym_corot_voxels8(
             }
         }
     }
-    softgym_v8 h = dt * softgym_v8_load(inv_mass + i);
-    softgym_v8 vx = v0 + (f0 * h), vy = v1 + (f1 * h), vz = v2 + (f2 * h);
-    softgym_v8 px = p0 + (vx * dt), py = p1 + (vy * dt), pz = p2 + (vz * dt);
-    softgym_v8 run = (softgym_vabs(px) + softgym_vabs(py)) + softgym_vabs(pz);
-    if ((SOFTGYM_V8_LT(run, _mm512_set1_pd(runaway)) & 0xFF) != 0xFF)
-        return 0;
-    softgym_v8_store3(vel + 3 * i, vx, vy, vz);
-    softgym_v8_store3(pos + 3 * i, px, py, pz);
-    memset(force + 4 * i, 0, 32 * sizeof(double));
-    memset(moment + 4 * i, 0, 32 * sizeof(double));
-    if (ref != NULL) {
-        softgym_v8 r0, r1, r2;
-        softgym_v8_load3(ref + 3 * (i - vs), &r0, &r1, &r2);
-        softgym_v8 d0 = (px - r0) - c[0], d1 = (py - r1) - c[1], d2 = (pz - r2) - c[2];
-        softgym_v8 dd = ((d0 * d0) + (d1 * d1)) + (d2 * d2);
-        double t[8], best = *dmax;
-        memcpy(t, &dd, sizeof t);
-        for (int k = 0; k < 8; k++)
-            if (t[k] > best)
-                best = t[k];
-        *dmax = best;
-    }
-    softgym_v8 w0, w1, w2;
-    softgym_v8_load3(av + 3 * i, &w0, &w1, &w2);
-    softgym_v8 hi = dt * softgym_v8_load(inv_inertia + i), rd = softgym_v8_load(rot_damp + i);
-    w0 = (w0 + (M0 * hi)) * rd;
-    w1 = (w1 + (M1 * hi)) * rd;
-    w2 = (w2 + (M2 * hi)) * rd;
-    softgym_v8_store3(av + 3 * i, w0, w1, w2);
-    return 1;
+    SOFTGYM_VOXELS8_FINISH;
 }
 #else
 #define SOFTGYM_VOXELS8 0
-/* (without AVX-512 the scalar loop steps every voxel) */
-static int softgym_seed_voxels8(
-    Py_ssize_t i, Py_ssize_t vs, double dt, double g, int has_floor, double *pos,
-    double *vel, double *av, double *force, double *moment, const double *ext,
-    const double *c_global, const double *mass, const double *inv_mass,
-    const double *inv_inertia, const double *rot_damp, const double *scale,
-    const double *k_floor, const double *c_floor, const double *mu_s, const double *mu_k,
-    const signed char *fixed, const double *ref, const double *c, int track_speed,
-    double runaway, double *dmax, double *vmax2)
-{
-    return 0;
-}
-static int softgym_corot_voxels8(
-    Py_ssize_t i, Py_ssize_t vs, double dt, double g, int has_floor, double *pos,
-    double *vel, double *av, double *force, double *moment, const double *ext,
-    const double *c_global, const double *mass, const double *inv_mass,
-    const double *inv_inertia, const double *rot_damp, const double *scale,
-    const double *k_floor, const double *c_floor, const double *mu_s, const double *mu_k,
-    const signed char *fixed, const double *ref, const double *c, double runaway,
-    double *dmax)
-{
-    return 0;
-}
+/* (without AVX-512 the scalar loops step every voxel) */
+static int softgym_seed_voxels8(SOFTGYM_VOXELS8_PARAMS) { return 0; }
+static int softgym_corot_voxels8(SOFTGYM_VOXELS8_PARAMS) { return 0; }
 #endif
 
 #endif  /* SOFTGYM_VOXELS_H */
