@@ -120,20 +120,15 @@ cdef extern from "softgym_voxels.h":
     # SOFTGYM_VOXELS8 is 1); 1: stepped, 0: nothing written (a fixed or runaway voxel
     # among them: the scalar loop steps them). Documented in include/softgym_voxels.h
     int SOFTGYM_VOXELS8
-    int softgym_seed_voxels8(...) noexcept nogil
-    int softgym_corot_voxels8(...) noexcept nogil
-
-
-# their signature (SOFTGYM_VOXELS8_PARAMS)
-ctypedef int (*voxels8_t)(
-    intp_t i, intp_t vs, float64_t dt, float64_t g, int has_floor, float64_t* pos,
-    float64_t* vel, float64_t* av, float64_t* force, float64_t* moment,
-    const float64_t* ext, const float64_t* c_global, const float64_t* mass,
-    const float64_t* inv_mass, const float64_t* inv_inertia, const float64_t* rot_damp,
-    const float64_t* scale, const float64_t* k_floor, const float64_t* c_floor,
-    const float64_t* mu_s, const float64_t* mu_k, const flag_t* fixed,
-    const float64_t* ref, const float64_t* c, int track_speed, float64_t runaway,
-    float64_t* dmax, float64_t* vmax2) noexcept nogil
+    int voxels8 "softgym_voxels8" (
+        int seed, intp_t i, intp_t vs, float64_t dt, float64_t g, int has_floor,
+        float64_t* pos, float64_t* vel, float64_t* av, float64_t* force, float64_t* moment,
+        const float64_t* ext, const float64_t* c_global, const float64_t* mass,
+        const float64_t* inv_mass, const float64_t* inv_inertia, const float64_t* rot_damp,
+        const float64_t* scale, const float64_t* k_floor, const float64_t* c_floor,
+        const float64_t* mu_s, const float64_t* mu_k, const flag_t* fixed,
+        const float64_t* ref, const float64_t* c, int track_speed, float64_t runaway,
+        float64_t* dmax, float64_t* vmax2) noexcept nogil
 
 
 cdef inline intp_t _scalar_run(Batch* b, intp_t r, intp_t* lo, int seed, const float64_t* ref,
@@ -146,13 +141,12 @@ cdef inline intp_t _scalar_run(Batch* b, intp_t r, intp_t* lo, int seed, const f
     # first voxel, a block the lanes left (a fixed or runaway voxel), or the rest
     cdef:
         intp_t vs = b.vox_start[r], ve = b.vox_start[r + 1]
-        voxels8_t step8 = <voxels8_t> softgym_seed_voxels8 if seed else <voxels8_t> softgym_corot_voxels8
     if not SOFTGYM_VOXELS8 or b.fluid_drag > 0.0 or b.box_start[r] != b.box_start[r + 1]:
         return ve
     if lo[0] == vs:
         return vs + 1
     while lo[0] + 8 <= ve:
-        if not step8(lo[0], vs, b.dt[r], b.gravity, b.floor[r], b.pos, b.vel, b.angvel, b.force,
+        if not voxels8(seed, lo[0], vs, b.dt[r], b.gravity, b.floor[r], b.pos, b.vel, b.angvel, b.force,
                      b.moment, b.ext_force, b.c_global, b.mass, b.inv_mass, b.inv_inertia,
                      b.rot_damp, b.scale, b.k_floor, b.c_floor, b.mu_s, b.mu_k, b.fixed, ref,
                      c, b.self_collision and seed, RUNAWAY, dmax, vmax2):
@@ -193,7 +187,7 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
     cdef:
         intp_t i, k
         float64_t dt = b.dt[r]
-        float64_t m, pen, cg, d2, mx, my, mz
+        float64_t m, pen, cg, mx, my, mz
         float64_t c[3]
         float64_t f[3]
         float64_t* pos = b.pos
@@ -290,7 +284,7 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
     cdef:
         intp_t i, k
         float64_t dt = b.dt[r]
-        float64_t pen, cg, d2, v2, mx, my, mz
+        float64_t cg, mx, my, mz
         float64_t c[3]
         float64_t f[3]
         float64_t* pos = b.pos
@@ -338,9 +332,7 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
             if ref != NULL:
                 dmax = _raise(dmax, _drift2(pos, ref, i, vs, c))
             if track_speed:
-                v2 = speed_squared(vel[3 * i], vel[3 * i + 1], vel[3 * i + 2])
-                if v2 > vmax2:
-                    vmax2 = v2
+                vmax2 = _raise(vmax2, speed_squared(vel[3 * i], vel[3 * i + 1], vel[3 * i + 2]))
             _spin(b, i, dt, mx, my, mz)
         lo = hi
     dmax2[0] = dmax

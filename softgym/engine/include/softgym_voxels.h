@@ -29,6 +29,10 @@
     const signed char *fixed, const double *ref, const double *c, int track_speed, \
     double runaway, double *dmax, double *vmax2
 
+#define SOFTGYM_VOXELS8_ARGS i, vs, dt, g, has_floor, pos, vel, av, force, moment, ext, \
+    c_global, mass, inv_mass, inv_inertia, rot_damp, scale, k_floor, c_floor, mu_s, mu_k, \
+    fixed, ref, c, track_speed, runaway, dmax, vmax2
+
 #if defined(__AVX512F__) && (defined(__GNUC__) || defined(__clang__))
 #define SOFTGYM_VOXELS8 1
 typedef double softgym_v8 __attribute__((vector_size(64)));
@@ -101,9 +105,6 @@ static inline softgym_v8 softgym_v8_load(const double *a)
 #define SOFTGYM_V8_GT(a, b) _mm512_cmp_pd_mask((__m512d)(a), (__m512d)(b), _CMP_GT_OQ)
 #define SOFTGYM_V8_EQ(a, b) _mm512_cmp_pd_mask((__m512d)(a), (__m512d)(b), _CMP_EQ_OQ)
 
-#define SOFTGYM_VOXELS8_ARGS i, vs, dt, g, has_floor, pos, vel, av, force, moment, ext, \
-    c_global, mass, inv_mass, inv_inertia, rot_damp, scale, k_floor, c_floor, mu_s, mu_k, \
-    fixed, ref, c, track_speed, runaway, dmax, vmax2
 
 /* the block's records as rows: velocity, position, external force, force, moment; 0 when
    a voxel of the block is fixed (the scalar loop's case) */
@@ -293,9 +294,19 @@ static int softgym_corot_voxels8(SOFTGYM_VOXELS8_PARAMS)
 }
 #else
 #define SOFTGYM_VOXELS8 0
-/* (without AVX-512 the scalar loops step every voxel) */
-static int softgym_seed_voxels8(SOFTGYM_VOXELS8_PARAMS) { return 0; }
-static int softgym_corot_voxels8(SOFTGYM_VOXELS8_PARAMS) { return 0; }
 #endif
+
+/* the entry _integrate.pyx calls: model 0 (seed = 1) or 1's block; without AVX-512 the
+   scalar loops step every voxel (0) */
+static inline int softgym_voxels8(int seed, SOFTGYM_VOXELS8_PARAMS)
+{
+#if SOFTGYM_VOXELS8
+    return seed ? softgym_seed_voxels8(SOFTGYM_VOXELS8_ARGS)
+                : softgym_corot_voxels8(SOFTGYM_VOXELS8_ARGS);
+#else
+    (void)seed;
+    return 0;
+#endif
+}
 
 #endif  /* SOFTGYM_VOXELS_H */
