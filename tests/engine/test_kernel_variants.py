@@ -33,6 +33,13 @@ two = Body(grid=grid, youngs_modulus=[0.0, 5e6, 5e6], density=[0.0, 1e6, 1e6],
            mu_kinetic=[0.0, 0.5, 0.5])
 # the walker dropped from 3 voxel lengths: its links go through the large-angle mode
 bodies = [two, default_walker().to_body(), default_walker().to_body(origin=(0.0, 0.0, 0.03))]
+# a filled 4^3 lattice, dropped: its links along the slower axes join runs of consecutive
+# voxels, which the AVX-512 geometry loads as rows (softgym_seed_rows8)
+grid = np.ones((4, 4, 4), dtype=np.int32)
+grid[2:] = 2
+bodies.append(Body(grid=grid, youngs_modulus=[0.0, 5e6, 5e6], density=[0.0, 1e6, 1e6],
+                   poisson=[0.0, 0.35, 0.35], cte=[0.0, 0.01, -0.01], mu_static=[0.0, 1.0, 1.0],
+                   mu_kinetic=[0.0, 0.5, 0.5], origin=(0.0, 0.0, 0.03)))
 out = {}
 for model in ("seed", "corotational"):
     sim = Simulation(bodies, SimConfig(model=model, self_collision=True), n_threads=1)

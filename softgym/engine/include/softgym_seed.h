@@ -118,6 +118,16 @@ static inline void softgym_seed_gather(const Py_ssize_t *idx, const double *pos,
     SOFTGYM_VJOIN(r, a, a, 8);
 #endif
 }
+#if SOFTGYM_VLANES == 8
+/* the same for the 8 consecutive voxels v .. v + 7: their records as rows (no gather) */
+static inline void softgym_seed_rows8(Py_ssize_t v, const double *pos, const double *quat,
+                                      const double *scale, softgym_vd *r)
+{
+    softgym_v8_load3(pos + 3 * v, &r[0], &r[1], &r[2]);
+    softgym_v8_load4x4(quat + 4 * v, r + 3);
+    memcpy(&r[7], scale + v, sizeof r[7]);
+}
+#endif
 #endif
 /* links lo..hi by the formula on doubles, in a loop the compiler vectorises */
 SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_scalar(const int ax, Py_ssize_t lo, Py_ssize_t hi,
@@ -162,8 +172,18 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
     }
     for (; li + SOFTGYM_VLANES <= hi; li += SOFTGYM_VLANES) {
         softgym_vd gi[8], gj[8];
-        softgym_seed_gather(v1 + li, pos, quat, scale, gi);
-        softgym_seed_gather(v2 + li, pos, quat, scale, gj);
+#if SOFTGYM_VLANES == 8
+        /* links whose voxels 1 and 2 are runs of consecutive voxels (a filled lattice's
+           links along its slower axes): each voxel's records as rows at unit stride */
+        if (softgym_run8(v1 + li) & softgym_run8(v2 + li)) {
+            softgym_seed_rows8(v1[li], pos, quat, scale, gi);
+            softgym_seed_rows8(v2[li], pos, quat, scale, gj);
+        } else
+#endif
+        {
+            softgym_seed_gather(v1 + li, pos, quat, scale, gi);
+            softgym_seed_gather(v2 + li, pos, quat, scale, gj);
+        }
         softgym_vd dx = gj[0] - gi[0], dy = gj[1] - gi[1], dz = gj[2] - gi[2];
         SOFTGYM_SEED_GEOM_LINK_T(softgym_vd, SOFTGYM_VSQRT, softgym_vabs, SOFTGYM_VPUT, li, dx,
                                  dy, dz, gi[3], gi[4], gi[5], gi[6], gj[3], gj[4], gj[5], gj[6],

@@ -78,6 +78,92 @@ static inline void softgym_quat_matrix(const double *q, double *R)
 #define SOFTGYM_VLANES 8
 typedef double softgym_vd __attribute__((vector_size(64)));
 #define SOFTGYM_VSQRT(v) ((softgym_vd)_mm512_sqrt_pd((__m512d)(v)))
+/* 8 doubles as GCC's vector (the same type as softgym_vd here): the transposes between
+   8 voxels' records (3 or 4 doubles each, consecutive) and rows of 8 lanes, for the voxel
+   updates (softgym_voxels.h) and the link geometry of a run of voxels (softgym_seed.h) */
+typedef double softgym_v8 __attribute__((vector_size(64)));
+/* 8 voxels' records of 3 (a[0..23]) as rows x, y, z */
+static inline void softgym_v8_load3(const double *a, softgym_v8 *x, softgym_v8 *y,
+                                    softgym_v8 *z)
+{
+    __m512d p0 = _mm512_loadu_pd(a), p1 = _mm512_loadu_pd(a + 8), p2 = _mm512_loadu_pd(a + 16);
+    /* element e of the 24 is voxel e / 3, component e % 3 */
+    const __m512i ix0 = _mm512_set_epi64(0, 0, 15, 12, 9, 6, 3, 0);
+    const __m512i iy0 = _mm512_set_epi64(0, 0, 8 + 8, 13, 10, 7, 4, 1);
+    const __m512i iz0 = _mm512_set_epi64(0, 0, 8 + 9, 14, 11, 8, 5, 2);
+    const __m512i ix1 = _mm512_set_epi64(8 + 5, 8 + 2, 5, 4, 3, 2, 1, 0);
+    const __m512i iy1 = _mm512_set_epi64(8 + 6, 8 + 3, 8 + 0, 4, 3, 2, 1, 0);
+    const __m512i iz1 = _mm512_set_epi64(8 + 7, 8 + 4, 8 + 1, 4, 3, 2, 1, 0);
+    /* x: 0 3 6 9 12 15 | 18 21; y: 1 4 7 10 13 | 16 19 22; z: 2 5 8 11 14 | 17 20 23 */
+    *x = (softgym_v8)_mm512_permutex2var_pd(_mm512_permutex2var_pd(p0, ix0, p1), ix1, p2);
+    *y = (softgym_v8)_mm512_permutex2var_pd(_mm512_permutex2var_pd(p0, iy0, p1), iy1, p2);
+    *z = (softgym_v8)_mm512_permutex2var_pd(_mm512_permutex2var_pd(p0, iz0, p1), iz1, p2);
+}
+/* rows x, y, z back into 8 records of 3 at a[0..23] */
+static inline void softgym_v8_store3(double *a, softgym_v8 x, softgym_v8 y, softgym_v8 z)
+{
+    /* out0 = x0 y0 z0 x1 y1 z1 x2 y2; out1 = z2 x3 y3 z3 x4 y4 z4 x5;
+       out2 = y5 z5 x6 y6 z6 x7 y7 z7 */
+    /* t0 = x0 y0 _ x1 y1 _ x2 y2, then z0, z1 into its gaps; the same for out1, out2 */
+    __m512d t0 = _mm512_permutex2var_pd(
+        (__m512d)x, _mm512_set_epi64(8 + 2, 2, 0, 8 + 1, 1, 0, 8 + 0, 0), (__m512d)y);
+    __m512d o0 = _mm512_permutex2var_pd(t0, _mm512_set_epi64(7, 6, 8 + 1, 4, 3, 8 + 0, 1, 0),
+                                        (__m512d)z);
+    __m512d t1 = _mm512_permutex2var_pd((__m512d)x, _mm512_set_epi64(5, 0, 8 + 4, 4, 0, 8 + 3, 3, 0),
+                                        (__m512d)y);
+    __m512d o1 = _mm512_permutex2var_pd(t1, _mm512_set_epi64(7, 8 + 4, 5, 4, 8 + 3, 2, 1, 8 + 2),
+                                        (__m512d)z);
+    __m512d t2 = _mm512_permutex2var_pd((__m512d)x, _mm512_set_epi64(0, 8 + 7, 7, 0, 8 + 6, 6, 0, 8 + 5),
+                                        (__m512d)y);
+    __m512d o2 = _mm512_permutex2var_pd(t2, _mm512_set_epi64(8 + 7, 6, 5, 8 + 6, 3, 2, 8 + 5, 0),
+                                        (__m512d)z);
+    _mm512_storeu_pd(a, o0);
+    _mm512_storeu_pd(a + 8, o1);
+    _mm512_storeu_pd(a + 16, o2);
+}
+/* 8 voxels' rows of 4 (a[0..31]) as rows x, y, z (lane 3 of each record dropped) */
+static inline void softgym_v8_load4(const double *a, softgym_v8 *x, softgym_v8 *y,
+                                    softgym_v8 *z)
+{
+    __m512d p0 = _mm512_loadu_pd(a), p1 = _mm512_loadu_pd(a + 8);
+    __m512d p2 = _mm512_loadu_pd(a + 16), p3 = _mm512_loadu_pd(a + 24);
+    /* from p0, p1: x0 x1 x2 x3 y0 y1 y2 y3; z0 z1 z2 z3 _ */
+    const __m512i ixy = _mm512_set_epi64(8 + 5, 8 + 1, 5, 1, 8 + 4, 8 + 0, 4, 0);
+    const __m512i iz = _mm512_set_epi64(0, 0, 0, 0, 8 + 6, 8 + 2, 6, 2);
+    __m512d a01 = _mm512_permutex2var_pd(p0, ixy, p1), a23 = _mm512_permutex2var_pd(p2, ixy, p3);
+    __m512d z01 = _mm512_permutex2var_pd(p0, iz, p1), z23 = _mm512_permutex2var_pd(p2, iz, p3);
+    const __m512i lo = _mm512_set_epi64(8 + 3, 8 + 2, 8 + 1, 8 + 0, 3, 2, 1, 0);
+    const __m512i hi = _mm512_set_epi64(8 + 7, 8 + 6, 8 + 5, 8 + 4, 7, 6, 5, 4);
+    *x = (softgym_v8)_mm512_permutex2var_pd(a01, lo, a23);
+    *y = (softgym_v8)_mm512_permutex2var_pd(a01, hi, a23);
+    *z = (softgym_v8)_mm512_permutex2var_pd(z01, lo, z23);
+}
+/* 8 voxels' records of 4 (a[0..31]) as its 4 rows r[0..3] (element 0 .. 3 of each) */
+static inline void softgym_v8_load4x4(const double *a, softgym_v8 *r)
+{
+    __m512d p0 = _mm512_loadu_pd(a), p1 = _mm512_loadu_pd(a + 8);
+    __m512d p2 = _mm512_loadu_pd(a + 16), p3 = _mm512_loadu_pd(a + 24);
+    /* from p0, p1: elements 0 and 1 of records 0-3; elements 2 and 3 of them */
+    const __m512i i01 = _mm512_set_epi64(8 + 5, 8 + 1, 5, 1, 8 + 4, 8 + 0, 4, 0);
+    const __m512i i23 = _mm512_set_epi64(8 + 7, 8 + 3, 7, 3, 8 + 6, 8 + 2, 6, 2);
+    __m512d a01 = _mm512_permutex2var_pd(p0, i01, p1), b01 = _mm512_permutex2var_pd(p2, i01, p3);
+    __m512d a23 = _mm512_permutex2var_pd(p0, i23, p1), b23 = _mm512_permutex2var_pd(p2, i23, p3);
+    const __m512i lo = _mm512_set_epi64(8 + 3, 8 + 2, 8 + 1, 8 + 0, 3, 2, 1, 0);
+    const __m512i hi = _mm512_set_epi64(8 + 7, 8 + 6, 8 + 5, 8 + 4, 7, 6, 5, 4);
+    r[0] = (softgym_v8)_mm512_permutex2var_pd(a01, lo, b01);
+    r[1] = (softgym_v8)_mm512_permutex2var_pd(a01, hi, b01);
+    r[2] = (softgym_v8)_mm512_permutex2var_pd(a23, lo, b23);
+    r[3] = (softgym_v8)_mm512_permutex2var_pd(a23, hi, b23);
+}
+/* whether the 8 indices v[0..7] are v[0], v[0] + 1, ..., v[0] + 7 (a run of records) */
+static inline int softgym_run8(const Py_ssize_t *v)
+{
+    __m512i a = _mm512_loadu_si512((const void *)v);
+    __m512i e = _mm512_add_epi64(_mm512_set1_epi64((long long)v[0]),
+                                 _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0));
+    return _mm512_cmpeq_epi64_mask(a, e) == 0xFF;
+}
+
 #else
 #define SOFTGYM_VLANES 4
 typedef double softgym_vd __attribute__((vector_size(32)));
