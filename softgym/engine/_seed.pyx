@@ -91,7 +91,7 @@ cdef extern from "softgym_seed.h":
                              const float64_t* sa_, const float64_t* chg_,
                              const float64_t* ka_, const float64_t* kt_, const float64_t* kb_,
                              const float64_t* cs_, float64_t* link_last,
-                             float64_t* const* out) noexcept nogil
+                             float64_t* out) noexcept nogil
     intp_t softgym_seed_modes(intp_t lo, intp_t hi, intp_t n, float64_t max_ext,
                               float64_t sa_w, float64_t sah_w, float64_t st_in, float64_t ex_in,
                               float64_t st_out, float64_t ex_out, lane_flag_t* link_sa,
@@ -105,7 +105,7 @@ cdef extern from "softgym_seed.h":
                                float inv_dt, const float* const* inp, const float64_t* sa_,
                                const float64_t* chg_, const float* ka_, const float* kt_,
                                const float* kb_, const float* cs_, float* link_last,
-                               float64_t* const* out) noexcept nogil
+                               float64_t* out) noexcept nogil
 
 
 #: the passes of links_seed that the cycle probes time, in slot order
@@ -215,15 +215,6 @@ cdef inline void _put(float64_t* o, intp_t n, intp_t ls, intp_t k, intp_t li, fl
         o[k * n + li] = v
 
 
-cdef inline void _forces_rows(Batch* b, intp_t c0, float64_t** out) noexcept nogil:
-    # the rows the forces pass writes and softgym_seed_scatter reads (in either
-    # precision) for the chunk of links from c0: f1 0-2, f2 3-5, m1 6-8, m2 9-11 of
-    # b.chunk_out, indexed by link
-    cdef intp_t k
-    for k in range(SOFTGYM_CHUNK_ROWS):
-        out[k] = b.chunk_out + k * SOFTGYM_CHUNK_STRIDE - c0
-
-
 cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end, float64_t inv_dt,
                                        intp_t ls) noexcept nogil:
     # links_seed's frames and forces passes in single precision
@@ -237,7 +228,6 @@ cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end, float64_
         float64_t* o = b.link_out
         float* f[12]
         const float* inp[11]
-        float64_t* out[12]
         const float* k32
         unsigned long long t0
     for k in range(12):
@@ -254,12 +244,11 @@ cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end, float64_
     t0 = softgym_prof_tsc()
     for k in range(11):
         inp[k] = f[k]
-    _forces_rows(b, lo, out)
     k32 = b.k_seed32
     softgym_seed_forces32(lo, end, b.link_rows, <float> b.L, <float> (0.5 * b.bond_zeta),
                           <float> (0.25 * b.bond_zeta), <float> inv_dt, inp, o + 9 * n,
                           o + 22 * n, k32, k32 + b.link_rows, k32 + 2 * b.link_rows,
-                          k32 + 3 * b.link_rows, b.link_last32, out)
+                          k32 + 3 * b.link_rows, b.link_last32, b.chunk_out - lo)
     softgym_prof_add(4, t0)
 
 
@@ -274,7 +263,6 @@ cdef inline void _seed_frames_forces(Batch* b, intp_t lo, intp_t end,
         float64_t* o = b.link_out
         float64_t bz = 0.5 * b.bond_zeta
         const float64_t* inp[11]
-        float64_t* out[12]
         unsigned long long t0
     t0 = softgym_prof_tsc()
     fix = softgym_seed_frames(lo, end, SMALL_ANGLE_RAD, SLTHRESH_ACOS2SQRT, o, o + n, o + 2 * n,
@@ -292,10 +280,11 @@ cdef inline void _seed_frames_forces(Batch* b, intp_t lo, intp_t end,
     t0 = softgym_prof_tsc()
     for k in range(11):
         inp[k] = o + (10 + k) * n
-    _forces_rows(b, lo, out)
+    # the forces pass writes the chunk's rows of b.chunk_out (f1 0-2, f2 3-5, m1 6-8, m2
+    # 9-11, SOFTGYM_CHUNK_STRIDE apart, indexed by link), which softgym_seed_scatter reads
     softgym_seed_forces(lo, end, b.link_rows, b.L, bz, 0.5 * bz, inv_dt, inp, o + 9 * n,
                         o + 22 * n, b.k_axial, b.k_torsion, b.k_bend, b.c_seed, b.link_last,
-                        out)
+                        b.chunk_out - lo)
     softgym_prof_add(4, t0)
 
 

@@ -24,15 +24,18 @@ static void SOFTGYM_FNAME(
     Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, SOFTGYM_FT L, SOFTGYM_FT bz, SOFTGYM_FT bzh,
     SOFTGYM_FT inv_dt, const SOFTGYM_FT *const *in, const double *sa_, const double *chg_,
     const SOFTGYM_FT *ka_, const SOFTGYM_FT *kt_, const SOFTGYM_FT *kb_, const SOFTGYM_FT *cs_,
-    SOFTGYM_FT *link_last, double *const *out)
+    SOFTGYM_FT *link_last, double *out)
 {
     typedef SOFTGYM_FT T;
     const T *P0_ = in[0], *P1_ = in[1], *P2_ = in[2], *a1y_ = in[3], *a1z_ = in[4];
     const T *a2x_ = in[5], *a2y_ = in[6], *a2z_ = in[7], *rw_ = in[8], *ry_ = in[9];
     const T *rz_ = in[10];
-    double *o0 = out[0], *o1 = out[1], *o2 = out[2], *o3 = out[3], *o4 = out[4];
-    double *o5 = out[5], *o6 = out[6], *o7 = out[7], *o8 = out[8], *o9 = out[9];
-    double *o10 = out[10], *o11 = out[11];
+    /* the output rows from one pointer at a compile-time stride (one register, where 12
+       row pointers spilled) */
+    const Py_ssize_t os = SOFTGYM_CHUNK_STRIDE;
+    double *o0 = out, *o1 = out + os, *o2 = out + 2 * os, *o3 = out + 3 * os;
+    double *o4 = out + 4 * os, *o5 = out + 5 * os, *o6 = out + 6 * os, *o7 = out + 7 * os;
+    double *o8 = out + 8 * os, *o9 = out + 9 * os, *o10 = out + 10 * os, *o11 = out + 11 * os;
     const T two = (T)2.0, half = (T)0.5, zero = (T)0.0;
     Py_ssize_t li;
     SOFTGYM_IVDEP
