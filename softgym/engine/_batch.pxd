@@ -103,6 +103,8 @@ cdef struct Batch:
     float64_t* chunk_out     # scratch of the seed model's forces pass: SOFTGYM_CHUNK_ROWS rows,
                              #   SOFTGYM_CHUNK_STRIDE apart, for one chunk of links from its
                              #   first (include/softgym_seed.h, _seed.links_seed)
+    float* chunk_f32         # scratch of the seed model's single-precision frames: SOFTGYM_CHUNK_FROWS
+                             #   float rows, SOFTGYM_CHUNK_FSTRIDE apart, for one chunk of links
     intp_t* v1               # (n_links,) voxel on the negative side
     intp_t* v2               # (n_links,) voxel on the positive side
     int32* axis              # (n_links,) 0, 1, 2 for x, y, z

@@ -32,7 +32,8 @@ from softgym.engine._integrate cimport integrate_corotational, integrate_seed, c
 from softgym.engine._record cimport record, robot_aux, robot_energy
 from softgym.engine._prof cimport (softgym_prof_enabled, softgym_prof_tsc, softgym_prof_add,
                                    softgym_prof_get, softgym_prof_reset)
-from softgym.engine._seed cimport links_seed, SOFTGYM_CHUNK_STRIDE, SOFTGYM_CHUNK_ROWS
+from softgym.engine._seed cimport (links_seed, SOFTGYM_CHUNK_STRIDE, SOFTGYM_CHUNK_ROWS,
+                                  SOFTGYM_CHUNK_FSTRIDE, SOFTGYM_CHUNK_FROWS)
 from softgym.engine._typedefs cimport float64_t, intp_t, step_t, int32, flag_t, lane_flag_t
 
 from softgym.engine._integrate import refresh_rotations  # noqa: F401 (Python API)
@@ -331,6 +332,7 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.force = _f(a, "force")
     b.vox_out = NULL  # per thread, set by advance
     b.chunk_out = NULL
+    b.chunk_f32 = NULL
     b.vox_stride = 0
     b.moment = _f(a, "moment")
     b.ext_force = _f(a, "ext_force")
@@ -485,7 +487,7 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
         Batch b
         Batch bt
         intp_t r, n, t
-        intp_t stride = 0, vstride = 0, block, i, m
+        intp_t stride = 0, vstride = 0, block, fblock, i, m
         float64_t* scratch
     _bind(&b, arrays, settings)
     n = b.n_robots
@@ -502,7 +504,10 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
     vstride = row_stride(vstride)
     b.link_stride = stride
     b.vox_stride = vstride
-    block = N_LINK_OUT * stride + N_VOX_OUT * vstride + SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE
+    # the float rows' floats rounded up to doubles (a multiple of 8: they start on a line)
+    fblock = (SOFTGYM_CHUNK_FROWS * SOFTGYM_CHUNK_FSTRIDE + 15) // 16 * 8
+    block = (N_LINK_OUT * stride + N_VOX_OUT * vstride + SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE
+             + fblock)
     scratch = cache.scratch(max(n_threads * block, 1))
     # robots in the order 0, 8, 16, ..., then 1, 9, 17, ...: the robots that the
     # threads step at one time are ROBOT_SPREAD apart, so no two of them write
@@ -526,6 +531,7 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
                 bt.link_out = scratch + t * block - b.link_start[r]
                 bt.vox_out = scratch + t * block + N_LINK_OUT * stride - b.vox_start[r]
                 bt.chunk_out = scratch + t * block + N_LINK_OUT * stride + N_VOX_OUT * vstride
+                bt.chunk_f32 = <float*> (bt.chunk_out + SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE)
                 advance_robot(&bt, r, targets[r], &cache.items[r])
 
 

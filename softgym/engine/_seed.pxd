@@ -17,3 +17,5 @@ cdef extern from "softgym_seed.h":
         SOFTGYM_CHUNK_LINKS
         SOFTGYM_CHUNK_STRIDE
         SOFTGYM_CHUNK_ROWS
+        SOFTGYM_CHUNK_FSTRIDE
+        SOFTGYM_CHUNK_FROWS

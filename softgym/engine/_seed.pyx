@@ -87,8 +87,8 @@ cdef extern from "softgym_seed.h":
                             float64_t* o_rw, float64_t* o_ry, float64_t* o_rz,
                             float64_t* o_fix) noexcept nogil
     void softgym_seed_forces(intp_t lo, intp_t hi, intp_t n, float64_t L, float64_t bz,
-                             float64_t bzh, float64_t inv_dt, const float64_t* const* inp,
-                             const float64_t* sa_, const float64_t* chg_,
+                             float64_t bzh, float64_t inv_dt, const float64_t* inp,
+                             intp_t in_stride, const float64_t* sa_, const float64_t* chg_,
                              const float64_t* ka_, const float64_t* kt_, const float64_t* kb_,
                              const float64_t* cs_, float64_t* link_last,
                              float64_t* out) noexcept nogil
@@ -100,12 +100,12 @@ cdef extern from "softgym_seed.h":
                               const float64_t* rot, const float64_t* o, const float64_t* neg2_row,
                               float64_t* force, float64_t* moment) noexcept nogil
     int softgym_seed_frames32(intp_t lo, intp_t hi, intp_t n, float sa_rad, float w_acos,
-                              const float64_t* o, float* const* f) noexcept nogil
+                              const float64_t* o, float* f) noexcept nogil
     void softgym_seed_forces32(intp_t lo, intp_t hi, intp_t n, float L, float bz, float bzh,
-                               float inv_dt, const float* const* inp, const float64_t* sa_,
-                               const float64_t* chg_, const float* ka_, const float* kt_,
-                               const float* kb_, const float* cs_, float* link_last,
-                               float64_t* out) noexcept nogil
+                               float inv_dt, const float* inp, intp_t in_stride,
+                               const float64_t* sa_, const float64_t* chg_, const float* ka_,
+                               const float* kt_, const float* kb_, const float* cs_,
+                               float* link_last, float64_t* out) noexcept nogil
 
 
 #: the passes of links_seed that the cycle probes time, in slot order
@@ -123,10 +123,10 @@ def cycle_counts(bint reset=False):
     return out
 
 
-cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n, bint f32, intp_t ls) noexcept nogil:
+cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n, float* f) noexcept nogil:
     # softgym_seed_frames for one link, with the seed's branches (its acos
-    # approximation and the backward-chord rule); f32: into the float rows of
-    # the single-precision passes (_float_row; ls: the robot's first link)
+    # approximation and the backward-chord rule), into the scratch's double rows
+    # 10-20, or (f not NULL) into the single-precision passes' float rows (_put)
     cdef:
         float64_t sa_rad = SMALL_ANGLE_RAD
         float64_t th_discard = SEED_PI - DISCARD_ANGLE_RAD
@@ -186,68 +186,57 @@ cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n, bint f32, intp_t ls
         P0 = o[8 * n + li] - nom
         P1 = 0.0
         P2 = 0.0
-    _put(o, n, ls, 10, li, P0, f32)
-    _put(o, n, ls, 11, li, P1, f32)
-    _put(o, n, ls, 12, li, P2, f32)
-    _put(o, n, ls, 13, li, a1y, f32)
-    _put(o, n, ls, 14, li, a1z, f32)
-    _put(o, n, ls, 15, li, a2x, f32)
-    _put(o, n, ls, 16, li, a2y, f32)
-    _put(o, n, ls, 17, li, a2z, f32)
-    _put(o, n, ls, 18, li, rw, f32)
-    _put(o, n, ls, 19, li, ry, f32)
-    _put(o, n, ls, 20, li, rz, f32)
+    _put(o, n, f, 10, li, P0)
+    _put(o, n, f, 11, li, P1)
+    _put(o, n, f, 12, li, P2)
+    _put(o, n, f, 13, li, a1y)
+    _put(o, n, f, 14, li, a1z)
+    _put(o, n, f, 15, li, a2x)
+    _put(o, n, f, 16, li, a2y)
+    _put(o, n, f, 17, li, a2z)
+    _put(o, n, f, 18, li, rw)
+    _put(o, n, f, 19, li, ry)
+    _put(o, n, f, 20, li, rz)
 
 
-cdef inline float* _float_row(float64_t* o, intp_t n, intp_t ls, intp_t k) noexcept nogil:
-    # the float view of the scratch's row k (o + k n, indexed by link from the
-    # robot's first link ls: its floats start where its doubles do) so that
-    # [li] is link li's float
-    return <float*> (o + k * n + ls) - ls
-
-
-cdef inline void _put(float64_t* o, intp_t n, intp_t ls, intp_t k, intp_t li, float64_t v,
-                      bint f32) noexcept nogil:
-    # row k of link li: a double, or (f32) a float of the row's float view
-    if f32:
-        _float_row(o, n, ls, k)[li] = <float> v
+cdef inline void _put(float64_t* o, intp_t n, float* f, intp_t k, intp_t li,
+                      float64_t v) noexcept nogil:
+    # row k of link li: the scratch's double, or (f not NULL) a float of the chunk's
+    # float rows (row k - 10 of f, SOFTGYM_CHUNK_FSTRIDE apart)
+    if f != NULL:
+        f[(k - 10) * SOFTGYM_CHUNK_FSTRIDE + li] = <float> v
     else:
         o[k * n + li] = v
 
 
-cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end, float64_t inv_dt,
-                                       intp_t ls) noexcept nogil:
+cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end,
+                                       float64_t inv_dt) noexcept nogil:
     # links_seed's frames and forces passes in single precision
-    # (SimConfig.link_precision = "single"; include/softgym_seed.h): float
-    # rows 10-21 from the frames, double rows of b.chunk_out from the forces for
-    # the scatter (links lo..end: one chunk). ls: the robot's first link (_float_row)
+    # (SimConfig.link_precision = "single"; include/softgym_seed.h): the chunk's float
+    # rows in b.chunk_out from the frames, double rows of b.chunk_out from the forces for
+    # the scatter (links lo..end: one chunk)
     cdef:
-        intp_t li, k
+        intp_t li
         int fix
         intp_t n = b.link_stride
         float64_t* o = b.link_out
-        float* f[12]
-        const float* inp[11]
+        float* f = b.chunk_f32 - lo  # indexed by link
         const float* k32
         unsigned long long t0
-    for k in range(12):
-        f[k] = _float_row(o, n, ls, 10 + k)
     t0 = softgym_prof_tsc()
     fix = softgym_seed_frames32(lo, end, n, <float> SMALL_ANGLE_RAD, <float> ACOS2SQRT_W, o, f)
     softgym_prof_add(2, t0)
     t0 = softgym_prof_tsc()
     if fix:  # rare: links turned past 120 degrees, or a backward chord
         for li in range(lo, end):
-            if f[11][li] != 0.0:
-                _seed_frame_one(li, o, n, 1, ls)
+            if f[11 * SOFTGYM_CHUNK_FSTRIDE + li] != 0.0:
+                _seed_frame_one(li, o, n, f)
     softgym_prof_add(3, t0)
     t0 = softgym_prof_tsc()
-    for k in range(11):
-        inp[k] = f[k]
     k32 = b.k_seed32
     softgym_seed_forces32(lo, end, b.link_rows, <float> b.L, <float> (0.5 * b.bond_zeta),
-                          <float> (0.25 * b.bond_zeta), <float> inv_dt, inp, o + 9 * n,
-                          o + 22 * n, k32, k32 + b.link_rows, k32 + 2 * b.link_rows,
+                          <float> (0.25 * b.bond_zeta), <float> inv_dt, f, SOFTGYM_CHUNK_FSTRIDE,
+                          o + 9 * n, o + 22 * n, k32, k32 + b.link_rows, k32 + 2 * b.link_rows,
                           k32 + 3 * b.link_rows, b.link_last32, b.chunk_out - lo)
     softgym_prof_add(4, t0)
 
@@ -257,12 +246,11 @@ cdef inline void _seed_frames_forces(Batch* b, intp_t lo, intp_t end,
     # links_seed's frames and forces passes in double precision (the seed's
     # own operations)
     cdef:
-        intp_t li, k
+        intp_t li
         int fix
         intp_t n = b.link_stride
         float64_t* o = b.link_out
         float64_t bz = 0.5 * b.bond_zeta
-        const float64_t* inp[11]
         unsigned long long t0
     t0 = softgym_prof_tsc()
     fix = softgym_seed_frames(lo, end, SMALL_ANGLE_RAD, SLTHRESH_ACOS2SQRT, o, o + n, o + 2 * n,
@@ -275,15 +263,13 @@ cdef inline void _seed_frames_forces(Batch* b, intp_t lo, intp_t end,
     if fix:  # links whose rotation needs the seed's acos branch
         for li in range(lo, end):
             if o[21 * n + li] != 0.0:
-                _seed_frame_one(li, o, n, 0, 0)
+                _seed_frame_one(li, o, n, NULL)
     softgym_prof_add(3, t0)
     t0 = softgym_prof_tsc()
-    for k in range(11):
-        inp[k] = o + (10 + k) * n
     # the forces pass writes the chunk's rows of b.chunk_out (f1 0-2, f2 3-5, m1 6-8, m2
     # 9-11, SOFTGYM_CHUNK_STRIDE apart, indexed by link), which softgym_seed_scatter reads
-    softgym_seed_forces(lo, end, b.link_rows, b.L, bz, 0.5 * bz, inv_dt, inp, o + 9 * n,
-                        o + 22 * n, b.k_axial, b.k_torsion, b.k_bend, b.c_seed, b.link_last,
+    softgym_seed_forces(lo, end, b.link_rows, b.L, bz, 0.5 * bz, inv_dt, o + 10 * n, n,
+                        o + 9 * n, o + 22 * n, b.k_axial, b.k_torsion, b.k_bend, b.c_seed, b.link_last,
                         b.chunk_out - lo)
     softgym_prof_add(4, t0)
 
@@ -377,7 +363,7 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
                     break  # a strained link: the links after it stay as they were
                 end = c1
         if b.link_f32:
-            _seed_frames_forces32(b, c0, end, inv_dt, lo)
+            _seed_frames_forces32(b, c0, end, inv_dt)
         else:
             _seed_frames_forces(b, c0, end, inv_dt)
         t0 = softgym_prof_tsc()
@@ -416,27 +402,34 @@ def seed_frames(float64_t[:, ::1] geom, bint scalar=False, bint single=False):
         intp_t n = geom.shape[1], li, k
         cnp.ndarray[float64_t, ndim=2] o = np.zeros((N_LINK_OUT, max(n, 1)))
         float64_t* op = <float64_t*> cnp.PyArray_DATA(o)
-        intp_t stride = o.shape[1]
-        float* f[12]
+        intp_t stride = o.shape[1], c0, c1
+        # the float rows of one chunk, as links_seed has them
+        cnp.ndarray[cnp.float32_t, ndim=1] fbuf = np.zeros(
+            SOFTGYM_CHUNK_FROWS * SOFTGYM_CHUNK_FSTRIDE, dtype=np.float32)
+        float* f
     if geom.shape[0] != 10:
         raise ValueError("geom must have 10 rows")
     for k in range(10):
         for li in range(n):
             op[k * stride + li] = geom[k, li]
-    for k in range(12):
-        f[k] = <float*> (op + (10 + k) * stride)
     with nogil:
         if single:
-            softgym_seed_frames32(0, n, stride, <float> SMALL_ANGLE_RAD, <float> ACOS2SQRT_W, op, f)
-            for li in range(n):
-                if f[11][li] != 0.0:
-                    _seed_frame_one(li, op, stride, 1, 0)
-            for k in range(11):
-                for li in range(n - 1, -1, -1):  # the float row widened in place
-                    op[(10 + k) * stride + li] = f[k][li]
+            c0 = 0
+            while c0 < n:  # chunk by chunk
+                c1 = min(c0 + SOFTGYM_CHUNK_LINKS, n)
+                f = <float*> cnp.PyArray_DATA(fbuf) - c0
+                softgym_seed_frames32(c0, c1, stride, <float> SMALL_ANGLE_RAD,
+                                      <float> ACOS2SQRT_W, op, f)
+                for li in range(c0, c1):
+                    if f[11 * SOFTGYM_CHUNK_FSTRIDE + li] != 0.0:
+                        _seed_frame_one(li, op, stride, f)
+                for k in range(11):
+                    for li in range(c0, c1):
+                        op[(10 + k) * stride + li] = f[k * SOFTGYM_CHUNK_FSTRIDE + li]
+                c0 = c1
         elif scalar:
             for li in range(n):
-                _seed_frame_one(li, op, stride, 0, 0)
+                _seed_frame_one(li, op, stride, NULL)
         else:
             softgym_seed_frames(0, n, SMALL_ANGLE_RAD, SLTHRESH_ACOS2SQRT, op, op + stride,
                                 op + 2 * stride, op + 3 * stride, op + 4 * stride,
@@ -448,5 +441,5 @@ def seed_frames(float64_t[:, ::1] geom, bint scalar=False, bint single=False):
                                 op + 20 * stride, op + 21 * stride)
             for li in range(n):
                 if op[21 * stride + li] != 0.0:
-                    _seed_frame_one(li, op, stride, 0, 0)
+                    _seed_frame_one(li, op, stride, NULL)
     return o[10:21, :n].copy()

@@ -32,11 +32,11 @@ PASSES = {
     "softgym_seed_geom": "softgym_seed_geom(ax, 0, n, n, ip, ip, d, d, d, o);",
     "softgym_seed_frames": "softgym_seed_frames(0, n, 0.01, 0.002, d, d, d, d, d, d, d, d, d, d, "
                            "o, o, o, o, o, o, o, o, o, o, o, o);",
-    "softgym_seed_forces": "softgym_seed_forces(0, n, n, 0.01, 0.1, 0.05, 1e4, cin, d, d, d, d, d, d, "
-                           "o, out);",
-    "softgym_seed_frames32": "softgym_seed_frames32(0, n, n, 0.01f, 0.9988f, d, fo);",
-    "softgym_seed_forces32": "softgym_seed_forces32(0, n, n, 0.01f, 0.1f, 0.05f, 1e4f, fin, d, d, fc, fc, "
-                             "fc, fc, fo[0], out);",
+    "softgym_seed_forces": "softgym_seed_forces(0, n, n, 0.01, 0.1, 0.05, 1e4, d, n, d, d, d, d, d, "
+                           "d, o, o);",
+    "softgym_seed_frames32": "softgym_seed_frames32(0, n, n, 0.01f, 0.9988f, d, fo[0]);",
+    "softgym_seed_forces32": "softgym_seed_forces32(0, n, n, 0.01f, 0.1f, 0.05f, 1e4f, fc, 0, d, d, "
+                             "fc, fc, fc, fc, fo[0], o);",
     "softgym_seed_modes": "return (long)softgym_seed_modes(0, n, n, 0.3, 0.99, 0.98, 0.05, 1.3, "
                           "0.055, 1.43, lf, lf, o);",
     "softgym_seed_quats": "softgym_seed_quats(0, n, n, 1e-4, d, d, o);",
@@ -71,8 +71,7 @@ def _compile_pass(call, march, guard, tmp_path):
         + "".join(f'#include "{h}"\n' for h in HEADERS)
         + guard
         + "long run(int ax, Py_ssize_t n, const Py_ssize_t *ip, const double *d, double *o,\n"
-        "         long long *lf, const double *const *cin, double *const *out,\n"
-        "         const float *fc, float *const *fo, const float *const *fin)\n"
+        "         long long *lf, const float *fc, float *const *fo)\n"
         "{\n"
         f"    {call}\n"
         "    return 0;\n"

@@ -20,6 +20,13 @@
 #define SOFTGYM_CHUNK_LINKS 128
 #define SOFTGYM_CHUNK_STRIDE (SOFTGYM_CHUNK_LINKS + 8)
 #define SOFTGYM_CHUNK_ROWS 12
+/* the single-precision frames pass leaves a chunk's 12 float rows (P0, P1, P2, a1y, a1z,
+   a2x, a2y, a2z, rw, ry, rz, fix) SOFTGYM_CHUNK_FSTRIDE floats apart (each row on a cache
+   line of its own, consecutive rows on different sets), so the frames and forces passes
+   address them from one pointer: with a pointer per row, the forces pass's 40-odd rows
+   outnumbered the general registers and spilled */
+#define SOFTGYM_CHUNK_FSTRIDE (SOFTGYM_CHUNK_LINKS + 16)
+#define SOFTGYM_CHUNK_FROWS 12
 
 /* The first pass of links_seed (_seed.pyx): links lo..hi (all along axis ax, a
    compile-time constant in each copy) measured in the bond frame, without
@@ -419,11 +426,12 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_impl(
     }
     return any_fix;
 }
-/* the frames pass in float: rows in as softgym_seed_frames, float rows out (f[k]:
-   row 10 + k); returns whether any link got fix = 1 */
+/* the frames pass in float: rows in as softgym_seed_frames, float rows out (row k at f +
+   k SOFTGYM_CHUNK_FSTRIDE, indexed by link); returns whether any link got fix = 1 */
 static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, float sa_rad,
-                                 float w_acos, const double *o, float *const *f)
+                                 float w_acos, const double *o, float *f)
 {
+    const Py_ssize_t fs = SOFTGYM_CHUNK_FSTRIDE;
     Py_ssize_t blo, bhi;
     int all_small, any_fix = 0;
     const double *sa_ = o + 9 * n;
@@ -431,8 +439,9 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
         bhi = softgym_small_block(sa_, blo, hi, &all_small);
 #define SOFTGYM_FRAMES32(s) any_fix |= softgym_seed_frames32_impl( \
             s, blo, bhi, sa_rad, w_acos, o, o + n, o + 2 * n, o + 3 * n, o + 4 * n, o + 5 * n, \
-            o + 6 * n, o + 7 * n, o + 8 * n, sa_, f[0], f[1], f[2], f[3], f[4], f[5], f[6], \
-            f[7], f[8], f[9], f[10], f[11])
+            o + 6 * n, o + 7 * n, o + 8 * n, sa_, f, f + fs, f + 2 * fs, f + 3 * fs, \
+            f + 4 * fs, f + 5 * fs, f + 6 * fs, f + 7 * fs, f + 8 * fs, f + 9 * fs, \
+            f + 10 * fs, f + 11 * fs)
         if (all_small)
             SOFTGYM_FRAMES32(1);
         else
@@ -449,20 +458,24 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
    link_precision "single" (its lanes' conditions 32 bits wide) */
 #define SOFTGYM_FT double
 #define SOFTGYM_FNAME softgym_seed_forces
+#define SOFTGYM_FIN_STRIDE in_stride
 #define SOFTGYM_FPICK softgym_pick
 #define SOFTGYM_FMASK long long
 #include "softgym_seed_forces.h"
 #undef SOFTGYM_FT
 #undef SOFTGYM_FNAME
+#undef SOFTGYM_FIN_STRIDE
 #undef SOFTGYM_FPICK
 #undef SOFTGYM_FMASK
 #define SOFTGYM_FT float
 #define SOFTGYM_FNAME softgym_seed_forces32
+#define SOFTGYM_FIN_STRIDE SOFTGYM_CHUNK_FSTRIDE
 #define SOFTGYM_FPICK(c, a, b) ((c) ? (a) : (b))
 #define SOFTGYM_FMASK int
 #include "softgym_seed_forces.h"
 #undef SOFTGYM_FT
 #undef SOFTGYM_FNAME
+#undef SOFTGYM_FIN_STRIDE
 #undef SOFTGYM_FPICK
 #undef SOFTGYM_FMASK
 

@@ -1,7 +1,8 @@
 /* The forces pass of links_seed, one definition for both precisions:
    softgym_seed.h includes this file twice, with SOFTGYM_FT (the arithmetic's
    type: double, or float for SimConfig.link_precision = "single"),
-   SOFTGYM_FNAME (the function's name), SOFTGYM_FPICK (c ? a : b in that
+   SOFTGYM_FNAME (the function's name), SOFTGYM_FIN_STRIDE (its input rows' stride),
+   SOFTGYM_FPICK (c ? a : b in that
    type) and SOFTGYM_FMASK (the type of the lanes' conditions: as wide as
    SOFTGYM_FT) defined. No include guard, on purpose.
 
@@ -9,7 +10,8 @@
    quantities (stiffness; the seed's damping from the link's memory of the
    last step, skipped on a mode-change step), turned back by rq^-1 for a
    large-angle link, without branches so the loop vectorises. Inputs: the
-   frames' rows in[k] (P0, P1, P2, a1y, a1z, a2x, a2y, a2z, rw, ry, rz), the
+   frames' rows in + k SOFTGYM_FIN_STRIDE (P0, P1, P2, a1y, a1z, a2x, a2y, a2z, rw, ry,
+   rz), the
    mode (sa_: 1.0 small angle) and mode-change (chg_) rows, the link
    constants (ka_, kt_, kb_; cs_: the 8 rows of c_seed, stride n) and memory
    (link_last, 9 rows of stride n). Outputs (double rows, for the scatter)
@@ -22,14 +24,18 @@
    operations as the seed's scalar code. */
 static void SOFTGYM_FNAME(
     Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, SOFTGYM_FT L, SOFTGYM_FT bz, SOFTGYM_FT bzh,
-    SOFTGYM_FT inv_dt, const SOFTGYM_FT *const *in, const double *sa_, const double *chg_,
+    SOFTGYM_FT inv_dt, const SOFTGYM_FT *in, Py_ssize_t in_stride, const double *sa_,
+    const double *chg_,
     const SOFTGYM_FT *ka_, const SOFTGYM_FT *kt_, const SOFTGYM_FT *kb_, const SOFTGYM_FT *cs_,
     SOFTGYM_FT *link_last, double *out)
 {
     typedef SOFTGYM_FT T;
-    const T *P0_ = in[0], *P1_ = in[1], *P2_ = in[2], *a1y_ = in[3], *a1z_ = in[4];
-    const T *a2x_ = in[5], *a2y_ = in[6], *a2z_ = in[7], *rw_ = in[8], *ry_ = in[9];
-    const T *rz_ = in[10];
+    /* the input rows' stride: in_stride (the scratch's) in double, the chunk's float rows'
+       (SOFTGYM_CHUNK_FSTRIDE, a compile-time constant) in float */
+    const Py_ssize_t is = SOFTGYM_FIN_STRIDE;
+    const T *P0_ = in, *P1_ = in + is, *P2_ = in + 2 * is, *a1y_ = in + 3 * is;
+    const T *a1z_ = in + 4 * is, *a2x_ = in + 5 * is, *a2y_ = in + 6 * is;
+    const T *a2z_ = in + 7 * is, *rw_ = in + 8 * is, *ry_ = in + 9 * is, *rz_ = in + 10 * is;
     /* the output rows from one pointer at a compile-time stride (one register, where 12
        row pointers spilled) */
     const Py_ssize_t os = SOFTGYM_CHUNK_STRIDE;
