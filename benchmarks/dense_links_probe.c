@@ -243,7 +243,7 @@ int main(int argc, char **argv)
         unsigned long long t0, t;
         t0 = __rdtsc();
         for (int ax = 0; ax < 3; ax++)
-            softgym_seed_geom(ax, start[ax], start[ax + 1], ne, v1, v2, pos, quat, scale, o);
+            softgym_seed_geom(ax, start[ax], start[ax + 1], ne, v1, v2, nv, pos, quat, scale, o);
         t = __rdtsc() - t0;
         best[0] = t < best[0] ? t : best[0];
         memset(fa, 0, 4 * nv * 8);

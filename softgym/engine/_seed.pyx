@@ -74,7 +74,8 @@ cdef extern from "softgym_seed.h":
     # the passes of links_seed (C, for the vectorising pragma and one
     # copy per link axis; documented in include/softgym_seed.h)
     void softgym_seed_geom(int ax, intp_t lo, intp_t hi, intp_t n, const intp_t* v1,
-                           const intp_t* v2, const float64_t* pos, const float64_t* quat,
+                           const intp_t* v2, intp_t vend, const float64_t* pos,
+                           const float64_t* quat,
                            const float64_t* scale, float64_t* o) noexcept nogil
     # (the two frames passes return whether any link needs _seed_frame_one)
     int softgym_seed_frames(intp_t lo, intp_t hi, float64_t sa_rad, float64_t thr,
@@ -282,7 +283,8 @@ cdef inline intp_t _seed_geom_modes(Batch* b, int ax, intp_t lo, intp_t hi, intp
         intp_t end
         unsigned long long t0
     t0 = softgym_prof_tsc()
-    softgym_seed_geom(ax, lo, hi, n, b.v1, b.v2, b.pos, b.quat, b.scale, o)
+    softgym_seed_geom(ax, lo, hi, n, b.v1, b.v2, b.vox_start[b.n_robots], b.pos, b.quat,
+                      b.scale, o)
     softgym_prof_add(0, t0)
     t0 = softgym_prof_tsc()
     end = softgym_seed_modes(lo, hi, n, b.max_strain * b.L, SMALL_ANGLE_W, SMALLISH_ANGLE_W,

@@ -29,7 +29,7 @@ FLAGS = ["-O3", "-ffp-contract=fast", "-fno-math-errno", "-fno-trapping-math",
 
 # one call per pass (the headers' functions are static: only the called one is compiled)
 PASSES = {
-    "softgym_seed_geom": "softgym_seed_geom(ax, 0, n, n, ip, ip, d, d, d, o);",
+    "softgym_seed_geom": "softgym_seed_geom(ax, 0, n, n, ip, ip, n, d, d, d, o);",
     "softgym_seed_frames": "softgym_seed_frames(0, n, 0.01, 0.002, d, d, d, d, d, d, d, d, d, d, "
                            "o, o, o, o, o, o, o, o, o, o, o, o);",
     "softgym_seed_forces": "softgym_seed_forces(0, n, n, 0.01, 0.1, 0.05, 1e4, d, n, d, d, d, d, d, "
@@ -119,14 +119,15 @@ HARNESS = r"""
 #include <string.h>
 typedef long Py_ssize_t;
 #include "softgym_seed.h"
-/* links of random voxels along each axis through softgym_seed_geom (the hand-vectorised
-   loop and its remainder) against SOFTGYM_SEED_GEOM_LINK, one link at a time */
+/* links along each axis through softgym_seed_geom (the hand-vectorised loop with its
+   three ways of loading the voxels: runs, windows of 16, gathers; and its remainder)
+   against SOFTGYM_SEED_GEOM_LINK, one link at a time */
 static double urand(void) { return rand() / (double)RAND_MAX - 0.5; }
 SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, Py_ssize_t n, const Py_ssize_t *v1,
-                                    const Py_ssize_t *v2, const double *pos, const double *quat,
-                                    const double *sc, double *o, double *r)
+                                    const Py_ssize_t *v2, Py_ssize_t nv, const double *pos,
+                                    const double *quat, const double *sc, double *o, double *r)
 {
-    softgym_seed_geom(ax, 0, n, n, v1, v2, pos, quat, sc, o);
+    softgym_seed_geom(ax, 0, n, n, v1, v2, nv, pos, quat, sc, o);
     SOFTGYM_SEED_GEOM_AXIS(ax);
     SOFTGYM_SEED_GEOM_OUT(r, n);
     long bad = 0;
@@ -154,13 +155,23 @@ int main(void)
         for (int k = 0; k < 3; k++) pos[3 * i + k] = 0.01 * (i % 7 + urand());
         sc[i] = 0.01 * (1.0 + 0.1 * urand());
     }
-    for (int li = 0; li < N; li++) {
-        v1[li] = rand() % NV;
-        v2[li] = (v1[li] + 1 + rand() % (NV - 1)) % NV;
+    for (int pattern = 0; pattern < 3; pattern++) {
+        for (int li = 0; li < N; li++) {
+            if (pattern == 0) {  /* random voxels: gathers */
+                v1[li] = rand() % NV;
+                v2[li] = (v1[li] + 1 + rand() % (NV - 1)) % NV;
+            } else if (pattern == 1) {  /* runs of consecutive voxels, to the last voxel */
+                v1[li] = li % (NV - 7);
+                v2[li] = v1[li] + 7;
+            } else {  /* a lattice row's links with gaps: windows of 16 */
+                v1[li] = (li + li / 5) % (NV - 1);
+                v2[li] = v1[li] + 1;
+            }
+        }
+        bad += check_ax(0, N, v1, v2, NV, pos, quat, sc, o, r);
+        bad += check_ax(1, N, v1, v2, NV, pos, quat, sc, o, r);
+        bad += check_ax(2, N, v1, v2, NV, pos, quat, sc, o, r);
     }
-    bad += check_ax(0, N, v1, v2, pos, quat, sc, o, r);
-    bad += check_ax(1, N, v1, v2, pos, quat, sc, o, r);
-    bad += check_ax(2, N, v1, v2, pos, quat, sc, o, r);
     printf("%ld\n", bad);
     return 0;
 }
@@ -260,4 +271,4 @@ def test_hand_vectorised_corotational_kernel_is_the_formula_bit_for_bit(level, t
 @pytest.mark.parametrize("level", ["x86-64-v3", "x86-64-v4"])
 def test_hand_vectorised_geometry_is_the_formula_bit_for_bit(level, tmp_path):
     out = _run_harness(level, HARNESS, tmp_path)
-    assert out == "0", f"{out} of {3 * 10 * 203} geometry values differ"
+    assert out == "0", f"{out} of {3 * 3 * 10 * 203} geometry values differ"

@@ -134,6 +134,31 @@ static inline void softgym_seed_rows8(Py_ssize_t v, const double *pos, const dou
     softgym_v8_load4x4(quat + 4 * v, r + 3);
     memcpy(&r[7], scale + v, sizeof r[7]);
 }
+/* links whose voxels all lie in the 16 voxels from voxel 1 of the first (a[0]: the
+   links along a lattice's fastest axis, and most blocks of a sparse body): those 16
+   voxels' records as rows, each link's voxels picked from them by a two-source permute
+   (the voxels' indices below vend, the end of the records). 0 when they do not fit. */
+static inline int softgym_seed_window8(const Py_ssize_t *a, const Py_ssize_t *b,
+                                       Py_ssize_t vend, const double *pos, const double *quat,
+                                       const double *scale, softgym_vd *gi, softgym_vd *gj)
+{
+    Py_ssize_t base = a[0];
+    if (base + 16 > vend)
+        return 0;
+    __m512i vbase = _mm512_set1_epi64((long long)base), sixteen = _mm512_set1_epi64(16);
+    __m512i ia = _mm512_sub_epi64(_mm512_loadu_si512((const void *)a), vbase);
+    __m512i ib = _mm512_sub_epi64(_mm512_loadu_si512((const void *)b), vbase);
+    if ((_mm512_cmplt_epu64_mask(ia, sixteen) & _mm512_cmplt_epu64_mask(ib, sixteen)) != 0xFF)
+        return 0;
+    softgym_vd lo[8], hi[8];
+    softgym_seed_rows8(base, pos, quat, scale, lo);
+    softgym_seed_rows8(base + 8, pos, quat, scale, hi);
+    for (int k = 0; k < 8; k++) {
+        gi[k] = (softgym_vd)_mm512_permutex2var_pd((__m512d)lo[k], ia, (__m512d)hi[k]);
+        gj[k] = (softgym_vd)_mm512_permutex2var_pd((__m512d)lo[k], ib, (__m512d)hi[k]);
+    }
+    return 1;
+}
 #endif
 #endif
 /* links lo..hi by the formula on doubles, in a loop the compiler vectorises */
@@ -157,7 +182,8 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_scalar(const int ax, Py_ssize_t lo,
 }
 SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
                                                 Py_ssize_t n, const Py_ssize_t *v1,
-                                                const Py_ssize_t *v2, const double *pos,
+                                                const Py_ssize_t *v2, Py_ssize_t vend,
+                                                const double *pos,
                                                 const double *quat, const double *scale,
                                                 double *o)
 {
@@ -185,7 +211,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
         if (softgym_run8(v1 + li) & softgym_run8(v2 + li)) {
             softgym_seed_rows8(v1[li], pos, quat, scale, gi);
             softgym_seed_rows8(v2[li], pos, quat, scale, gj);
-        } else
+        } else if (!softgym_seed_window8(v1 + li, v2 + li, vend, pos, quat, scale, gi, gj))
 #endif
         {
             softgym_seed_gather(v1 + li, pos, quat, scale, gi);
@@ -200,11 +226,13 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
     /* the rest (and every link without AVX): the compiler's vectoriser */
     softgym_seed_geom_scalar(ax, li, hi, n, v1, v2, pos, quat, scale, o);
 }
+/* vend: the end of the voxel records (voxel indices below it may be read) */
 static void softgym_seed_geom(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
-                              const Py_ssize_t *v1, const Py_ssize_t *v2, const double *pos,
-                              const double *quat, const double *scale, double *o)
+                              const Py_ssize_t *v1, const Py_ssize_t *v2, Py_ssize_t vend,
+                              const double *pos, const double *quat, const double *scale,
+                              double *o)
 {
-    SOFTGYM_BY_AXIS(ax, softgym_seed_geom_ax, lo, hi, n, v1, v2, pos, quat, scale, o);
+    SOFTGYM_BY_AXIS(ax, softgym_seed_geom_ax, lo, hi, n, v1, v2, vend, pos, quat, scale, o);
 }
 
 /* The frames pass of links_seed, in C for one pragma: the bond-frame
