@@ -1,0 +1,278 @@
+"""Static port bound of the seed step's hot loops (llvm-mca), against the measured cycles.
+
+The VM this project runs on exposes no hardware counters (``perf`` offers software
+events only), so whether a pass is bound by its instructions or by something else
+(latency, store forwarding, the divider's queue) cannot be read off a counter. This
+script gives the other half of the answer. It disassembles the x86-64-v4 build of the
+engine with its line tables, finds each pass's innermost vector loop (attributed by the
+inlined function its instructions come from), and asks LLVM's machine-code analyser
+(``llvm-mca``, which models a core's ports and latencies) how many core cycles an
+iteration needs at best. Divided by the links (or voxels) an iteration handles and
+scaled to a voxel-step of the reference robot, that is the pass's floor on that core
+model; ``profile_engine.py --cycles`` measures what the pass takes.
+
+    python benchmarks/port_bound.py                  # the in-place build
+    python benchmarks/port_bound.py --build DIR      # another tree, built in place
+    python benchmarks/port_bound.py --cpu icelake-server
+
+The in-place build has the line tables where Python's compiler flags carry -g (they
+usually do); where they do not, a copy of the tree is built with CFLAGS=-g.
+
+A loop with a branch inside (the geometry's rows-or-gather choice, the scatter's
+voxel-2 force) is analysed as one straight run of both paths: its floor is an upper
+bound of the path taken. Needs ``objdump`` (binutils) and ``llvm-mca`` (LLVM) on the
+PATH; the numbers are a model's, not a measurement.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+# the inlined functions each pass's instructions come from (objdump -l names them);
+# helpers shared by several passes (the record/row transposes) count for none
+PASSES = {
+    "geometry": ("softgym_seed_geom_ax", "softgym_seed_gather", "softgym_seed_gather4",
+                 "softgym_seed_rows8"),
+    "modes": ("softgym_seed_modes",),
+    "frames (float)": ("softgym_seed_frames32_impl", "softgym_rotvec_k32",
+                       "softgym_rotvec_k32_acos"),
+    "forces (float)": ("softgym_seed_forces32",),
+    "scatter": ("softgym_seed_scatter_ax",),
+    "voxel update": ("softgym_seed_voxels8", "softgym_v8_finish"),
+}
+# the geometry's two paths for 8 links: the voxels' records loaded as rows (a loop of its
+# own while the runs last) and gathered (the rest of the loop around it)
+GEOMETRY_PATHS = ("  rows path", "  gather path")
+# what one iteration of a pass's main loop handles: links, except the voxel update
+PER_ITERATION = {"geometry": 8, "  rows path": 8, "  gather path": 8, "modes": 8, "frames (float)": 16, "forces (float)": 16,
+                 "scatter": 1, "voxel update": 8}
+MODULES = ("_seed", "_integrate")
+
+
+def build_copy(dest: Path) -> Path:
+    """A copy of the working tree's tracked files, built in place with -g."""
+    files = subprocess.run(["git", "ls-files", "-z"], cwd=ROOT, capture_output=True,
+                           check=True).stdout.decode().split("\0")
+    for f in filter(None, files):
+        src = ROOT / f
+        if src.is_file():
+            (dest / f).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(src, dest / f)
+    env = dict(os.environ, CFLAGS=(os.environ.get("CFLAGS", "") + " -g").strip())
+    subprocess.run([sys.executable, "setup.py", "build_ext", "--inplace"], cwd=dest, env=env,
+                   check=True, capture_output=True)
+    return dest
+
+
+def disassemble(so: Path) -> list[tuple[int, str, str, str]]:
+    """(address, symbol, inlined function, instruction) for every instruction of `so`."""
+    out = subprocess.run(["objdump", "-d", "-l", "--no-show-raw-insn", "-M", "att", str(so)],
+                         capture_output=True, text=True, check=True).stdout
+    rows, sym, fn = [], None, None
+    for line in out.splitlines():
+        m = re.match(r"^[0-9a-f]+ <(.+)>:$", line)
+        if m:
+            sym = fn = m.group(1)
+            continue
+        m = re.match(r"^([A-Za-z_]\w*)\(\):$", line)
+        if m:
+            fn = m.group(1)
+            continue
+        m = re.match(r"^\s+([0-9a-f]+):\s+(.*)$", line)
+        if m and sym:
+            rows.append((int(m.group(1), 16), sym, fn, m.group(2).split("#")[0].strip()))
+    return rows
+
+
+def all_loops(rows):
+    """Index ranges [start, end] of loops: a conditional jump back within a symbol."""
+    at = {a: k for k, (a, *_rest) in enumerate(rows)}
+    loops = []
+    for k, (a, sym, _fn, text) in enumerate(rows):
+        m = re.match(r"^(j\w+)\s+([0-9a-f]+) <", text)
+        if m and m.group(1) != "jmp":
+            target = int(m.group(2), 16)
+            if target <= a and target in at and rows[at[target]][1] == sym:
+                loops.append((at[target], k))
+    return loops
+
+
+def innermost_loops(rows):
+    """The loops with no loop inside."""
+    loops = all_loops(rows)
+    return [(s, e) for s, e in loops
+            if not any(s <= s2 and e2 <= e and (s2, e2) != (s, e) for s2, e2 in loops)]
+
+
+def pass_of(rows, s, e) -> str | None:
+    counts = collections.Counter()
+    for _a, _sym, fn, _t in rows[s:e + 1]:
+        for name, fns in PASSES.items():
+            if fn in fns:
+                counts[name] += 1
+    if not counts:
+        return None
+    name, n = counts.most_common(1)[0]
+    return name if n >= (e - s + 1) // 3 else None
+
+
+def mca(body: list[str], cpu: str) -> dict:
+    """llvm-mca's figures for the straight run `body` repeated."""
+    src = ".Ltop:\n" + "\n".join(body) + "\n"
+    r = subprocess.run(["llvm-mca", f"-mcpu={cpu}", "-iterations=100"], input=src,
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        raise SystemExit(f"port_bound: llvm-mca failed: {r.stderr.strip()[:300]}")
+
+    def num(key):
+        m = re.search(rf"{key}:\s+([\d.]+)", r.stdout)
+        return float(m.group(1)) if m else float("nan")
+
+    return {"rthroughput": num("Block RThroughput"), "cycles": num("Total Cycles") / 100,
+            "uops": num("Total uOps") / 100}
+
+
+# instructions left out of a body: branches (it runs as one straight block), padding
+SKIP = ("j", "call", "nop", "data16", "cs nop", "xchg   %ax,%ax", "ret")
+# the voxel update's helpers (record/row transposes, intrinsics) inlined with it
+VOXEL_HELPERS = ("softgym_v8_", "_mm512_", "_mm256_")
+
+
+def loop_body(rows, s, e) -> list[str]:
+    return [text for _a, _sym, _fn, text in rows[s:e + 1] if not text.startswith(SKIP)]
+
+
+def find_loops(tree: Path) -> dict[str, tuple] | None:
+    """Each pass's largest innermost loop in the x86-64-v4 build of `tree` (None: no
+    such build; empty: no line tables to attribute the loops by)."""
+    best: dict[str, tuple] = {}
+    for mod in MODULES:
+        sos = sorted((tree / "softgym" / "engine" / "_x86_64_v4").glob(f"{mod}.*.so"))
+        if not sos:
+            return None
+        rows = disassemble(sos[0])
+        if mod == "_integrate":
+            # the voxel update's lanes are straight code (8 voxels a block) inlined into
+            # the seed model's voxel loop: its instructions there, as one block
+            body = [t for _a, sym, fn, t in rows
+                    if sym.endswith("integrate_integrate_seed")
+                    and (fn in PASSES["voxel update"] or fn.startswith(VOXEL_HELPERS))]
+            body = [t for t in body if not t.startswith(SKIP)]
+            if body:
+                best["voxel update"] = (body, 0)
+            continue
+        for s, e in innermost_loops(rows):
+            name = pass_of(rows, s, e)
+            body = loop_body(rows, s, e)
+            if name and (name not in best or len(body) > len(best[name][0])):
+                best[name] = (body, rows[s][0])
+        if mod == "_seed":
+            _geometry_paths(rows, best)
+    return best
+
+
+_ROWS_ONLY = ("softgym_seed_rows8", "softgym_v8_load3", "softgym_v8_load4x4",
+              "_mm512_permutex2var_pd", "_mm512_loadu_pd")
+_GATHER_ONLY = ("softgym_seed_gather", "softgym_seed_gather4", "_mm512_insertf64x4",
+                "_mm512_castpd256_pd512")
+
+
+def _geometry_paths(rows, best) -> None:
+    """The geometry's rows path (the innermost loop of softgym_seed_rows8) and its gather
+    path: GCC folds the gathers, the scalar remainder and the rows loop into one loop nest,
+    so the gather path is taken as the rows loop's arithmetic with the gathers (the
+    instructions of softgym_seed_gather4 and its intrinsics in the smallest loop around
+    them) in place of the rows' loads."""
+    loops = all_loops(rows)
+
+    def has(s, e, fn_name):
+        return any(fn == fn_name for _a, _sym, fn, _t in rows[s:e + 1])
+
+    inner = [(s, e) for s, e in innermost_loops(rows) if has(s, e, "softgym_seed_rows8")]
+    outer = [(s, e) for s, e in loops if has(s, e, "softgym_seed_gather4")]
+    if not inner or not outer:
+        return
+    s, e = max(inner, key=lambda r: r[1] - r[0])
+    best["  rows path"] = (loop_body(rows, s, e), rows[s][0])
+    arithmetic = [t for _a, _sym, fn, t in rows[s:e + 1]
+                  if not t.startswith(SKIP) and fn not in _ROWS_ONLY]
+    s, e = min(outer, key=lambda r: r[1] - r[0])
+    gathers = [t for _a, _sym, fn, t in rows[s:e + 1] if not t.startswith(SKIP)
+               and (fn in _GATHER_ONLY or fn.startswith(("_mm256_", "_mm_")))]
+    best["  gather path"] = (arithmetic + gathers, rows[s][0])
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--build", type=Path, default=ROOT,
+                    help="a tree built in place (default: this one)")
+    ap.add_argument("--cpu", default="sapphirerapids", help="llvm-mca's core model")
+    ap.add_argument("--links-per-voxel", type=float, default=540 / 216,
+                    help="links a voxel-step (the 6^3 reference robot: 540 / 216)")
+    ap.add_argument("--json", action="store_true", help="print one JSON object as the last line")
+    args = ap.parse_args(argv)
+    for tool in ("objdump", "llvm-mca"):
+        if shutil.which(tool) is None:
+            print(f"port_bound: {tool} is not on the PATH", file=sys.stderr)
+            return 2
+    tmp = None
+    best = find_loops(args.build)
+    if best is None:
+        print(f"port_bound: no x86-64-v4 build under {args.build} (python setup.py "
+              "build_ext --inplace on an x86-64 machine builds one)", file=sys.stderr)
+        return 2
+    if not best:  # no line tables: a copy built with -g
+        tmp = tempfile.TemporaryDirectory()
+        best = find_loops(build_copy(Path(tmp.name))) or {}
+    print(f"llvm-mca -mcpu={args.cpu}: each pass's main loop in the x86-64-v4 build (the "
+          f"voxel update: its 8-voxel block); core cycles an iteration and per voxel-step at "
+          f"{args.links_per_voxel:.2f} links a voxel")
+    print(f"{'pass':18s} {'insns':>6s} {'stack':>6s} {'uops':>6s} {'per iter':>9s} "
+          f"{'bound':>7s} {'sim':>7s} {'bound/vs':>9s} {'sim/vs':>7s}")
+    total_b = total_s = 0.0
+    report = {"cpu": args.cpu, "links_per_voxel": args.links_per_voxel, "passes": {}}
+    for name in ("geometry", *GEOMETRY_PATHS, *list(PASSES)[1:]):
+        if name not in best:
+            print(f"{name:18s} (loop not found)")
+            continue
+        body, _addr = best[name]
+        m = mca(body, args.cpu)
+        per = PER_ITERATION[name]
+        scale = (1.0 if name == "voxel update" else args.links_per_voxel) / per
+        b, c = m["rthroughput"] * scale, m["cycles"] * scale
+        stack = sum(bool(re.search(r"\(%r[sb]p\)", t)) for t in body)
+        report["passes"][name.strip()] = {
+            "instructions": len(body), "stack": stack, "uops": m["uops"], "per_iteration": per,
+            "bound": m["rthroughput"], "sim": m["cycles"], "bound_per_voxel_step": b,
+            "sim_per_voxel_step": c}
+        if name not in GEOMETRY_PATHS:
+            total_b += b
+            total_s += c
+        print(f"{name:18s} {len(body):6d} {stack:6d} {m['uops']:6.0f} {per:9d} "
+              f"{m['rthroughput']:7.1f} {m['cycles']:7.1f} {b:9.1f} {c:7.1f}")
+    print(f"{'total':18s} {'':6s} {'':6s} {'':6s} {'':9s} {'':7s} {'':7s} {total_b:9.1f} "
+          f"{total_s:7.1f}")
+    print("stack: instructions of the loop that load or store a stack slot (spilled "
+          "registers); bound: llvm-mca's block reciprocal throughput (the ports alone), sim: "
+          "its simulated cycles an iteration; /vs: per voxel-step")
+    if args.json:
+        report.update(total_bound=total_b, total_sim=total_s)
+        print(json.dumps(report))
+    if tmp is not None:
+        tmp.cleanup()
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
