@@ -18,6 +18,14 @@ model; ``profile_engine.py --cycles`` measures what the pass takes.
 The in-place build has the line tables where Python's compiler flags carry -g (they
 usually do); where they do not, a copy of the tree is built with CFLAGS=-g.
 
+LLVM 14's model of ``sapphirerapids`` is Skylake-server's (its resources are named
+SKXPort0-7: two load ports where Sapphire Rapids has three, one store-data port where it
+has two), so the floors are those of the older core and, for load-heavy loops, above the
+newer one's. ``--calibrate`` also times a chain of dependent integer additions (one core
+cycle each) against the time-stamp counter, which ``profile_engine.py --cycles`` counts in:
+core cycles per TSC cycle, to put the two in one unit (the clock under 512-bit code may
+be lower).
+
 A loop with a branch inside (the geometry's rows-or-gather choice, the scatter's
 voxel-2 force) is analysed as one straight run of both paths: its floor is an upper
 bound of the path taken. Needs ``objdump`` (binutils) and ``llvm-mca`` (LLVM) on the
@@ -213,6 +221,44 @@ def _geometry_paths(rows, best) -> None:
     best["  gather path"] = (arithmetic + gathers, rows[s][0])
 
 
+CLOCK_C = r"""
+#include <stdio.h>
+#include <x86intrin.h>
+int main(void)
+{
+    unsigned long long x = 1, y = 3, best = ~0ull;
+    const long n = 50000000;
+    for (int rep = 0; rep < 5; rep++) {
+        unsigned long long t0 = __rdtsc();
+        for (long i = 0; i < n; i++)  /* 8 dependent additions: 8 core cycles */
+            __asm__ volatile("add %1, %0\n\tadd %1, %0\n\tadd %1, %0\n\tadd %1, %0\n\t"
+                             "add %1, %0\n\tadd %1, %0\n\tadd %1, %0\n\tadd %1, %0"
+                             : "+r"(x) : "r"(y));
+        unsigned long long t = __rdtsc() - t0;
+        if (t < best)
+            best = t;
+    }
+    printf("%.4f\n", 8.0 * n / (double)best);
+    return (int)(x & 1);
+}
+"""
+
+
+def core_cycles_per_tsc() -> float | None:
+    """Core cycles per time-stamp-counter cycle (the fastest of 5 timings), or None
+    without a C compiler."""
+    cc = shutil.which("cc") or shutil.which("gcc")
+    if cc is None:
+        return None
+    with tempfile.TemporaryDirectory() as tmp:
+        src, exe = Path(tmp) / "clock.c", Path(tmp) / "clock"
+        src.write_text(CLOCK_C)
+        if subprocess.run([cc, "-O2", str(src), "-o", str(exe)], capture_output=True).returncode:
+            return None
+        out = subprocess.run([str(exe)], capture_output=True, text=True).stdout
+    return float(out) if out.strip() else None
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--build", type=Path, default=ROOT,
@@ -220,6 +266,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--cpu", default="sapphirerapids", help="llvm-mca's core model")
     ap.add_argument("--links-per-voxel", type=float, default=540 / 216,
                     help="links a voxel-step (the 6^3 reference robot: 540 / 216)")
+    ap.add_argument("--calibrate", action="store_true",
+                    help="also measure core cycles per time-stamp-counter cycle")
     ap.add_argument("--json", action="store_true", help="print one JSON object as the last line")
     args = ap.parse_args(argv)
     for tool in ("objdump", "llvm-mca"):
@@ -266,6 +314,11 @@ def main(argv: list[str] | None = None) -> int:
     print("stack: instructions of the loop that load or store a stack slot (spilled "
           "registers); bound: llvm-mca's block reciprocal throughput (the ports alone), sim: "
           "its simulated cycles an iteration; /vs: per voxel-step")
+    if args.calibrate:
+        ratio = core_cycles_per_tsc()
+        report["core_cycles_per_tsc"] = ratio
+        print("core cycles per time-stamp-counter cycle: "
+              + (f"{ratio:.3f} (a chain of dependent additions)" if ratio else "no C compiler"))
     if args.json:
         report.update(total_bound=total_b, total_sim=total_s)
         print(json.dumps(report))
