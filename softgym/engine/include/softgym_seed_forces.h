@@ -71,6 +71,16 @@ static void SOFTGYM_FNAME(
         T ra1x = (a1x - l3) * inv_dt, ra1y = (a1y - l4) * inv_dt;
         T ra1z = (a1z - l5) * inv_dt, ra2x = (a2x - l6) * inv_dt;
         T ra2y = (a2y - l7) * inv_dt, ra2z = (a2z - l8) * inv_dt;
+        /* the memory updated at once (the old values' registers free for what follows) */
+        link_last[li] = SOFTGYM_FPICK(changed, l0, P0);
+        link_last[n + li] = SOFTGYM_FPICK(changed, l1, P1);
+        link_last[2 * n + li] = SOFTGYM_FPICK(changed, l2, P2);
+        link_last[3 * n + li] = SOFTGYM_FPICK(changed, l3, a1x);
+        link_last[4 * n + li] = SOFTGYM_FPICK(changed, l4, a1y);
+        link_last[5 * n + li] = SOFTGYM_FPICK(changed, l5, a1z);
+        link_last[6 * n + li] = SOFTGYM_FPICK(changed, l6, a2x);
+        link_last[7 * n + li] = SOFTGYM_FPICK(changed, l7, a2y);
+        link_last[8 * n + li] = SOFTGYM_FPICK(changed, l8, a2z);
         T ca = cs_[li], cb2 = cs_[n + li];
         T ca2 = cs_[2 * n + li], cb3 = cs_[3 * n + li];
         T d1x = f1x + bz * (ca * vx);
@@ -89,15 +99,6 @@ static void SOFTGYM_FNAME(
         T e2x = m2x + bzh * (ca2 * (ra2x - ra1x));
         T e2y = m2y + bzh * (cb2 * vz + cb3 * (ra1y + two * ra2y));
         T e2z = m2z + bzh * (-cb2 * vy + cb3 * (ra1z + two * ra2z));
-        link_last[li] = SOFTGYM_FPICK(changed, l0, P0);
-        link_last[n + li] = SOFTGYM_FPICK(changed, l1, P1);
-        link_last[2 * n + li] = SOFTGYM_FPICK(changed, l2, P2);
-        link_last[3 * n + li] = SOFTGYM_FPICK(changed, l3, a1x);
-        link_last[4 * n + li] = SOFTGYM_FPICK(changed, l4, a1y);
-        link_last[5 * n + li] = SOFTGYM_FPICK(changed, l5, a1z);
-        link_last[6 * n + li] = SOFTGYM_FPICK(changed, l6, a2x);
-        link_last[7 * n + li] = SOFTGYM_FPICK(changed, l7, a2y);
-        link_last[8 * n + li] = SOFTGYM_FPICK(changed, l8, a2z);
         /* (x, y, z) stays where c holds, else becomes (dx, dy, dz) */
 #define SOFTGYM_KEEP3(c, x, y, z, dx, dy, dz) do { \
             x = SOFTGYM_FPICK(c, x, dx); \
