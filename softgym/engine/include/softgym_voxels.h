@@ -49,19 +49,19 @@ static inline softgym_v8 softgym_v8_load(const double *a)
 #define SOFTGYM_V8_EQ(a, b) _mm512_cmp_pd_mask((__m512d)(a), (__m512d)(b), _CMP_EQ_OQ)
 
 
-/* the block's records as rows: velocity, position, external force, force, moment; 0 when
-   a voxel of the block is fixed (the scalar loop's case) */
+/* the block's records as rows: velocity, position, external force, force; 0 when a voxel
+   of the block is fixed (the scalar loop's case). The moment is loaded by softgym_v8_finish,
+   where it is used (its rows' registers free for the floor's arithmetic before) */
 #define SOFTGYM_VOXELS8_LOAD \
     long long fx_; \
     memcpy(&fx_, fixed + i, sizeof fx_); \
     if (fx_ != 0) \
         return 0; \
-    softgym_v8 v0, v1, v2, p0, p1, p2, F0, F1, F2, M0, M1, M2, E0, E1, E2; \
+    softgym_v8 v0, v1, v2, p0, p1, p2, F0, F1, F2, E0, E1, E2; \
     softgym_v8_load3(vel + 3 * i, &v0, &v1, &v2); \
     softgym_v8_load3(pos + 3 * i, &p0, &p1, &p2); \
     softgym_v8_load3(ext + 3 * i, &E0, &E1, &E2); \
     softgym_v8_load4(force + 4 * i, &F0, &F1, &F2); \
-    softgym_v8_load4(moment + 4 * i, &M0, &M1, &M2); \
     softgym_v8 cg = softgym_v8_load(c_global + i), m = softgym_v8_load(mass + i)
 
 /* the largest lane of v above *best, as the scalar loop's "if v > best" (NaN never) */
@@ -80,9 +80,10 @@ static inline void softgym_v8_raise_max(softgym_v8 v, double *best)
    stores, the drift and speed maxima, the angular velocity; returns 1 */
 static inline int softgym_v8_finish(SOFTGYM_VOXELS8_PARAMS, softgym_v8 v0, softgym_v8 v1,
                                     softgym_v8 v2, softgym_v8 p0, softgym_v8 p1, softgym_v8 p2,
-                                    softgym_v8 f0, softgym_v8 f1, softgym_v8 f2, softgym_v8 M0,
-                                    softgym_v8 M1, softgym_v8 M2)
+                                    softgym_v8 f0, softgym_v8 f1, softgym_v8 f2)
 {
+    softgym_v8 M0, M1, M2;
+    softgym_v8_load4(moment + 4 * i, &M0, &M1, &M2);
     softgym_v8 h = dt * softgym_v8_load(inv_mass + i);
     softgym_v8 vx = v0 + (f0 * h), vy = v1 + (f1 * h), vz = v2 + (f2 * h);
     softgym_v8 px = p0 + (vx * dt), py = p1 + (vy * dt), pz = p2 + (vz * dt);
@@ -121,8 +122,7 @@ static inline int softgym_v8_finish(SOFTGYM_VOXELS8_PARAMS, softgym_v8 v0, softg
     return 1;
 }
 #define SOFTGYM_VOXELS8_FINISH \
-    return softgym_v8_finish(SOFTGYM_VOXELS8_ARGS, v0, v1, v2, p0, p1, p2, f0, f1, f2, M0, \
-                             M1, M2)
+    return softgym_v8_finish(SOFTGYM_VOXELS8_ARGS, v0, v1, v2, p0, p1, p2, f0, f1, f2)
 
 /* model 0 (integrate_seed): 1 when voxels i..i+7 were stepped, 0 when nothing was
    written (a fixed voxel in the block, or a runaway one) */
