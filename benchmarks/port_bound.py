@@ -49,7 +49,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 # the inlined functions each pass's instructions come from (objdump -l names them);
 # helpers shared by several passes (the record/row transposes) count for none
-PASSES = {
+SEED_PASSES = {
     "geometry": ("softgym_seed_geom_ax", "softgym_seed_gather", "softgym_seed_gather4",
                  "softgym_seed_rows8"),
     "modes": ("softgym_seed_modes",),
@@ -59,13 +59,23 @@ PASSES = {
     "scatter": ("softgym_seed_scatter_ax",),
     "voxel update": ("softgym_seed_voxels8", "softgym_v8_finish"),
 }
+COROT_PASSES = {
+    "links": ("softgym_corot_links_ax", "softgym_corot_gather4"),
+    "scatter": ("softgym_corot_scatter",),
+    "voxel update": ("softgym_corot_voxels8", "softgym_v8_finish"),
+}
 # the geometry's two paths for 8 links: the voxels' records loaded as rows (a loop of its
 # own while the runs last) and gathered (the rest of the loop around it)
 GEOMETRY_PATHS = ("  rows path", "  gather path")
+# per model: its passes, its link module, the voxel loop's symbol (the lanes inlined there)
+MODELS = {
+    "seed": (SEED_PASSES, "_seed", "integrate_integrate_seed"),
+    "corotational": (COROT_PASSES, "_corotational", "integrate_integrate_corotational"),
+}
 # what one iteration of a pass's main loop handles: links, except the voxel update
-PER_ITERATION = {"geometry": 8, "  rows path": 8, "  gather path": 8, "modes": 8, "frames (float)": 16, "forces (float)": 16,
-                 "scatter": 1, "voxel update": 8}
-MODULES = ("_seed", "_integrate")
+PER_ITERATION = {"geometry": 8, "  rows path": 8, "  gather path": 8, "modes": 8,
+                 "frames (float)": 16, "forces (float)": 16, "scatter": 1, "voxel update": 8,
+                 "links": 4}
 
 
 def build_copy(dest: Path) -> Path:
@@ -123,10 +133,10 @@ def innermost_loops(rows):
             if not any(s <= s2 and e2 <= e and (s2, e2) != (s, e) for s2, e2 in loops)]
 
 
-def pass_of(rows, s, e) -> str | None:
+def pass_of(rows, s, e, passes) -> str | None:
     counts = collections.Counter()
     for _a, _sym, fn, _t in rows[s:e + 1]:
-        for name, fns in PASSES.items():
+        for name, fns in passes.items():
             if fn in fns:
                 counts[name] += 1
     if not counts:
@@ -161,27 +171,28 @@ def loop_body(rows, s, e) -> list[str]:
     return [text for _a, _sym, _fn, text in rows[s:e + 1] if not text.startswith(SKIP)]
 
 
-def find_loops(tree: Path) -> dict[str, tuple] | None:
+def find_loops(tree: Path, model: str = "seed") -> dict[str, tuple] | None:
     """Each pass's largest innermost loop in the x86-64-v4 build of `tree` (None: no
     such build; empty: no line tables to attribute the loops by)."""
+    passes, link_module, voxel_symbol = MODELS[model]
     best: dict[str, tuple] = {}
-    for mod in MODULES:
+    for mod in (link_module, "_integrate"):
         sos = sorted((tree / "softgym" / "engine" / "_x86_64_v4").glob(f"{mod}.*.so"))
         if not sos:
             return None
         rows = disassemble(sos[0])
         if mod == "_integrate":
             # the voxel update's lanes are straight code (8 voxels a block) inlined into
-            # the seed model's voxel loop: its instructions there, as one block
+            # the model's voxel loop: its instructions there, as one block
             body = [t for _a, sym, fn, t in rows
-                    if sym.endswith("integrate_integrate_seed")
-                    and (fn in PASSES["voxel update"] or fn.startswith(VOXEL_HELPERS))]
+                    if sym.endswith(voxel_symbol)
+                    and (fn in passes["voxel update"] or fn.startswith(VOXEL_HELPERS))]
             body = [t for t in body if not t.startswith(SKIP)]
             if body:
                 best["voxel update"] = (body, 0)
             continue
         for s, e in innermost_loops(rows):
-            name = pass_of(rows, s, e)
+            name = pass_of(rows, s, e, passes)
             body = loop_body(rows, s, e)
             if name and (name not in best or len(body) > len(best[name][0])):
                 best[name] = (body, rows[s][0])
@@ -264,6 +275,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--build", type=Path, default=ROOT,
                     help="a tree built in place (default: this one)")
     ap.add_argument("--cpu", default="sapphirerapids", help="llvm-mca's core model")
+    ap.add_argument("--model", choices=tuple(MODELS), default="seed",
+                    help="the preset whose passes are analysed")
     ap.add_argument("--links-per-voxel", type=float, default=540 / 216,
                     help="links a voxel-step (the 6^3 reference robot: 540 / 216)")
     ap.add_argument("--calibrate", action="store_true",
@@ -275,22 +288,26 @@ def main(argv: list[str] | None = None) -> int:
             print(f"port_bound: {tool} is not on the PATH", file=sys.stderr)
             return 2
     tmp = None
-    best = find_loops(args.build)
+    best = find_loops(args.build, args.model)
     if best is None:
         print(f"port_bound: no x86-64-v4 build under {args.build} (python setup.py "
               "build_ext --inplace on an x86-64 machine builds one)", file=sys.stderr)
         return 2
     if not best:  # no line tables: a copy built with -g
         tmp = tempfile.TemporaryDirectory()
-        best = find_loops(build_copy(Path(tmp.name))) or {}
-    print(f"llvm-mca -mcpu={args.cpu}: each pass's main loop in the x86-64-v4 build (the "
+        best = find_loops(build_copy(Path(tmp.name)), args.model) or {}
+    print(f"llvm-mca -mcpu={args.cpu}, {args.model} preset: each pass's main loop in the "
+          f"x86-64-v4 build (the "
           f"voxel update: its 8-voxel block); core cycles an iteration and per voxel-step at "
           f"{args.links_per_voxel:.2f} links a voxel")
     print(f"{'pass':18s} {'insns':>6s} {'stack':>6s} {'uops':>6s} {'per iter':>9s} "
           f"{'bound':>7s} {'sim':>7s} {'bound/vs':>9s} {'sim/vs':>7s}")
     total_b = total_s = 0.0
-    report = {"cpu": args.cpu, "links_per_voxel": args.links_per_voxel, "passes": {}}
-    for name in ("geometry", *GEOMETRY_PATHS, *list(PASSES)[1:]):
+    report = {"cpu": args.cpu, "model": args.model, "links_per_voxel": args.links_per_voxel,
+              "passes": {}}
+    passes = MODELS[args.model][0]
+    names = ("geometry", *GEOMETRY_PATHS, *list(passes)[1:]) if args.model == "seed" else passes
+    for name in names:
         if name not in best:
             print(f"{name:18s} (loop not found)")
             continue

@@ -42,6 +42,18 @@ def test_every_pass_has_a_loop_and_a_floor_under_its_simulated_cycles():
         p["bound_per_voxel_step"] for k, p in passes.items() if not k.endswith("path")))
 
 
+@pytest.mark.skipif(shutil.which("llvm-mca") is None or shutil.which("objdump") is None
+                    or not any(V4.glob("_corotational.*")),
+                    reason="needs llvm-mca, objdump and the x86-64-v4 build")  # fmt: skip
+def test_the_corotational_preset_has_its_own_passes():
+    res = _run("--model", "corotational", "--json")
+    assert res.returncode == 0, res.stderr
+    out = json.loads(res.stdout.strip().splitlines()[-1])
+    assert out["model"] == "corotational"
+    assert set(out["passes"]) == {"links", "scatter", "voxel update"}
+    assert all(0.0 < p["bound"] <= p["sim"] for p in out["passes"].values())
+
+
 def test_a_tree_without_a_build_is_refused_in_one_line(tmp_path):
     if shutil.which("llvm-mca") is None or shutil.which("objdump") is None:
         pytest.skip("needs llvm-mca and objdump")
