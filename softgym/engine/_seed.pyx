@@ -214,7 +214,7 @@ cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end,
                                        float64_t inv_dt) noexcept nogil:
     # links_seed's frames and forces passes in single precision
     # (SimConfig.link_precision = "single"; include/softgym_seed.h): the chunk's float
-    # rows in b.chunk_out from the frames, double rows of b.chunk_out from the forces for
+    # rows in b.chunk_f32 from the frames, double rows of b.chunk_out from the forces for
     # the scatter (links lo..end: one chunk)
     cdef:
         intp_t li
@@ -276,15 +276,15 @@ cdef inline void _seed_frames_forces(Batch* b, intp_t lo, intp_t end,
 
 
 cdef inline intp_t _seed_geom_modes(Batch* b, int ax, intp_t lo, intp_t hi, intp_t n,
-                                   float64_t* o) noexcept nogil:
+                                   float64_t* o, intp_t vend) noexcept nogil:
     # the geometry and the modes of links lo..hi along axis ax, the modes while
     # the geometry's rows are in the cache: hi, or the first strained link
     cdef:
         intp_t end
         unsigned long long t0
     t0 = softgym_prof_tsc()
-    softgym_seed_geom(ax, lo, hi, n, b.v1, b.v2, b.vox_start[b.n_robots], b.pos, b.quat,
-                      b.scale, o)
+    # vend: the robot's voxels end there (the geometry reads no other robot's records)
+    softgym_seed_geom(ax, lo, hi, n, b.v1, b.v2, vend, b.pos, b.quat, b.scale, o)
     softgym_prof_add(0, t0)
     t0 = softgym_prof_tsc()
     end = softgym_seed_modes(lo, hi, n, b.max_strain * b.L, SMALL_ANGLE_W, SMALLISH_ANGLE_W,
@@ -360,7 +360,7 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
             a0 = max(c0, run[ax])
             a1 = min(c1, run[ax + 1])
             if a0 < a1:
-                end = _seed_geom_modes(b, ax, a0, a1, n, o)
+                end = _seed_geom_modes(b, ax, a0, a1, n, o, b.vox_start[r + 1])
                 if end < a1:
                     break  # a strained link: the links after it stay as they were
                 end = c1
