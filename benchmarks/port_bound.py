@@ -1,4 +1,4 @@
-"""Static port bound of the seed step's hot loops (llvm-mca), against the measured cycles.
+"""Static port bound of the engine's hot loops (llvm-mca), against the measured cycles.
 
 The VM this project runs on exposes no hardware counters (``perf`` offers software
 events only), so whether a pass is bound by its instructions or by something else
@@ -11,9 +11,10 @@ iteration needs at best. Divided by the links (or voxels) an iteration handles a
 scaled to a voxel-step of the reference robot, that is the pass's floor on that core
 model; ``profile_engine.py --cycles`` measures what the pass takes.
 
-    python benchmarks/port_bound.py                  # the in-place build
+    python benchmarks/port_bound.py                  # the in-place build, seed preset
+    python benchmarks/port_bound.py --model corotational
     python benchmarks/port_bound.py --build DIR      # another tree, built in place
-    python benchmarks/port_bound.py --cpu icelake-server
+    python benchmarks/port_bound.py --cpu icelake-server --calibrate --json
 
 The in-place build has the line tables where Python's compiler flags carry -g (they
 usually do); where they do not, a copy of the tree is built with CFLAGS=-g.
@@ -26,9 +27,10 @@ cycle each) against the time-stamp counter, which ``profile_engine.py --cycles``
 core cycles per TSC cycle, to put the two in one unit (the clock under 512-bit code may
 be lower).
 
-A loop with a branch inside (the geometry's rows-or-gather choice, the scatter's
-voxel-2 force) is analysed as one straight run of both paths: its floor is an upper
-bound of the path taken. Needs ``objdump`` (binutils) and ``llvm-mca`` (LLVM) on the
+A loop with a branch inside (the scatter's voxel-2 force) is analysed as one straight
+run of both paths: its floor is an upper bound of the path taken. The seed geometry's
+paths are reported apart (its rows path is a loop of its own; its gather path is taken
+as the rows loop's arithmetic with the gathers in place of the rows' loads). Needs ``objdump`` (binutils) and ``llvm-mca`` (LLVM) on the
 PATH; the numbers are a model's, not a measurement.
 """
 
