@@ -47,6 +47,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from tree_run import build_tree, copy_tree
+
 ROOT = Path(__file__).resolve().parent.parent
 
 # the inlined functions each pass's instructions come from (objdump -l names them);
@@ -81,17 +83,10 @@ PER_ITERATION = {"geometry": 8, "  rows path": 8, "  gather path": 8, "modes": 8
 
 
 def build_copy(dest: Path) -> Path:
-    """A copy of the working tree's tracked files, built in place with -g."""
-    files = subprocess.run(["git", "ls-files", "-z"], cwd=ROOT, capture_output=True,
-                           check=True).stdout.decode().split("\0")
-    for f in filter(None, files):
-        src = ROOT / f
-        if src.is_file():
-            (dest / f).parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(src, dest / f)
-    env = dict(os.environ, CFLAGS=(os.environ.get("CFLAGS", "") + " -g").strip())
-    subprocess.run([sys.executable, "setup.py", "build_ext", "--inplace"], cwd=dest, env=env,
-                   check=True, capture_output=True)
+    """A copy of the working tree, built in place with -g (line tables)."""
+    copy_tree(dest)
+    cflags = (os.environ.get("CFLAGS", "") + " -g").strip()
+    build_tree(dest, {"CFLAGS": cflags}, "port_bound", "the build with -g")
     return dest
 
 

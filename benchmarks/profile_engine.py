@@ -49,7 +49,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from tree_run import run_in_tree
+from tree_run import build_tree, copy_tree, run_in_tree
 
 HERE = Path(__file__).resolve().parent
 
@@ -154,17 +154,6 @@ CYCLE_ROWS = (
 )
 
 
-def _tree_copy(dest: Path) -> None:
-    """The repository's tracked and untracked (not ignored) files, copied to ``dest``."""
-    root = HERE.parent
-    listed = subprocess.run(["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"],
-                            cwd=root, capture_output=True, check=True).stdout  # fmt: skip
-    for rel in listed.decode().split("\0"):
-        if rel and (root / rel).is_file():
-            (dest / rel).parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(root / rel, dest / rel)
-
-
 def _ref_copy(dest: Path, ref: str) -> None:
     """The files of git revision ``ref`` (``git archive``), extracted into ``dest``."""
     root = HERE.parent
@@ -173,14 +162,6 @@ def _ref_copy(dest: Path, ref: str) -> None:
     if archive.returncode != 0:
         raise SystemExit(f"profile_engine: git archive {ref}: {archive.stderr.decode().strip()}")
     subprocess.run(["tar", "-x", "-C", str(dest)], input=archive.stdout, check=True)
-
-
-def _probed_build(tree: Path) -> None:
-    env = dict(os.environ, SOFTGYM_PROFILE_CYCLES="1")
-    res = subprocess.run([sys.executable, "setup.py", "build_ext", "--inplace"], cwd=tree,
-                         env=env, capture_output=True, text=True, check=False)  # fmt: skip
-    if res.returncode != 0:
-        raise SystemExit(f"profile_engine: the probed build failed:\n{res.stderr[-2000:]}")
 
 
 def _total(counts: dict) -> int:
@@ -206,13 +187,13 @@ def profile_cycles(collisions: bool, seconds: float, n: int, repeats: int,
     with tempfile.TemporaryDirectory(prefix="softgym-cycles-") as tmp:
         trees = [Path(tmp) / "tree"]
         trees[0].mkdir()
-        _tree_copy(trees[0])
+        copy_tree(trees[0])
         if baseline is not None:
             trees.append(Path(tmp) / "baseline")
             trees[1].mkdir()
             _ref_copy(trees[1], baseline)
         for tree in trees:
-            _probed_build(tree)
+            build_tree(tree, {"SOFTGYM_PROFILE_CYCLES": "1"}, "profile_engine", "the probed build")
         runs: list[list[dict]] = [[] for _ in trees]
         for _ in range(repeats):
             for tree, out in zip(trees, runs):

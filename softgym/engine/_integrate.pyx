@@ -244,7 +244,7 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
             _spin(b, i, dt, mx, my, mz)
         lo = hi
     dmax2[0] = dmax
-    _orient(b, vs, b.vox_start[r + 1], dt, 0)
+    _orient(b, vs, ve, dt, 0)
     return STATUS_OK
 
 
@@ -336,7 +336,7 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
             _spin(b, i, dt, mx, my, mz)
         lo = hi
     dmax2[0] = dmax
-    _orient(b, vs, b.vox_start[r + 1], dt, 1)
+    _orient(b, vs, ve, dt, 1)
     if track_speed:
         b.col_vmax[r] = sqrt(vmax2)
     return STATUS_OK

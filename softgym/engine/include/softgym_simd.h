@@ -121,23 +121,6 @@ static inline void softgym_v8_store3(double *a, softgym_v8 x, softgym_v8 y, soft
     _mm512_storeu_pd(a + 8, o1);
     _mm512_storeu_pd(a + 16, o2);
 }
-/* 8 voxels' rows of 4 (a[0..31]) as rows x, y, z (lane 3 of each record dropped) */
-static inline void softgym_v8_load4(const double *a, softgym_v8 *x, softgym_v8 *y,
-                                    softgym_v8 *z)
-{
-    __m512d p0 = _mm512_loadu_pd(a), p1 = _mm512_loadu_pd(a + 8);
-    __m512d p2 = _mm512_loadu_pd(a + 16), p3 = _mm512_loadu_pd(a + 24);
-    /* from p0, p1: x0 x1 x2 x3 y0 y1 y2 y3; z0 z1 z2 z3 _ */
-    const __m512i ixy = _mm512_set_epi64(8 + 5, 8 + 1, 5, 1, 8 + 4, 8 + 0, 4, 0);
-    const __m512i iz = _mm512_set_epi64(0, 0, 0, 0, 8 + 6, 8 + 2, 6, 2);
-    __m512d a01 = _mm512_permutex2var_pd(p0, ixy, p1), a23 = _mm512_permutex2var_pd(p2, ixy, p3);
-    __m512d z01 = _mm512_permutex2var_pd(p0, iz, p1), z23 = _mm512_permutex2var_pd(p2, iz, p3);
-    const __m512i lo = _mm512_set_epi64(8 + 3, 8 + 2, 8 + 1, 8 + 0, 3, 2, 1, 0);
-    const __m512i hi = _mm512_set_epi64(8 + 7, 8 + 6, 8 + 5, 8 + 4, 7, 6, 5, 4);
-    *x = (softgym_v8)_mm512_permutex2var_pd(a01, lo, a23);
-    *y = (softgym_v8)_mm512_permutex2var_pd(a01, hi, a23);
-    *z = (softgym_v8)_mm512_permutex2var_pd(z01, lo, z23);
-}
 /* 8 voxels' records of 4 (a[0..31]) as its 4 rows r[0..3] (element 0 .. 3 of each) */
 static inline void softgym_v8_load4x4(const double *a, softgym_v8 *r)
 {
@@ -154,6 +137,17 @@ static inline void softgym_v8_load4x4(const double *a, softgym_v8 *r)
     r[1] = (softgym_v8)_mm512_permutex2var_pd(a01, hi, b01);
     r[2] = (softgym_v8)_mm512_permutex2var_pd(a23, lo, b23);
     r[3] = (softgym_v8)_mm512_permutex2var_pd(a23, hi, b23);
+}
+/* 8 voxels' rows of 4 (a[0..31]) as rows x, y, z (element 3 of each record dropped: the
+   compiler drops its permute) */
+static inline void softgym_v8_load4(const double *a, softgym_v8 *x, softgym_v8 *y,
+                                    softgym_v8 *z)
+{
+    softgym_v8 r[4];
+    softgym_v8_load4x4(a, r);
+    *x = r[0];
+    *y = r[1];
+    *z = r[2];
 }
 /* whether the 8 indices v[0..7] are v[0], v[0] + 1, ..., v[0] + 7 (a run of records) */
 static inline int softgym_run8(const Py_ssize_t *v)
