@@ -27,8 +27,10 @@ cycle each) against the time-stamp counter, which ``profile_engine.py --cycles``
 core cycles per TSC cycle, to put the two in one unit (the clock under 512-bit code may
 be lower).
 
-A loop with a branch inside (the scatter's voxel-2 force) is analysed as one straight
-run of both paths: its floor is an upper bound of the path taken. The seed geometry's
+A loop with a branch inside (the scatter's carried rows along x) is analysed as one
+straight run of both paths: its floor is an upper bound of the path taken. The seed
+scatter is its AVX-512 loop of 8 links (the links before and after its blocks go one by
+one). The seed geometry's
 paths are reported apart (its rows path is a loop of its own; its gather path is taken
 as the rows loop's arithmetic with the gathers in place of the rows' loads). Needs ``objdump`` (binutils) and ``llvm-mca`` (LLVM) on the
 PATH; the numbers are a model's, not a measurement.
@@ -60,7 +62,8 @@ SEED_PASSES = {
     "frames (float)": ("softgym_seed_frames32_impl", "softgym_rotvec_k32",
                        "softgym_rotvec_k32_acos"),
     "forces (float)": ("softgym_seed_forces32",),
-    "scatter": ("softgym_seed_scatter_ax",),
+    "scatter": ("softgym_seed_scatter_ax", "softgym_seed_scatter8", "softgym_turn8",
+                "softgym_v8_rows4"),
     "voxel update": ("softgym_seed_voxels8", "softgym_v8_finish"),
 }
 COROT_PASSES = {
@@ -78,7 +81,7 @@ MODELS = {
 }
 # what one iteration of a pass's main loop handles: links, except the voxel update
 PER_ITERATION = {"geometry": 8, "  rows path": 8, "  gather path": 8, "modes": 8,
-                 "frames (float)": 16, "forces (float)": 16, "scatter": 1, "voxel update": 8,
+                 "frames (float)": 16, "forces (float)": 16, "scatter": 8, "voxel update": 8,
                  "links": 4}
 
 

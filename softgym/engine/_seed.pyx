@@ -76,7 +76,7 @@ cdef extern from "softgym_seed.h":
     void softgym_seed_geom(int ax, intp_t lo, intp_t hi, intp_t n, const intp_t* v1,
                            const intp_t* v2, intp_t vend, const float64_t* pos,
                            const float64_t* quat,
-                           const float64_t* scale, float64_t* o) noexcept nogil
+                           const float64_t* scale, float64_t* o, float64_t* rr) noexcept nogil
     # (the two frames passes return whether any link needs _seed_frame_one)
     int softgym_seed_frames(intp_t lo, intp_t hi, float64_t sa_rad, float64_t thr,
                             const float64_t* p0_, const float64_t* p1_, const float64_t* p2_,
@@ -100,6 +100,10 @@ cdef extern from "softgym_seed.h":
     void softgym_seed_scatter(int ax, intp_t lo, intp_t hi, const intp_t* v1, const intp_t* v2,
                               const float64_t* rot, const float64_t* o, const float64_t* neg2_row,
                               float64_t* force, float64_t* moment) noexcept nogil
+    # rows of the chunk's scratch that hold voxel 1's rotation (read where
+    # SOFTGYM_SEED_R_USED: the AVX-512 builds' scatter)
+    enum: SOFTGYM_SEED_R_ROWS
+    enum: SOFTGYM_SEED_R_USED
     int softgym_seed_frames32(intp_t lo, intp_t hi, intp_t n, float sa_rad, float w_acos,
                               const float64_t* o, float* f) noexcept nogil
     void softgym_seed_forces32(intp_t lo, intp_t hi, intp_t n, float L, float bz, float bzh,
@@ -276,7 +280,7 @@ cdef inline void _seed_frames_forces(Batch* b, intp_t lo, intp_t end,
 
 
 cdef inline intp_t _seed_geom_modes(Batch* b, int ax, intp_t lo, intp_t hi, intp_t n,
-                                   float64_t* o, intp_t vend) noexcept nogil:
+                                   float64_t* o, intp_t vend, float64_t* rr) noexcept nogil:
     # the geometry and the modes of links lo..hi along axis ax, the modes while
     # the geometry's rows are in the cache: hi, or the first strained link
     cdef:
@@ -284,7 +288,7 @@ cdef inline intp_t _seed_geom_modes(Batch* b, int ax, intp_t lo, intp_t hi, intp
         unsigned long long t0
     t0 = softgym_prof_tsc()
     # vend: the robot's voxels end there (the geometry reads no other robot's records)
-    softgym_seed_geom(ax, lo, hi, n, b.v1, b.v2, vend, b.pos, b.quat, b.scale, o)
+    softgym_seed_geom(ax, lo, hi, n, b.v1, b.v2, vend, b.pos, b.quat, b.scale, o, rr)
     softgym_prof_add(0, t0)
     t0 = softgym_prof_tsc()
     end = softgym_seed_modes(lo, hi, n, b.max_strain * b.L, SMALL_ANGLE_W, SMALLISH_ANGLE_W,
@@ -346,6 +350,9 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
         int ax
         float64_t inv_dt = 1.0 / b.dt[r]
         float64_t* o = b.link_out
+        # the geometry's rotation rows for the scatter (NULL: not used in this build)
+        float64_t* rr = (b.chunk_out + SOFTGYM_SEED_R_ROWS * SOFTGYM_CHUNK_STRIDE
+                         if SOFTGYM_SEED_R_USED else NULL)
         unsigned long long t0
     if hi <= lo:
         return STATUS_OK
@@ -360,7 +367,7 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
             a0 = max(c0, run[ax])
             a1 = min(c1, run[ax + 1])
             if a0 < a1:
-                end = _seed_geom_modes(b, ax, a0, a1, n, o, b.vox_start[r + 1])
+                end = _seed_geom_modes(b, ax, a0, a1, n, o, b.vox_start[r + 1], rr - c0 if rr != NULL else NULL)
                 if end < a1:
                     break  # a strained link: the links after it stay as they were
                 end = c1

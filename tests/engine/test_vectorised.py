@@ -29,7 +29,7 @@ FLAGS = ["-O3", "-ffp-contract=fast", "-fno-math-errno", "-fno-trapping-math",
 
 # one call per pass (the headers' functions are static: only the called one is compiled)
 PASSES = {
-    "softgym_seed_geom": "softgym_seed_geom(ax, 0, n, n, ip, ip, n, d, d, d, o);",
+    "softgym_seed_geom": "softgym_seed_geom(ax, 0, n, n, ip, ip, n, d, d, d, o, o);",
     "softgym_seed_frames": "softgym_seed_frames(0, n, 0.01, 0.002, d, d, d, d, d, d, d, d, d, d, "
                            "o, o, o, o, o, o, o, o, o, o, o, o);",
     "softgym_seed_forces": "softgym_seed_forces(0, n, n, 0.01, 0.1, 0.05, 1e4, d, n, d, d, d, d, d, "
@@ -121,16 +121,29 @@ typedef long Py_ssize_t;
 #include "softgym_seed.h"
 /* links along each axis through softgym_seed_geom (the hand-vectorised loop with its
    three ways of loading the voxels: runs, windows of 16, gathers; and its remainder)
-   against SOFTGYM_SEED_GEOM_LINK, one link at a time */
+   against SOFTGYM_SEED_GEOM_LINK, one link at a time; and, run a chunk at a time as the
+   engine does, the rotation rows it leaves for the scatter against voxel 1's matrix */
 static double urand(void) { return rand() / (double)RAND_MAX - 0.5; }
+static double rr[SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE];
 SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, Py_ssize_t n, const Py_ssize_t *v1,
                                     const Py_ssize_t *v2, Py_ssize_t nv, const double *pos,
                                     const double *quat, const double *sc, double *o, double *r)
 {
-    softgym_seed_geom(ax, 0, n, n, v1, v2, nv, pos, quat, sc, o);
+    long bad = 0;
+    for (Py_ssize_t c0 = 0; c0 < n; c0 += SOFTGYM_CHUNK_LINKS) {
+        Py_ssize_t c1 = c0 + SOFTGYM_CHUNK_LINKS < n ? c0 + SOFTGYM_CHUNK_LINKS : n;
+        double *R = rr + SOFTGYM_SEED_R_ROWS * SOFTGYM_CHUNK_STRIDE;
+        softgym_seed_geom(ax, c0, c1, n, v1, v2, nv, pos, quat, sc, o, R - c0);
+        for (Py_ssize_t li = c0; li < c1; li++) {
+            double m[9];
+            softgym_quat_matrix(quat + 4 * v1[li], m);
+            for (int k = 0; k < 9; k++)
+                bad += memcmp(&m[k], R + k * SOFTGYM_CHUNK_STRIDE + li - c0, sizeof(double)) != 0;
+        }
+    }
+    softgym_seed_geom(ax, 0, n, n, v1, v2, nv, pos, quat, sc, o, (double *)0);
     SOFTGYM_SEED_GEOM_AXIS(ax);
     SOFTGYM_SEED_GEOM_OUT(r, n);
-    long bad = 0;
     for (Py_ssize_t li = 0; li < n; li++) {
         Py_ssize_t i = v1[li], j = v2[li];
         const double *qi = quat + 4 * i, *qj = quat + 4 * j;
@@ -272,3 +285,79 @@ def test_hand_vectorised_corotational_kernel_is_the_formula_bit_for_bit(level, t
 def test_hand_vectorised_geometry_is_the_formula_bit_for_bit(level, tmp_path):
     out = _run_harness(level, HARNESS, tmp_path)
     assert out == "0", f"{out} of {3 * 3 * 10 * 203} geometry values differ"
+
+
+SCATTER_HARNESS = r"""
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+typedef long Py_ssize_t;
+#include "softgym_seed.h"
+/* one chunk's links scattered by softgym_seed_scatter (with AVX-512: blocks of 8 turned in
+   the lanes with the geometry's rotation rows, the links before and after them one by
+   one) against softgym_seed_scatter_links (every link one by one, voxel 1's matrix from
+   rot): the voxels' forces and moments (lanes 0-2 of their rows; lane 3 is padding) */
+static double urand(void) { return rand() / (double)RAND_MAX - 0.5; }
+enum { NV = 300, N = SOFTGYM_CHUNK_LINKS };
+static double rot[9 * NV], f_a[4 * NV], m_a[4 * NV], f_b[4 * NV], m_b[4 * NV], neg2[N];
+static double chunk[SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE] __attribute__((aligned(64)));
+static Py_ssize_t v1[N], v2[N];
+SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi)
+{
+    for (int k = 0; k < 12 * SOFTGYM_CHUNK_STRIDE; k++)
+        chunk[k] = urand();
+    for (Py_ssize_t li = 0; li < N; li++) {
+        neg2[li] = rand() % 3 == 0 ? 0.0 : 1.0;
+        for (int k = 0; k < 9; k++)
+            chunk[(SOFTGYM_SEED_R_ROWS + k) * SOFTGYM_CHUNK_STRIDE + li] = rot[9 * v1[li] + k];
+    }
+    for (int k = 0; k < 4 * NV; k++) {
+        f_a[k] = f_b[k] = urand();
+        m_a[k] = m_b[k] = urand();
+    }
+    softgym_seed_scatter(ax, lo, hi, v1, v2, rot, chunk, neg2, f_a, m_a);
+    SOFTGYM_BY_AXIS(ax, softgym_seed_scatter_links, lo, hi, v1, v2, rot, chunk, neg2, f_b, m_b);
+    long bad = 0;
+    for (int i = 0; i < NV; i++)
+        for (int c = 0; c < 3; c++)
+            bad += (memcmp(&f_a[4 * i + c], &f_b[4 * i + c], sizeof(double)) != 0)
+                   + (memcmp(&m_a[4 * i + c], &m_b[4 * i + c], sizeof(double)) != 0);
+    return bad;
+}
+int main(void)
+{
+    for (int i = 0; i < NV; i++) {
+        double q[4], s = 0.0;
+        for (int k = 0; k < 4; k++) { q[k] = urand(); s += q[k] * q[k]; }
+        for (int k = 0; k < 4; k++) q[k] /= sqrt(s);
+        softgym_quat_matrix(q, rot + 9 * i);
+    }
+    long bad = 0;
+    for (int pattern = 0; pattern < 3; pattern++) {
+        for (int li = 0; li < N; li++) {
+            if (pattern == 0) {  /* rows along x: runs of 5 links, voxel 2 the next voxel 1 */
+                v1[li] = li + li / 5;
+                v2[li] = v1[li] + 1;
+            } else if (pattern == 1) {  /* along y of a 6-wide lattice */
+                v1[li] = li % 30 + 36 * (li / 30);
+                v2[li] = v1[li] + 6;
+            } else {  /* any voxels, distinct within the link */
+                v1[li] = rand() % NV;
+                v2[li] = (v1[li] + 1 + rand() % (NV - 1)) % NV;
+            }
+        }
+        for (int ax = 0; ax < 3; ax++) {
+            bad += check_ax(ax, 0, N);
+            bad += check_ax(ax, 3, N - 5);  /* links one by one before and after the blocks */
+        }
+    }
+    printf("%ld\n", bad);
+    return 0;
+}
+"""
+
+
+@pytest.mark.parametrize("level", ["x86-64-v3", "x86-64-v4"])
+def test_scatter_in_blocks_is_the_link_by_link_scatter_bit_for_bit(level, tmp_path):
+    out = _run_harness(level, SCATTER_HARNESS, tmp_path)
+    assert out == "0", f"{out} of {3 * 3 * 2 * 2 * 3 * 300} voxel components differ"

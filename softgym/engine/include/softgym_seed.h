@@ -19,7 +19,15 @@
    that consecutive rows start on different cache sets) */
 #define SOFTGYM_CHUNK_LINKS 128
 #define SOFTGYM_CHUNK_STRIDE (SOFTGYM_CHUNK_LINKS + 8)
-#define SOFTGYM_CHUNK_ROWS 12
+#define SOFTGYM_CHUNK_ROWS 21
+/* rows 12-20 of those: voxel 1's rotation matrix, row-major, from the geometry (AVX-512
+   builds: softgym_seed_scatter8 turns the forces with it) */
+#define SOFTGYM_SEED_R_ROWS 12
+#if defined(__AVX512F__) && (defined(__GNUC__) || defined(__clang__))
+#define SOFTGYM_SEED_R_USED 1
+#else
+#define SOFTGYM_SEED_R_USED 0
+#endif
 /* the single-precision frames pass leaves a chunk's 12 float rows (P0, P1, P2, a1y, a1z,
    a2x, a2y, a2z, rw, ry, rz, fix) SOFTGYM_CHUNK_FSTRIDE floats apart (each row on a cache
    line of its own, consecutive rows on different sets), so the frames and forces passes
@@ -62,14 +70,20 @@
    below and benchmarks/dense_links_probe.c share it */
 #define SOFTGYM_SEED_GEOM_LINK(li, dx, dy, dz, w, x, y, z, wj, xj, yj, zj, si, sj) \
     SOFTGYM_SEED_GEOM_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, li, dx, dy, dz, w, x, y, z, \
-                             wj, xj, yj, zj, si, sj)
+                             wj, xj, yj, zj, si, sj, (double *)0)
 /* the same for any arithmetic type T (double, or a vector of doubles: then links li ..
    li + lanes - 1 at once, SQRT and FABS T's square root and absolute value, PUT(row,
-   li, v) storing v at row + li) */
+   li, v) storing v at row + li); rr not NULL: also voxel 1's rotation matrix, element k
+   in row rr + k SOFTGYM_CHUNK_STRIDE (the chunk's rows that softgym_seed_scatter8 turns
+   the forces with) */
 #define SOFTGYM_SEED_GEOM_LINK_T(T, SQRT, FABS, PUT, li, dx, dy, dz, w, x, y, z, wj, xj, yj, \
-                                 zj, si, sj) do { \
+                                 zj, si, sj, rr) do { \
         T geo_R[9]; \
         SOFTGYM_QUAT_MATRIX(w, x, y, z, geo_R); \
+        if ((rr) != 0) { \
+            for (int geo_k = 0; geo_k < 9; geo_k++) \
+                PUT((rr) + geo_k * SOFTGYM_CHUNK_STRIDE, li, geo_R[geo_k]); \
+        } \
         /* relative position in voxel 1's frame (column a of its rotation . d) */ \
         T geo_p0 = (((geo_R[a0] * (dx)) + (geo_R[3 + a0] * (dy))) + (geo_R[6 + a0] * (dz))); \
         T geo_p1 = (s1 * (((geo_R[a1] * (dx)) + (geo_R[3 + a1] * (dy))) + (geo_R[6 + a1] * (dz)))); \
@@ -166,7 +180,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_scalar(const int ax, Py_ssize_t lo,
                                                     Py_ssize_t n, const Py_ssize_t *v1,
                                                     const Py_ssize_t *v2, const double *pos,
                                                     const double *quat, const double *scale,
-                                                    double *o)
+                                                    double *o, double *rr)
 {
     SOFTGYM_SEED_GEOM_AXIS(ax);
     SOFTGYM_SEED_GEOM_OUT(o, n);
@@ -177,7 +191,8 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_scalar(const int ax, Py_ssize_t lo,
         SOFTGYM_DIFF3(pos, i, j, dx, dy, dz);
         double w = quat[4 * i], x = quat[4 * i + 1], y = quat[4 * i + 2], z = quat[4 * i + 3];
         double wj = quat[4 * j], xj = quat[4 * j + 1], yj = quat[4 * j + 2], zj = quat[4 * j + 3];
-        SOFTGYM_SEED_GEOM_LINK(li, dx, dy, dz, w, x, y, z, wj, xj, yj, zj, scale[i], scale[j]);
+        SOFTGYM_SEED_GEOM_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, li, dx, dy, dz, w, x, y, z,
+                                 wj, xj, yj, zj, scale[i], scale[j], rr);
     }
 }
 SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
@@ -185,7 +200,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
                                                 const Py_ssize_t *v2, Py_ssize_t vend,
                                                 const double *pos,
                                                 const double *quat, const double *scale,
-                                                double *o)
+                                                double *o, double *rr)
 {
     Py_ssize_t li = lo;
 #if defined(SOFTGYM_VLANES)
@@ -200,7 +215,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
     while (al < hi && ((uintptr_t)(o + al) & 63) != 0)
         al++;
     if (al + SOFTGYM_VLANES <= hi) {
-        softgym_seed_geom_scalar(ax, lo, al, n, v1, v2, pos, quat, scale, o);
+        softgym_seed_geom_scalar(ax, lo, al, n, v1, v2, pos, quat, scale, o, rr);
         li = al;
     }
     for (; li + SOFTGYM_VLANES <= hi; li += SOFTGYM_VLANES) {
@@ -220,19 +235,25 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
         softgym_vd dx = gj[0] - gi[0], dy = gj[1] - gi[1], dz = gj[2] - gi[2];
         SOFTGYM_SEED_GEOM_LINK_T(softgym_vd, SOFTGYM_VSQRT, softgym_vabs, SOFTGYM_VPUT, li, dx,
                                  dy, dz, gi[3], gi[4], gi[5], gi[6], gj[3], gj[4], gj[5], gj[6],
-                                 gi[7], gj[7]);
+                                 gi[7], gj[7], rr);
     }
 #endif
     /* the rest (and every link without AVX): the compiler's vectoriser */
-    softgym_seed_geom_scalar(ax, li, hi, n, v1, v2, pos, quat, scale, o);
+    softgym_seed_geom_scalar(ax, li, hi, n, v1, v2, pos, quat, scale, o, rr);
 }
-/* vend: the end of the voxel records (voxel indices below it may be read) */
+/* vend: the end of the voxel records (voxel indices below it may be read); rr: the
+   chunk's rotation rows (SOFTGYM_SEED_R_ROWS), indexed by link, or NULL */
 static void softgym_seed_geom(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
                               const Py_ssize_t *v1, const Py_ssize_t *v2, Py_ssize_t vend,
                               const double *pos, const double *quat, const double *scale,
-                              double *o)
+                              double *o, double *rr)
 {
-    SOFTGYM_BY_AXIS(ax, softgym_seed_geom_ax, lo, hi, n, v1, v2, vend, pos, quat, scale, o);
+    if (rr != NULL)
+        SOFTGYM_BY_AXIS(ax, softgym_seed_geom_ax, lo, hi, n, v1, v2, vend, pos, quat, scale, o,
+                        rr);
+    else
+        SOFTGYM_BY_AXIS(ax, softgym_seed_geom_ax, lo, hi, n, v1, v2, vend, pos, quat, scale, o,
+                        (double *)0);
 }
 
 /* The frames pass of links_seed, in C for one pragma: the bond-frame
@@ -647,11 +668,12 @@ typedef long long softgym_v4i __attribute__((vector_size(32)));
             SOFTGYM_SCATTER_TURN(fj, x, y, z); \
         } \
     } while (0)
-SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
-                                                   const Py_ssize_t *v1, const Py_ssize_t *v2,
-                                                   const double *rot, const double *o,
-                                                   const double *neg2_row, double *force,
-                                                   double *moment)
+SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_links(const int ax, Py_ssize_t lo,
+                                                      Py_ssize_t hi, const Py_ssize_t *v1,
+                                                      const Py_ssize_t *v2, const double *rot,
+                                                      const double *o,
+                                                      const double *neg2_row, double *force,
+                                                      double *moment)
 {
     const Py_ssize_t n = SOFTGYM_CHUNK_STRIDE;
     Py_ssize_t li;
@@ -739,6 +761,130 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
 #undef SOFTGYM_SCATTER_W
 #undef SOFTGYM_SCATTER_V4
 #undef SOFTGYM_NEG1
+
+#if defined(__AVX512F__) && (defined(__GNUC__) || defined(__clang__))
+#define SOFTGYM_SCATTER8 1
+/* the 8 links' vectors (x, y, z) in the lanes of x, y, z as the links' rows of 4 (x, y,
+   z, z; lane 3 is the accumulators' padding), two links to a register: link k's in half
+   k / 4 of out[k % 4] (SOFTGYM_ROW4) */
+static inline void softgym_v8_rows4(softgym_v8 x, softgym_v8 y, softgym_v8 z, __m512d *out)
+{
+    __m512d t0 = _mm512_unpacklo_pd((__m512d)x, (__m512d)y);  /* x0 y0 x2 y2 x4 y4 x6 y6 */
+    __m512d t1 = _mm512_unpackhi_pd((__m512d)x, (__m512d)y);  /* x1 y1 x3 y3 x5 y5 x7 y7 */
+    out[0] = _mm512_permutex2var_pd(t0, _mm512_set_epi64(12, 12, 5, 4, 8, 8, 1, 0), (__m512d)z);
+    out[1] = _mm512_permutex2var_pd(t1, _mm512_set_epi64(13, 13, 5, 4, 9, 9, 1, 0), (__m512d)z);
+    out[2] = _mm512_permutex2var_pd(t0, _mm512_set_epi64(14, 14, 7, 6, 10, 10, 3, 2),
+                                    (__m512d)z);
+    out[3] = _mm512_permutex2var_pd(t1, _mm512_set_epi64(15, 15, 7, 6, 11, 11, 3, 2),
+                                    (__m512d)z);
+}
+#define SOFTGYM_ROW4(w, k) \
+    ((k) < 4 ? _mm512_castpd512_pd256((w)[(k) % 4]) : _mm512_extractf64x4_pd((w)[(k) % 4], 1))
+/* R1 P^T v of the 8 links in the lanes, v's bond-frame components in v[0..2] (P^T and
+   the first column's sign as in softgym_seed_scatter_links: component c is R[3c] x +
+   R[3c+1] y + R[3c+2] z in that order, with R[3c] negated for the y and z links), as the
+   links' rows of 4 */
+SOFTGYM_ALWAYS_INLINE void softgym_turn8(const int ax, const softgym_v8 *R, const softgym_v8 *v,
+                                         __m512d *out)
+{
+    softgym_v8 x = ax == 0 ? v[0] : (ax == 1 ? v[1] : v[2]);
+    softgym_v8 y = ax == 1 ? v[0] : v[1];
+    softgym_v8 z = ax == 2 ? v[0] : v[2];
+    softgym_v8 wx = R[0] * x + R[1] * y + R[2] * z;
+    softgym_v8 wy = R[3] * x + R[4] * y + R[5] * z;
+    softgym_v8 wz = R[6] * x + R[7] * y + R[8] * z;
+    softgym_v8_rows4(wx, wy, wz, out);
+}
+/* link k's turned vectors w added to its voxels' rows: voxel 1's force f1, moment m1,
+   voxel 2's f2, m2; along x, where a link's voxel 1 is the last link's voxel 2, its rows
+   come from the registers just stored rather than loads that would wait on those stores */
+#define SOFTGYM_ADD1(k) do { \
+        Py_ssize_t i_ = 4 * v1[li + (k)], j_ = 4 * v2[li + (k)]; \
+        __m256d af_, am_; \
+        if (ax == 0 && (k) > 0 && i_ == pj) { \
+            af_ = cf; \
+            am_ = cm; \
+        } else { \
+            af_ = _mm256_load_pd(force + i_); \
+            am_ = _mm256_load_pd(moment + i_); \
+        } \
+        _mm256_store_pd(force + i_, _mm256_add_pd(af_, SOFTGYM_ROW4(wf1, k))); \
+        _mm256_store_pd(moment + i_, _mm256_add_pd(am_, SOFTGYM_ROW4(wm1, k))); \
+        cf = _mm256_add_pd(_mm256_load_pd(force + j_), SOFTGYM_ROW4(wf2, k)); \
+        cm = _mm256_add_pd(_mm256_load_pd(moment + j_), SOFTGYM_ROW4(wm2, k)); \
+        _mm256_store_pd(force + j_, cf); \
+        _mm256_store_pd(moment + j_, cm); \
+        pj = j_; \
+    } while (0)
+/* softgym_seed_scatter_links for the 8 links li..li + 7 (q = o + li on a cache line):
+   the turns in the lanes of AVX-512 with voxel 1's rotation from the geometry's rows
+   (SOFTGYM_SEED_R_ROWS), the same IEEE operations as the per-link turns, then each link's
+   4 turned vectors added to its voxels' rows, link after link: each voxel's sum in the
+   same order. Where voxel 2 takes -F1 (neg2_row), its force is the turn of -F1: exactly
+   minus F1's, and adding it is subtracting F1's */
+SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter8(const int ax, Py_ssize_t li,
+                                                 const Py_ssize_t *v1, const Py_ssize_t *v2,
+                                                 const double *o, const double *neg2_row,
+                                                 double *force, double *moment)
+{
+    const Py_ssize_t n = SOFTGYM_CHUNK_STRIDE;
+    const double *q = o + li;
+    softgym_v8 R[9], a[3], b[3];
+    for (int k = 0; k < 9; k++)
+        R[k] = softgym_v8_load(q + (SOFTGYM_SEED_R_ROWS + k) * n);
+    if (ax != 0) {
+        R[0] = -R[0];
+        R[3] = -R[3];
+        R[6] = -R[6];
+    }
+    __mmask8 neg2 = _mm512_cmpneq_epi64_mask(_mm512_loadu_si512((const void *)(neg2_row + li)),
+                                             _mm512_setzero_si512());
+    __m512d wf1[4], wf2[4], wm1[4], wm2[4];
+    for (int c = 0; c < 3; c++) {
+        a[c] = softgym_v8_load(q + c * n);
+        b[c] = (softgym_v8)_mm512_mask_blend_pd(neg2, (__m512d)softgym_v8_load(q + (3 + c) * n),
+                                                (__m512d)(-a[c]));
+    }
+    softgym_turn8(ax, R, a, wf1);
+    softgym_turn8(ax, R, b, wf2);
+    for (int c = 0; c < 3; c++) {
+        a[c] = softgym_v8_load(q + (6 + c) * n);
+        b[c] = softgym_v8_load(q + (9 + c) * n);
+    }
+    softgym_turn8(ax, R, a, wm1);
+    softgym_turn8(ax, R, b, wm2);
+    __m256d cf = _mm256_setzero_pd(), cm = cf;
+    Py_ssize_t pj = -1;
+    SOFTGYM_ADD1(0);
+    SOFTGYM_ADD1(1);
+    SOFTGYM_ADD1(2);
+    SOFTGYM_ADD1(3);
+    SOFTGYM_ADD1(4);
+    SOFTGYM_ADD1(5);
+    SOFTGYM_ADD1(6);
+    SOFTGYM_ADD1(7);
+}
+#endif
+/* links lo..hi along ax: blocks of 8 whose rows start on a cache line through
+   softgym_seed_scatter8 (with AVX-512), the others link by link */
+SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
+                                                   const Py_ssize_t *v1, const Py_ssize_t *v2,
+                                                   const double *rot, const double *o,
+                                                   const double *neg2_row, double *force,
+                                                   double *moment)
+{
+#if defined(SOFTGYM_SCATTER8)
+    Py_ssize_t al = lo;
+    while (al < hi && ((uintptr_t)(o + al) & 63) != 0)
+        al++;
+    if (al + 8 <= hi) {
+        softgym_seed_scatter_links(ax, lo, al, v1, v2, rot, o, neg2_row, force, moment);
+        for (lo = al; lo + 8 <= hi; lo += 8)
+            softgym_seed_scatter8(ax, lo, v1, v2, o, neg2_row, force, moment);
+    }
+#endif
+    softgym_seed_scatter_links(ax, lo, hi, v1, v2, rot, o, neg2_row, force, moment);
+}
 
 static void softgym_seed_scatter(int ax, Py_ssize_t lo, Py_ssize_t hi, const Py_ssize_t *v1,
                                  const Py_ssize_t *v2, const double *rot, const double *o,

@@ -83,6 +83,13 @@ typedef double softgym_vd __attribute__((vector_size(64)));
    updates (softgym_voxels.h) and the link geometry of a run of voxels (softgym_seed.h) */
 typedef double softgym_v8 __attribute__((vector_size(64)));
 /* 8 voxels' records of 3 (a[0..23]) as rows x, y, z */
+/* 8 consecutive doubles from a */
+static inline softgym_v8 softgym_v8_load(const double *a)
+{
+    softgym_v8 v;
+    memcpy(&v, a, sizeof v);
+    return v;
+}
 static inline void softgym_v8_load3(const double *a, softgym_v8 *x, softgym_v8 *y,
                                     softgym_v8 *z)
 {

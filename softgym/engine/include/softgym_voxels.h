@@ -36,12 +36,6 @@
 #if defined(__AVX512F__) && (defined(__GNUC__) || defined(__clang__))
 #define SOFTGYM_VOXELS8 1
 
-static inline softgym_v8 softgym_v8_load(const double *a)
-{
-    softgym_v8 v;
-    memcpy(&v, a, sizeof v);
-    return v;
-}
 #define SOFTGYM_V8_PICK(m, a, b) ((softgym_v8)_mm512_mask_blend_pd((m), (__m512d)(b), (__m512d)(a)))
 #define SOFTGYM_V8_LT(a, b) _mm512_cmp_pd_mask((__m512d)(a), (__m512d)(b), _CMP_LT_OQ)
 #define SOFTGYM_V8_LE(a, b) _mm512_cmp_pd_mask((__m512d)(a), (__m512d)(b), _CMP_LE_OQ)
