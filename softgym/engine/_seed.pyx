@@ -325,8 +325,11 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     #                        seed's damping from the link's memory; rq^-1 for
     #                        large angles) into the 12 rows of b.chunk_out
     #   softgym_seed_scatter back to the world, scattered in link order (once
-    #                        per axis)
-    # The passes run over one chunk of SOFTGYM_CHUNK_LINKS links at a time (128),
+    #                        per axis; with AVX-512, 8 links at a time turned in
+    #                        the lanes with voxel 1's rotation, which the geometry
+    #                        leaves in rows 12-20 of b.chunk_out: rr)
+    # The passes run over one chunk of SOFTGYM_CHUNK_LINKS links at a time (64; 128
+    # before the scatter took voxel 1's rotation from 9 more rows of the chunk),
     # all of them before the next chunk: a chunk's scratch rows stay in the L1
     # cache from the geometry to the scatter (the whole robot's 25 rows, 108 KB
     # for the reference robot, did not), and the forces pass's rows, one chunk's,

@@ -16,8 +16,9 @@
    pass leaves a chunk's forces and moments in 12 rows of their own, SOFTGYM_CHUNK_STRIDE
    doubles apart (a compile-time constant: the scatter addresses all 12 from one pointer,
    where a run-time stride took a register per row and spilled; 8 more than the chunk, so
-   that consecutive rows start on different cache sets) */
-#define SOFTGYM_CHUNK_LINKS 128
+   that consecutive rows start on different cache sets). 64 links: with the rotation rows
+   below, chunks of 128 overflowed the L1 cache (1.6 % slower on an Intel Xeon) */
+#define SOFTGYM_CHUNK_LINKS 64
 #define SOFTGYM_CHUNK_STRIDE (SOFTGYM_CHUNK_LINKS + 8)
 #define SOFTGYM_CHUNK_ROWS 21
 /* rows 12-20 of those: voxel 1's rotation matrix, row-major, from the geometry (AVX-512
