@@ -28,7 +28,8 @@ from softgym.engine._batch cimport (Batch, STATUS_OK, STATUS_STRAIN, STATUS_NONF
 from softgym.engine._contact cimport (Contacts, contacts_corotational, contacts_seed, collide,
                                       collide_obstacles)
 from softgym.engine._corotational cimport links_corotational
-from softgym.engine._integrate cimport integrate_corotational, integrate_seed, clear_robot
+from softgym.engine._integrate cimport (integrate_corotational, integrate_seed, clear_robot,
+                                       refresh_robot_rotations)
 from softgym.engine._record cimport record, robot_aux, robot_energy
 from softgym.engine._prof cimport (softgym_prof_enabled, softgym_prof_tsc, softgym_prof_add,
                                    softgym_prof_get, softgym_prof_reset)
@@ -177,6 +178,9 @@ cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
         b.steps[r] += 1
         record(b, r)
         softgym_prof_add(4, t0)
+    # the rotation matrices, where the seed step leaves them (its scatter takes voxel 1's
+    # from the geometry): up to date whenever the kernel returns
+    refresh_robot_rotations(b, r)
     return status
 
 

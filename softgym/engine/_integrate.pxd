@@ -11,6 +11,9 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
     # positions of the last candidate rebuild, NULL: none). Returns a STATUS_*.
 cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
                         float64_t* dmax2) noexcept nogil
-    # model 0 (the seed's EulerStep), same contract.
+    # model 0 (the seed's EulerStep), same contract, except rot where the build's seed
+    # step does not read it (SOFTGYM_SEED_R_USED): then refresh_robot_rotations.
+cdef void refresh_robot_rotations(Batch* b, intp_t r) noexcept nogil
+    # robot r's rot from its quat where integrate_seed leaves it (else nothing)
 cdef void clear_robot(Batch* b, intp_t r) noexcept nogil
     # zero robot r's force and moment scratch (after an early exit)

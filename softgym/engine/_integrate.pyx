@@ -20,6 +20,10 @@ cdef float64_t RUNAWAY = 1.0e6  # |coordinate| (m) beyond which a robot diverged
 cdef extern from "softgym_simd.h":
     # R = the rotation matrix of the unit quaternion q = (w, x, y, z), row-major
     void _rotation_matrix "softgym_quat_matrix" (const float64_t* q, float64_t* R) noexcept nogil
+    # 1 where the seed model's step does not read the voxels' rotation matrices (its
+    # scatter takes voxel 1's from the geometry's rows): the seed voxel update does not
+    # store them, refresh_robot_rotations does at the end of advance_robot
+    enum: SOFTGYM_SEED_R_USED
     # |v|^2 with the same bits in every build that inlines it
     float64_t speed_squared "softgym_speed2" (float64_t vx, float64_t vy, float64_t vz) noexcept nogil
 
@@ -30,12 +34,15 @@ cdef inline void _fluid_drag(Batch* b, intp_t i, float64_t* f) noexcept nogil:
     # -fluid_drag s^2 (v.n)^2 n (fluid_drag = rho C_d / 2); a face moving away
     # takes none. Applied at the voxel's centre. IN/OUT: f.
     cdef:
-        const float64_t* R = b.rot + 9 * i
+        float64_t R[9]
         const float64_t* v = b.vel + 3 * i
         float64_t k = b.fluid_drag * b.scale[i] * b.scale[i]
         float64_t vn, g
         int32 a, bit
         int32 exposed = b.faces[i]
+    # the voxel's rotation matrix from its quaternion (the bits b.rot holds where it is
+    # kept up to date: the seed step may leave it to the end of advance_robot)
+    _rotation_matrix(b.quat + 4 * i, R)
     for a in range(3):
         vn = v[0] * R[a] + v[1] * R[3 + a] + v[2] * R[6 + a]
         bit = 2 * a + 1 if vn > 0.0 else 2 * a
@@ -270,7 +277,19 @@ cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int
         softgym_seed_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
     else:
         softgym_corot_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
-    softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat, b.rot)
+    # (the seed model's rotation matrices: refresh_robot_rotations, where its step does
+    # not read them)
+    softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat,
+                         NULL if seed and SOFTGYM_SEED_R_USED else b.rot)
+
+
+cdef void refresh_robot_rotations(Batch* b, intp_t r) noexcept nogil:
+    # robot r's rotation matrices from its quaternions (where the seed step leaves them)
+    cdef intp_t i
+    if not SOFTGYM_SEED_R_USED:
+        return
+    for i in range(b.vox_start[r], b.vox_start[r + 1]):
+        _rotation_matrix(b.quat + 4 * i, b.rot + 9 * i)
 
 
 cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,

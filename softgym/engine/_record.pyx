@@ -9,6 +9,11 @@ from softgym.engine._contact cimport box_penetration
 from softgym.engine._typedefs cimport float64_t, intp_t, int32
 
 
+cdef extern from "softgym_simd.h":
+    # R = the rotation matrix of the unit quaternion q = (w, x, y, z), row-major
+    void _rotation_matrix "softgym_quat_matrix" (const float64_t* q, float64_t* R) noexcept nogil
+
+
 cdef void robot_cm(Batch* b, intp_t r, float64_t* out) noexcept nogil:
     # OUT: out[0:3] = mass-weighted centre of the robot's voxels (m).
     cdef:
@@ -32,6 +37,7 @@ cdef void robot_aux(Batch* b, intp_t r, float64_t* out) noexcept nogil:
         intp_t i, k
         intp_t be = b.body_end[r]
         float64_t m, mo = 0.0
+        float64_t R[9]
     for k in range(N_AUX):
         out[k] = 0.0
     out[5] = b.pos[3 * b.vox_start[r]]
@@ -41,8 +47,11 @@ cdef void robot_aux(Batch* b, intp_t r, float64_t* out) noexcept nogil:
     out[9] = b.pos[3 * b.vox_start[r] + 2]
     for i in range(b.vox_start[r], be):
         m = b.mass[i]
-        out[3] += m * b.rot[9 * i]
-        out[4] += m * b.rot[9 * i + 3]
+        # the heading from the quaternion (rot is not up to date within a seed step's
+        # run where the build's seed step does not read it): the same bits
+        _rotation_matrix(b.quat + 4 * i, R)
+        out[3] += m * R[0]
+        out[4] += m * R[3]
         if b.pos[3 * i] < out[5]:
             out[5] = b.pos[3 * i]
         if b.pos[3 * i] > out[6]:

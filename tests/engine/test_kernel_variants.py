@@ -144,3 +144,25 @@ def test_a_normal_build_has_no_cycle_probes():
     assert _seed.cycle_counts() is None
     assert _core.CYCLE_STAGES == ("contacts", "links", "collide", "integrate", "drive_record")
     assert len(_seed.CYCLE_PASSES) == 6
+
+
+@pytest.mark.parametrize("model", ["seed", "corotational"])
+def test_the_rotation_matrices_are_their_quaternions_whenever_the_kernel_returns(model):
+    # the seed step of the AVX-512 build does not read or store the voxels' rotation
+    # matrices (its scatter takes voxel 1's from the geometry); advance_robot stores them
+    # before it returns, so every reader outside a step sees its quaternions' matrices
+    from softgym.design import default_walker
+    from softgym.engine import SimConfig, Simulation, _core
+
+    sim = Simulation(default_walker().to_body(origin=(0.0, 0.0, 0.02)),
+                     SimConfig(model=model), n_threads=1)  # fmt: skip
+    state = sim.get_state()  # the voxels spun a little, each its own way
+    state["angvel"][:] = np.random.default_rng(3).normal(0.0, 20.0, state["angvel"].shape)
+    sim.set_state(state)
+    for seconds in (0.05, 0.2):
+        sim.advance(seconds)
+        quat = np.array(sim.get_state()["quat"])
+        assert np.abs(quat[:, 1:]).max() > 1e-4  # the voxels turned
+        expect = np.empty((quat.shape[0], 9))
+        _core.refresh_rotations(np.ascontiguousarray(quat), expect)
+        np.testing.assert_array_equal(sim.get_state()["rot"], expect)

@@ -70,7 +70,7 @@ static void softgym_corot_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, doub
 }
 
 /* voxels lo..hi but the fixed: the new quaternions from the rows q_out into quat, and their
-   rotation matrices into rot (softgym_quat_matrix_wxyz, from registers). Scalar stores: GCC
+   rotation matrices into rot (softgym_quat_matrix_wxyz, from registers; rot NULL: none). Scalar stores: GCC
    packed each matrix into a 512-bit register with seven shuffles and stored it across
    two cache lines (a voxel's matrix is 72 bytes), and on an Intel Xeon the loop waited on
    that (perf annotate) */
@@ -90,7 +90,8 @@ static void softgym_orient_store(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, con
         qq[1] = x;
         qq[2] = y;
         qq[3] = z;
-        softgym_quat_matrix_wxyz(w, x, y, z, rot + 9 * i);
+        if (rot != NULL)
+            softgym_quat_matrix_wxyz(w, x, y, z, rot + 9 * i);
     }
 }
 

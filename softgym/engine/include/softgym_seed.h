@@ -24,11 +24,6 @@
 /* rows 12-20 of those: voxel 1's rotation matrix, row-major, from the geometry (AVX-512
    builds: softgym_seed_scatter8 turns the forces with it) */
 #define SOFTGYM_SEED_R_ROWS 12
-#if defined(__AVX512F__) && (defined(__GNUC__) || defined(__clang__))
-#define SOFTGYM_SEED_R_USED 1
-#else
-#define SOFTGYM_SEED_R_USED 0
-#endif
 /* the single-precision frames pass leaves a chunk's 12 float rows (P0, P1, P2, a1y, a1z,
    a2x, a2y, a2z, rw, ry, rz, fix) SOFTGYM_CHUNK_FSTRIDE floats apart (each row on a cache
    line of its own, consecutive rows on different sets), so the frames and forces passes
@@ -688,8 +683,19 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_links(const int ax, Py_ssize_t l
 #endif
     for (li = lo; li < hi; li++) {
         Py_ssize_t i = v1[li], j = v2[li];
+#if SOFTGYM_SEED_R_USED
+        /* the columns from the geometry's rotation rows of the chunk (rot is not kept up
+           to date during a step in these builds) */
+        const double *Rq = o + li + SOFTGYM_SEED_R_ROWS * n;
+        (void)rot;
+        softgym_v4d c0 = {Rq[0], Rq[3 * n], Rq[6 * n], Rq[6 * n]};
+        softgym_v4d c1 = {Rq[n], Rq[4 * n], Rq[7 * n], Rq[7 * n]};
+        softgym_v4d c2 = {Rq[2 * n], Rq[5 * n], Rq[8 * n], Rq[8 * n]};
+        if (ax != 0)
+            c0 = -c0;
+        softgym_v4d w;
+#elif defined(SOFTGYM_SCATTER_V4)
         const double *Rp = rot + 9 * i;
-#if defined(SOFTGYM_SCATTER_V4)
         /* the columns from two row loads and R[8] (lane 3 is padding: the
            rows' padding lane takes what it gets); for the y and z links the
            first column negated instead of the first input, (-c0) a =
@@ -706,7 +712,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_links(const int ax, Py_ssize_t l
         softgym_v4d w;
 #else
         double R[9];
-        memcpy(R, Rp, sizeof R);
+        memcpy(R, rot + 9 * i, sizeof R);
         double w[3];
 #endif
         const double *q = o + li;
@@ -763,7 +769,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_links(const int ax, Py_ssize_t l
 #undef SOFTGYM_SCATTER_V4
 #undef SOFTGYM_NEG1
 
-#if defined(__AVX512F__) && (defined(__GNUC__) || defined(__clang__))
+#if SOFTGYM_SEED_R_USED
 #define SOFTGYM_SCATTER8 1
 /* the 8 links' vectors (x, y, z) in the lanes of x, y, z as the links' rows of 4 (x, y,
    z, z; lane 3 is the accumulators' padding), two links to a register: link k's in half

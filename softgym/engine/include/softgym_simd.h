@@ -253,6 +253,15 @@ static inline softgym_v4 softgym_v4load(const double *row, Py_ssize_t li)
 /* v stored at row[li] (a pass's formula macro on doubles; SOFTGYM_VPUT on vectors) */
 #define SOFTGYM_PUT1(row, li, v) ((row)[li] = (v))
 
+/* 1 where the seed model's step takes each link's rotation of voxel 1 from the geometry's
+   rows (softgym_seed.h: the AVX-512 builds' scatter) and does not read the voxels'
+   rotation matrices: the seed voxel update then leaves them to advance_robot's end */
+#if defined(SOFTGYM_VLANES) && SOFTGYM_VLANES == 8
+#define SOFTGYM_SEED_R_USED 1
+#else
+#define SOFTGYM_SEED_R_USED 0
+#endif
+
 #if defined(_MSC_VER)
 #define SOFTGYM_ALWAYS_INLINE static __forceinline
 #else
