@@ -138,7 +138,7 @@ print("CYCLES", json.dumps(dict(counts=_core.cycle_counts(), steps=int(r.steps[0
       n_voxels=sim.n_voxels, wall=wall, build=kernel_build(), module=_core.__file__)))
 """
 
-#: the rows of the --cycles table: (label, key, indented under "links")
+#: the rows of the --cycles table: (label, key, indented: a part of the stage above it)
 CYCLE_ROWS = (
     ("contacts_seed (collision list)", "contacts", False),
     ("links_seed", "links", False),
@@ -150,6 +150,8 @@ CYCLE_ROWS = (
     ("softgym_seed_scatter", "scatter", True),
     ("collide (contact forces)", "collide", False),
     ("integrate_seed", "integrate", False),
+    ("softgym_seed_voxels8, scalar loop", "voxels", True),
+    ("_orient (quaternions)", "orient", True),
     ("drive, record", "drive_record", False),
 )
 

@@ -40,6 +40,7 @@ from softgym.engine._typedefs cimport float64_t, intp_t, step_t, int32, flag_t, 
 from softgym.engine._integrate import refresh_rotations  # noqa: F401 (Python API)
 from softgym.engine._seed import seed_frames  # noqa: F401 (Python API, for tests)
 from softgym.engine._seed import cycle_counts as seed_cycle_counts
+from softgym.engine._integrate import cycle_counts as integrate_cycle_counts
 
 cnp.import_array()
 
@@ -120,13 +121,15 @@ CYCLE_STAGES = ("contacts", "links", "collide", "integrate", "drive_record")
 
 def cycle_counts(bint reset=False):
     """TSC cycles spent in each stage of the seed model's step (``CYCLE_STAGES``) and in
-    each pass of its links (``_seed.CYCLE_PASSES``) since the last reset, as a dict; None
+    each pass of its links and voxel update (``_seed.CYCLE_PASSES``,
+    ``_integrate.CYCLE_PASSES``) since the last reset, as a dict; None
     unless the engine was built with SOFTGYM_PROFILE_CYCLES (setup.py;
     ``benchmarks/profile_engine.py --cycles`` builds such a copy). One thread only."""
     if not softgym_prof_enabled():
         return None
     out = {name: int(softgym_prof_get(k)) for k, name in enumerate(CYCLE_STAGES)}
     out.update(seed_cycle_counts(reset))
+    out.update(integrate_cycle_counts(reset))
     if reset:
         softgym_prof_reset()
     return out

@@ -12,6 +12,8 @@ from libc.string cimport memset
 
 from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_NONFINITE
 from softgym.engine._contact cimport surface_contact, box_penetration, seed_floor
+from softgym.engine._prof cimport (softgym_prof_enabled, softgym_prof_tsc, softgym_prof_add,
+                                   softgym_prof_get, softgym_prof_reset)
 from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t
 
 cdef float64_t RUNAWAY = 1.0e6  # |coordinate| (m) beyond which a robot diverged
@@ -318,6 +320,7 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
         int32 track_speed = b.self_collision
         intp_t lo, hi
         intp_t ve = b.vox_start[r + 1]
+        unsigned long long t0 = softgym_prof_tsc()
     dmax2[0] = 0.0
     c[0] = 0.0
     c[1] = 0.0
@@ -355,10 +358,29 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
             _spin(b, i, dt, mx, my, mz)
         lo = hi
     dmax2[0] = dmax
+    softgym_prof_add(0, t0)
+    t0 = softgym_prof_tsc()
     _orient(b, vs, ve, dt, 1)
+    softgym_prof_add(1, t0)
     if track_speed:
         b.col_vmax[r] = sqrt(vmax2)
     return STATUS_OK
+
+
+#: the parts of integrate_seed that the cycle probes time, in slot order: the
+#: translation and spin (the vector lanes and the scalar loop), the orientation
+CYCLE_PASSES = ("voxels", "orient")
+
+
+def cycle_counts(bint reset=False):
+    """TSC cycles spent in each of ``CYCLE_PASSES`` since the last reset (a dict), or
+    None when the module was built without SOFTGYM_PROFILE_CYCLES (setup.py)."""
+    if not softgym_prof_enabled():
+        return None
+    out = {name: int(softgym_prof_get(k)) for k, name in enumerate(CYCLE_PASSES)}
+    if reset:
+        softgym_prof_reset()
+    return out
 
 
 def refresh_rotations(float64_t[:, ::1] quat, float64_t[:, ::1] rot):

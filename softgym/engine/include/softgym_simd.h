@@ -82,7 +82,6 @@ typedef double softgym_vd __attribute__((vector_size(64)));
    8 voxels' records (3 or 4 doubles each, consecutive) and rows of 8 lanes, for the voxel
    updates (softgym_voxels.h) and the link geometry of a run of voxels (softgym_seed.h) */
 typedef double softgym_v8 __attribute__((vector_size(64)));
-/* 8 voxels' records of 3 (a[0..23]) as rows x, y, z */
 /* 8 consecutive doubles from a */
 static inline softgym_v8 softgym_v8_load(const double *a)
 {
@@ -90,6 +89,7 @@ static inline softgym_v8 softgym_v8_load(const double *a)
     memcpy(&v, a, sizeof v);
     return v;
 }
+/* 8 voxels' records of 3 (a[0..23]) as rows x, y, z */
 static inline void softgym_v8_load3(const double *a, softgym_v8 *x, softgym_v8 *y,
                                     softgym_v8 *z)
 {
