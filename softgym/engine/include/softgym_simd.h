@@ -145,6 +145,22 @@ static inline void softgym_v8_load4x4(const double *a, softgym_v8 *r)
     r[2] = (softgym_v8)_mm512_permutex2var_pd(a23, lo, b23);
     r[3] = (softgym_v8)_mm512_permutex2var_pd(a23, hi, b23);
 }
+/* rows r[0..3] (element 0 .. 3 of 8 records) back into the 8 records of 4 at a[0..31] */
+static inline void softgym_v8_store4x4(double *a, const softgym_v8 *r)
+{
+    __m512d l01 = _mm512_unpacklo_pd((__m512d)r[0], (__m512d)r[1]);  /* records 0 2 4 6 */
+    __m512d h01 = _mm512_unpackhi_pd((__m512d)r[0], (__m512d)r[1]);  /* records 1 3 5 7 */
+    __m512d l23 = _mm512_unpacklo_pd((__m512d)r[2], (__m512d)r[3]);
+    __m512d h23 = _mm512_unpackhi_pd((__m512d)r[2], (__m512d)r[3]);
+    const __m512i i02 = _mm512_set_epi64(8 + 3, 8 + 2, 3, 2, 8 + 1, 8 + 0, 1, 0);
+    const __m512i i46 = _mm512_set_epi64(8 + 7, 8 + 6, 7, 6, 8 + 5, 8 + 4, 5, 4);
+    __m512d r02 = _mm512_permutex2var_pd(l01, i02, l23), r13 = _mm512_permutex2var_pd(h01, i02, h23);
+    __m512d r46 = _mm512_permutex2var_pd(l01, i46, l23), r57 = _mm512_permutex2var_pd(h01, i46, h23);
+    _mm512_storeu_pd(a, _mm512_shuffle_f64x2(r02, r13, 0x44));       /* records 0, 1 */
+    _mm512_storeu_pd(a + 8, _mm512_shuffle_f64x2(r02, r13, 0xEE));   /* records 2, 3 */
+    _mm512_storeu_pd(a + 16, _mm512_shuffle_f64x2(r46, r57, 0x44));  /* records 4, 5 */
+    _mm512_storeu_pd(a + 24, _mm512_shuffle_f64x2(r46, r57, 0xEE));  /* records 6, 7 */
+}
 /* 8 voxels' rows of 4 (a[0..31]) as rows x, y, z (element 3 of each record dropped: the
    compiler drops its permute) */
 static inline void softgym_v8_load4(const double *a, softgym_v8 *x, softgym_v8 *y,
