@@ -79,10 +79,12 @@ MODELS = {
     "seed": (SEED_PASSES, "_seed", "integrate_integrate_seed"),
     "corotational": (COROT_PASSES, "_corotational", "integrate_integrate_corotational"),
 }
-# what one iteration of a pass's main loop handles: links, except the voxel update
+# what one iteration of a pass's main loop handles: links, except the voxel update (per
+# model where they differ: the seed scatter's loop takes 8 links, the corotational one's 1)
 PER_ITERATION = {"geometry": 8, "  rows path": 8, "  gather path": 8, "modes": 8,
                  "frames (float)": 16, "forces (float)": 16, "scatter": 8, "voxel update": 8,
                  "links": 4}
+PER_ITERATION_OF = {"seed": PER_ITERATION, "corotational": {**PER_ITERATION, "scatter": 1}}
 
 
 def build_copy(dest: Path) -> Path:
@@ -313,7 +315,7 @@ def main(argv: list[str] | None = None) -> int:
             continue
         body, _addr = best[name]
         m = mca(body, args.cpu)
-        per = PER_ITERATION[name]
+        per = PER_ITERATION_OF[args.model][name]
         scale = (1.0 if name == "voxel update" else args.links_per_voxel) / per
         b, c = m["rthroughput"] * scale, m["cycles"] * scale
         stack = sum(bool(re.search(r"\(%r[sb]p\)", t)) for t in body)

@@ -202,12 +202,59 @@ static Py_ssize_t softgym_corot_scatter(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t
                                         const Py_ssize_t *v2, const double *o, double *force,
                                         double *moment)
 {
-    Py_ssize_t li;
+    Py_ssize_t li = lo;
+#if defined(SOFTGYM_VLANES) && SOFTGYM_VLANES == 8
+    /* 8 links at a time with AVX-512 while none of them is strained: their rows turned
+       into each link's rows of 4 in registers (softgym_v8_rows4), then added link after
+       link, as below (the first strained link's block goes link by link) */
+    for (; li + 8 <= hi; li += 8) {
+        __m512d e = _mm512_loadu_pd(o + li);
+        if (_mm512_cmp_pd_mask(e, _mm512_set1_pd(max_ext), _CMP_LE_OQ) != 0xFF)
+            break;
+        __m512d wf[4], w1[4], w2[4];
+        softgym_v8_rows4(softgym_v8_load(o + n + li), softgym_v8_load(o + 2 * n + li),
+                         softgym_v8_load(o + 3 * n + li), wf);
+        softgym_v8_rows4(softgym_v8_load(o + 4 * n + li), softgym_v8_load(o + 5 * n + li),
+                         softgym_v8_load(o + 6 * n + li), w1);
+        softgym_v8_rows4(softgym_v8_load(o + 7 * n + li), softgym_v8_load(o + 8 * n + li),
+                         softgym_v8_load(o + 9 * n + li), w2);
+        __m256d bf = _mm256_setzero_pd(), bm = bf;
+        Py_ssize_t pb = -1;
+#define SOFTGYM_COROT_ADD1(k) do { \
+            Py_ssize_t i_ = 4 * v1[li + (k)], j_ = 4 * v2[li + (k)]; \
+            __m256d f_ = SOFTGYM_ROW4(wf, k); \
+            __m256d af_, am_; \
+            if (i_ == pb) { \
+                af_ = bf; \
+                am_ = bm; \
+            } else { \
+                af_ = _mm256_load_pd(force + i_); \
+                am_ = _mm256_load_pd(moment + i_); \
+            } \
+            bf = _mm256_add_pd(_mm256_load_pd(force + j_), f_); \
+            bm = _mm256_add_pd(_mm256_load_pd(moment + j_), SOFTGYM_ROW4(w2, k)); \
+            _mm256_store_pd(force + j_, bf); \
+            _mm256_store_pd(force + i_, _mm256_sub_pd(af_, f_)); \
+            _mm256_store_pd(moment + i_, _mm256_add_pd(am_, SOFTGYM_ROW4(w1, k))); \
+            _mm256_store_pd(moment + j_, bm); \
+            pb = j_; \
+        } while (0)
+        SOFTGYM_COROT_ADD1(0);
+        SOFTGYM_COROT_ADD1(1);
+        SOFTGYM_COROT_ADD1(2);
+        SOFTGYM_COROT_ADD1(3);
+        SOFTGYM_COROT_ADD1(4);
+        SOFTGYM_COROT_ADD1(5);
+        SOFTGYM_COROT_ADD1(6);
+        SOFTGYM_COROT_ADD1(7);
+#undef SOFTGYM_COROT_ADD1
+    }
+#endif
 #if defined(SOFTGYM_VLANES)
     softgym_v4 cf = {0.0, 0.0, 0.0, 0.0}, cm = cf;
     Py_ssize_t pj = -1;
 #endif
-    for (li = lo; li < hi; li++) {
+    for (; li < hi; li++) {
         if (!(o[li] <= max_ext))
             return li;
         Py_ssize_t i = v1[li], j = v2[li];

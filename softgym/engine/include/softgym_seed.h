@@ -771,22 +771,6 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_links(const int ax, Py_ssize_t l
 
 #if SOFTGYM_SEED_R_USED
 #define SOFTGYM_SCATTER8 1
-/* the 8 links' vectors (x, y, z) in the lanes of x, y, z as the links' rows of 4 (x, y,
-   z, z; lane 3 is the accumulators' padding), two links to a register: link k's in half
-   k / 4 of out[k % 4] (SOFTGYM_ROW4) */
-static inline void softgym_v8_rows4(softgym_v8 x, softgym_v8 y, softgym_v8 z, __m512d *out)
-{
-    __m512d t0 = _mm512_unpacklo_pd((__m512d)x, (__m512d)y);  /* x0 y0 x2 y2 x4 y4 x6 y6 */
-    __m512d t1 = _mm512_unpackhi_pd((__m512d)x, (__m512d)y);  /* x1 y1 x3 y3 x5 y5 x7 y7 */
-    out[0] = _mm512_permutex2var_pd(t0, _mm512_set_epi64(12, 12, 5, 4, 8, 8, 1, 0), (__m512d)z);
-    out[1] = _mm512_permutex2var_pd(t1, _mm512_set_epi64(13, 13, 5, 4, 9, 9, 1, 0), (__m512d)z);
-    out[2] = _mm512_permutex2var_pd(t0, _mm512_set_epi64(14, 14, 7, 6, 10, 10, 3, 2),
-                                    (__m512d)z);
-    out[3] = _mm512_permutex2var_pd(t1, _mm512_set_epi64(15, 15, 7, 6, 11, 11, 3, 2),
-                                    (__m512d)z);
-}
-#define SOFTGYM_ROW4(w, k) \
-    ((k) < 4 ? _mm512_castpd512_pd256((w)[(k) % 4]) : _mm512_extractf64x4_pd((w)[(k) % 4], 1))
 /* R1 P^T v of the 8 links in the lanes, v's bond-frame components in v[0..2] (P^T and
    the first column's sign as in softgym_seed_scatter_links: component c is R[3c] x +
    R[3c+1] y + R[3c+2] z in that order, with R[3c] negated for the y and z links), as the
