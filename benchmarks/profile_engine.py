@@ -243,6 +243,10 @@ def print_cycles_against(p: dict, q: dict, baseline: str) -> None:
     for label, key, sub in [*CYCLE_ROWS, ("total", None, False)]:
         if key is None:
             a, b = _total(p["counts"]) / vp, _total(q["counts"]) / vq
+        elif key not in q["counts"]:  # a part the baseline's probes do not time
+            name = ("  " + label) if sub else label
+            print(f"{name:40s} {p['counts'][key] / vp:10.1f} {'-':>12s} {'':>8s}")
+            continue
         else:
             a, b = p["counts"][key] / vp, q["counts"][key] / vq
         name = ("  " + label) if sub else label
