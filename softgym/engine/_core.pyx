@@ -31,8 +31,7 @@ from softgym.engine._corotational cimport links_corotational
 from softgym.engine._integrate cimport (integrate_corotational, integrate_seed, clear_robot,
                                        refresh_robot_rotations)
 from softgym.engine._record cimport record, robot_aux, robot_energy
-from softgym.engine._prof cimport (softgym_prof_enabled, softgym_prof_tsc, softgym_prof_add,
-                                   softgym_prof_get, softgym_prof_reset)
+from softgym.engine._prof cimport softgym_prof_tsc, softgym_prof_add, prof_counts
 from softgym.engine._seed cimport (links_seed, SOFTGYM_CHUNK_STRIDE, SOFTGYM_CHUNK_ROWS,
                                   SOFTGYM_CHUNK_FSTRIDE, SOFTGYM_CHUNK_FROWS)
 from softgym.engine._typedefs cimport float64_t, intp_t, step_t, int32, flag_t, lane_flag_t
@@ -125,13 +124,10 @@ def cycle_counts(bint reset=False):
     ``_integrate.CYCLE_PASSES``) since the last reset, as a dict; None
     unless the engine was built with SOFTGYM_PROFILE_CYCLES (setup.py;
     ``benchmarks/profile_engine.py --cycles`` builds such a copy). One thread only."""
-    if not softgym_prof_enabled():
-        return None
-    out = {name: int(softgym_prof_get(k)) for k, name in enumerate(CYCLE_STAGES)}
-    out.update(seed_cycle_counts(reset))
-    out.update(integrate_cycle_counts(reset))
-    if reset:
-        softgym_prof_reset()
+    out = prof_counts(CYCLE_STAGES, reset)
+    if out is not None:
+        out.update(seed_cycle_counts(reset))
+        out.update(integrate_cycle_counts(reset))
     return out
 
 

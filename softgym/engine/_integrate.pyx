@@ -12,8 +12,7 @@ from libc.string cimport memset
 
 from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_NONFINITE
 from softgym.engine._contact cimport surface_contact, box_penetration, seed_floor
-from softgym.engine._prof cimport (softgym_prof_enabled, softgym_prof_tsc, softgym_prof_add,
-                                   softgym_prof_get, softgym_prof_reset)
+from softgym.engine._prof cimport softgym_prof_tsc, softgym_prof_add, prof_counts
 from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t
 
 cdef float64_t RUNAWAY = 1.0e6  # |coordinate| (m) beyond which a robot diverged
@@ -375,12 +374,7 @@ CYCLE_PASSES = ("voxels", "orient")
 def cycle_counts(bint reset=False):
     """TSC cycles spent in each of ``CYCLE_PASSES`` since the last reset (a dict), or
     None when the module was built without SOFTGYM_PROFILE_CYCLES (setup.py)."""
-    if not softgym_prof_enabled():
-        return None
-    out = {name: int(softgym_prof_get(k)) for k, name in enumerate(CYCLE_PASSES)}
-    if reset:
-        softgym_prof_reset()
-    return out
+    return prof_counts(CYCLE_PASSES, reset)
 
 
 def refresh_rotations(float64_t[:, ::1] quat, float64_t[:, ::1] rot):

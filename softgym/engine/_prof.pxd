@@ -8,3 +8,14 @@ cdef extern from "softgym_prof.h":
     void softgym_prof_add(int k, unsigned long long t0) noexcept nogil
     unsigned long long softgym_prof_get(int k) noexcept nogil
     void softgym_prof_reset() noexcept nogil
+
+
+cdef inline object prof_counts(tuple names, bint reset):
+    # the calling module's counters (each module has its own) by slot name, as a dict;
+    # None in a build without probes
+    if not softgym_prof_enabled():
+        return None
+    out = {name: int(softgym_prof_get(k)) for k, name in enumerate(names)}
+    if reset:
+        softgym_prof_reset()
+    return out

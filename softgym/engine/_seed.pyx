@@ -39,8 +39,7 @@ cimport numpy as cnp
 import numpy as np
 
 from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_STRAIN, N_LINK_OUT
-from softgym.engine._prof cimport (softgym_prof_enabled, softgym_prof_tsc, softgym_prof_add,
-                                   softgym_prof_get, softgym_prof_reset)
+from softgym.engine._prof cimport softgym_prof_tsc, softgym_prof_add, prof_counts
 from softgym.engine._typedefs cimport float64_t, intp_t, lane_flag_t
 
 cnp.import_array()
@@ -120,12 +119,7 @@ CYCLE_PASSES = ("geometry", "modes", "frames", "frames_acos", "forces", "scatter
 def cycle_counts(bint reset=False):
     """TSC cycles spent in each of ``CYCLE_PASSES`` since the last reset (a dict), or
     None when the module was built without SOFTGYM_PROFILE_CYCLES (setup.py)."""
-    if not softgym_prof_enabled():
-        return None
-    out = {name: int(softgym_prof_get(k)) for k, name in enumerate(CYCLE_PASSES)}
-    if reset:
-        softgym_prof_reset()
-    return out
+    return prof_counts(CYCLE_PASSES, reset)
 
 
 cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n, float* f) noexcept nogil:

@@ -113,17 +113,55 @@ def test_the_portable_build_vectorises_the_hand_vectorised_passes_loops(name, tm
     assert vectorised, f"{name}: GCC vectorised no loop in the portable build"
 
 
-HARNESS = r"""
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-typedef long Py_ssize_t;
-#include "softgym_seed.h"
+def _c_harness(header: str, body: str) -> str:
+    """A C harness's source: the C headers it uses, Python.h's ``Py_ssize_t`` (which Cython
+    includes first), the kernel header ``header``, ``urand()`` (uniform in [-0.5, 0.5]) and
+    ``urand_quat(q)`` (a random unit quaternion; ``URAND_ROT(R)`` its matrix),
+    ``urand_both``, ``link_pattern`` and ``rows_differ`` (the scatters' links, force and
+    moment rows), then ``body``."""
+    return ("#include <stdio.h>\n#include <stdlib.h>\n#include <string.h>\n"
+            "typedef long Py_ssize_t;\n"
+            f'#include "{header}"\n'
+            "static double urand(void) { return rand() / (double)RAND_MAX - 0.5; }\n"
+            "static inline void urand_quat(double *q) {  /* a random unit quaternion */\n"
+            "    double s = 0.0;\n"
+            "    for (int k = 0; k < 4; k++) { q[k] = urand(); s += q[k] * q[k]; }\n"
+            "    for (int k = 0; k < 4; k++) q[k] /= sqrt(s);\n"
+            "}\n"
+            "#define URAND_ROT(R) do { double q_[4]; urand_quat(q_); softgym_quat_matrix(q_, R); } "
+            "while (0)\n"
+            "static inline void urand_both(double *a, double *b, int n) {  /* a = b = random */\n"
+            "    for (int k = 0; k < n; k++) a[k] = b[k] = urand();\n"
+            "}\n"
+            "static inline void link_pattern(int pattern, Py_ssize_t *v1, Py_ssize_t *v2, int n,\n"
+            "                                int nv) {  /* 0: runs along x, 1: along y, 2: any */\n"
+            "    for (int li = 0; li < n; li++) {\n"
+            "        if (pattern == 0) {  /* runs of 5 links, voxel 2 the next link's voxel 1 */\n"
+            "            v1[li] = li + li / 5;\n"
+            "            v2[li] = v1[li] + 1;\n"
+            "        } else if (pattern == 1) {  /* along y of a 6-wide lattice */\n"
+            "            v1[li] = li % 30 + 36 * (li / 30);\n"
+            "            v2[li] = v1[li] + 6;\n"
+            "        } else {  /* any voxels, distinct within the link */\n"
+            "            v1[li] = rand() % nv;\n"
+            "            v2[li] = (v1[li] + 1 + rand() % (nv - 1)) % nv;\n"
+            "        }\n"
+            "    }\n"
+            "}\n"
+            "static inline long rows_differ(const double *a, const double *b, int nv) {\n"
+            "    long bad = 0;  /* lanes 0-2 of nv rows of 4 (lane 3: padding) */\n"
+            "    for (int i = 0; i < nv; i++)\n"
+            "        for (int c = 0; c < 3; c++)\n"
+            "            bad += memcmp(&a[4 * i + c], &b[4 * i + c], sizeof(double)) != 0;\n"
+            "    return bad;\n"
+            "}\n" + body)
+
+
+HARNESS = _c_harness("softgym_seed.h", r"""
 /* links along each axis through softgym_seed_geom (the hand-vectorised loop with its
    three ways of loading the voxels: runs, windows of 16, gathers; and its remainder)
    against SOFTGYM_SEED_GEOM_LINK, one link at a time; and, run a chunk at a time as the
    engine does, the rotation rows it leaves for the scatter against voxel 1's matrix */
-static double urand(void) { return rand() / (double)RAND_MAX - 0.5; }
 static double rr[SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE];
 SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, Py_ssize_t n, const Py_ssize_t *v1,
                                     const Py_ssize_t *v2, Py_ssize_t nv, const double *pos,
@@ -162,9 +200,7 @@ int main(void)
     static Py_ssize_t v1[N], v2[N];
     long bad = 0;
     for (int i = 0; i < NV; i++) {
-        double q[4], s = 0.0;
-        for (int k = 0; k < 4; k++) { q[k] = urand(); s += q[k] * q[k]; }
-        for (int k = 0; k < 4; k++) quat[4 * i + k] = q[k] / sqrt(s);
+        urand_quat(quat + 4 * i);
         for (int k = 0; k < 3; k++) pos[3 * i + k] = 0.01 * (i % 7 + urand());
         sc[i] = 0.01 * (1.0 + 0.1 * urand());
     }
@@ -188,18 +224,12 @@ int main(void)
     printf("%ld\n", bad);
     return 0;
 }
-"""
+""")
 
 
-COROT_HARNESS = r"""
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-typedef long Py_ssize_t;
-#include "softgym_corot.h"
+COROT_HARNESS = _c_harness("softgym_corot.h", r"""
 /* links of random voxels along each axis through softgym_corot_links (the hand-vectorised
    loop and its remainder) against SOFTGYM_COROT_LINK_T on doubles, one link at a time */
-static double urand(void) { return rand() / (double)RAND_MAX - 0.5; }
 enum { NV = 200, N = 203 };  /* N: not a multiple of the lanes */
 static double pos[3 * NV], vel[3 * NV], av[3 * NV], rot[9 * NV], sc[NV];
 static double ka[N], ca[N], kb[N], cb[N], kt[N], ct[N], o[10 * N], r[10 * N];
@@ -231,10 +261,7 @@ SOFTGYM_ALWAYS_INLINE long check_ax(const int ax)
 int main(void)
 {
     for (int i = 0; i < NV; i++) {
-        double q[4], s = 0.0;
-        for (int k = 0; k < 4; k++) { q[k] = urand(); s += q[k] * q[k]; }
-        for (int k = 0; k < 4; k++) q[k] /= sqrt(s);
-        softgym_quat_matrix(q, rot + 9 * i);
+        URAND_ROT(rot + 9 * i);
         for (int k = 0; k < 3; k++) {
             pos[3 * i + k] = 0.01 * (i % 7 + urand());
             vel[3 * i + k] = urand();
@@ -252,7 +279,7 @@ int main(void)
     printf("%ld\n", check_ax(0) + check_ax(1) + check_ax(2));
     return 0;
 }
-"""
+""")
 
 
 def _run_harness(level, text, tmp_path):
@@ -287,17 +314,11 @@ def test_hand_vectorised_geometry_is_the_formula_bit_for_bit(level, tmp_path):
     assert out == "0", f"{out} of {3 * 3 * 10 * 203} geometry values differ"
 
 
-SCATTER_HARNESS = r"""
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-typedef long Py_ssize_t;
-#include "softgym_seed.h"
+SCATTER_HARNESS = _c_harness("softgym_seed.h", r"""
 /* one chunk's links scattered by softgym_seed_scatter (with AVX-512: blocks of 8 turned in
    the lanes with the geometry's rotation rows, the links before and after them one by
    one) against softgym_seed_scatter_links (every link one by one, voxel 1's matrix from
    rot): the voxels' forces and moments (lanes 0-2 of their rows; lane 3 is padding) */
-static double urand(void) { return rand() / (double)RAND_MAX - 0.5; }
 enum { NV = 300, N = SOFTGYM_CHUNK_LINKS };
 static double rot[9 * NV], f_a[4 * NV], m_a[4 * NV], f_b[4 * NV], m_b[4 * NV], neg2[N];
 static double chunk[SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE] __attribute__((aligned(64)));
@@ -311,41 +332,20 @@ SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi)
         for (int k = 0; k < 9; k++)
             chunk[(SOFTGYM_SEED_R_ROWS + k) * SOFTGYM_CHUNK_STRIDE + li] = rot[9 * v1[li] + k];
     }
-    for (int k = 0; k < 4 * NV; k++) {
-        f_a[k] = f_b[k] = urand();
-        m_a[k] = m_b[k] = urand();
-    }
+    urand_both(f_a, f_b, 4 * NV);
+    urand_both(m_a, m_b, 4 * NV);
     softgym_seed_scatter(ax, lo, hi, v1, v2, rot, chunk, neg2, f_a, m_a);
     SOFTGYM_BY_AXIS(ax, softgym_seed_scatter_links, lo, hi, v1, v2, rot, chunk, neg2, f_b, m_b);
-    long bad = 0;
-    for (int i = 0; i < NV; i++)
-        for (int c = 0; c < 3; c++)
-            bad += (memcmp(&f_a[4 * i + c], &f_b[4 * i + c], sizeof(double)) != 0)
-                   + (memcmp(&m_a[4 * i + c], &m_b[4 * i + c], sizeof(double)) != 0);
-    return bad;
+    return rows_differ(f_a, f_b, NV) + rows_differ(m_a, m_b, NV);
 }
 int main(void)
 {
     for (int i = 0; i < NV; i++) {
-        double q[4], s = 0.0;
-        for (int k = 0; k < 4; k++) { q[k] = urand(); s += q[k] * q[k]; }
-        for (int k = 0; k < 4; k++) q[k] /= sqrt(s);
-        softgym_quat_matrix(q, rot + 9 * i);
+        URAND_ROT(rot + 9 * i);
     }
     long bad = 0;
     for (int pattern = 0; pattern < 3; pattern++) {
-        for (int li = 0; li < N; li++) {
-            if (pattern == 0) {  /* rows along x: runs of 5 links, voxel 2 the next voxel 1 */
-                v1[li] = li + li / 5;
-                v2[li] = v1[li] + 1;
-            } else if (pattern == 1) {  /* along y of a 6-wide lattice */
-                v1[li] = li % 30 + 36 * (li / 30);
-                v2[li] = v1[li] + 6;
-            } else {  /* any voxels, distinct within the link */
-                v1[li] = rand() % NV;
-                v2[li] = (v1[li] + 1 + rand() % (NV - 1)) % NV;
-            }
-        }
+        link_pattern(pattern, v1, v2, N, NV);
         for (int ax = 0; ax < 3; ax++) {
             bad += check_ax(ax, 0, N);
             bad += check_ax(ax, 3, N - 5);  /* links one by one before and after the blocks */
@@ -354,25 +354,13 @@ int main(void)
     printf("%ld\n", bad);
     return 0;
 }
-"""
+""")
 
 
-@pytest.mark.parametrize("level", ["x86-64-v3", "x86-64-v4"])
-def test_scatter_in_blocks_is_the_link_by_link_scatter_bit_for_bit(level, tmp_path):
-    out = _run_harness(level, SCATTER_HARNESS, tmp_path)
-    assert out == "0", f"{out} of {3 * 3 * 2 * 2 * 3 * 300} voxel components differ"
-
-
-COROT_SCATTER_HARNESS = r"""
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-typedef long Py_ssize_t;
-#include "softgym_corot.h"
+COROT_SCATTER_HARNESS = _c_harness("softgym_corot.h", r"""
 /* softgym_corot_scatter (with AVX-512: blocks of 8 links turned into rows of 4 in
    registers) against the scatter written out per component, link by link: the voxels'
    forces and moments (lanes 0-2 of their rows), and where it stops (a strained link) */
-static double urand(void) { return rand() / (double)RAND_MAX - 0.5; }
 enum { NV = 300, N = 203 };
 static double o[10 * N], f_a[4 * NV], m_a[4 * NV], f_b[4 * NV], m_b[4 * NV];
 static Py_ssize_t v1[N], v2[N];
@@ -385,10 +373,8 @@ static long check(Py_ssize_t strained)
         o[li] = 0.3 * (urand() + 0.5);  /* |extension| under max_ext */
     if (strained >= 0)
         o[strained] = 0.5;
-    for (int k = 0; k < 4 * NV; k++) {
-        f_a[k] = f_b[k] = urand();
-        m_a[k] = m_b[k] = urand();
-    }
+    urand_both(f_a, f_b, 4 * NV);
+    urand_both(m_a, m_b, 4 * NV);
     Py_ssize_t end = softgym_corot_scatter(0, N, N, max_ext, v1, v2, o, f_a, m_a);
     Py_ssize_t want = strained >= 0 ? strained : N;
     for (Py_ssize_t li = 0; li < want; li++)
@@ -398,35 +384,26 @@ static long check(Py_ssize_t strained)
             m_b[4 * v1[li] + c] += o[(4 + c) * N + li];
             m_b[4 * v2[li] + c] += o[(7 + c) * N + li];
         }
-    long bad = end != want;
-    for (int i = 0; i < NV; i++)
-        for (int c = 0; c < 3; c++)
-            bad += (memcmp(&f_a[4 * i + c], &f_b[4 * i + c], sizeof(double)) != 0)
-                   + (memcmp(&m_a[4 * i + c], &m_b[4 * i + c], sizeof(double)) != 0);
-    return bad;
+    return (end != want) + rows_differ(f_a, f_b, NV) + rows_differ(m_a, m_b, NV);
 }
 int main(void)
 {
     long bad = 0;
-    for (int pattern = 0; pattern < 2; pattern++) {
-        for (int li = 0; li < N; li++) {
-            if (pattern == 0) {  /* rows along x: runs of 5 links, voxel 2 the next voxel 1 */
-                v1[li] = li + li / 5;
-                v2[li] = v1[li] + 1;
-            } else {  /* any voxels, distinct within the link */
-                v1[li] = rand() % NV;
-                v2[li] = (v1[li] + 1 + rand() % (NV - 1)) % NV;
-            }
-        }
+    for (int pattern = 0; pattern < 3; pattern += 2) {  /* runs along x, any voxels */
+        link_pattern(pattern, v1, v2, N, NV);
         bad += check(-1) + check(45) + check(200);
     }
     printf("%ld\n", bad);
     return 0;
 }
-"""
+""")
 
 
 @pytest.mark.parametrize("level", ["x86-64-v3", "x86-64-v4"])
-def test_corotational_scatter_in_blocks_is_the_scatter_per_component_bit_for_bit(level, tmp_path):
-    out = _run_harness(level, COROT_SCATTER_HARNESS, tmp_path)
+@pytest.mark.parametrize("model", ["seed", "corotational"])
+def test_the_scatters_in_blocks_are_the_scatters_link_by_link_bit_for_bit(model, level, tmp_path):
+    # the seed scatter against its own links one by one, the corotational one against
+    # the scatter written out per component (and where it stops at a strained link)
+    harness = SCATTER_HARNESS if model == "seed" else COROT_SCATTER_HARNESS
+    out = _run_harness(level, harness, tmp_path)
     assert out == "0", f"{out} voxel components (or ends) differ"

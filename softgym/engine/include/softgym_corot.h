@@ -224,13 +224,7 @@ static Py_ssize_t softgym_corot_scatter(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t
             Py_ssize_t i_ = 4 * v1[li + (k)], j_ = 4 * v2[li + (k)]; \
             __m256d f_ = SOFTGYM_ROW4(wf, k); \
             __m256d af_, am_; \
-            if (i_ == pb) { \
-                af_ = bf; \
-                am_ = bm; \
-            } else { \
-                af_ = _mm256_load_pd(force + i_); \
-                am_ = _mm256_load_pd(moment + i_); \
-            } \
+            SOFTGYM_ROWS_OR_CARRIED(i_ == pb, af_, am_, bf, bm, force, moment, i_); \
             bf = _mm256_add_pd(_mm256_load_pd(force + j_), f_); \
             bm = _mm256_add_pd(_mm256_load_pd(moment + j_), SOFTGYM_ROW4(w2, k)); \
             _mm256_store_pd(force + j_, bf); \
@@ -239,14 +233,7 @@ static Py_ssize_t softgym_corot_scatter(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t
             _mm256_store_pd(moment + j_, bm); \
             pb = j_; \
         } while (0)
-        SOFTGYM_COROT_ADD1(0);
-        SOFTGYM_COROT_ADD1(1);
-        SOFTGYM_COROT_ADD1(2);
-        SOFTGYM_COROT_ADD1(3);
-        SOFTGYM_COROT_ADD1(4);
-        SOFTGYM_COROT_ADD1(5);
-        SOFTGYM_COROT_ADD1(6);
-        SOFTGYM_COROT_ADD1(7);
+        SOFTGYM_EACH8(SOFTGYM_COROT_ADD1);
 #undef SOFTGYM_COROT_ADD1
     }
 #endif

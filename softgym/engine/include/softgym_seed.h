@@ -792,13 +792,8 @@ SOFTGYM_ALWAYS_INLINE void softgym_turn8(const int ax, const softgym_v8 *R, cons
 #define SOFTGYM_ADD1(k) do { \
         Py_ssize_t i_ = 4 * v1[li + (k)], j_ = 4 * v2[li + (k)]; \
         __m256d af_, am_; \
-        if (ax == 0 && (k) > 0 && i_ == pj) { \
-            af_ = cf; \
-            am_ = cm; \
-        } else { \
-            af_ = _mm256_load_pd(force + i_); \
-            am_ = _mm256_load_pd(moment + i_); \
-        } \
+        SOFTGYM_ROWS_OR_CARRIED(ax == 0 && (k) > 0 && i_ == pj, af_, am_, cf, cm, force, moment, \
+                                i_); \
         _mm256_store_pd(force + i_, _mm256_add_pd(af_, SOFTGYM_ROW4(wf1, k))); \
         _mm256_store_pd(moment + i_, _mm256_add_pd(am_, SOFTGYM_ROW4(wm1, k))); \
         cf = _mm256_add_pd(_mm256_load_pd(force + j_), SOFTGYM_ROW4(wf2, k)); \
@@ -846,14 +841,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter8(const int ax, Py_ssize_t li,
     softgym_turn8(ax, R, b, wm2);
     __m256d cf = _mm256_setzero_pd(), cm = cf;
     Py_ssize_t pj = -1;
-    SOFTGYM_ADD1(0);
-    SOFTGYM_ADD1(1);
-    SOFTGYM_ADD1(2);
-    SOFTGYM_ADD1(3);
-    SOFTGYM_ADD1(4);
-    SOFTGYM_ADD1(5);
-    SOFTGYM_ADD1(6);
-    SOFTGYM_ADD1(7);
+    SOFTGYM_EACH8(SOFTGYM_ADD1);
 }
 #endif
 /* links lo..hi along ax: blocks of 8 whose rows start on a cache line through

@@ -186,6 +186,22 @@ static inline void softgym_v8_rows4(softgym_v8 x, softgym_v8 y, softgym_v8 z, __
     out[3] = _mm512_permutex2var_pd(t1, _mm512_set_epi64(15, 15, 7, 6, 11, 11, 3, 2),
                                     (__m512d)z);
 }
+/* voxel row i's force and moment rows (doubles force + i, moment + i) into af, am: the
+   registers cf, cm where carried (the rows a store has just made: a link's voxel 1 that is
+   the last link's voxel 2), else loads that would wait on such a store */
+#define SOFTGYM_ROWS_OR_CARRIED(carried, af, am, cf, cm, force, moment, i) do { \
+        if (carried) { \
+            af = cf; \
+            am = cm; \
+        } else { \
+            af = _mm256_load_pd((force) + (i)); \
+            am = _mm256_load_pd((moment) + (i)); \
+        } \
+    } while (0)
+/* M(0); M(1); ... M(7): a block's 8 links in order, each index a compile-time constant */
+#define SOFTGYM_EACH8(M) do { \
+        M(0); M(1); M(2); M(3); M(4); M(5); M(6); M(7); \
+    } while (0)
 #define SOFTGYM_ROW4(w, k) \
     ((k) < 4 ? _mm512_castpd512_pd256((w)[(k) % 4]) : _mm512_extractf64x4_pd((w)[(k) % 4], 1))
 /* whether the 8 indices v[0..7] are v[0], v[0] + 1, ..., v[0] + 7 (a run of records) */
