@@ -99,10 +99,9 @@ cdef extern from "softgym_seed.h":
     void softgym_seed_scatter(int ax, intp_t lo, intp_t hi, const intp_t* v1, const intp_t* v2,
                               const float64_t* rot, const float64_t* o, const float64_t* neg2_row,
                               float64_t* force, float64_t* moment) noexcept nogil
-    # rows of the chunk's scratch that hold voxel 1's rotation (read where
-    # SOFTGYM_SEED_R_USED: the AVX-512 builds' scatter)
+    # the rows of the chunk's scratch that hold voxel 1's rotation (the geometry writes
+    # them, the scatter reads them, where the build's SOFTGYM_SEED_R_USED is 1: AVX-512)
     enum: SOFTGYM_SEED_R_ROWS
-    enum: SOFTGYM_SEED_R_USED
     int softgym_seed_frames32(intp_t lo, intp_t hi, intp_t n, float sa_rad, float w_acos,
                               const float64_t* o, float* f) noexcept nogil
     void softgym_seed_forces32(intp_t lo, intp_t hi, intp_t n, float L, float bz, float bzh,
@@ -347,9 +346,8 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
         int ax
         float64_t inv_dt = 1.0 / b.dt[r]
         float64_t* o = b.link_out
-        # the geometry's rotation rows for the scatter (NULL: not used in this build)
-        float64_t* rr = (b.chunk_out + SOFTGYM_SEED_R_ROWS * SOFTGYM_CHUNK_STRIDE
-                         if SOFTGYM_SEED_R_USED else NULL)
+        # the geometry's rotation rows for the scatter (the chunk's)
+        float64_t* rr = b.chunk_out + SOFTGYM_SEED_R_ROWS * SOFTGYM_CHUNK_STRIDE
         unsigned long long t0
     if hi <= lo:
         return STATUS_OK
@@ -364,7 +362,7 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
             a0 = max(c0, run[ax])
             a1 = min(c1, run[ax + 1])
             if a0 < a1:
-                end = _seed_geom_modes(b, ax, a0, a1, n, o, b.vox_start[r + 1], rr - c0 if rr != NULL else NULL)
+                end = _seed_geom_modes(b, ax, a0, a1, n, o, b.vox_start[r + 1], rr - c0)
                 if end < a1:
                     break  # a strained link: the links after it stay as they were
                 end = c1

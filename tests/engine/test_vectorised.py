@@ -161,7 +161,8 @@ HARNESS = _c_harness("softgym_seed.h", r"""
 /* links along each axis through softgym_seed_geom (the hand-vectorised loop with its
    three ways of loading the voxels: runs, windows of 16, gathers; and its remainder)
    against SOFTGYM_SEED_GEOM_LINK, one link at a time; and, run a chunk at a time as the
-   engine does, the rotation rows it leaves for the scatter against voxel 1's matrix */
+   engine does, the rotation rows it leaves for the scatter (AVX-512) against voxel 1's
+   matrix */
 static double rr[SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE];
 SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, Py_ssize_t n, const Py_ssize_t *v1,
                                     const Py_ssize_t *v2, Py_ssize_t nv, const double *pos,
@@ -172,7 +173,7 @@ SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, Py_ssize_t n, const Py_ssize_t
         Py_ssize_t c1 = c0 + SOFTGYM_CHUNK_LINKS < n ? c0 + SOFTGYM_CHUNK_LINKS : n;
         double *R = rr + SOFTGYM_SEED_R_ROWS * SOFTGYM_CHUNK_STRIDE;
         softgym_seed_geom(ax, c0, c1, n, v1, v2, nv, pos, quat, sc, o, R - c0);
-        for (Py_ssize_t li = c0; li < c1; li++) {
+        for (Py_ssize_t li = c0; li < c1 && SOFTGYM_SEED_R_USED; li++) {  /* (where written) */
             double m[9];
             softgym_quat_matrix(quat + 4 * v1[li], m);
             for (int k = 0; k < 9; k++)

@@ -69,11 +69,6 @@ static void softgym_corot_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, doub
     softgym_quats_impl(0, lo, hi, n, dt, av, quat, q_out);
 }
 
-/* voxels lo..hi but the fixed: the new quaternions from the rows q_out into quat, and their
-   rotation matrices into rot (softgym_quat_matrix_wxyz, from registers; rot NULL: none). Scalar stores: GCC
-   packed each matrix into a 512-bit register with seven shuffles and stored it across
-   two cache lines (a voxel's matrix is 72 bytes), and on an Intel Xeon the loop waited on
-   that (perf annotate) */
 /* voxel i's (not fixed), its matrix into R unless R is NULL */
 #define SOFTGYM_ORIENT_STORE1(i, R) do { \
         double w_ = q_out[i], x_ = q_out[n + (i)], y_ = q_out[2 * n + (i)]; \
@@ -86,6 +81,11 @@ static void softgym_corot_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, doub
         if ((R) != NULL) \
             softgym_quat_matrix_wxyz(w_, x_, y_, z_, (R) + 9 * (i)); \
     } while (0)
+/* voxels lo..hi but the fixed: the new quaternions from the rows q_out into quat, and their
+   rotation matrices into rot (softgym_quat_matrix_wxyz, from registers; rot NULL: none).
+   Scalar stores: GCC packed each matrix into a 512-bit register with seven shuffles and
+   stored it across two cache lines (a voxel's matrix is 72 bytes), and on an Intel Xeon
+   the loop waited on that (perf annotate) */
 #if defined(__GNUC__) && !defined(__clang__)
 __attribute__((optimize("no-tree-slp-vectorize")))
 #endif

@@ -69,14 +69,15 @@
                              wj, xj, yj, zj, si, sj, (double *)0)
 /* the same for any arithmetic type T (double, or a vector of doubles: then links li ..
    li + lanes - 1 at once, SQRT and FABS T's square root and absolute value, PUT(row,
-   li, v) storing v at row + li); rr not NULL: also voxel 1's rotation matrix, element k
-   in row rr + k SOFTGYM_CHUNK_STRIDE (the chunk's rows that softgym_seed_scatter8 turns
-   the forces with) */
+   li, v) storing v at row + li); in builds whose scatter reads them (SOFTGYM_SEED_R_USED)
+   and rr not NULL, also voxel 1's rotation matrix, element k in row rr + k
+   SOFTGYM_CHUNK_STRIDE (the chunk's rows that softgym_seed_scatter8 turns the forces
+   with) */
 #define SOFTGYM_SEED_GEOM_LINK_T(T, SQRT, FABS, PUT, li, dx, dy, dz, w, x, y, z, wj, xj, yj, \
                                  zj, si, sj, rr) do { \
         T geo_R[9]; \
         SOFTGYM_QUAT_MATRIX(w, x, y, z, geo_R); \
-        if ((rr) != 0) { \
+        if (SOFTGYM_SEED_R_USED && (rr) != 0) { \
             for (int geo_k = 0; geo_k < 9; geo_k++) \
                 PUT((rr) + geo_k * SOFTGYM_CHUNK_STRIDE, li, geo_R[geo_k]); \
         } \
@@ -238,18 +239,14 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
     softgym_seed_geom_scalar(ax, li, hi, n, v1, v2, pos, quat, scale, o, rr);
 }
 /* vend: the end of the voxel records (voxel indices below it may be read); rr: the
-   chunk's rotation rows (SOFTGYM_SEED_R_ROWS), indexed by link, or NULL */
+   chunk's rotation rows (SOFTGYM_SEED_R_ROWS), indexed by link, or NULL (written only
+   where SOFTGYM_SEED_R_USED) */
 static void softgym_seed_geom(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
                               const Py_ssize_t *v1, const Py_ssize_t *v2, Py_ssize_t vend,
                               const double *pos, const double *quat, const double *scale,
                               double *o, double *rr)
 {
-    if (rr != NULL)
-        SOFTGYM_BY_AXIS(ax, softgym_seed_geom_ax, lo, hi, n, v1, v2, vend, pos, quat, scale, o,
-                        rr);
-    else
-        SOFTGYM_BY_AXIS(ax, softgym_seed_geom_ax, lo, hi, n, v1, v2, vend, pos, quat, scale, o,
-                        (double *)0);
+    SOFTGYM_BY_AXIS(ax, softgym_seed_geom_ax, lo, hi, n, v1, v2, vend, pos, quat, scale, o, rr);
 }
 
 /* The frames pass of links_seed, in C for one pragma: the bond-frame
