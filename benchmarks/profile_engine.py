@@ -35,6 +35,13 @@ background load that comes and goes then falls on both), printing each pass's ch
 on a shared VM whose runs scatter by 5 %, the way to judge a change of a few per cent:
 
     python benchmarks/profile_engine.py --cycles --repeats 8 --baseline HEAD
+
+``--modes`` prints how the reference robot's links split between the seed model's
+small- and large-angle modes over its run (sampled every 0.05 s from the state): the
+share of links in large-angle mode and of blocks of 16 links all in small-angle mode (the
+blocks for which the frames pass takes its small-angle copy):
+
+    python benchmarks/profile_engine.py --modes
 """
 
 from __future__ import annotations
@@ -253,6 +260,28 @@ def print_cycles_against(p: dict, q: dict, baseline: str) -> None:
         print(f"{name:40s} {a:10.1f} {b:12.1f} {100 * (a - b) / b if b else 0.0:+7.1f}%")
 
 
+def link_modes(seconds: float, n: int, collisions: bool, every: float = 0.05,
+               block: int = 16) -> dict:
+    """The reference robot's links by mode (seed preset) over ``seconds``, sampled every
+    ``every`` s: the mean share of links in large-angle mode and of ``block``-link blocks
+    (in link order) whose links are all in small-angle mode."""
+    import numpy as np
+
+    from bench_engine import reference_robot
+    from softgym.engine import SimConfig, Simulation
+
+    sim = Simulation([reference_robot(n)], SimConfig(self_collision=collisions), n_threads=1)
+    large, small_blocks, samples = 0.0, 0.0, 0
+    for _ in range(max(int(round(seconds / every)), 1)):
+        sim.run(every)
+        sa = np.asarray(sim.get_state()["link_sa"]).ravel() != 0
+        large += 1.0 - sa.mean()
+        small_blocks += np.mean([sa[k:k + block].all() for k in range(0, sa.size, block)])
+        samples += 1
+    return {"links": int(sa.size), "samples": samples, "large_angle_share": large / samples,
+            "all_small_block_share": small_blocks / samples, "block": block}
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--model", default="seed", choices=("seed", "corotational"))
@@ -269,7 +298,19 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--baseline", metavar="GITREF", default=None,
                     help="--cycles: also a probed build of this git revision, run alternately "
                          "with the tree's, and each pass's change against it")
+    ap.add_argument("--modes", action="store_true",
+                    help="the links' small- and large-angle modes over the run (seed preset)")
     args = ap.parse_args(argv)
+    if args.modes:
+        m = link_modes(args.seconds, args.size, not args.no_collision)
+        print(f"seed preset, {args.size}^3 reference robot, self-collision "
+              f"{'off' if args.no_collision else 'on'}, {m['links']} links, {m['samples']} "
+              f"samples over {args.seconds:g} s: {100 * m['large_angle_share']:.1f} % of the "
+              f"links in large-angle mode, {100 * m['all_small_block_share']:.1f} % of the "
+              f"blocks of {m['block']} links all in small-angle mode")
+        if args.json:
+            print(json.dumps(m))
+        return 0
     if args.cycles:
         if args.model != "seed":
             raise SystemExit("profile_engine: --cycles times the seed preset's passes only")
