@@ -260,23 +260,24 @@ def print_cycles_against(p: dict, q: dict, baseline: str) -> None:
         print(f"{name:40s} {a:10.1f} {b:12.1f} {100 * (a - b) / b if b else 0.0:+7.1f}%")
 
 
-def link_modes(seconds: float, n: int, collisions: bool, every: float = 0.05,
-               block: int = 16) -> dict:
+def link_modes(seconds: float, n: int, collisions: bool, precision: str | None = None,
+               every: float = 0.05, block: int = 16) -> dict:
     """The reference robot's links by mode (seed preset) over ``seconds``, sampled every
     ``every`` s: the mean share of links in large-angle mode and of ``block``-link blocks
     (in link order) whose links are all in small-angle mode."""
     import numpy as np
-
     from bench_engine import reference_robot
+
     from softgym.engine import SimConfig, Simulation
 
-    sim = Simulation([reference_robot(n)], SimConfig(self_collision=collisions), n_threads=1)
+    sim = Simulation([reference_robot(n)],
+                     SimConfig(self_collision=collisions, link_precision=precision), n_threads=1)
     large, small_blocks, samples = 0.0, 0.0, 0
     for _ in range(max(int(round(seconds / every)), 1)):
         sim.run(every)
         sa = np.asarray(sim.get_state()["link_sa"]).ravel() != 0
         large += 1.0 - sa.mean()
-        small_blocks += np.mean([sa[k:k + block].all() for k in range(0, sa.size, block)])
+        small_blocks += np.logical_and.reduceat(sa, np.arange(0, sa.size, block)).mean()
         samples += 1
     return {"links": int(sa.size), "samples": samples, "large_angle_share": large / samples,
             "all_small_block_share": small_blocks / samples, "block": block}
@@ -302,7 +303,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="the links' small- and large-angle modes over the run (seed preset)")
     args = ap.parse_args(argv)
     if args.modes:
-        m = link_modes(args.seconds, args.size, not args.no_collision)
+        if args.model != "seed":
+            raise SystemExit("profile_engine: --modes counts the seed preset's link modes only")
+        m = link_modes(args.seconds, args.size, not args.no_collision, args.link_precision)
         print(f"seed preset, {args.size}^3 reference robot, self-collision "
               f"{'off' if args.no_collision else 'on'}, {m['links']} links, {m['samples']} "
               f"samples over {args.seconds:g} s: {100 * m['large_angle_share']:.1f} % of the "
