@@ -205,7 +205,10 @@ def test_seeds_run_in_parallel_on_a_local_cluster(tmp_path):
 
 
 def test_parallel_runs_start_in_run_order(tmp_path):
-    # 2 workers, 4 runs: they start in run_order, the third only once a run has ended
+    # 2 workers, 4 runs submitted in run_order through a window of 2: the third starts only
+    # once a run has ended, the fourth once two have. (Which of the first two writes its
+    # folder first is up to the workers: a worker still importing can start the second run
+    # after the other has ended the first and taken the third, as a CI run saw)
     pytest.importorskip("distributed")
     specs = plan(tmp_path, scenarios=["basic", "controller-tournament"], seeds=2, generations=1,
                  pop_size=4, seconds=1.0, shape=(3, 3, 3))  # fmt: skip
@@ -214,7 +217,6 @@ def test_parallel_runs_start_in_run_order(tmp_path):
     ordered = run_order(specs)
     started = [(s.out / "config.json").stat().st_mtime for s in ordered]
     ended = [(s.out / "final_population.json").stat().st_mtime for s in ordered]
-    assert max(started[:2]) <= started[2] <= started[3]
     assert started[2] >= min(ended[:2]) and started[3] >= sorted(ended[:3])[1]
     # completion order: every result is reported, each run once
     assert sorted((r["scenario"], r["seed"]) for r in res) == sorted(
