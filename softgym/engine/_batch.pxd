@@ -97,12 +97,16 @@ cdef struct Batch:
     intp_t n_links           # links in the batch
     intp_t link_rows         # row stride (elements) of c_seed, k_seed32 and link_last: n_links
                              #   or more (row_stride in _core: rows apart in the cache)
-    float64_t* link_out      # scratch of the link kernels (each names its rows): row k of link li
-                             #   at link_out[k * link_stride + li], li among the robot's links
+    float64_t* link_out      # scratch of the corotational link kernel (it names its rows): row k
+                             #   of link li at link_out[k * link_stride + li], li among the robot's
+                             #   links (the seed model's is chunk_link)
     intp_t link_stride       # its row stride (the most links of one robot)
     float64_t* chunk_out     # scratch of the seed model's forces pass: SOFTGYM_CHUNK_ROWS rows,
                              #   SOFTGYM_CHUNK_STRIDE apart, for one chunk of links from its
                              #   first (include/softgym_seed.h, _seed.links_seed)
+    float64_t* chunk_link    # the seed model's link scratch for one chunk of links: N_LINK_OUT
+                             #   rows, SOFTGYM_CHUNK_STRIDE apart, indexed by link from the chunk's
+                             #   first (_seed.links_seed; per thread)
     float* chunk_f32         # scratch of the seed model's single-precision frames: SOFTGYM_CHUNK_FROWS
                              #   float rows, SOFTGYM_CHUNK_FSTRIDE apart, for one chunk of links
     intp_t* v1               # (n_links,) voxel on the negative side

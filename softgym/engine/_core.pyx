@@ -336,6 +336,7 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.vox_out = NULL  # per thread, set by advance
     b.chunk_out = NULL
     b.chunk_f32 = NULL
+    b.chunk_link = NULL
     b.vox_stride = 0
     b.moment = _f(a, "moment")
     b.ext_force = _f(a, "ext_force")
@@ -510,7 +511,7 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
     # the float rows' floats rounded up to doubles (a multiple of 8: they start on a line)
     fblock = (SOFTGYM_CHUNK_FROWS * SOFTGYM_CHUNK_FSTRIDE + 15) // 16 * 8
     block = (N_LINK_OUT * stride + N_VOX_OUT * vstride + SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE
-             + fblock)
+             + fblock + N_LINK_OUT * SOFTGYM_CHUNK_STRIDE)
     scratch = cache.scratch(max(n_threads * block, 1))
     # robots in the order 0, 8, 16, ..., then 1, 9, 17, ...: the robots that the
     # threads step at one time are ROBOT_SPREAD apart, so no two of them write
@@ -535,6 +536,7 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
                 bt.vox_out = scratch + t * block + N_LINK_OUT * stride - b.vox_start[r]
                 bt.chunk_out = scratch + t * block + N_LINK_OUT * stride + N_VOX_OUT * vstride
                 bt.chunk_f32 = <float*> (bt.chunk_out + SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE)
+                bt.chunk_link = bt.chunk_out + SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE + fblock
                 advance_robot(&bt, r, targets[r], &cache.items[r])
 
 

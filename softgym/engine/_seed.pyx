@@ -207,8 +207,8 @@ cdef inline void _put(float64_t* o, intp_t n, float* f, intp_t k, intp_t li,
         o[k * n + li] = v
 
 
-cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end,
-                                       float64_t inv_dt) noexcept nogil:
+cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end, float64_t* o,
+                                       intp_t n, float64_t inv_dt) noexcept nogil:
     # links_seed's frames and forces passes in single precision
     # (SimConfig.link_precision = "single"; include/softgym_seed.h): the chunk's float
     # rows in b.chunk_f32 from the frames, double rows of b.chunk_out from the forces for
@@ -216,8 +216,6 @@ cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end,
     cdef:
         intp_t li
         int fix
-        intp_t n = b.link_stride
-        float64_t* o = b.link_out
         float* f = b.chunk_f32 - lo  # indexed by link
         const float* k32
         unsigned long long t0
@@ -239,15 +237,13 @@ cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end,
     softgym_prof_add(4, t0)
 
 
-cdef inline void _seed_frames_forces(Batch* b, intp_t lo, intp_t end,
-                                     float64_t inv_dt) noexcept nogil:
+cdef inline void _seed_frames_forces(Batch* b, intp_t lo, intp_t end, float64_t* o,
+                                     intp_t n, float64_t inv_dt) noexcept nogil:
     # links_seed's frames and forces passes in double precision (the seed's
     # own operations)
     cdef:
         intp_t li
         int fix
-        intp_t n = b.link_stride
-        float64_t* o = b.link_out
         float64_t bz = 0.5 * b.bond_zeta
         unsigned long long t0
     t0 = softgym_prof_tsc()
@@ -298,7 +294,7 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     # onto +x, voxel 1's orientation removed); rotations back to the world
     # go through voxel 1's rotation matrix. A robot's links are sorted by
     # axis (x, then y, then z); the passes below run over the link scratch
-    # b.link_out (profiled: the square roots and divisions of the large-angle
+    # b.chunk_link, one chunk's rows (profiled: the square roots and divisions of the large-angle
     # frames dominated the step; one branch-free vector loop does them for
     # many links at once, the same IEEE operations as the seed's scalar code):
     #   softgym_seed_geom    rows 0-9: relative position p, orientation (qw, n),
@@ -325,8 +321,11 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     # before the scatter took voxel 1's rotation from 9 more rows of the chunk),
     # all of them before the next chunk: a chunk's scratch rows stay in the L1
     # cache from the geometry to the scatter (the whole robot's 25 rows, 108 KB
-    # for the reference robot, did not), and the forces pass's rows, one chunk's,
-    # are a compile-time stride apart (include/softgym_seed.h). The geometry and
+    # for the reference robot, did not), and every pass's rows are one chunk's,
+    # a compile-time stride apart (b.chunk_link, b.chunk_out, b.chunk_f32: one
+    # register for all of a pass's rows, and the same 14 KB of scratch for every
+    # chunk, where rows of b.link_out took a register each and walked the robot's
+    # 108 KB each step). The geometry and
     # the scatter split a chunk at the axis runs; the modes, frames and forces
     # passes need no axis. Each link's quantities are its own and the links are
     # scattered in the same order, so the result is the one of running each pass
@@ -341,11 +340,13 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
         intp_t lo = b.link_start[r]
         intp_t hi = b.link_start[r + 1]
         intp_t run[4]  # the x, y and z links are run[ax] .. run[ax + 1]
-        intp_t n = b.link_stride  # the scratch's row stride
+        # the chunk's rows of link scratch (b.chunk_link, indexed by link), a compile-time
+        # stride apart
+        intp_t n = SOFTGYM_CHUNK_STRIDE
         intp_t c0, c1, a0, a1, end
         int ax
         float64_t inv_dt = 1.0 / b.dt[r]
-        float64_t* o = b.link_out
+        float64_t* o
         # the geometry's rotation rows for the scatter (the chunk's)
         float64_t* rr = b.chunk_out + SOFTGYM_SEED_R_ROWS * SOFTGYM_CHUNK_STRIDE
         unsigned long long t0
@@ -357,6 +358,7 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     c0 = lo
     while c0 < hi:
         c1 = min(c0 + SOFTGYM_CHUNK_LINKS, hi)
+        o = b.chunk_link - c0
         end = c1
         for ax in range(3):
             a0 = max(c0, run[ax])
@@ -367,9 +369,9 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
                     break  # a strained link: the links after it stay as they were
                 end = c1
         if b.link_f32:
-            _seed_frames_forces32(b, c0, end, inv_dt)
+            _seed_frames_forces32(b, c0, end, o, n, inv_dt)
         else:
-            _seed_frames_forces(b, c0, end, inv_dt)
+            _seed_frames_forces(b, c0, end, o, n, inv_dt)
         t0 = softgym_prof_tsc()
         for ax in range(3):
             a0 = max(c0, run[ax])
