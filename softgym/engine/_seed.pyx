@@ -293,10 +293,10 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     # Quantities are those of the seed's bond frame (the link axis turned
     # onto +x, voxel 1's orientation removed); rotations back to the world
     # go through voxel 1's rotation matrix. A robot's links are sorted by
-    # axis (x, then y, then z); the passes below run over the link scratch
-    # b.chunk_link, one chunk's rows (profiled: the square roots and divisions of the large-angle
-    # frames dominated the step; one branch-free vector loop does them for
-    # many links at once, the same IEEE operations as the seed's scalar code):
+    # axis (x, then y, then z); the passes below run over one chunk's rows of
+    # link scratch, b.chunk_link (profiled: the square roots and divisions of the
+    # large-angle frames dominated the step; one branch-free vector loop does them
+    # for many links at once, the same IEEE operations as the seed's scalar code):
     #   softgym_seed_geom    rows 0-9: relative position p, orientation (qw, n),
     #                        nominal length, chord length, transverse ratio
     #                        (once per axis: each run gets a copy with the axis
@@ -320,14 +320,12 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     # The passes run over one chunk of SOFTGYM_CHUNK_LINKS links at a time (64; 128
     # before the scatter took voxel 1's rotation from 9 more rows of the chunk),
     # all of them before the next chunk: a chunk's scratch rows stay in the L1
-    # cache from the geometry to the scatter (the whole robot's 25 rows, 108 KB
-    # for the reference robot, did not), and every pass's rows are one chunk's,
-    # a compile-time stride apart (b.chunk_link, b.chunk_out, b.chunk_f32: one
-    # register for all of a pass's rows, and the same 14 KB of scratch for every
-    # chunk, where rows of b.link_out took a register each and walked the robot's
-    # 108 KB each step). The geometry and
-    # the scatter split a chunk at the axis runs; the modes, frames and forces
-    # passes need no axis. Each link's quantities are its own and the links are
+    # cache from the geometry to the scatter, and they are the same rows for every
+    # chunk, a compile-time stride apart (b.chunk_link, b.chunk_out, b.chunk_f32:
+    # one register addresses all of a pass's rows; the robot's rows of scratch, a
+    # run-time stride apart, took a register each and 108 KB for the reference
+    # robot, walked each step). The geometry and the scatter split a chunk at the
+    # axis runs; the modes, frames and forces passes need no axis. Each link's quantities are its own and the links are
     # scattered in the same order, so the result is the one of running each pass
     # over all the links, bit for bit (a strained link stops the step after the
     # links before it, as the seed's scalar loop does; 3.0 % on an Intel Xeon,
