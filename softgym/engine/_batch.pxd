@@ -64,10 +64,12 @@ cdef struct Batch:
     float64_t* quat          # (n_voxels, 4) orientation, unit quaternion (w, x, y, z)
     float64_t* angvel        # (n_voxels, 3) angular velocity, world frame (rad/s)
     float64_t* rot           # (n_voxels, 9) rotation matrix of quat, row-major (derived)
-    float64_t* force         # (n_voxels, 4) scratch: accumulated force (N) in columns 0-2;
-                             #   column 3 pads a voxel's row to 4 lanes (the seed scatter
-                             #   adds whole rows) and is never read
-    float64_t* moment        # (n_voxels, 4) scratch: accumulated moment (N m), as force
+    float64_t* force         # (n_voxels, SOFTGYM_FM_STRIDE) scratch, one 64-byte row a voxel:
+                             #   accumulated force (N) in columns 0-2, moment (N m) in 4-6;
+                             #   columns 3 and 7 pad it (the vector scatters add whole
+                             #   rows) and are never read; voxel i's force at
+                             #   force[SOFTGYM_FM_STRIDE * i]
+    float64_t* moment        # force + 4: voxel i's moment at moment[SOFTGYM_FM_STRIDE * i]
     float64_t* vox_out       # scratch of the seed model's new orientations: row k of voxel i at
                              #   vox_out[k * vox_stride + i], i among the robot's voxels
     intp_t vox_stride        # its row stride (the most voxels of one robot)
@@ -153,6 +155,11 @@ cdef enum:
 cdef enum:
     N_LINK_OUT = 25          # rows of the per-link scratch (see _corotational, _seed)
     N_VOX_OUT = 4            # rows of the per-voxel scratch (see _integrate.integrate_seed)
+
+
+cdef extern from "softgym_simd.h":
+    # the row of Batch.force (doubles a voxel: its force, then its moment)
+    enum: SOFTGYM_FM_STRIDE
 
 
 cdef extern from *:

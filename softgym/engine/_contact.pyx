@@ -18,7 +18,7 @@ from libc.stdint cimport int64_t
 from libc.stdlib cimport malloc, realloc, qsort
 from libc.string cimport memcpy, memset
 
-from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_MEMORY
+from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_MEMORY, SOFTGYM_FM_STRIDE
 from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t, lane_flag_t
 
 # ---------------------------------------------------------------------------
@@ -545,9 +545,9 @@ cdef void collide_obstacles(Batch* b, Contacts* c) noexcept nogil:
         dist = sqrt(d2)
         kk = b.k_floor[i] * b.obs[4 * m + 3] / (b.k_floor[i] + b.obs[4 * m + 3])
         fmag = kk * (env - dist) / dist
-        b.force[4 * i] += fmag * dx
-        b.force[4 * i + 1] += fmag * dy
-        b.force[4 * i + 2] += fmag * dz
+        b.force[SOFTGYM_FM_STRIDE * i] += fmag * dx
+        b.force[SOFTGYM_FM_STRIDE * i + 1] += fmag * dy
+        b.force[SOFTGYM_FM_STRIDE * i + 2] += fmag * dz
 
 
 cdef void collide(Batch* b, Contacts* c) noexcept nogil:
@@ -570,9 +570,9 @@ cdef void collide(Batch* b, Contacts* c) noexcept nogil:
         # E_h L = harmonic mean of the voxels' E L = k1 k2 / (k1 + k2), k = 2 E L
         kk = b.k_floor[i] * b.k_floor[j] / (b.k_floor[i] + b.k_floor[j])
         fmag = kk * (env - dist) / dist
-        b.force[4 * j] += fmag * dx
-        b.force[4 * j + 1] += fmag * dy
-        b.force[4 * j + 2] += fmag * dz
-        b.force[4 * i] -= fmag * dx
-        b.force[4 * i + 1] -= fmag * dy
-        b.force[4 * i + 2] -= fmag * dz
+        b.force[SOFTGYM_FM_STRIDE * j] += fmag * dx
+        b.force[SOFTGYM_FM_STRIDE * j + 1] += fmag * dy
+        b.force[SOFTGYM_FM_STRIDE * j + 2] += fmag * dz
+        b.force[SOFTGYM_FM_STRIDE * i] -= fmag * dx
+        b.force[SOFTGYM_FM_STRIDE * i + 1] -= fmag * dy
+        b.force[SOFTGYM_FM_STRIDE * i + 2] -= fmag * dz

@@ -24,7 +24,8 @@ cimport numpy as cnp
 import numpy as np
 
 from softgym.engine._batch cimport (Batch, STATUS_OK, STATUS_STRAIN, STATUS_NONFINITE,
-                                    STATUS_MEMORY, N_AUX, N_LINK_OUT, N_VOX_OUT)
+                                    STATUS_MEMORY, N_AUX, N_LINK_OUT, N_VOX_OUT,
+                                    SOFTGYM_FM_STRIDE)
 from softgym.engine._contact cimport (Contacts, contacts_corotational, contacts_seed, collide,
                                       collide_obstacles)
 from softgym.engine._corotational cimport links_corotational
@@ -241,13 +242,17 @@ STATUS_NAMES = {
     STATUS_MEMORY: "out of memory for the self-collision candidates",
 }
 
+#: Doubles in a voxel's row of the force scratch ("force": its force in columns 0-2, its
+#: moment in 4-6; _batch.pxd)
+FM_STRIDE = SOFTGYM_FM_STRIDE
+
 #: The arrays that cross into the kernel (bound by _bind; shapes, dtypes and
 #: units in _batch.pxd's Batch): the Python side must provide every one.
 KERNEL_ARRAYS = (
     "vox_start", "link_start", "link_axis_count", "dt", "steps", "temp_amp", "period",
     "use_temp", "floor", "box_start", "boxes", "diverged", "diverged_time", "diverged_code",
     "init_done", "cm_init", "mass_total", "trace_n", "trace_t", "trace_cm",
-    "pos", "vel", "quat", "angvel", "rot", "force", "moment", "ext_force", "mass", "inv_mass",
+    "pos", "vel", "quat", "angvel", "rot", "force", "ext_force", "mass", "inv_mass",
     "inv_inertia", "scale", "cte", "cos_phase", "sin_phase", "temp", "k_floor", "c_floor",
     "c_global", "rot_damp", "mu_s", "mu_k", "fixed", "surface", "excl_start", "excl_idx",
     "seed_rank", "col_ref", "col_acc", "col_vmax", "obs_start", "obs", "obs_rank",
@@ -338,7 +343,7 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.chunk_f32 = NULL
     b.chunk_link = NULL
     b.vox_stride = 0
-    b.moment = _f(a, "moment")
+    b.moment = b.force + 4  # its columns 4-6 (_batch.pxd)
     b.ext_force = _f(a, "ext_force")
     b.mass = _f(a, "mass")
     b.inv_mass = _f(a, "inv_mass")

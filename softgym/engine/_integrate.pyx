@@ -10,7 +10,7 @@
 from libc.math cimport fabs, sqrt
 from libc.string cimport memset
 
-from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_NONFINITE
+from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_NONFINITE, SOFTGYM_FM_STRIDE
 from softgym.engine._contact cimport surface_contact, box_penetration, seed_floor
 from softgym.engine._prof cimport softgym_prof_tsc, softgym_prof_add, prof_counts
 from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t
@@ -55,21 +55,14 @@ cdef inline void _fluid_drag(Batch* b, intp_t i, float64_t* f) noexcept nogil:
 
 
 cdef inline void _clear(Batch* b, intp_t i) noexcept nogil:
-    b.force[4 * i] = 0.0
-    b.force[4 * i + 1] = 0.0
-    b.force[4 * i + 2] = 0.0
-    b.force[4 * i + 3] = 0.0
-    b.moment[4 * i] = 0.0
-    b.moment[4 * i + 1] = 0.0
-    b.moment[4 * i + 2] = 0.0
-    b.moment[4 * i + 3] = 0.0
+    # voxel i's force and moment row (padding included)
+    memset(b.force + SOFTGYM_FM_STRIDE * i, 0, SOFTGYM_FM_STRIDE * sizeof(float64_t))
 
 
 cdef void clear_robot(Batch* b, intp_t r) noexcept nogil:
     # zero the robot's force/moment scratch (after an early exit)
     cdef intp_t vs = b.vox_start[r], ve = b.vox_start[r + 1]
-    memset(b.force + 4 * vs, 0, 4 * (ve - vs) * sizeof(float64_t))
-    memset(b.moment + 4 * vs, 0, 4 * (ve - vs) * sizeof(float64_t))
+    memset(b.force + SOFTGYM_FM_STRIDE * vs, 0, SOFTGYM_FM_STRIDE * (ve - vs) * sizeof(float64_t))
 
 
 cdef inline float64_t _drift2(const float64_t* pos, const float64_t* ref, intp_t i, intp_t vs,
@@ -196,6 +189,7 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
         intp_t i, k
         float64_t dt = b.dt[r]
         float64_t m, pen, cg, mx, my, mz
+        const float64_t* fm
         float64_t c[3]
         float64_t f[3]
         float64_t* pos = b.pos
@@ -229,12 +223,13 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
                 continue
             m = b.mass[i]
             cg = b.c_global[i]
-            f[0] = b.force[4 * i] + b.ext_force[3 * i] - cg * vel[3 * i]
-            f[1] = b.force[4 * i + 1] + b.ext_force[3 * i + 1] - cg * vel[3 * i + 1]
-            f[2] = b.force[4 * i + 2] + b.ext_force[3 * i + 2] - cg * vel[3 * i + 2] + m * g
-            mx = b.moment[4 * i]
-            my = b.moment[4 * i + 1]
-            mz = b.moment[4 * i + 2]
+            fm = b.force + SOFTGYM_FM_STRIDE * i  # the voxel's force, then moment (+ 4)
+            f[0] = fm[0] + b.ext_force[3 * i] - cg * vel[3 * i]
+            f[1] = fm[1] + b.ext_force[3 * i + 1] - cg * vel[3 * i + 1]
+            f[2] = fm[2] + b.ext_force[3 * i + 2] - cg * vel[3 * i + 2] + m * g
+            mx = fm[4]
+            my = fm[5]
+            mz = fm[6]
             _clear(b, i)  # the scratch is zero again for the next step
             if has_fluid:
                 _fluid_drag(b, i, f)
@@ -305,6 +300,7 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
         intp_t i, k
         float64_t dt = b.dt[r]
         float64_t cg, mx, my, mz
+        const float64_t* fm
         float64_t c[3]
         float64_t f[3]
         float64_t* pos = b.pos
@@ -335,13 +331,14 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
                 _clear(b, i)
                 continue
             cg = b.c_global[i]
-            f[0] = -cg * vel[3 * i] + b.force[4 * i] + b.ext_force[3 * i]
-            f[1] = -cg * vel[3 * i + 1] + b.force[4 * i + 1] + b.ext_force[3 * i + 1]
-            f[2] = (-cg * vel[3 * i + 2] + b.force[4 * i + 2] + b.mass[i] * b.gravity
+            fm = b.force + SOFTGYM_FM_STRIDE * i  # the voxel's force, then moment (+ 4)
+            f[0] = -cg * vel[3 * i] + fm[0] + b.ext_force[3 * i]
+            f[1] = -cg * vel[3 * i + 1] + fm[1] + b.ext_force[3 * i + 1]
+            f[2] = (-cg * vel[3 * i + 2] + fm[2] + b.mass[i] * b.gravity
                     + b.ext_force[3 * i + 2])
-            mx = b.moment[4 * i]
-            my = b.moment[4 * i + 1]
-            mz = b.moment[4 * i + 2]
+            mx = fm[4]
+            my = fm[5]
+            mz = fm[6]
             _clear(b, i)
             if has_fluid:
                 _fluid_drag(b, i, f)

@@ -577,8 +577,9 @@ def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layou
     a["rot"][:, [0, 4, 8]] = 1.0
     for name in ("vel", "angvel"):
         a[name] = np.zeros((n_vox, 3))
-    for name in ("force", "moment"):  # column 3: padding for 4-lane adds (_batch.pxd)
-        a[name] = np.zeros((n_vox, 4))
+    # each voxel's force (columns 0-2) and moment (4-6) in one row, 3 and 7 padding for
+    # whole-row vector adds (_batch.pxd)
+    a["force"] = np.zeros((n_vox, _core.FM_STRIDE))
     a["ext_force"] = np.ascontiguousarray(a["ext_force"], dtype=np.float64).reshape(-1, 3)
     a["faces"] = a["faces"].astype(np.int8)
     a["body_end"] = np.asarray(body_end, dtype=np.intp)

@@ -149,10 +149,11 @@ def _c_harness(header: str, body: str) -> str:
             "    }\n"
             "}\n"
             "static inline long rows_differ(const double *a, const double *b, int nv) {\n"
-            "    long bad = 0;  /* lanes 0-2 of nv rows of 4 (lane 3: padding) */\n"
+            "    long bad = 0;  /* force (lanes 0-2) and moment (4-6) of nv voxels' rows */\n"
             "    for (int i = 0; i < nv; i++)\n"
-            "        for (int c = 0; c < 3; c++)\n"
-            "            bad += memcmp(&a[4 * i + c], &b[4 * i + c], sizeof(double)) != 0;\n"
+            "        for (int c = 0; c < 7; c++)\n"
+            "            bad += c != 3 && memcmp(&a[SOFTGYM_FM_STRIDE * i + c],\n"
+            "                                    &b[SOFTGYM_FM_STRIDE * i + c], sizeof(double)) != 0;\n"
             "    return bad;\n"
             "}\n" + body)
 
@@ -319,9 +320,11 @@ SCATTER_HARNESS = _c_harness("softgym_seed.h", r"""
 /* one chunk's links scattered by softgym_seed_scatter (with AVX-512: blocks of 8 turned in
    the lanes with the geometry's rotation rows, the links before and after them one by
    one) against softgym_seed_scatter_links (every link one by one, voxel 1's matrix from
-   rot): the voxels' forces and moments (lanes 0-2 of their rows; lane 3 is padding) */
-enum { NV = 300, N = SOFTGYM_CHUNK_LINKS };
-static double rot[9 * NV], f_a[4 * NV], m_a[4 * NV], f_b[4 * NV], m_b[4 * NV], neg2[N];
+   rot): the voxels' forces and moments (lanes 0-2 and 4-6 of their rows; 3 and 7 are
+   padding) */
+enum { NV = 300, N = SOFTGYM_CHUNK_LINKS, FM = SOFTGYM_FM_STRIDE * NV };
+static double fm_a[FM] __attribute__((aligned(64))), fm_b[FM] __attribute__((aligned(64)));
+static double rot[9 * NV], neg2[N];
 static double chunk[SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE] __attribute__((aligned(64)));
 static Py_ssize_t v1[N], v2[N];
 SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi)
@@ -333,11 +336,11 @@ SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi)
         for (int k = 0; k < 9; k++)
             chunk[(SOFTGYM_SEED_R_ROWS + k) * SOFTGYM_CHUNK_STRIDE + li] = rot[9 * v1[li] + k];
     }
-    urand_both(f_a, f_b, 4 * NV);
-    urand_both(m_a, m_b, 4 * NV);
-    softgym_seed_scatter(ax, lo, hi, v1, v2, rot, chunk, neg2, f_a, m_a);
-    SOFTGYM_BY_AXIS(ax, softgym_seed_scatter_links, lo, hi, v1, v2, rot, chunk, neg2, f_b, m_b);
-    return rows_differ(f_a, f_b, NV) + rows_differ(m_a, m_b, NV);
+    urand_both(fm_a, fm_b, FM);
+    softgym_seed_scatter(ax, lo, hi, v1, v2, rot, chunk, neg2, fm_a, fm_a + 4);
+    SOFTGYM_BY_AXIS(ax, softgym_seed_scatter_links, lo, hi, v1, v2, rot, chunk, neg2, fm_b,
+                    fm_b + 4);
+    return rows_differ(fm_a, fm_b, NV);
 }
 int main(void)
 {
@@ -361,9 +364,11 @@ int main(void)
 COROT_SCATTER_HARNESS = _c_harness("softgym_corot.h", r"""
 /* softgym_corot_scatter (with AVX-512: blocks of 8 links turned into rows of 4 in
    registers) against the scatter written out per component, link by link: the voxels'
-   forces and moments (lanes 0-2 of their rows), and where it stops (a strained link) */
-enum { NV = 300, N = 203 };
-static double o[10 * N], f_a[4 * NV], m_a[4 * NV], f_b[4 * NV], m_b[4 * NV];
+   forces and moments (lanes 0-2 and 4-6 of their rows), and where it stops (a strained
+   link) */
+enum { NV = 300, N = 203, S = SOFTGYM_FM_STRIDE, FM = SOFTGYM_FM_STRIDE * NV };
+static double fm_a[FM] __attribute__((aligned(64))), fm_b[FM] __attribute__((aligned(64)));
+static double o[10 * N];
 static Py_ssize_t v1[N], v2[N];
 static long check(Py_ssize_t strained)
 {
@@ -374,18 +379,17 @@ static long check(Py_ssize_t strained)
         o[li] = 0.3 * (urand() + 0.5);  /* |extension| under max_ext */
     if (strained >= 0)
         o[strained] = 0.5;
-    urand_both(f_a, f_b, 4 * NV);
-    urand_both(m_a, m_b, 4 * NV);
-    Py_ssize_t end = softgym_corot_scatter(0, N, N, max_ext, v1, v2, o, f_a, m_a);
+    urand_both(fm_a, fm_b, FM);
+    Py_ssize_t end = softgym_corot_scatter(0, N, N, max_ext, v1, v2, o, fm_a, fm_a + 4);
     Py_ssize_t want = strained >= 0 ? strained : N;
     for (Py_ssize_t li = 0; li < want; li++)
         for (int c = 0; c < 3; c++) {
-            f_b[4 * v2[li] + c] += o[(1 + c) * N + li];
-            f_b[4 * v1[li] + c] -= o[(1 + c) * N + li];
-            m_b[4 * v1[li] + c] += o[(4 + c) * N + li];
-            m_b[4 * v2[li] + c] += o[(7 + c) * N + li];
+            fm_b[S * v2[li] + c] += o[(1 + c) * N + li];
+            fm_b[S * v1[li] + c] -= o[(1 + c) * N + li];
+            fm_b[S * v1[li] + 4 + c] += o[(4 + c) * N + li];
+            fm_b[S * v2[li] + 4 + c] += o[(7 + c) * N + li];
         }
-    return (end != want) + rows_differ(f_a, f_b, NV) + rows_differ(m_a, m_b, NV);
+    return (end != want) + rows_differ(fm_a, fm_b, NV);
 }
 int main(void)
 {

@@ -205,8 +205,9 @@ static Py_ssize_t softgym_corot_scatter(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t
     Py_ssize_t li = lo;
 #if defined(SOFTGYM_VLANES) && SOFTGYM_VLANES == 8
     /* 8 links at a time with AVX-512 while none of them is strained: their rows turned
-       into each link's rows of 4 in registers (softgym_v8_rows4), then added link after
-       link, as below (the first strained link's block goes link by link) */
+       into each link's rows of 4 in registers (softgym_v8_rows4), paired into the rows of
+       8 each voxel takes (force and moment: SOFTGYM_ROW8), then added link after link, as
+       below (the first strained link's block goes link by link) */
     for (; li + 8 <= hi; li += 8) {
         __m512d e = _mm512_loadu_pd(o + li);
         if (_mm512_cmp_pd_mask(e, _mm512_set1_pd(max_ext), _CMP_LE_OQ) != 0xFF)
@@ -218,19 +219,19 @@ static Py_ssize_t softgym_corot_scatter(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t
                          softgym_v8_load(o + 6 * n + li), w1);
         softgym_v8_rows4(softgym_v8_load(o + 7 * n + li), softgym_v8_load(o + 8 * n + li),
                          softgym_v8_load(o + 9 * n + li), w2);
-        __m256d bf = _mm256_setzero_pd(), bm = bf;
+        /* voxel 1's row takes [-f | m1]: fmadd of [-1 .. | 1 ..] times [f | m1] is its sum
+           with f negated (exactly: the product by -1 is exact and the sum rounds once) */
+        const __m512d sg = _mm512_set_pd(1.0, 1.0, 1.0, 1.0, -1.0, -1.0, -1.0, -1.0);
+        __m512d c = _mm512_setzero_pd();
         Py_ssize_t pb = -1;
 #define SOFTGYM_COROT_ADD1(k) do { \
-            Py_ssize_t i_ = 4 * v1[li + (k)], j_ = 4 * v2[li + (k)]; \
-            __m256d f_ = SOFTGYM_ROW4(wf, k); \
-            __m256d af_, am_; \
-            SOFTGYM_ROWS_OR_CARRIED(i_ == pb, af_, am_, bf, bm, force, moment, i_); \
-            bf = _mm256_add_pd(_mm256_load_pd(force + j_), f_); \
-            bm = _mm256_add_pd(_mm256_load_pd(moment + j_), SOFTGYM_ROW4(w2, k)); \
-            _mm256_store_pd(force + j_, bf); \
-            _mm256_store_pd(force + i_, _mm256_sub_pd(af_, f_)); \
-            _mm256_store_pd(moment + i_, _mm256_add_pd(am_, SOFTGYM_ROW4(w1, k))); \
-            _mm256_store_pd(moment + j_, bm); \
+            Py_ssize_t i_ = SOFTGYM_FM_STRIDE * v1[li + (k)]; \
+            Py_ssize_t j_ = SOFTGYM_FM_STRIDE * v2[li + (k)]; \
+            __m512d a_; \
+            SOFTGYM_ROW_OR_CARRIED(i_ == pb, a_, c, force, i_); \
+            c = _mm512_add_pd(_mm512_load_pd(force + j_), SOFTGYM_ROW8(wf, w2, k)); \
+            _mm512_store_pd(force + j_, c); \
+            _mm512_store_pd(force + i_, _mm512_fmadd_pd(sg, SOFTGYM_ROW8(wf, w1, k), a_)); \
             pb = j_; \
         } while (0)
         SOFTGYM_EACH8(SOFTGYM_COROT_ADD1);
@@ -255,35 +256,35 @@ static Py_ssize_t softgym_corot_scatter(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t
             fi = cf;
             mi = cm;
         } else {
-            memcpy(&fi, force + 4 * i, sizeof fi);
-            memcpy(&mi, moment + 4 * i, sizeof mi);
+            memcpy(&fi, force + SOFTGYM_FM_STRIDE * i, sizeof fi);
+            memcpy(&mi, moment + SOFTGYM_FM_STRIDE * i, sizeof mi);
         }
-        memcpy(&fj, force + 4 * j, sizeof fj);
-        memcpy(&mj, moment + 4 * j, sizeof mj);
+        memcpy(&fj, force + SOFTGYM_FM_STRIDE * j, sizeof fj);
+        memcpy(&mj, moment + SOFTGYM_FM_STRIDE * j, sizeof mj);
         fj += f;
         fi -= f;
         mi += m1;
         mj += m2;
-        memcpy(force + 4 * j, &fj, sizeof fj);
-        memcpy(force + 4 * i, &fi, sizeof fi);
-        memcpy(moment + 4 * i, &mi, sizeof mi);
-        memcpy(moment + 4 * j, &mj, sizeof mj);
+        memcpy(force + SOFTGYM_FM_STRIDE * j, &fj, sizeof fj);
+        memcpy(force + SOFTGYM_FM_STRIDE * i, &fi, sizeof fi);
+        memcpy(moment + SOFTGYM_FM_STRIDE * i, &mi, sizeof mi);
+        memcpy(moment + SOFTGYM_FM_STRIDE * j, &mj, sizeof mj);
         cf = fj;
         cm = mj;
         pj = j;
 #else
-        force[4 * j] += fx;
-        force[4 * j + 1] += fy;
-        force[4 * j + 2] += fz;
-        force[4 * i] -= fx;
-        force[4 * i + 1] -= fy;
-        force[4 * i + 2] -= fz;
-        moment[4 * i] += o[4 * n + li];
-        moment[4 * i + 1] += o[5 * n + li];
-        moment[4 * i + 2] += o[6 * n + li];
-        moment[4 * j] += o[7 * n + li];
-        moment[4 * j + 1] += o[8 * n + li];
-        moment[4 * j + 2] += o[9 * n + li];
+        force[SOFTGYM_FM_STRIDE * j] += fx;
+        force[SOFTGYM_FM_STRIDE * j + 1] += fy;
+        force[SOFTGYM_FM_STRIDE * j + 2] += fz;
+        force[SOFTGYM_FM_STRIDE * i] -= fx;
+        force[SOFTGYM_FM_STRIDE * i + 1] -= fy;
+        force[SOFTGYM_FM_STRIDE * i + 2] -= fz;
+        moment[SOFTGYM_FM_STRIDE * i] += o[4 * n + li];
+        moment[SOFTGYM_FM_STRIDE * i + 1] += o[5 * n + li];
+        moment[SOFTGYM_FM_STRIDE * i + 2] += o[6 * n + li];
+        moment[SOFTGYM_FM_STRIDE * j] += o[7 * n + li];
+        moment[SOFTGYM_FM_STRIDE * j + 1] += o[8 * n + li];
+        moment[SOFTGYM_FM_STRIDE * j + 2] += o[9 * n + li];
 #endif
     }
     return hi;

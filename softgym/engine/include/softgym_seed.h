@@ -718,8 +718,8 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_links(const int ax, Py_ssize_t l
         unsigned long long neg2_bits;
         memcpy(&neg2_bits, neg2_row + li, sizeof neg2_bits);
         int neg2 = neg2_bits != 0;
-        double *fi = force + 4 * i, *fj = force + 4 * j;
-        double *mi = moment + 4 * i, *mj = moment + 4 * j;
+        double *fi = force + SOFTGYM_FM_STRIDE * i, *fj = force + SOFTGYM_FM_STRIDE * j;
+        double *mi = moment + SOFTGYM_FM_STRIDE * i, *mj = moment + SOFTGYM_FM_STRIDE * j;
 #if defined(SOFTGYM_SCATTER_V4)
         softgym_v4d fi_v, fj_v, mi_v, mj_v;
         if (i == pj) {
@@ -783,27 +783,24 @@ SOFTGYM_ALWAYS_INLINE void softgym_turn8(const int ax, const softgym_v8 *R, cons
     softgym_v8 wz = R[6] * x + R[7] * y + R[8] * z;
     softgym_v8_rows4(wx, wy, wz, out);
 }
-/* link k's turned vectors w added to its voxels' rows: voxel 1's force f1, moment m1,
-   voxel 2's f2, m2; along x, where a link's voxel 1 is the last link's voxel 2, its rows
-   come from the registers just stored rather than loads that would wait on those stores */
+/* link k's turned vectors w added to its voxels' rows: voxel 1's force f1 and moment m1
+   in one 8-lane read-add-write of its row (SOFTGYM_FM_STRIDE), voxel 2's f2 and m2 in
+   another; along x, where a link's voxel 1 is the last link's voxel 2, its row comes from
+   the register just stored rather than a load that would wait on that store */
 #define SOFTGYM_ADD1(k) do { \
-        Py_ssize_t i_ = 4 * v1[li + (k)], j_ = 4 * v2[li + (k)]; \
-        __m256d af_, am_; \
-        SOFTGYM_ROWS_OR_CARRIED(ax == 0 && (k) > 0 && i_ == pj, af_, am_, cf, cm, force, moment, \
-                                i_); \
-        _mm256_store_pd(force + i_, _mm256_add_pd(af_, SOFTGYM_ROW4(wf1, k))); \
-        _mm256_store_pd(moment + i_, _mm256_add_pd(am_, SOFTGYM_ROW4(wm1, k))); \
-        cf = _mm256_add_pd(_mm256_load_pd(force + j_), SOFTGYM_ROW4(wf2, k)); \
-        cm = _mm256_add_pd(_mm256_load_pd(moment + j_), SOFTGYM_ROW4(wm2, k)); \
-        _mm256_store_pd(force + j_, cf); \
-        _mm256_store_pd(moment + j_, cm); \
+        Py_ssize_t i_ = SOFTGYM_FM_STRIDE * v1[li + (k)], j_ = SOFTGYM_FM_STRIDE * v2[li + (k)]; \
+        __m512d a_; \
+        SOFTGYM_ROW_OR_CARRIED(ax == 0 && (k) > 0 && i_ == pj, a_, c, force, i_); \
+        _mm512_store_pd(force + i_, _mm512_add_pd(a_, SOFTGYM_ROW8(wf1, wm1, k))); \
+        c = _mm512_add_pd(_mm512_load_pd(force + j_), SOFTGYM_ROW8(wf2, wm2, k)); \
+        _mm512_store_pd(force + j_, c); \
         pj = j_; \
     } while (0)
 /* softgym_seed_scatter_links for the 8 links li..li + 7 (q = o + li on a cache line):
    the turns in the lanes of AVX-512 with voxel 1's rotation from the geometry's rows
    (SOFTGYM_SEED_R_ROWS), the same IEEE operations as the per-link turns, then each link's
-   4 turned vectors added to its voxels' rows, link after link: each voxel's sum in the
-   same order. Where voxel 2 takes -F1 (neg2_row), its force is the turn of -F1: exactly
+   4 turned vectors added to its voxels' rows (one 8-lane add a voxel: its force and
+   moment), link after link: each voxel's sum in the same order. Where voxel 2 takes -F1 (neg2_row), its force is the turn of -F1: exactly
    minus F1's, and adding it is subtracting F1's */
 SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter8(const int ax, Py_ssize_t li,
                                                  const Py_ssize_t *v1, const Py_ssize_t *v2,
@@ -836,8 +833,9 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter8(const int ax, Py_ssize_t li,
     }
     softgym_turn8(ax, R, a, wm1);
     softgym_turn8(ax, R, b, wm2);
-    __m256d cf = _mm256_setzero_pd(), cm = cf;
+    __m512d c = _mm512_setzero_pd();
     Py_ssize_t pj = -1;
+    (void)moment;
     SOFTGYM_EACH8(SOFTGYM_ADD1);
 }
 #endif

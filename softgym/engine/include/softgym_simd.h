@@ -14,6 +14,11 @@
 #endif
 #include <math.h>
 #include <string.h>
+/* Each voxel's accumulated force and moment share one row of SOFTGYM_FM_STRIDE doubles
+   (Batch.force: force in columns 0-2, moment in 4-6, columns 3 and 7 padding, never
+   read; Batch.moment points at column 4): 64 bytes, one cache line, so that a link's
+   vector scatter adds its force and moment to a voxel in one 8-lane read-add-write */
+#define SOFTGYM_FM_STRIDE 8
 /* c ? a : b on the bits: compilers keep it a blend (a select before a
    store may otherwise become a masked store, slow on some cores) */
 static inline double softgym_pick(long long c, double a, double b)
@@ -145,6 +150,30 @@ static inline void softgym_v8_load4x4(const double *a, softgym_v8 *r)
     r[2] = (softgym_v8)_mm512_permutex2var_pd(a23, lo, b23);
     r[3] = (softgym_v8)_mm512_permutex2var_pd(a23, hi, b23);
 }
+/* the same for 8 records of 4 that start SOFTGYM_FM_STRIDE doubles apart (a[0..3],
+   a[8..11], ...: the force or the moment columns of the voxels' rows) */
+static inline void softgym_v8_load4x4_fm(const double *a, softgym_v8 *r)
+{
+    const int s = SOFTGYM_FM_STRIDE;
+    __m512d p0 = _mm512_insertf64x4(_mm512_castpd256_pd512(_mm256_load_pd(a)),
+                                    _mm256_load_pd(a + s), 1);
+    __m512d p1 = _mm512_insertf64x4(_mm512_castpd256_pd512(_mm256_load_pd(a + 2 * s)),
+                                    _mm256_load_pd(a + 3 * s), 1);
+    __m512d p2 = _mm512_insertf64x4(_mm512_castpd256_pd512(_mm256_load_pd(a + 4 * s)),
+                                    _mm256_load_pd(a + 5 * s), 1);
+    __m512d p3 = _mm512_insertf64x4(_mm512_castpd256_pd512(_mm256_load_pd(a + 6 * s)),
+                                    _mm256_load_pd(a + 7 * s), 1);
+    const __m512i i01 = _mm512_set_epi64(8 + 5, 8 + 1, 5, 1, 8 + 4, 8 + 0, 4, 0);
+    const __m512i i23 = _mm512_set_epi64(8 + 7, 8 + 3, 7, 3, 8 + 6, 8 + 2, 6, 2);
+    __m512d a01 = _mm512_permutex2var_pd(p0, i01, p1), b01 = _mm512_permutex2var_pd(p2, i01, p3);
+    __m512d a23 = _mm512_permutex2var_pd(p0, i23, p1), b23 = _mm512_permutex2var_pd(p2, i23, p3);
+    const __m512i lo = _mm512_set_epi64(8 + 3, 8 + 2, 8 + 1, 8 + 0, 3, 2, 1, 0);
+    const __m512i hi = _mm512_set_epi64(8 + 7, 8 + 6, 8 + 5, 8 + 4, 7, 6, 5, 4);
+    r[0] = (softgym_v8)_mm512_permutex2var_pd(a01, lo, b01);
+    r[1] = (softgym_v8)_mm512_permutex2var_pd(a01, hi, b01);
+    r[2] = (softgym_v8)_mm512_permutex2var_pd(a23, lo, b23);
+    r[3] = (softgym_v8)_mm512_permutex2var_pd(a23, hi, b23);
+}
 /* rows r[0..3] (element 0 .. 3 of 8 records) back into the 8 records of 4 at a[0..31] */
 static inline void softgym_v8_store4x4(double *a, const softgym_v8 *r)
 {
@@ -161,20 +190,21 @@ static inline void softgym_v8_store4x4(double *a, const softgym_v8 *r)
     _mm512_storeu_pd(a + 16, _mm512_shuffle_f64x2(r46, r57, 0x44));  /* records 4, 5 */
     _mm512_storeu_pd(a + 24, _mm512_shuffle_f64x2(r46, r57, 0xEE));  /* records 6, 7 */
 }
-/* 8 voxels' rows of 4 (a[0..31]) as rows x, y, z (element 3 of each record dropped: the
-   compiler drops its permute) */
-static inline void softgym_v8_load4(const double *a, softgym_v8 *x, softgym_v8 *y,
-                                    softgym_v8 *z)
+/* the force (a = force + SOFTGYM_FM_STRIDE i) or moment columns of 8 voxels' rows as rows
+   x, y, z (element 3 of each record dropped: the compiler drops its permute) */
+static inline void softgym_v8_load4_fm(const double *a, softgym_v8 *x, softgym_v8 *y,
+                                       softgym_v8 *z)
 {
     softgym_v8 r[4];
-    softgym_v8_load4x4(a, r);
+    softgym_v8_load4x4_fm(a, r);
     *x = r[0];
     *y = r[1];
     *z = r[2];
 }
 /* 8 links' (or voxels') vectors (x, y, z) in the lanes of x, y, z as their rows of 4 (x,
-   y, z, z: lane 3 is the force and moment rows' padding), two to a register: link k's in
-   half k / 4 of out[k % 4] (SOFTGYM_ROW4; the link scatters add them to the rows) */
+   y, z, z: lane 3 lands in a force or moment row's padding), two to a register: link k's
+   in half k / 4 of out[k % 4] (SOFTGYM_ROW8 pairs a force's with a moment's, the link
+   scatters add them to the voxels' rows) */
 static inline void softgym_v8_rows4(softgym_v8 x, softgym_v8 y, softgym_v8 z, __m512d *out)
 {
     __m512d t0 = _mm512_unpacklo_pd((__m512d)x, (__m512d)y);  /* x0 y0 x2 y2 x4 y4 x6 y6 */
@@ -186,24 +216,24 @@ static inline void softgym_v8_rows4(softgym_v8 x, softgym_v8 y, softgym_v8 z, __
     out[3] = _mm512_permutex2var_pd(t1, _mm512_set_epi64(15, 15, 7, 6, 11, 11, 3, 2),
                                     (__m512d)z);
 }
-/* voxel row i's force and moment rows (doubles force + i, moment + i) into af, am: the
-   registers cf, cm where carried (the rows a store has just made: a link's voxel 1 that is
-   the last link's voxel 2), else loads that would wait on such a store */
-#define SOFTGYM_ROWS_OR_CARRIED(carried, af, am, cf, cm, force, moment, i) do { \
-        if (carried) { \
-            af = cf; \
-            am = cm; \
-        } else { \
-            af = _mm256_load_pd((force) + (i)); \
-            am = _mm256_load_pd((moment) + (i)); \
-        } \
+/* the 8 lanes of a voxel's force and moment row (double fm + i: SOFTGYM_FM_STRIDE) into
+   a: the register c where carried (the row a store has just made: a link's voxel 1 that
+   is the last link's voxel 2), else a load that would wait on such a store */
+#define SOFTGYM_ROW_OR_CARRIED(carried, a, c, fm, i) do { \
+        if (carried) \
+            a = c; \
+        else \
+            a = _mm512_load_pd((fm) + (i)); \
     } while (0)
+/* link k's rows of 4 in two of softgym_v8_rows4's outputs (w for the force, u for the
+   moment) as one row of 8: the voxel's force and moment lanes */
+#define SOFTGYM_ROW8(w, u, k) \
+    ((k) < 4 ? _mm512_shuffle_f64x2((w)[(k) % 4], (u)[(k) % 4], 0x44) \
+             : _mm512_shuffle_f64x2((w)[(k) % 4], (u)[(k) % 4], 0xEE))
 /* M(0); M(1); ... M(7): a block's 8 links in order, each index a compile-time constant */
 #define SOFTGYM_EACH8(M) do { \
         M(0); M(1); M(2); M(3); M(4); M(5); M(6); M(7); \
     } while (0)
-#define SOFTGYM_ROW4(w, k) \
-    ((k) < 4 ? _mm512_castpd512_pd256((w)[(k) % 4]) : _mm512_extractf64x4_pd((w)[(k) % 4], 1))
 /* whether the 8 indices v[0..7] are v[0], v[0] + 1, ..., v[0] + 7 (a run of records) */
 static inline int softgym_run8(const Py_ssize_t *v)
 {

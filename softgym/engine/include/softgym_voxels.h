@@ -3,8 +3,8 @@
    lane by lane, each expression written in the scalar code's shape (so the build fuses
    the same multiply-adds), the seed's floor with every branch computed and one selected.
    The voxels' records (position, velocity, angular velocity and external force: 3
-   doubles each; force and moment: rows of 4) are turned into rows of 8 lanes and back
-   by two-source permutes. Only for the common block: no fixed voxel, no fluid, no
+   doubles each; force and moment: halves of one row of SOFTGYM_FM_STRIDE) are turned
+   into rows of 8 lanes and back by two-source permutes. Only for the common block: no fixed voxel, no fluid, no
    terrain box; a block where a voxel runs away is left to the scalar loop untouched
    (nothing is stored before the check), which then stops where the seed's loop stops.
    Py_ssize_t comes from Python.h, which Cython includes first. */
@@ -55,7 +55,7 @@
     softgym_v8_load3(vel + 3 * i, &v0, &v1, &v2); \
     softgym_v8_load3(pos + 3 * i, &p0, &p1, &p2); \
     softgym_v8_load3(ext + 3 * i, &E0, &E1, &E2); \
-    softgym_v8_load4(force + 4 * i, &F0, &F1, &F2); \
+    softgym_v8_load4_fm(force + SOFTGYM_FM_STRIDE * i, &F0, &F1, &F2); \
     softgym_v8 cg = softgym_v8_load(c_global + i), m = softgym_v8_load(mass + i)
 
 /* the largest lane of v above *best, as the scalar loop's "if v > best" (NaN never) */
@@ -77,7 +77,7 @@ static inline int softgym_v8_finish(SOFTGYM_VOXELS8_PARAMS, softgym_v8 v0, softg
                                     softgym_v8 f0, softgym_v8 f1, softgym_v8 f2)
 {
     softgym_v8 M0, M1, M2;
-    softgym_v8_load4(moment + 4 * i, &M0, &M1, &M2);
+    softgym_v8_load4_fm(moment + SOFTGYM_FM_STRIDE * i, &M0, &M1, &M2);
     softgym_v8 h = dt * softgym_v8_load(inv_mass + i);
     softgym_v8 vx = v0 + (f0 * h), vy = v1 + (f1 * h), vz = v2 + (f2 * h);
     softgym_v8 px = p0 + (vx * dt), py = p1 + (vy * dt), pz = p2 + (vz * dt);
@@ -87,8 +87,8 @@ static inline int softgym_v8_finish(SOFTGYM_VOXELS8_PARAMS, softgym_v8 v0, softg
     /* the block is stepped: from here on, stores */
     softgym_v8_store3(vel + 3 * i, vx, vy, vz);
     softgym_v8_store3(pos + 3 * i, px, py, pz);
-    memset(force + 4 * i, 0, 32 * sizeof(double));
-    memset(moment + 4 * i, 0, 32 * sizeof(double));
+    /* the 8 voxels' force and moment rows, padding included */
+    memset(force + SOFTGYM_FM_STRIDE * i, 0, 8 * SOFTGYM_FM_STRIDE * sizeof(double));
     if (ref != NULL) {
         softgym_v8 r0, r1, r2;
         softgym_v8_load3(ref + 3 * (i - vs), &r0, &r1, &r2);
