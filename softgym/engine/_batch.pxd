@@ -70,8 +70,9 @@ cdef struct Batch:
                              #   rows) and are never read; voxel i's force at
                              #   force[SOFTGYM_FM_STRIDE * i]
     float64_t* moment        # force + 4: voxel i's moment at moment[SOFTGYM_FM_STRIDE * i]
-    float64_t* vox_out       # scratch of the seed model's new orientations: row k of voxel i at
-                             #   vox_out[k * vox_stride + i], i among the robot's voxels
+    float64_t* vox_out       # the voxel update's scratch, SOFTGYM_VOXEL_ROWS rows: row k of
+                             #   voxel i at vox_out[k * vox_stride + i], i among the robot's
+                             #   voxels (include/softgym_simd.h)
     intp_t vox_stride        # its row stride (the most voxels of one robot)
     float64_t* ext_force     # (n_voxels, 3) constant external force (N)
     float64_t* mass          # (n_voxels,) rho L^3 (kg)
@@ -151,15 +152,17 @@ cdef enum:
 
 
 # Rows of the per-thread scratch the link and voxel kernels share
-# (Batch.link_out, Batch.vox_out; allocated by _core.advance).
+# (Batch.link_out; Batch.vox_out has SOFTGYM_VOXEL_ROWS; allocated by _core.advance).
 cdef enum:
     N_LINK_OUT = 25          # rows of the per-link scratch (see _corotational, _seed)
-    N_VOX_OUT = 4            # rows of the per-voxel scratch (see _integrate.integrate_seed)
 
 
 cdef extern from "softgym_simd.h":
     # the row of Batch.force (doubles a voxel: its force, then its moment)
     enum: SOFTGYM_FM_STRIDE
+    # rows of the per-voxel scratch, Batch.vox_out (the voxel update's quaternions; the
+    # seed step's voxel rows)
+    enum: SOFTGYM_VOXEL_ROWS
 
 
 cdef extern from *:

@@ -24,13 +24,13 @@ cimport numpy as cnp
 import numpy as np
 
 from softgym.engine._batch cimport (Batch, STATUS_OK, STATUS_STRAIN, STATUS_NONFINITE,
-                                    STATUS_MEMORY, N_AUX, N_LINK_OUT, N_VOX_OUT,
+                                    STATUS_MEMORY, N_AUX, N_LINK_OUT, SOFTGYM_VOXEL_ROWS,
                                     SOFTGYM_FM_STRIDE)
 from softgym.engine._contact cimport (Contacts, contacts_corotational, contacts_seed, collide,
                                       collide_obstacles)
 from softgym.engine._corotational cimport links_corotational
 from softgym.engine._integrate cimport (integrate_corotational, integrate_seed, clear_robot,
-                                       refresh_robot_rotations)
+                                       refresh_robot_rotations, seed_voxel_rows)
 from softgym.engine._record cimport record, robot_aux, robot_energy
 from softgym.engine._prof cimport softgym_prof_tsc, softgym_prof_add, prof_counts
 from softgym.engine._seed cimport (links_seed, SOFTGYM_CHUNK_STRIDE, SOFTGYM_CHUNK_ROWS,
@@ -140,6 +140,8 @@ cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
         int status = STATUS_OK
         float64_t dmax2 = 0.0
         unsigned long long t0
+    # the voxel rows the geometry reads, as the state is now (integrate_seed keeps them)
+    seed_voxel_rows(b, r)
     while b.steps[r] < target:
         t0 = softgym_prof_tsc()
         if b.self_collision:
@@ -515,7 +517,7 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
     b.vox_stride = vstride
     # the float rows' floats rounded up to doubles (a multiple of 8: they start on a line)
     fblock = (SOFTGYM_CHUNK_FROWS * SOFTGYM_CHUNK_FSTRIDE + 15) // 16 * 8
-    block = (N_LINK_OUT * stride + N_VOX_OUT * vstride + SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE
+    block = (N_LINK_OUT * stride + SOFTGYM_VOXEL_ROWS * vstride + SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE
              + fblock + N_LINK_OUT * SOFTGYM_CHUNK_STRIDE)
     scratch = cache.scratch(max(n_threads * block, 1))
     # robots in the order 0, 8, 16, ..., then 1, 9, 17, ...: the robots that the
@@ -539,7 +541,7 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
                 # robot's first link and voxel
                 bt.link_out = scratch + t * block - b.link_start[r]
                 bt.vox_out = scratch + t * block + N_LINK_OUT * stride - b.vox_start[r]
-                bt.chunk_out = scratch + t * block + N_LINK_OUT * stride + N_VOX_OUT * vstride
+                bt.chunk_out = scratch + t * block + N_LINK_OUT * stride + SOFTGYM_VOXEL_ROWS * vstride
                 bt.chunk_f32 = <float*> (bt.chunk_out + SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE)
                 bt.chunk_link = bt.chunk_out + SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE + fblock
                 advance_robot(&bt, r, targets[r], &cache.items[r])

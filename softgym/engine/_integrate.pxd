@@ -13,6 +13,10 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
                         float64_t* dmax2) noexcept nogil
     # model 0 (the seed's EulerStep), same contract, except rot where the build's seed
     # step does not read it (SOFTGYM_SEED_R_USED): then refresh_robot_rotations.
+cdef void seed_voxel_rows(Batch* b, intp_t r) noexcept nogil
+    # robot r's voxel rows (rows 0-6 of b.vox_out: quaternions, positions) from quat and
+    # pos, where the build's seed step reads them (SOFTGYM_SEED_R_USED; else nothing):
+    # before its first step of a call, integrate_seed keeps them after each
 cdef void refresh_robot_rotations(Batch* b, intp_t r) noexcept nogil
     # robot r's rot from its quat where integrate_seed leaves it (else nothing)
 cdef void clear_robot(Batch* b, intp_t r) noexcept nogil

@@ -258,8 +258,11 @@ cdef extern from "softgym_orient.h":
                             const float64_t* quat, float64_t* q_out) noexcept nogil
     void softgym_corot_quats(intp_t lo, intp_t hi, intp_t n, float64_t dt, const float64_t* av,
                              const float64_t* quat, float64_t* q_out) noexcept nogil
-    void softgym_orient_store(intp_t lo, intp_t hi, intp_t n, const float64_t* q_out,
-                              const flag_t* fixed, float64_t* quat, float64_t* rot) noexcept nogil
+    void softgym_orient_store(intp_t lo, intp_t hi, intp_t n, float64_t* q_out,
+                              const flag_t* fixed, float64_t* quat, float64_t* rot,
+                              const float64_t* pos) noexcept nogil
+    void softgym_voxel_rows(intp_t lo, intp_t hi, intp_t n, const float64_t* pos,
+                            const float64_t* quat, float64_t* rows) noexcept nogil
 
 
 cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int seed) noexcept nogil:
@@ -274,9 +277,18 @@ cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int
     else:
         softgym_corot_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
     # (the seed model's rotation matrices: refresh_robot_rotations, where its step does
-    # not read them)
-    softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat,
-                         NULL if seed and SOFTGYM_SEED_R_USED else b.rot)
+    # not read them; it reads the voxel rows instead, kept here)
+    if seed and SOFTGYM_SEED_R_USED:
+        softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat, NULL, b.pos)
+    else:
+        softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat, b.rot, NULL)
+
+
+cdef void seed_voxel_rows(Batch* b, intp_t r) noexcept nogil:
+    # robot r's voxel rows from quat and pos (_integrate.pxd)
+    if SOFTGYM_SEED_R_USED:
+        softgym_voxel_rows(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.pos, b.quat,
+                           b.vox_out)
 
 
 cdef void refresh_robot_rotations(Batch* b, intp_t r) noexcept nogil:

@@ -74,7 +74,7 @@ cdef extern from "softgym_seed.h":
     # copy per link axis; documented in include/softgym_seed.h)
     void softgym_seed_geom(int ax, intp_t lo, intp_t hi, intp_t n, const intp_t* v1,
                            const intp_t* v2, intp_t vend, const float64_t* pos,
-                           const float64_t* quat,
+                           const float64_t* quat, const float64_t* vr, intp_t vn,
                            const float64_t* scale, float64_t* o, float64_t* rr) noexcept nogil
     # (the two frames passes return whether any link needs _seed_frame_one)
     int softgym_seed_frames(intp_t lo, intp_t hi, float64_t sa_rad, float64_t thr,
@@ -277,7 +277,9 @@ cdef inline intp_t _seed_geom_modes(Batch* b, int ax, intp_t lo, intp_t hi, intp
         unsigned long long t0
     t0 = softgym_prof_tsc()
     # vend: the robot's voxels end there (the geometry reads no other robot's records)
-    softgym_seed_geom(ax, lo, hi, n, b.v1, b.v2, vend, b.pos, b.quat, b.scale, o, rr)
+    # (b.vox_out: the voxel rows, integrate_seed's; _integrate.pxd seed_voxel_rows)
+    softgym_seed_geom(ax, lo, hi, n, b.v1, b.v2, vend, b.pos, b.quat, b.vox_out, b.vox_stride,
+                      b.scale, o, rr)
     softgym_prof_add(0, t0)
     t0 = softgym_prof_tsc()
     end = softgym_seed_modes(lo, hi, n, b.max_strain * b.L, SMALL_ANGLE_W, SMALLISH_ANGLE_W,

@@ -29,7 +29,7 @@ FLAGS = ["-O3", "-ffp-contract=fast", "-fno-math-errno", "-fno-trapping-math",
 
 # one call per pass (the headers' functions are static: only the called one is compiled)
 PASSES = {
-    "softgym_seed_geom": "softgym_seed_geom(ax, 0, n, n, ip, ip, n, d, d, d, o, o);",
+    "softgym_seed_geom": "softgym_seed_geom(ax, 0, n, n, ip, ip, n, d, d, d, n, d, o, o);",
     "softgym_seed_frames": "softgym_seed_frames(0, n, 0.01, 0.002, d, d, d, d, d, d, d, d, d, d, "
                            "o, o, o, o, o, o, o, o, o, o, o, o);",
     "softgym_seed_forces": "softgym_seed_forces(0, n, n, 0.01, 0.1, 0.05, 1e4, d, n, d, d, d, d, d, "
@@ -163,8 +163,10 @@ HARNESS = _c_harness("softgym_seed.h", r"""
    three ways of loading the voxels: runs, windows of 16, gathers; and its remainder)
    against SOFTGYM_SEED_GEOM_LINK, one link at a time; and, run a chunk at a time as the
    engine does, the rotation rows it leaves for the scatter (AVX-512) against voxel 1's
-   matrix */
-static double rr[SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE];
+   matrix. The runs and windows load the voxel rows vr (quaternions in rows 0-3, positions
+   in 4-6, VN apart), which the engine keeps equal to the records */
+enum { VN = 216 };
+static double rr[SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE], vr[SOFTGYM_VOXEL_ROWS * VN];
 SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, Py_ssize_t n, const Py_ssize_t *v1,
                                     const Py_ssize_t *v2, Py_ssize_t nv, const double *pos,
                                     const double *quat, const double *sc, double *o, double *r)
@@ -173,7 +175,7 @@ SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, Py_ssize_t n, const Py_ssize_t
     for (Py_ssize_t c0 = 0; c0 < n; c0 += SOFTGYM_CHUNK_LINKS) {
         Py_ssize_t c1 = c0 + SOFTGYM_CHUNK_LINKS < n ? c0 + SOFTGYM_CHUNK_LINKS : n;
         double *R = rr + SOFTGYM_SEED_R_ROWS * SOFTGYM_CHUNK_STRIDE;
-        softgym_seed_geom(ax, c0, c1, n, v1, v2, nv, pos, quat, sc, o, R - c0);
+        softgym_seed_geom(ax, c0, c1, n, v1, v2, nv, pos, quat, vr, VN, sc, o, R - c0);
         for (Py_ssize_t li = c0; li < c1 && SOFTGYM_SEED_R_USED; li++) {  /* (where written) */
             double m[9];
             softgym_quat_matrix(quat + 4 * v1[li], m);
@@ -181,7 +183,7 @@ SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, Py_ssize_t n, const Py_ssize_t
                 bad += memcmp(&m[k], R + k * SOFTGYM_CHUNK_STRIDE + li - c0, sizeof(double)) != 0;
         }
     }
-    softgym_seed_geom(ax, 0, n, n, v1, v2, nv, pos, quat, sc, o, (double *)0);
+    softgym_seed_geom(ax, 0, n, n, v1, v2, nv, pos, quat, vr, VN, sc, o, (double *)0);
     SOFTGYM_SEED_GEOM_AXIS(ax);
     SOFTGYM_SEED_GEOM_OUT(r, n);
     for (Py_ssize_t li = 0; li < n; li++) {
@@ -205,6 +207,8 @@ int main(void)
         urand_quat(quat + 4 * i);
         for (int k = 0; k < 3; k++) pos[3 * i + k] = 0.01 * (i % 7 + urand());
         sc[i] = 0.01 * (1.0 + 0.1 * urand());
+        for (int k = 0; k < 4; k++) vr[k * VN + i] = quat[4 * i + k];
+        for (int k = 0; k < 3; k++) vr[(4 + k) * VN + i] = pos[3 * i + k];
     }
     for (int pattern = 0; pattern < 3; pattern++) {
         for (int li = 0; li < N; li++) {

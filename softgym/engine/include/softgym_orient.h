@@ -69,42 +69,71 @@ static void softgym_corot_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, doub
     softgym_quats_impl(0, lo, hi, n, dt, av, quat, q_out);
 }
 
-/* voxel i's (not fixed), its matrix into R unless R is NULL */
+/* voxel i's new quaternion and its matrix into R unless R is NULL, where it is not fixed;
+   where it is and pos is not NULL, its quaternion (unchanged) back into the rows */
 #define SOFTGYM_ORIENT_STORE1(i, R) do { \
-        double w_ = q_out[i], x_ = q_out[n + (i)], y_ = q_out[2 * n + (i)]; \
-        double z_ = q_out[3 * n + (i)]; \
-        double *qq_ = quat + 4 * (i); \
-        qq_[0] = w_; \
-        qq_[1] = x_; \
-        qq_[2] = y_; \
-        qq_[3] = z_; \
-        if ((R) != NULL) \
-            softgym_quat_matrix_wxyz(w_, x_, y_, z_, (R) + 9 * (i)); \
+        if (!fixed[i]) { \
+            double w_ = q_out[i], x_ = q_out[n + (i)], y_ = q_out[2 * n + (i)]; \
+            double z_ = q_out[3 * n + (i)]; \
+            double *qq_ = quat + 4 * (i); \
+            qq_[0] = w_; \
+            qq_[1] = x_; \
+            qq_[2] = y_; \
+            qq_[3] = z_; \
+            if ((R) != NULL) \
+                softgym_quat_matrix_wxyz(w_, x_, y_, z_, (R) + 9 * (i)); \
+        } else if (pos != NULL) { \
+            for (int k_ = 0; k_ < 4; k_++) \
+                q_out[k_ * n + (i)] = quat[4 * (i) + k_]; \
+        } \
     } while (0)
+/* voxels lo..hi: their quaternions and positions into rows 0-6 of the voxel scratch rows
+   (SOFTGYM_VOXEL_ROWS, n apart, indexed by voxel), as the seed step's geometry reads them */
+static void softgym_voxel_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const double *pos,
+                               const double *quat, double *rows)
+{
+    Py_ssize_t i;
+    for (int k = 0; k < 4; k++)
+        for (i = lo; i < hi; i++)
+            rows[k * n + i] = quat[4 * i + k];
+    for (int k = 0; k < 3; k++)
+        for (i = lo; i < hi; i++)
+            rows[(4 + k) * n + i] = pos[3 * i + k];
+}
 /* voxels lo..hi but the fixed: the new quaternions from the rows q_out into quat, and their
    rotation matrices into rot (softgym_quat_matrix_wxyz, from registers; rot NULL: none).
+   With pos not NULL, the rows are kept as softgym_voxel_rows leaves them: the fixed
+   voxels' quaternions (unchanged) back into rows 0-3 and every voxel's position into
+   rows 4-6.
    Scalar stores: GCC packed each matrix into a 512-bit register with seven shuffles and
    stored it across two cache lines (a voxel's matrix is 72 bytes), and on an Intel Xeon
    the loop waited on that (perf annotate) */
 #if defined(__GNUC__) && !defined(__clang__)
 __attribute__((optimize("no-tree-slp-vectorize")))
 #endif
-static void softgym_orient_store(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const double *q_out,
-                                 const signed char *fixed, double *quat, double *rot)
+static void softgym_orient_store(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double *q_out,
+                                 const signed char *fixed, double *quat, double *rot,
+                                 const double *pos)
 {
     Py_ssize_t i = lo;
 #if defined(SOFTGYM_VLANES) && SOFTGYM_VLANES == 8
     /* without matrices (the seed step that does not read them), 8 voxels at a time: their
        rows turned back into records where none of them is fixed (2.4 cycles a voxel-step
-       one by one on an Intel Xeon) */
+       one by one on an Intel Xeon), their positions' records into rows */
     if (rot == NULL) {
         for (; i + 8 <= hi; i += 8) {
+            if (pos != NULL) {
+                softgym_v8 x, y, z;
+                softgym_v8_load3(pos + 3 * i, &x, &y, &z);
+                memcpy(q_out + 4 * n + i, &x, sizeof x);
+                memcpy(q_out + 5 * n + i, &y, sizeof y);
+                memcpy(q_out + 6 * n + i, &z, sizeof z);
+            }
             long long fx;
             memcpy(&fx, fixed + i, sizeof fx);
             if (fx != 0) {
                 for (Py_ssize_t k = i; k < i + 8; k++)
-                    if (!fixed[k])
-                        SOFTGYM_ORIENT_STORE1(k, (double *)0);
+                    SOFTGYM_ORIENT_STORE1(k, (double *)0);
                 continue;
             }
             softgym_v8 r[4];
@@ -114,9 +143,12 @@ static void softgym_orient_store(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, con
         }
     }
 #endif
-    for (; i < hi; i++)
-        if (!fixed[i])
-            SOFTGYM_ORIENT_STORE1(i, rot);
+    for (; i < hi; i++) {
+        SOFTGYM_ORIENT_STORE1(i, rot);
+        if (pos != NULL)
+            for (int k = 0; k < 3; k++)
+                q_out[(4 + k) * n + i] = pos[3 * i + k];
+    }
 }
 #undef SOFTGYM_ORIENT_STORE1
 

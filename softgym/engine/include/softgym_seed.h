@@ -45,14 +45,12 @@
    (softgym_quat_matrix, as the voxel update stores it): the same bits as
    the stored matrix, and 9 fewer gathered loads a link. */
 /* the axis constants of the geometry of links along ax: the components a0, a1, a2 of
-   the bond frame's axes in voxel 1's frame and their signs s1, s2; W (w00..w22) */
+   the bond frame's axes in voxel 1's frame and their signs s1, s2 (the bond-frame
+   vector part of a relative quaternion is (q[a0], s1 q[a1], s2 q[a2]): a permutation
+   and exact sign changes) */
 #define SOFTGYM_SEED_GEOM_AXIS(ax) \
     const int a0 = (ax), a1 = (ax) == 1 ? 0 : 1, a2 = (ax) == 2 ? 0 : 2; \
-    const double s1 = (ax) == 1 ? -1.0 : 1.0, s2 = (ax) == 2 ? -1.0 : 1.0; \
-    /* n = W (qx, qy, qz): W's rows one-hot (x 1 + y 0 + z 0 = x exactly) */ \
-    const double w00 = a0 == 0, w01 = a0 == 1, w02 = a0 == 2; \
-    const double w10 = a1 == 0 ? s1 : 0.0, w11 = a1 == 1 ? s1 : 0.0, w12 = a1 == 2 ? s1 : 0.0; \
-    const double w20 = a2 == 0 ? s2 : 0.0, w21 = a2 == 1 ? s2 : 0.0, w22 = a2 == 2 ? s2 : 0.0
+    const double s1 = (ax) == 1 ? -1.0 : 1.0, s2 = (ax) == 2 ? -1.0 : 1.0
 /* the geometry's output rows 0-9 of the scratch o (row stride n) */
 #define SOFTGYM_SEED_GEOM_OUT(o, n) \
     double *__restrict__ o_p0 = (o), *__restrict__ o_p1 = (o) + (n); \
@@ -93,9 +91,10 @@
         PUT(o_p1, li, geo_p1); \
         PUT(o_p2, li, geo_p2); \
         PUT(o_qw, li, geo_qw); \
-        PUT(o_n1, li, (((geo_qx * w00) + (geo_qy * w01)) + (geo_qz * w02))); \
-        PUT(o_n2, li, (((geo_qx * w10) + (geo_qy * w11)) + (geo_qz * w12))); \
-        PUT(o_n3, li, (((geo_qx * w20) + (geo_qy * w21)) + (geo_qz * w22))); \
+        T geo_qv[3] = {geo_qx, geo_qy, geo_qz}; \
+        PUT(o_n1, li, geo_qv[a0]); \
+        PUT(o_n2, li, (s1 * geo_qv[a1])); \
+        PUT(o_n3, li, (s2 * geo_qv[a2])); \
         PUT(o_nom, li, (0.5 * ((si) + (sj)))); \
         PUT(o_len, li, SQRT(((((dx) * (dx)) + ((dy) * (dy))) + ((dz) * (dz))))); \
         PUT(o_st, li, ((FABS(geo_p2) + FABS(geo_p1)) / geo_p0)); \
@@ -137,12 +136,15 @@ static inline void softgym_seed_gather(const Py_ssize_t *idx, const double *pos,
 #endif
 }
 #if SOFTGYM_VLANES == 8
-/* the same for the 8 consecutive voxels v .. v + 7: their records as rows (no gather) */
-static inline void softgym_seed_rows8(Py_ssize_t v, const double *pos, const double *quat,
+/* the same for the 8 consecutive voxels v .. v + 7, from the voxels' rows vr (no gather,
+   no transpose: SOFTGYM_VOXEL_ROWS, vn apart) */
+static inline void softgym_seed_rows8(Py_ssize_t v, const double *vr, Py_ssize_t vn,
                                       const double *scale, softgym_vd *r)
 {
-    softgym_v8_load3(pos + 3 * v, &r[0], &r[1], &r[2]);
-    softgym_v8_load4x4(quat + 4 * v, r + 3);
+    for (int k = 0; k < 3; k++)
+        r[k] = softgym_v8_load(vr + (4 + k) * vn + v);
+    for (int k = 0; k < 4; k++)
+        r[3 + k] = softgym_v8_load(vr + k * vn + v);
     memcpy(&r[7], scale + v, sizeof r[7]);
 }
 /* links whose voxels all lie in the 16 voxels from voxel 1 of the first (a[0]: the
@@ -150,7 +152,7 @@ static inline void softgym_seed_rows8(Py_ssize_t v, const double *pos, const dou
    voxels' records as rows, each link's voxels picked from them by a two-source permute
    (the voxels' indices below vend, the end of the records). 0 when they do not fit. */
 static inline int softgym_seed_window8(const Py_ssize_t *a, const Py_ssize_t *b,
-                                       Py_ssize_t vend, const double *pos, const double *quat,
+                                       Py_ssize_t vend, const double *vr, Py_ssize_t vn,
                                        const double *scale, softgym_vd *gi, softgym_vd *gj)
 {
     Py_ssize_t base = a[0];
@@ -162,8 +164,8 @@ static inline int softgym_seed_window8(const Py_ssize_t *a, const Py_ssize_t *b,
     if ((_mm512_cmplt_epu64_mask(ia, sixteen) & _mm512_cmplt_epu64_mask(ib, sixteen)) != 0xFF)
         return 0;
     softgym_vd lo[8], hi[8];
-    softgym_seed_rows8(base, pos, quat, scale, lo);
-    softgym_seed_rows8(base + 8, pos, quat, scale, hi);
+    softgym_seed_rows8(base, vr, vn, scale, lo);
+    softgym_seed_rows8(base + 8, vr, vn, scale, hi);
     for (int k = 0; k < 8; k++) {
         gi[k] = (softgym_vd)_mm512_permutex2var_pd((__m512d)lo[k], ia, (__m512d)hi[k]);
         gj[k] = (softgym_vd)_mm512_permutex2var_pd((__m512d)lo[k], ib, (__m512d)hi[k]);
@@ -195,9 +197,9 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_scalar(const int ax, Py_ssize_t lo,
 SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
                                                 Py_ssize_t n, const Py_ssize_t *v1,
                                                 const Py_ssize_t *v2, Py_ssize_t vend,
-                                                const double *pos,
-                                                const double *quat, const double *scale,
-                                                double *o, double *rr)
+                                                const double *pos, const double *quat,
+                                                const double *vr, Py_ssize_t vn,
+                                                const double *scale, double *o, double *rr)
 {
     Py_ssize_t li = lo;
 #if defined(SOFTGYM_VLANES)
@@ -221,9 +223,9 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
         /* links whose voxels 1 and 2 are runs of consecutive voxels (a filled lattice's
            links along its slower axes): each voxel's records as rows at unit stride */
         if (softgym_run8(v1 + li) & softgym_run8(v2 + li)) {
-            softgym_seed_rows8(v1[li], pos, quat, scale, gi);
-            softgym_seed_rows8(v2[li], pos, quat, scale, gj);
-        } else if (!softgym_seed_window8(v1 + li, v2 + li, vend, pos, quat, scale, gi, gj))
+            softgym_seed_rows8(v1[li], vr, vn, scale, gi);
+            softgym_seed_rows8(v2[li], vr, vn, scale, gj);
+        } else if (!softgym_seed_window8(v1 + li, v2 + li, vend, vr, vn, scale, gi, gj))
 #endif
         {
             softgym_seed_gather(v1 + li, pos, quat, scale, gi);
@@ -237,16 +239,23 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
 #endif
     /* the rest (and every link without AVX): the compiler's vectoriser */
     softgym_seed_geom_scalar(ax, li, hi, n, v1, v2, pos, quat, scale, o, rr);
+#if !(defined(SOFTGYM_VLANES) && SOFTGYM_VLANES == 8)
+    (void)vr;
+    (void)vn;
+#endif
 }
-/* vend: the end of the voxel records (voxel indices below it may be read); rr: the
-   chunk's rotation rows (SOFTGYM_SEED_R_ROWS), indexed by link, or NULL (written only
-   where SOFTGYM_SEED_R_USED) */
+/* vend: the end of the voxel records (voxel indices below it may be read); vr: the
+   voxels' rows (SOFTGYM_VOXEL_ROWS: the same quaternions and positions as quat and pos,
+   rows vn apart, indexed by voxel; read by the AVX-512 builds' rows and window paths);
+   rr: the chunk's rotation rows (SOFTGYM_SEED_R_ROWS), indexed by link, or NULL
+   (written only where SOFTGYM_SEED_R_USED) */
 static void softgym_seed_geom(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
                               const Py_ssize_t *v1, const Py_ssize_t *v2, Py_ssize_t vend,
-                              const double *pos, const double *quat, const double *scale,
-                              double *o, double *rr)
+                              const double *pos, const double *quat, const double *vr,
+                              Py_ssize_t vn, const double *scale, double *o, double *rr)
 {
-    SOFTGYM_BY_AXIS(ax, softgym_seed_geom_ax, lo, hi, n, v1, v2, vend, pos, quat, scale, o, rr);
+    SOFTGYM_BY_AXIS(ax, softgym_seed_geom_ax, lo, hi, n, v1, v2, vend, pos, quat, vr, vn, scale,
+                    o, rr);
 }
 
 /* The frames pass of links_seed, in C for one pragma: the bond-frame

@@ -19,6 +19,13 @@
    read; Batch.moment points at column 4): 64 bytes, one cache line, so that a link's
    vector scatter adds its force and moment to a voxel in one 8-lane read-add-write */
 #define SOFTGYM_FM_STRIDE 8
+/* Rows of the per-thread voxel scratch (Batch.vox_out: row k of voxel i at k vox_stride +
+   i): the voxel update's new quaternions (w, x, y, z) in rows 0-3; in the seed model's
+   AVX-512 builds (SOFTGYM_SEED_R_USED) rows 0-3 and the positions (x, y, z) in rows 4-6
+   are the voxels' quaternions and positions throughout its step loop, which the link
+   geometry loads 8 voxels to a vector without transposing records
+   (include/softgym_orient.h: softgym_voxel_rows) */
+#define SOFTGYM_VOXEL_ROWS 7
 /* c ? a : b on the bits: compilers keep it a blend (a select before a
    store may otherwise become a masked store, slow on some cores) */
 static inline double softgym_pick(long long c, double a, double b)
