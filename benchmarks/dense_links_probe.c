@@ -111,11 +111,12 @@ SOFTGYM_ALWAYS_INLINE void pull_term(Py_ssize_t n, const double *Wa, const doubl
     }
 }
 
-/* the pull: each cell's force and moment rows (4 wide, as the engine's) from the W rows
-   and link flags of the three axes (padded by NY NZ slots before: flags 0 there) */
+/* the pull: each cell's force and moment row (as the engine's: SOFTGYM_FM_STRIDE, force in
+   columns 0-2, moment in 4-6) from the W rows and link flags of the three axes (padded by
+   NY NZ slots before: flags 0 there) */
 static void pull_dense(Py_ssize_t n, const double *Wx, const double *Wy, const double *Wz,
                        const double *vx, const double *vy, const double *vz,
-                       double *__restrict__ force, double *__restrict__ moment)
+                       double *__restrict__ fm)
 {
     Py_ssize_t c, sx = (Py_ssize_t)NY * NZ, sy = NZ;
     SOFTGYM_IVDEP
@@ -128,11 +129,11 @@ static void pull_dense(Py_ssize_t n, const double *Wx, const double *Wy, const d
         pull_term(n, Wz, vz, c - 1, 3, f, m);
         pull_term(n, Wz, vz, c, 0, f, m);
         for (int k = 0; k < 3; k++) {
-            force[4 * c + k] = f[k];
-            moment[4 * c + k] = m[k];
+            fm[SOFTGYM_FM_STRIDE * c + k] = f[k];
+            fm[SOFTGYM_FM_STRIDE * c + 4 + k] = m[k];
         }
-        force[4 * c + 3] = 0.0;
-        moment[4 * c + 3] = 0.0;
+        fm[SOFTGYM_FM_STRIDE * c + 3] = 0.0;
+        fm[SOFTGYM_FM_STRIDE * c + 7] = 0.0;
     }
 }
 
@@ -169,6 +170,9 @@ int main(int argc, char **argv)
     }
     double *pos = zalloc(3 * nv, 8), *quat = zalloc(4 * nv, 8), *rot = zalloc(9 * nv, 8);
     double *scale = zalloc(nv, 8), *P = zalloc(8 * NC, 8);
+    /* the engine's voxel rows (SOFTGYM_VOXEL_ROWS, vn apart: quaternions, then positions) */
+    Py_ssize_t vn = stride_of(nv);
+    double *vr = zalloc(SOFTGYM_VOXEL_ROWS * vn, 8);
     for (int i = 0; i < nv; i++) {
         int c = cell_of[i], x = c / (N * N), y = (c / N) % N, z = c % N;
         pos[3 * i] = x * L + 1e-4 * urand();
@@ -180,6 +184,10 @@ int main(int argc, char **argv)
             quat[4 * i + k] = q[k] / nq;
         softgym_quat_matrix(quat + 4 * i, rot + 9 * i);
         scale[i] = L * (1.0 + 0.01 * urand());
+        for (int k = 0; k < 4; k++)
+            vr[k * vn + i] = quat[4 * i + k];
+        for (int k = 0; k < 3; k++)
+            vr[(4 + k) * vn + i] = pos[3 * i + k];
     }
     /* empty cells: the identity orientation, unit size (their slots are never used) */
     for (int c = 0; c < NC; c++) {
@@ -227,15 +235,25 @@ int main(int argc, char **argv)
         valid[ax][c] = 1.0;
     }
     /* the same rows as the engine's forces pass leaves them for its scatter: per chunk of
-       SOFTGYM_CHUNK_LINKS links, 12 rows SOFTGYM_CHUNK_STRIDE apart */
+       SOFTGYM_CHUNK_LINKS links, 12 rows SOFTGYM_CHUNK_STRIDE apart, then voxel 1's
+       rotation in rows SOFTGYM_SEED_R_ROWS.. (the geometry's, in the AVX-512 builds) */
     Py_ssize_t nch = (nl + SOFTGYM_CHUNK_LINKS - 1) / SOFTGYM_CHUNK_LINKS;
-    double *bc = zalloc(nch * SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE, 8);
-    for (Py_ssize_t li = 0; li < nl; li++)
+    double *bc = aligned_alloc(64, nch * SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE * 8);
+    for (Py_ssize_t li = 0; li < nl; li++) {
+        double *col = bc + (li / SOFTGYM_CHUNK_LINKS) * SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE
+                      + li % SOFTGYM_CHUNK_LINKS;
         for (int k = 0; k < 12; k++)
-            bc[(li / SOFTGYM_CHUNK_LINKS) * SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE
-               + k * SOFTGYM_CHUNK_STRIDE + li % SOFTGYM_CHUNK_LINKS] = bo[rows[k] * ne + li];
-    double *fa = zalloc(4 * nv, 8), *ma = zalloc(4 * nv, 8);
-    double *fb = zalloc(4 * NC, 8), *mb = zalloc(4 * NC, 8);
+            col[k * SOFTGYM_CHUNK_STRIDE] = bo[rows[k] * ne + li];
+        for (int k = 0; k < 9; k++)
+            col[(SOFTGYM_SEED_R_ROWS + k) * SOFTGYM_CHUNK_STRIDE] = rot[9 * v1[li] + k];
+    }
+    /* force and moment rows, 64-byte aligned as the engine's */
+    double *fa = aligned_alloc(64, SOFTGYM_FM_STRIDE * nv * 8);
+    double *fb = aligned_alloc(64, SOFTGYM_FM_STRIDE * NC * 8);
+    if (bc == NULL || fa == NULL || fb == NULL) {
+        fprintf(stderr, "dense_links_probe: out of memory\n");
+        return 2;
+    }
     unsigned long long best[6];
     for (int k = 0; k < 6; k++)
         best[k] = ~0ull;
@@ -243,11 +261,11 @@ int main(int argc, char **argv)
         unsigned long long t0, t;
         t0 = __rdtsc();
         for (int ax = 0; ax < 3; ax++)
-            softgym_seed_geom(ax, start[ax], start[ax + 1], ne, v1, v2, nv, pos, quat, scale, o);
+            softgym_seed_geom(ax, start[ax], start[ax + 1], ne, v1, v2, nv, pos, quat, vr, vn,
+                              scale, o, (double *)0);
         t = __rdtsc() - t0;
         best[0] = t < best[0] ? t : best[0];
-        memset(fa, 0, 4 * nv * 8);
-        memset(ma, 0, 4 * nv * 8);
+        memset(fa, 0, SOFTGYM_FM_STRIDE * nv * 8);
         t0 = __rdtsc();
         for (Py_ssize_t ch = 0; ch < nch; ch++) {
             Py_ssize_t c0 = ch * SOFTGYM_CHUNK_LINKS, c1 = c0 + SOFTGYM_CHUNK_LINKS;
@@ -256,7 +274,8 @@ int main(int argc, char **argv)
                 Py_ssize_t a0 = start[ax] > c0 ? start[ax] : c0;
                 Py_ssize_t a1 = start[ax + 1] < c1 ? start[ax + 1] : c1;
                 if (a0 < a1)
-                    softgym_seed_scatter(ax, a0, a1, v1, v2, rot, chunk, bo + 23 * ne, fa, ma);
+                    softgym_seed_scatter(ax, a0, a1, v1, v2, rot, chunk, bo + 23 * ne, fa,
+                                         fa + 4);
             }
         }
         t = __rdtsc() - t0;
@@ -288,7 +307,7 @@ int main(int argc, char **argv)
         t = __rdtsc() - t0;
         best[4] = t < best[4] ? t : best[4];
         t0 = __rdtsc();
-        pull_dense(nd, W[0], W[1], W[2], valid[0], valid[1], valid[2], fb, mb);
+        pull_dense(nd, W[0], W[1], W[2], valid[0], valid[1], valid[2], fb);
         t = __rdtsc() - t0;
         best[5] = t < best[5] ? t : best[5];
     }
@@ -299,9 +318,9 @@ int main(int argc, char **argv)
             bad_geom += memcmp(&o[k * ne + li], &od[ax][k * nd + cell_of[v1[li]]], 8) != 0;
     }
     for (int i = 0; i < nv; i++)
-        for (int k = 0; k < 3; k++)
-            bad_force += (memcmp(&fa[4 * i + k], &fb[4 * cell_of[i] + k], 8) != 0)
-                         + (memcmp(&ma[4 * i + k], &mb[4 * cell_of[i] + k], 8) != 0);
+        for (int k = 0; k < 7; k++)  /* force 0-2, moment 4-6 */
+            bad_force += k != 3 && memcmp(&fa[SOFTGYM_FM_STRIDE * i + k],
+                                          &fb[SOFTGYM_FM_STRIDE * cell_of[i] + k], 8) != 0;
     double v = (double)nv;
     printf("lattice %d^3, fill %.2f: %d voxels, %ld links, %ld dense slots (%.0f %% more)\n",
            N, fill, nv, (long)nl, (long)slots, 100.0 * (slots - nl) / nl);

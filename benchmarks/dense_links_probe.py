@@ -62,7 +62,8 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         for level in args.levels:
             exe = build(level, Path(tmp))
-            if exe is None:
+            if exe is None:  # (the engine's headers changed under it: a failure)
+                status = 1
                 continue
             res = subprocess.run([str(exe), str(args.n), str(args.fill), str(args.seed)],
                                  capture_output=True, text=True, check=False)  # fmt: skip
