@@ -135,16 +135,17 @@ cdef extern from "softgym_voxels.h":
 cdef inline intp_t _scalar_run(Batch* b, intp_t r, intp_t* lo, int seed, const float64_t* ref,
                                const float64_t* c, float64_t* dmax,
                                float64_t* vmax2) noexcept nogil:
-    # The voxel updates' schedule from voxel lo[0] on: blocks of 8 after the robot's first
-    # voxel (which sets c) go to the vector lanes while they take them (where the build
-    # has them and the robot has no fluid and no terrain box; lo[0] moves past each
-    # block stepped); returns the end of the run the scalar loop must do from lo[0]: the
-    # first voxel, a block the lanes left (a fixed or runaway voxel), or the rest
+    # The voxel updates' schedule from voxel lo[0] on: blocks of 8 go to the vector lanes
+    # while they take them (where the build has them and the robot has no fluid and no
+    # terrain box; lo[0] moves past each block stepped), after the robot's first voxel
+    # where it sets c (a drift reference, ref, to measure from); returns the end of the
+    # run the scalar loop must do from lo[0]: that first voxel, a block the lanes left (a
+    # fixed or runaway voxel), or the rest
     cdef:
         intp_t vs = b.vox_start[r], ve = b.vox_start[r + 1]
     if not SOFTGYM_VOXELS8 or b.fluid_drag > 0.0 or b.box_start[r] != b.box_start[r + 1]:
         return ve
-    if lo[0] == vs:
+    if lo[0] == vs and ref != NULL:
         return vs + 1
     while lo[0] + 8 <= ve:
         if not voxels8(seed, lo[0], vs, b.dt[r], b.gravity, b.floor[r], b.pos, b.vel, b.angvel, b.force,

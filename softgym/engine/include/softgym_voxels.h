@@ -16,10 +16,11 @@
 #include "softgym_simd.h"
 
 /* the arguments of softgym_seed_voxels8 and softgym_corot_voxels8: voxels i..i+7 of a
-   robot whose first voxel is vs (i > vs), the robot's time step, gravity and floor flag,
-   the state and per-voxel constants (the Batch's arrays), the drift reference (ref and
-   the first voxel's displacement c; ref NULL: none), whether to track the fastest speed,
-   the runaway bound, and the running maxima of drift and speed squared (raised) */
+   robot whose first voxel is vs (i > vs where ref is set), the robot's time step,
+   gravity and floor flag, the state and per-voxel constants (the Batch's arrays), the
+   drift reference (ref and the first voxel's displacement c; ref NULL: none), whether to
+   track the fastest speed, the runaway bound, and the running maxima of drift and speed
+   squared (raised) */
 #define SOFTGYM_VOXELS8_PARAMS \
     Py_ssize_t i, Py_ssize_t vs, double dt, double g, int has_floor, double *pos, \
     double *vel, double *av, double *force, double *moment, const double *ext, \
