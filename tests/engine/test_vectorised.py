@@ -416,3 +416,88 @@ def test_the_scatters_in_blocks_are_the_scatters_link_by_link_bit_for_bit(model,
     harness = SCATTER_HARNESS if model == "seed" else COROT_SCATTER_HARNESS
     out = _run_harness(level, harness, tmp_path)
     assert out == "0", f"{out} voxel components (or ends) differ"
+
+
+MODES_HARNESS = _c_harness("softgym_seed.h", r"""
+/* softgym_seed_modes (branch-free, vectorised, the strain check after the loop) against
+   the seed's scalar loop written out (p0 / nom compared, stopping at the first strained
+   link): each link's mode, its rows 9, 22 and 23 up to where the loop stops, and that
+   link. Links right at the thresholds (quotients within a few units in the last place of
+   1.3 and 1.43), strained links, NaN */
+enum { N = 203, ROWS = 24 };
+static double o[ROWS * N], ref[ROWS * N];
+static long long sa_a[N], sa_b[N], homog[N];
+static const double SA_W = 0.9999625, SAH_W = 0.99995, ST_IN = 0.05, EX_IN = 1.30;
+static const double ST_OUT = 0.055, EX_OUT = 1.43, MAX_EXT = 0.02;
+static Py_ssize_t reference(long long *sa_, double *r)
+{
+    for (Py_ssize_t li = 0; li < N; li++) {
+        double p0 = r[li], qw = r[3 * N + li], nom = r[7 * N + li], st = r[9 * N + li];
+        double ex = p0 / nom, P0;
+        int sa = sa_[li] != 0, changed = 0;
+        if (!sa && qw > SA_W && st < ST_IN && ex < EX_IN) {
+            sa = 1;
+            changed = 1;
+        } else if (sa && (!(qw > SAH_W) || st > ST_OUT || ex > EX_OUT)) {
+            sa = 0;
+            changed = 1;
+        }
+        sa_[li] = sa;
+        r[9 * N + li] = sa ? 1.0 : 0.0;
+        r[22 * N + li] = changed ? 1.0 : 0.0;
+        r[23 * N + li] = (changed || homog[li]) ? 1.0 : 0.0;
+        P0 = sa ? p0 - nom : r[8 * N + li] - nom;
+        if (!(fabs(P0) <= MAX_EXT))
+            return li;
+    }
+    return N;
+}
+static long check(int round)
+{
+    for (Py_ssize_t li = 0; li < N; li++) {
+        double nom = 0.01 * (1.0 + 0.2 * urand());
+        double c = rand() % 2 ? EX_IN : EX_OUT;
+        int k = rand() % 17 - 8;  /* the quotient within 8 units in the last place of c */
+        double p0 = rand() % 4 ? nom * (1.0 + 0.02 * urand()) : c * nom * (1.0 + k * 0x1p-52);
+        o[li] = p0;
+        o[1 * N + li] = 6e-4 * urand();
+        o[2 * N + li] = 6e-4 * urand();
+        o[3 * N + li] = 1.0 - 1e-4 * (urand() + 0.5);
+        o[7 * N + li] = nom;
+        o[8 * N + li] = p0 * (1.0 + 1e-3 * urand());
+        /* the transverse ratio as the geometry leaves it */
+        o[9 * N + li] = (fabs(o[2 * N + li]) + fabs(o[1 * N + li])) / p0;
+        sa_a[li] = sa_b[li] = rand() % 2;
+        homog[li] = rand() % 2;
+    }
+    if (round == 1)
+        o[150] = o[7 * N + 150] + 0.05;  /* strained from link 150 on */
+    if (round == 2)
+        o[7 * N + 60] = NAN;
+    memcpy(ref, o, sizeof o);
+    Py_ssize_t end = softgym_seed_modes(0, N, N, MAX_EXT, SA_W, SAH_W, ST_IN, EX_IN, ST_OUT,
+                                        EX_OUT, sa_a, homog, o);
+    Py_ssize_t want = reference(sa_b, ref);
+    long bad = end != want;
+    for (Py_ssize_t li = 0; li < N; li++) {
+        bad += sa_a[li] != sa_b[li];
+        for (int r = 9; r < 24; r += r == 9 ? 13 : 1)
+            bad += li <= want && memcmp(&o[r * N + li], &ref[r * N + li], sizeof(double)) != 0;
+    }
+    return bad;
+}
+int main(void)
+{
+    long bad = 0;
+    for (int round = 0; round < 300; round++)
+        bad += check(round % 3);
+    printf("%ld\n", bad);
+    return 0;
+}
+""")
+
+
+@pytest.mark.parametrize("level", ["x86-64-v3", "x86-64-v4"])
+def test_the_modes_pass_decides_as_the_seeds_scalar_loop(level, tmp_path):
+    out = _run_harness(level, MODES_HARNESS, tmp_path)
+    assert out == "0", f"{out} modes, rows or ends differ"
