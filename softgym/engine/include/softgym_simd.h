@@ -140,11 +140,11 @@ static inline void softgym_v8_store3(double *a, softgym_v8 x, softgym_v8 y, soft
     _mm512_storeu_pd(a + 8, o1);
     _mm512_storeu_pd(a + 16, o2);
 }
-/* 8 voxels' records of 4 (a[0..31]) as its 4 rows r[0..3] (element 0 .. 3 of each) */
-static inline void softgym_v8_load4x4(const double *a, softgym_v8 *r)
+/* 8 records of 4, two to a register (p0: records 0 and 1, ..., p3: 6 and 7), as the 4 rows
+   r[0..3] (element 0 .. 3 of each record) */
+static inline void softgym_v8_rows_of4(__m512d p0, __m512d p1, __m512d p2, __m512d p3,
+                                       softgym_v8 *r)
 {
-    __m512d p0 = _mm512_loadu_pd(a), p1 = _mm512_loadu_pd(a + 8);
-    __m512d p2 = _mm512_loadu_pd(a + 16), p3 = _mm512_loadu_pd(a + 24);
     /* from p0, p1: elements 0 and 1 of records 0-3; elements 2 and 3 of them */
     const __m512i i01 = _mm512_set_epi64(8 + 5, 8 + 1, 5, 1, 8 + 4, 8 + 0, 4, 0);
     const __m512i i23 = _mm512_set_epi64(8 + 7, 8 + 3, 7, 3, 8 + 6, 8 + 2, 6, 2);
@@ -157,29 +157,23 @@ static inline void softgym_v8_load4x4(const double *a, softgym_v8 *r)
     r[2] = (softgym_v8)_mm512_permutex2var_pd(a23, lo, b23);
     r[3] = (softgym_v8)_mm512_permutex2var_pd(a23, hi, b23);
 }
+/* 8 voxels' records of 4 (a[0..31]) as its 4 rows r[0..3] (element 0 .. 3 of each) */
+static inline void softgym_v8_load4x4(const double *a, softgym_v8 *r)
+{
+    softgym_v8_rows_of4(_mm512_loadu_pd(a), _mm512_loadu_pd(a + 8), _mm512_loadu_pd(a + 16),
+                        _mm512_loadu_pd(a + 24), r);
+}
+/* two records of 4 that start SOFTGYM_FM_STRIDE doubles apart, at a, in one register */
+#define SOFTGYM_FM_PAIR(a) \
+    _mm512_insertf64x4(_mm512_castpd256_pd512(_mm256_load_pd(a)), \
+                       _mm256_load_pd((a) + SOFTGYM_FM_STRIDE), 1)
 /* the same for 8 records of 4 that start SOFTGYM_FM_STRIDE doubles apart (a[0..3],
    a[8..11], ...: the force or the moment columns of the voxels' rows) */
 static inline void softgym_v8_load4x4_fm(const double *a, softgym_v8 *r)
 {
     const int s = SOFTGYM_FM_STRIDE;
-    __m512d p0 = _mm512_insertf64x4(_mm512_castpd256_pd512(_mm256_load_pd(a)),
-                                    _mm256_load_pd(a + s), 1);
-    __m512d p1 = _mm512_insertf64x4(_mm512_castpd256_pd512(_mm256_load_pd(a + 2 * s)),
-                                    _mm256_load_pd(a + 3 * s), 1);
-    __m512d p2 = _mm512_insertf64x4(_mm512_castpd256_pd512(_mm256_load_pd(a + 4 * s)),
-                                    _mm256_load_pd(a + 5 * s), 1);
-    __m512d p3 = _mm512_insertf64x4(_mm512_castpd256_pd512(_mm256_load_pd(a + 6 * s)),
-                                    _mm256_load_pd(a + 7 * s), 1);
-    const __m512i i01 = _mm512_set_epi64(8 + 5, 8 + 1, 5, 1, 8 + 4, 8 + 0, 4, 0);
-    const __m512i i23 = _mm512_set_epi64(8 + 7, 8 + 3, 7, 3, 8 + 6, 8 + 2, 6, 2);
-    __m512d a01 = _mm512_permutex2var_pd(p0, i01, p1), b01 = _mm512_permutex2var_pd(p2, i01, p3);
-    __m512d a23 = _mm512_permutex2var_pd(p0, i23, p1), b23 = _mm512_permutex2var_pd(p2, i23, p3);
-    const __m512i lo = _mm512_set_epi64(8 + 3, 8 + 2, 8 + 1, 8 + 0, 3, 2, 1, 0);
-    const __m512i hi = _mm512_set_epi64(8 + 7, 8 + 6, 8 + 5, 8 + 4, 7, 6, 5, 4);
-    r[0] = (softgym_v8)_mm512_permutex2var_pd(a01, lo, b01);
-    r[1] = (softgym_v8)_mm512_permutex2var_pd(a01, hi, b01);
-    r[2] = (softgym_v8)_mm512_permutex2var_pd(a23, lo, b23);
-    r[3] = (softgym_v8)_mm512_permutex2var_pd(a23, hi, b23);
+    softgym_v8_rows_of4(SOFTGYM_FM_PAIR(a), SOFTGYM_FM_PAIR(a + 2 * s), SOFTGYM_FM_PAIR(a + 4 * s),
+                        SOFTGYM_FM_PAIR(a + 6 * s), r);
 }
 /* rows r[0..3] (element 0 .. 3 of 8 records) back into the 8 records of 4 at a[0..31] */
 static inline void softgym_v8_store4x4(double *a, const softgym_v8 *r)
