@@ -498,7 +498,7 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
         Batch b
         Batch bt
         intp_t r, n, t
-        intp_t stride = 0, vstride = 0, block, fblock, i, m
+        intp_t stride = 0, vstride = 0, block, fblock, i, m, vox_at, chunk_at, f32_at, link_at
         float64_t* scratch
     _bind(&b, arrays, settings)
     n = b.n_robots
@@ -517,8 +517,14 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
     b.vox_stride = vstride
     # the float rows' floats rounded up to doubles (a multiple of 8: they start on a line)
     fblock = (SOFTGYM_CHUNK_FROWS * SOFTGYM_CHUNK_FSTRIDE + 15) // 16 * 8
-    block = (N_LINK_OUT * stride + SOFTGYM_VOXEL_ROWS * vstride + SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE
-             + fblock + N_LINK_OUT * SOFTGYM_CHUNK_STRIDE)
+    # a thread's block, in doubles from its start: the robot's link rows (link_out), its
+    # voxel rows (vox_out), the chunk's output rows (chunk_out), float rows (chunk_f32)
+    # and link scratch rows (chunk_link)
+    vox_at = N_LINK_OUT * stride
+    chunk_at = vox_at + SOFTGYM_VOXEL_ROWS * vstride
+    f32_at = chunk_at + SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE
+    link_at = f32_at + fblock
+    block = link_at + N_LINK_OUT * SOFTGYM_CHUNK_STRIDE
     scratch = cache.scratch(max(n_threads * block, 1))
     # robots in the order 0, 8, 16, ..., then 1, 9, 17, ...: the robots that the
     # threads step at one time are ROBOT_SPREAD apart, so no two of them write
@@ -540,10 +546,10 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
                 # at vox_out[k * vstride + i]: the thread's block, offset by the
                 # robot's first link and voxel
                 bt.link_out = scratch + t * block - b.link_start[r]
-                bt.vox_out = scratch + t * block + N_LINK_OUT * stride - b.vox_start[r]
-                bt.chunk_out = scratch + t * block + N_LINK_OUT * stride + SOFTGYM_VOXEL_ROWS * vstride
-                bt.chunk_f32 = <float*> (bt.chunk_out + SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE)
-                bt.chunk_link = bt.chunk_out + SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE + fblock
+                bt.vox_out = scratch + t * block + vox_at - b.vox_start[r]
+                bt.chunk_out = scratch + t * block + chunk_at
+                bt.chunk_f32 = <float*> (scratch + t * block + f32_at)
+                bt.chunk_link = scratch + t * block + link_at
                 advance_robot(&bt, r, targets[r], &cache.items[r])
 
 

@@ -327,8 +327,8 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     # one register addresses all of a pass's rows; the robot's rows of scratch, a
     # run-time stride apart, took a register each and 108 KB for the reference
     # robot, walked each step). The geometry and the scatter split a chunk at the
-    # axis runs; the modes, frames and forces passes need no axis. Each link's quantities are its own and the links are
-    # scattered in the same order, so the result is the one of running each pass
+    # axis runs; the modes, frames and forces passes need no axis. Each link's
+    # quantities are its own and the links are scattered in the same order, so the result is the one of running each pass
     # over all the links, bit for bit (a strained link stops the step after the
     # links before it, as the seed's scalar loop does; 3.0 % on an Intel Xeon,
     # benchmarks/RESULTS.md). With link_precision "single" the

@@ -69,23 +69,17 @@ static void softgym_corot_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, doub
     softgym_quats_impl(0, lo, hi, n, dt, av, quat, q_out);
 }
 
-/* voxel i's new quaternion and its matrix into R unless R is NULL, where it is not fixed;
-   where it is and pos is not NULL, its quaternion (unchanged) back into the rows */
+/* voxel i's (not fixed), its matrix into R unless R is NULL */
 #define SOFTGYM_ORIENT_STORE1(i, R) do { \
-        if (!fixed[i]) { \
-            double w_ = q_out[i], x_ = q_out[n + (i)], y_ = q_out[2 * n + (i)]; \
-            double z_ = q_out[3 * n + (i)]; \
-            double *qq_ = quat + 4 * (i); \
-            qq_[0] = w_; \
-            qq_[1] = x_; \
-            qq_[2] = y_; \
-            qq_[3] = z_; \
-            if ((R) != NULL) \
-                softgym_quat_matrix_wxyz(w_, x_, y_, z_, (R) + 9 * (i)); \
-        } else if (pos != NULL) { \
-            for (int k_ = 0; k_ < 4; k_++) \
-                q_out[k_ * n + (i)] = quat[4 * (i) + k_]; \
-        } \
+        double w_ = q_out[i], x_ = q_out[n + (i)], y_ = q_out[2 * n + (i)]; \
+        double z_ = q_out[3 * n + (i)]; \
+        double *qq_ = quat + 4 * (i); \
+        qq_[0] = w_; \
+        qq_[1] = x_; \
+        qq_[2] = y_; \
+        qq_[3] = z_; \
+        if ((R) != NULL) \
+            softgym_quat_matrix_wxyz(w_, x_, y_, z_, (R) + 9 * (i)); \
     } while (0)
 /* voxels lo..hi: their quaternions and positions into rows 0-6 of the voxel scratch rows
    (SOFTGYM_VOXEL_ROWS, n apart, indexed by voxel), as the seed step's geometry reads them */
@@ -102,9 +96,10 @@ static void softgym_voxel_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const
 }
 /* voxels lo..hi but the fixed: the new quaternions from the rows q_out into quat, and their
    rotation matrices into rot (softgym_quat_matrix_wxyz, from registers; rot NULL: none).
-   With pos not NULL, the rows are kept as softgym_voxel_rows leaves them: the fixed
-   voxels' quaternions (unchanged) back into rows 0-3 and every voxel's position into
-   rows 4-6.
+   With pos not NULL, the rows are kept as softgym_voxel_rows leaves them: 8 voxels'
+   positions turned into rows 4-6 with the quaternions' transpose, softgym_voxel_rows for
+   the voxels the transpose does not take (a block with a fixed voxel, whose quaternion
+   stays as it was, and the voxels after the last block).
    Scalar stores: GCC packed each matrix into a 512-bit register with seven shuffles and
    stored it across two cache lines (a voxel's matrix is 72 bytes), and on an Intel Xeon
    the loop waited on that (perf annotate) */
@@ -133,7 +128,10 @@ static void softgym_orient_store(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, dou
             memcpy(&fx, fixed + i, sizeof fx);
             if (fx != 0) {
                 for (Py_ssize_t k = i; k < i + 8; k++)
-                    SOFTGYM_ORIENT_STORE1(k, (double *)0);
+                    if (!fixed[k])
+                        SOFTGYM_ORIENT_STORE1(k, (double *)0);
+                if (pos != NULL)
+                    softgym_voxel_rows(i, i + 8, n, pos, quat, q_out);
                 continue;
             }
             softgym_v8 r[4];
@@ -143,12 +141,12 @@ static void softgym_orient_store(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, dou
         }
     }
 #endif
-    for (; i < hi; i++) {
-        SOFTGYM_ORIENT_STORE1(i, rot);
-        if (pos != NULL)
-            for (int k = 0; k < 3; k++)
-                q_out[(4 + k) * n + i] = pos[3 * i + k];
-    }
+    Py_ssize_t rest = i;
+    for (; i < hi; i++)
+        if (!fixed[i])
+            SOFTGYM_ORIENT_STORE1(i, rot);
+    if (pos != NULL)
+        softgym_voxel_rows(rest, hi, n, pos, quat, q_out);
 }
 #undef SOFTGYM_ORIENT_STORE1
 

@@ -809,12 +809,13 @@ SOFTGYM_ALWAYS_INLINE void softgym_turn8(const int ax, const softgym_v8 *R, cons
    the turns in the lanes of AVX-512 with voxel 1's rotation from the geometry's rows
    (SOFTGYM_SEED_R_ROWS), the same IEEE operations as the per-link turns, then each link's
    4 turned vectors added to its voxels' rows (one 8-lane add a voxel: its force and
-   moment), link after link: each voxel's sum in the same order. Where voxel 2 takes -F1 (neg2_row), its force is the turn of -F1: exactly
-   minus F1's, and adding it is subtracting F1's */
+   moment, force being the rows' start), link after link: each voxel's sum in the same
+   order. Where voxel 2 takes -F1 (neg2_row), its force is the turn of -F1: exactly minus
+   F1's, and adding it is subtracting F1's */
 SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter8(const int ax, Py_ssize_t li,
                                                  const Py_ssize_t *v1, const Py_ssize_t *v2,
                                                  const double *o, const double *neg2_row,
-                                                 double *force, double *moment)
+                                                 double *force)
 {
     const Py_ssize_t n = SOFTGYM_CHUNK_STRIDE;
     const double *q = o + li;
@@ -844,7 +845,6 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter8(const int ax, Py_ssize_t li,
     softgym_turn8(ax, R, b, wm2);
     __m512d c = _mm512_setzero_pd();
     Py_ssize_t pj = -1;
-    (void)moment;
     SOFTGYM_EACH8(SOFTGYM_ADD1);
 }
 #endif
@@ -863,7 +863,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
     if (al + 8 <= hi) {
         softgym_seed_scatter_links(ax, lo, al, v1, v2, rot, o, neg2_row, force, moment);
         for (lo = al; lo + 8 <= hi; lo += 8)
-            softgym_seed_scatter8(ax, lo, v1, v2, o, neg2_row, force, moment);
+            softgym_seed_scatter8(ax, lo, v1, v2, o, neg2_row, force);
     }
 #endif
     softgym_seed_scatter_links(ax, lo, hi, v1, v2, rot, o, neg2_row, force, moment);

@@ -172,8 +172,8 @@ static inline void softgym_v8_load4x4(const double *a, softgym_v8 *r)
 static inline void softgym_v8_load4x4_fm(const double *a, softgym_v8 *r)
 {
     const int s = SOFTGYM_FM_STRIDE;
-    softgym_v8_rows_of4(SOFTGYM_FM_PAIR(a), SOFTGYM_FM_PAIR(a + 2 * s), SOFTGYM_FM_PAIR(a + 4 * s),
-                        SOFTGYM_FM_PAIR(a + 6 * s), r);
+    softgym_v8_rows_of4(SOFTGYM_FM_PAIR(a), SOFTGYM_FM_PAIR(a + 2 * s),
+                        SOFTGYM_FM_PAIR(a + 4 * s), SOFTGYM_FM_PAIR(a + 6 * s), r);
 }
 /* rows r[0..3] (element 0 .. 3 of 8 records) back into the 8 records of 4 at a[0..31] */
 static inline void softgym_v8_store4x4(double *a, const softgym_v8 *r)

@@ -4,8 +4,8 @@
    the same multiply-adds), the seed's floor with every branch computed and one selected.
    The voxels' records (position, velocity, angular velocity and external force: 3
    doubles each; force and moment: halves of one row of SOFTGYM_FM_STRIDE) are turned
-   into rows of 8 lanes and back by two-source permutes. Only for the common block: no fixed voxel, no fluid, no
-   terrain box; a block where a voxel runs away is left to the scalar loop untouched
+   into rows of 8 lanes and back by two-source permutes. Only for the common block: no
+   fixed voxel, no fluid, no terrain box; a block where a voxel runs away is left to the scalar loop untouched
    (nothing is stored before the check), which then stops where the seed's loop stops.
    Py_ssize_t comes from Python.h, which Cython includes first. */
 #ifndef SOFTGYM_VOXELS_H
