@@ -22,12 +22,17 @@
    is x + (-y) exactly, and a rotation of -v is exactly minus the rotation
    of v). Updates the memory unless the mode changed. In double, the same
    operations as the seed's scalar code. */
-static void SOFTGYM_FNAME(
-    Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, SOFTGYM_FT L, SOFTGYM_FT bz, SOFTGYM_FT bzh,
-    SOFTGYM_FT inv_dt, const SOFTGYM_FT *in, Py_ssize_t in_stride, const double *sa_,
-    const double *chg_,
-    const SOFTGYM_FT *ka_, const SOFTGYM_FT *kt_, const SOFTGYM_FT *kb_, const SOFTGYM_FT *cs_,
-    SOFTGYM_FT *link_last, double *out)
+#define SOFTGYM_FCAT2(a, b) a##b
+#define SOFTGYM_FCAT(a, b) SOFTGYM_FCAT2(a, b)
+#define SOFTGYM_FPARAMS \
+    Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, SOFTGYM_FT L, SOFTGYM_FT bz, SOFTGYM_FT bzh, \
+    SOFTGYM_FT inv_dt, const SOFTGYM_FT *in, Py_ssize_t in_stride, const double *sa_, \
+    const double *chg_, \
+    const SOFTGYM_FT *ka_, const SOFTGYM_FT *kt_, const SOFTGYM_FT *kb_, const SOFTGYM_FT *cs_, \
+    SOFTGYM_FT *link_last, double *out
+/* all_small: every link of lo..hi is in small-angle mode (softgym_small_block), so the
+   large-angle turn by rq^-1, selected away in every lane, is not computed */
+SOFTGYM_ALWAYS_INLINE void SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(const int all_small, SOFTGYM_FPARAMS)
 {
     typedef SOFTGYM_FT T;
     /* the input rows' stride: in_stride (the scratch's) in double, the chunk's float rows'
@@ -46,7 +51,7 @@ static void SOFTGYM_FNAME(
     Py_ssize_t li;
     SOFTGYM_IVDEP
     for (li = lo; li < hi; li++) {
-        SOFTGYM_FMASK sa = sa_[li] != 0.0, changed = chg_[li] != 0.0;
+        SOFTGYM_FMASK sa = all_small ? 1 : sa_[li] != 0.0, changed = chg_[li] != 0.0;
         T P0 = P0_[li], P1 = P1_[li], P2 = P2_[li];
         T a1x = zero, a1y = a1y_[li], a1z = a1z_[li];
         T a2x = a2x_[li], a2y = a2y_[li], a2z = a2z_[li];
@@ -143,3 +148,24 @@ static void SOFTGYM_FNAME(
         o11[li] = -m2z;
     }
 }
+
+/* blocks of up to 64 links, those wholly in small-angle mode without the large-angle turn */
+static void SOFTGYM_FNAME(SOFTGYM_FPARAMS)
+{
+    Py_ssize_t blo, bhi;
+    int all_small;
+    for (blo = lo; blo < hi; blo = bhi) {
+        bhi = softgym_small_block(sa_, blo, hi, &all_small);
+#define SOFTGYM_FCALL(s) SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)( \
+            s, blo, bhi, n, L, bz, bzh, inv_dt, in, in_stride, sa_, chg_, ka_, kt_, kb_, cs_, \
+            link_last, out)
+        if (all_small)
+            SOFTGYM_FCALL(1);
+        else
+            SOFTGYM_FCALL(0);
+#undef SOFTGYM_FCALL
+    }
+}
+#undef SOFTGYM_FPARAMS
+#undef SOFTGYM_FCAT
+#undef SOFTGYM_FCAT2
