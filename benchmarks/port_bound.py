@@ -61,7 +61,7 @@ SEED_PASSES = {
     "modes": ("softgym_seed_modes",),
     "frames (float)": ("softgym_seed_frames32_impl", "softgym_rotvec_k32",
                        "softgym_rotvec_k32_acos"),
-    "forces (float)": ("softgym_seed_forces32",),
+    "forces (float)": ("softgym_seed_forces32", "softgym_seed_forces32_impl"),
     "scatter": ("softgym_seed_scatter_ax", "softgym_seed_scatter8", "softgym_turn8",
                 "softgym_v8_rows4"),
     "voxel update": ("softgym_seed_voxels8", "softgym_v8_finish"),
