@@ -314,7 +314,8 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     #   _seed_frame_one      redoes those links with the seed's branches
     #   softgym_seed_forces  forces and moments in the bond frame (stiffness, the
     #                        seed's damping from the link's memory; rq^-1 for
-    #                        large angles) into the 12 rows of b.chunk_out
+    #                        large angles, not computed in blocks of links all in
+    #                        small-angle mode) into the 12 rows of b.chunk_out
     #   softgym_seed_scatter back to the world, scattered in link order (once
     #                        per axis; with AVX-512, 8 links at a time turned in
     #                        the lanes with voxel 1's rotation, which the geometry

@@ -149,22 +149,20 @@ SOFTGYM_ALWAYS_INLINE void SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(const int all_smal
     }
 }
 
-/* blocks of up to 64 links, those wholly in small-angle mode without the large-angle turn */
+/* links lo..hi (one chunk: at most 64), without the large-angle turn where all of them are
+   in small-angle mode (softgym_small_block) */
 static void SOFTGYM_FNAME(SOFTGYM_FPARAMS)
 {
-    Py_ssize_t blo, bhi;
     int all_small;
-    for (blo = lo; blo < hi; blo = bhi) {
-        bhi = softgym_small_block(sa_, blo, hi, &all_small);
-#define SOFTGYM_FCALL(s) SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)( \
-            s, blo, bhi, n, L, bz, bzh, inv_dt, in, in_stride, sa_, chg_, ka_, kt_, kb_, cs_, \
-            link_last, out)
-        if (all_small)
-            SOFTGYM_FCALL(1);
-        else
-            SOFTGYM_FCALL(0);
-#undef SOFTGYM_FCALL
-    }
+    Py_ssize_t end = softgym_small_block(sa_, lo, hi, &all_small);
+    if (end != hi)
+        all_small = 0;
+    if (all_small)
+        SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(1, lo, hi, n, L, bz, bzh, inv_dt, in, in_stride, sa_,
+                                           chg_, ka_, kt_, kb_, cs_, link_last, out);
+    else
+        SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(0, lo, hi, n, L, bz, bzh, inv_dt, in, in_stride, sa_,
+                                           chg_, ka_, kt_, kb_, cs_, link_last, out);
 }
 #undef SOFTGYM_FPARAMS
 #undef SOFTGYM_FCAT
