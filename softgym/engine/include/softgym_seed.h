@@ -317,19 +317,18 @@ static inline long long softgym_rotvec_needs_acos(double w, double thr)
     T tx = rw * n1 + ry * n3 - rz * n2; \
     T ty = rw * n2 + ry * qw + rz * n1; \
     T tz = rw * n3 - ry * n1 + rz * qw
-/* the end of the block of up to 64 links from blo (before hi), and in
-   *all_small whether every one of them is in small-angle mode (sa_ row): the
-   frames passes then skip the large-angle candidates (a settled or gently
-   actuated body: most blocks) */
-static inline Py_ssize_t softgym_small_block(const double *sa_, Py_ssize_t blo, Py_ssize_t hi,
-                                             int *all_small)
+/* whether every link of lo..hi (one chunk: SOFTGYM_CHUNK_LINKS at most) is in small-angle
+   mode (sa_ row): the frames and forces passes then run copies of their loops without the
+   large-angle candidates (a settled or gently actuated body: most chunks). One test a
+   chunk: with a loop of blocks around the two copies, the forces pass's mixed loop
+   spilled twice as many registers (benchmarks/RESULTS.md) */
+static inline int softgym_all_small(const double *sa_, Py_ssize_t lo, Py_ssize_t hi)
 {
-    Py_ssize_t li, bhi = blo + 64 < hi ? blo + 64 : hi;
+    Py_ssize_t li;
     int all = 1;
-    for (li = blo; li < bhi; li++)
+    for (li = lo; li < hi; li++)
         all &= sa_[li] != 0.0;
-    *all_small = all;
-    return bhi;
+    return all;
 }
 /* the frames pass's rows: geometry and mode in, frame quantities out */
 #define SOFTGYM_FRAME_ROWS \
@@ -387,16 +386,11 @@ SOFTGYM_ALWAYS_INLINE long long softgym_seed_frames_impl(
 static int softgym_seed_frames(
     Py_ssize_t lo, Py_ssize_t hi, double sa_rad, double thr, SOFTGYM_FRAME_ROWS)
 {
-    Py_ssize_t blo, bhi;
-    int all_small;
-    long long any_fix = 0;
-    for (blo = lo; blo < hi; blo = bhi) {
-        bhi = softgym_small_block(sa_, blo, hi, &all_small);
-        if (all_small)
-            any_fix |= softgym_seed_frames_impl(1, blo, bhi, sa_rad, thr, SOFTGYM_FRAME_ROW_NAMES);
-        else
-            any_fix |= softgym_seed_frames_impl(0, blo, bhi, sa_rad, thr, SOFTGYM_FRAME_ROW_NAMES);
-    }
+    long long any_fix;
+    if (softgym_all_small(sa_, lo, hi))
+        any_fix = softgym_seed_frames_impl(1, lo, hi, sa_rad, thr, SOFTGYM_FRAME_ROW_NAMES);
+    else
+        any_fix = softgym_seed_frames_impl(0, lo, hi, sa_rad, thr, SOFTGYM_FRAME_ROW_NAMES);
     return any_fix != 0;
 }
 
@@ -483,22 +477,15 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
                                  float w_acos, const double *o, float *f)
 {
     const Py_ssize_t fs = SOFTGYM_CHUNK_FSTRIDE;
-    Py_ssize_t blo, bhi;
-    int all_small, any_fix = 0;
     const double *sa_ = o + 9 * n;
-    for (blo = lo; blo < hi; blo = bhi) {
-        bhi = softgym_small_block(sa_, blo, hi, &all_small);
-#define SOFTGYM_FRAMES32(s) any_fix |= softgym_seed_frames32_impl( \
-            s, blo, bhi, sa_rad, w_acos, o, o + n, o + 2 * n, o + 3 * n, o + 4 * n, o + 5 * n, \
+    const int all_small = softgym_all_small(sa_, lo, hi);
+#define SOFTGYM_FRAMES32(s) softgym_seed_frames32_impl( \
+            s, lo, hi, sa_rad, w_acos, o, o + n, o + 2 * n, o + 3 * n, o + 4 * n, o + 5 * n, \
             o + 6 * n, o + 7 * n, o + 8 * n, sa_, f, f + fs, f + 2 * fs, f + 3 * fs, \
             f + 4 * fs, f + 5 * fs, f + 6 * fs, f + 7 * fs, f + 8 * fs, f + 9 * fs, \
             f + 10 * fs, f + 11 * fs)
-        if (all_small)
-            SOFTGYM_FRAMES32(1);
-        else
-            SOFTGYM_FRAMES32(0);
+    int any_fix = all_small ? SOFTGYM_FRAMES32(1) : SOFTGYM_FRAMES32(0);
 #undef SOFTGYM_FRAMES32
-    }
     return any_fix != 0;
 }
 

@@ -30,7 +30,7 @@
     const double *chg_, \
     const SOFTGYM_FT *ka_, const SOFTGYM_FT *kt_, const SOFTGYM_FT *kb_, const SOFTGYM_FT *cs_, \
     SOFTGYM_FT *link_last, double *out
-/* all_small: every link of lo..hi is in small-angle mode (softgym_small_block), so the
+/* all_small: every link of lo..hi is in small-angle mode (softgym_all_small), so the
    large-angle turn by rq^-1, selected away in every lane, is not computed */
 SOFTGYM_ALWAYS_INLINE void SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(const int all_small, SOFTGYM_FPARAMS)
 {
@@ -149,15 +149,11 @@ SOFTGYM_ALWAYS_INLINE void SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(const int all_smal
     }
 }
 
-/* links lo..hi (one chunk: at most 64), without the large-angle turn where all of them are
-   in small-angle mode (softgym_small_block) */
+/* links lo..hi (one chunk), without the large-angle turn where all of them are in
+   small-angle mode (softgym_all_small) */
 static void SOFTGYM_FNAME(SOFTGYM_FPARAMS)
 {
-    int all_small;
-    Py_ssize_t end = softgym_small_block(sa_, lo, hi, &all_small);
-    if (end != hi)
-        all_small = 0;
-    if (all_small)
+    if (softgym_all_small(sa_, lo, hi))
         SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(1, lo, hi, n, L, bz, bzh, inv_dt, in, in_stride, sa_,
                                            chg_, ka_, kt_, kb_, cs_, link_last, out);
     else
