@@ -817,13 +817,21 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter8(const int ax, Py_ssize_t li,
     __mmask8 neg2 = _mm512_cmpneq_epi64_mask(_mm512_loadu_si512((const void *)(neg2_row + li)),
                                              _mm512_setzero_si512());
     __m512d wf1[4], wf2[4], wm1[4], wm2[4];
-    for (int c = 0; c < 3; c++) {
+    for (int c = 0; c < 3; c++)
         a[c] = softgym_v8_load(q + c * n);
-        b[c] = (softgym_v8)_mm512_mask_blend_pd(neg2, (__m512d)softgym_v8_load(q + (3 + c) * n),
-                                                (__m512d)(-a[c]));
-    }
     softgym_turn8(ax, R, a, wf1);
-    softgym_turn8(ax, R, b, wf2);
+    if (neg2 == 0xFF) {
+        /* every voxel 2 takes -F1 (a single material, no mode change: most blocks): the
+           turn of -F1 is exactly minus F1's, so its rows are F1's negated (and a voxel's
+           sum is never -0.0, which is where the two could differ in sign) */
+        for (int k = 0; k < 4; k++)
+            wf2[k] = (__m512d)(-(softgym_v8)wf1[k]);
+    } else {
+        for (int c = 0; c < 3; c++)
+            b[c] = (softgym_v8)_mm512_mask_blend_pd(
+                neg2, (__m512d)softgym_v8_load(q + (3 + c) * n), (__m512d)(-a[c]));
+        softgym_turn8(ax, R, b, wf2);
+    }
     for (int c = 0; c < 3; c++) {
         a[c] = softgym_v8_load(q + (6 + c) * n);
         b[c] = softgym_v8_load(q + (9 + c) * n);
