@@ -89,9 +89,9 @@ cdef extern from "softgym_seed.h":
     void softgym_seed_forces(intp_t lo, intp_t hi, intp_t n, float64_t L, float64_t bz,
                              float64_t bzh, float64_t inv_dt, const float64_t* inp,
                              intp_t in_stride, const float64_t* sa_, const float64_t* chg_,
-                             const float64_t* ka_, const float64_t* kt_, const float64_t* kb_,
-                             const float64_t* cs_, float64_t* link_last,
-                             float64_t* out) noexcept nogil
+                             const float64_t* neg2_, const float64_t* ka_,
+                             const float64_t* kt_, const float64_t* kb_, const float64_t* cs_,
+                             float64_t* link_last, float64_t* out) noexcept nogil
     intp_t softgym_seed_modes(intp_t lo, intp_t hi, intp_t n, float64_t max_ext,
                               float64_t sa_w, float64_t sah_w, float64_t st_in, float64_t ex_in,
                               float64_t st_out, float64_t ex_out, lane_flag_t* link_sa,
@@ -106,7 +106,8 @@ cdef extern from "softgym_seed.h":
                               const float64_t* o, float* f) noexcept nogil
     void softgym_seed_forces32(intp_t lo, intp_t hi, intp_t n, float L, float bz, float bzh,
                                float inv_dt, const float* inp, intp_t in_stride,
-                               const float64_t* sa_, const float64_t* chg_, const float* ka_,
+                               const float64_t* sa_, const float64_t* chg_,
+                               const float64_t* neg2_, const float* ka_,
                                const float* kt_, const float* kb_, const float* cs_,
                                float* link_last, float64_t* out) noexcept nogil
 
@@ -232,8 +233,9 @@ cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end, float64_
     k32 = b.k_seed32
     softgym_seed_forces32(lo, end, b.link_rows, <float> b.L, <float> (0.5 * b.bond_zeta),
                           <float> (0.25 * b.bond_zeta), <float> inv_dt, f, SOFTGYM_CHUNK_FSTRIDE,
-                          o + 9 * n, o + 22 * n, k32, k32 + b.link_rows, k32 + 2 * b.link_rows,
-                          k32 + 3 * b.link_rows, b.link_last32, b.chunk_out - lo)
+                          o + 9 * n, o + 22 * n, o + 23 * n, k32, k32 + b.link_rows,
+                          k32 + 2 * b.link_rows, k32 + 3 * b.link_rows, b.link_last32,
+                          b.chunk_out - lo)
     softgym_prof_add(4, t0)
 
 
@@ -263,8 +265,8 @@ cdef inline void _seed_frames_forces(Batch* b, intp_t lo, intp_t end, float64_t*
     # the forces pass writes the chunk's rows of b.chunk_out (f1 0-2, f2 3-5, m1 6-8, m2
     # 9-11, SOFTGYM_CHUNK_STRIDE apart, indexed by link), which softgym_seed_scatter reads
     softgym_seed_forces(lo, end, b.link_rows, b.L, bz, 0.5 * bz, inv_dt, o + 10 * n, n,
-                        o + 9 * n, o + 22 * n, b.k_axial, b.k_torsion, b.k_bend, b.c_seed, b.link_last,
-                        b.chunk_out - lo)
+                        o + 9 * n, o + 22 * n, o + 23 * n, b.k_axial, b.k_torsion, b.k_bend,
+                        b.c_seed, b.link_last, b.chunk_out - lo)
     softgym_prof_add(4, t0)
 
 
@@ -314,8 +316,10 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     #   _seed_frame_one      redoes those links with the seed's branches
     #   softgym_seed_forces  forces and moments in the bond frame (stiffness, the
     #                        seed's damping from the link's memory; rq^-1 for
-    #                        large angles, not computed in blocks of links all in
-    #                        small-angle mode) into the 12 rows of b.chunk_out
+    #                        large angles, not computed where a chunk's links are
+    #                        all in small-angle mode; voxel 2's own force left out
+    #                        where they all give it -F1) into the 12 rows of
+    #                        b.chunk_out
     #   softgym_seed_scatter back to the world, scattered in link order (once
     #                        per axis; with AVX-512, 8 links at a time turned in
     #                        the lanes with voxel 1's rotation, which the geometry

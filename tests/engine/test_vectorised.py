@@ -33,10 +33,10 @@ PASSES = {
     "softgym_seed_frames": "softgym_seed_frames(0, n, 0.01, 0.002, d, d, d, d, d, d, d, d, d, d, "
                            "o, o, o, o, o, o, o, o, o, o, o, o);",
     "softgym_seed_forces": "softgym_seed_forces(0, n, n, 0.01, 0.1, 0.05, 1e4, d, n, d, d, d, d, d, "
-                           "d, o, o);",
+                           "d, d, o, o);",
     "softgym_seed_frames32": "softgym_seed_frames32(0, n, n, 0.01f, 0.9988f, d, fo[0]);",
     "softgym_seed_forces32": "softgym_seed_forces32(0, n, n, 0.01f, 0.1f, 0.05f, 1e4f, fc, 0, d, d, "
-                             "fc, fc, fc, fc, fo[0], o);",
+                             "d, fc, fc, fc, fc, fo[0], o);",
     "softgym_seed_modes": "return (long)softgym_seed_modes(0, n, n, 0.3, 0.99, 0.98, 0.05, 1.3, "
                           "0.055, 1.43, lf, lf, o);",
     "softgym_seed_quats": "softgym_seed_quats(0, n, n, 1e-4, d, d, o);",

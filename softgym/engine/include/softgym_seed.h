@@ -317,17 +317,19 @@ static inline long long softgym_rotvec_needs_acos(double w, double thr)
     T tx = rw * n1 + ry * n3 - rz * n2; \
     T ty = rw * n2 + ry * qw + rz * n1; \
     T tz = rw * n3 - ry * n1 + rz * qw
-/* whether every link of lo..hi (one chunk: SOFTGYM_CHUNK_LINKS at most) is in small-angle
-   mode (sa_ row): the frames and forces passes then run copies of their loops without the
-   large-angle candidates (a settled or gently actuated body: most chunks). One test a
-   chunk: with a loop of blocks around the two copies, the forces pass's mixed loop
-   spilled twice as many registers (benchmarks/RESULTS.md) */
-static inline int softgym_all_small(const double *sa_, Py_ssize_t lo, Py_ssize_t hi)
+/* whether every value of the row lo..hi is nonzero: with the mode row (sa_, 1.0 small
+   angle), whether a chunk's links (SOFTGYM_CHUNK_LINKS at most) are all in small-angle
+   mode, where the frames and forces passes run copies of their loops without the
+   large-angle candidates (a settled or gently actuated body: most chunks); with row 23,
+   whether voxel 2 takes -F1 at every link, where the forces pass leaves out voxel 2's own
+   force. One test a chunk: with a loop of blocks around the copies, the forces pass's
+   mixed loop spilled twice as many registers (benchmarks/RESULTS.md) */
+static inline int softgym_all_nonzero(const double *row, Py_ssize_t lo, Py_ssize_t hi)
 {
     Py_ssize_t li;
     int all = 1;
     for (li = lo; li < hi; li++)
-        all &= sa_[li] != 0.0;
+        all &= row[li] != 0.0;
     return all;
 }
 /* the frames pass's rows: geometry and mode in, frame quantities out */
@@ -387,7 +389,7 @@ static int softgym_seed_frames(
     Py_ssize_t lo, Py_ssize_t hi, double sa_rad, double thr, SOFTGYM_FRAME_ROWS)
 {
     long long any_fix;
-    if (softgym_all_small(sa_, lo, hi))
+    if (softgym_all_nonzero(sa_, lo, hi))
         any_fix = softgym_seed_frames_impl(1, lo, hi, sa_rad, thr, SOFTGYM_FRAME_ROW_NAMES);
     else
         any_fix = softgym_seed_frames_impl(0, lo, hi, sa_rad, thr, SOFTGYM_FRAME_ROW_NAMES);
@@ -478,7 +480,7 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
 {
     const Py_ssize_t fs = SOFTGYM_CHUNK_FSTRIDE;
     const double *sa_ = o + 9 * n;
-    const int all_small = softgym_all_small(sa_, lo, hi);
+    const int all_small = softgym_all_nonzero(sa_, lo, hi);
 #define SOFTGYM_FRAMES32(s) softgym_seed_frames32_impl( \
             s, lo, hi, sa_rad, w_acos, o, o + n, o + 2 * n, o + 3 * n, o + 4 * n, o + 5 * n, \
             o + 6 * n, o + 7 * n, o + 8 * n, sa_, f, f + fs, f + 2 * fs, f + 3 * fs, \

@@ -27,12 +27,16 @@
 #define SOFTGYM_FPARAMS \
     Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, SOFTGYM_FT L, SOFTGYM_FT bz, SOFTGYM_FT bzh, \
     SOFTGYM_FT inv_dt, const SOFTGYM_FT *in, Py_ssize_t in_stride, const double *sa_, \
-    const double *chg_, \
+    const double *chg_, const double *neg2_, \
     const SOFTGYM_FT *ka_, const SOFTGYM_FT *kt_, const SOFTGYM_FT *kb_, const SOFTGYM_FT *cs_, \
     SOFTGYM_FT *link_last, double *out
-/* all_small: every link of lo..hi is in small-angle mode (softgym_all_small), so the
-   large-angle turn by rq^-1, selected away in every lane, is not computed */
-SOFTGYM_ALWAYS_INLINE void SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(const int all_small, SOFTGYM_FPARAMS)
+/* all_small: every link of lo..hi is in small-angle mode (softgym_all_nonzero), so the
+   large-angle turn by rq^-1, selected away in every lane, is not computed; all_neg2: every
+   link's voxel 2 takes -F1 (row 23, neg2_), so voxel 2's own force is neither computed nor
+   stored (the scatter does not read it there) */
+SOFTGYM_ALWAYS_INLINE void SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(const int all_small,
+                                                             const int all_neg2,
+                                                             SOFTGYM_FPARAMS)
 {
     typedef SOFTGYM_FT T;
     /* the input rows' stride: in_stride (the scratch's) in double, the chunk's float rows'
@@ -131,15 +135,18 @@ SOFTGYM_ALWAYS_INLINE void SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(const int all_smal
         SOFTGYM_UNTURN(f1x, f1y, f1z);
         SOFTGYM_UNTURN(m1x, m1y, m1z);
         SOFTGYM_UNTURN(m2x, m2y, m2z);
-        SOFTGYM_UNTURN(f2x, f2y, f2z);
+        if (!all_neg2)
+            SOFTGYM_UNTURN(f2x, f2y, f2z);
 #undef SOFTGYM_UNTURN
 #undef SOFTGYM_KEEP3
         o0[li] = f1x;
         o1[li] = f1y;
         o2[li] = f1z;
-        o3[li] = f2x;
-        o4[li] = f2y;
-        o5[li] = f2z;
+        if (!all_neg2) {
+            o3[li] = f2x;
+            o4[li] = f2y;
+            o5[li] = f2z;
+        }
         o6[li] = -m1x;
         o7[li] = -m1y;
         o8[li] = -m1z;
@@ -149,17 +156,34 @@ SOFTGYM_ALWAYS_INLINE void SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(const int all_smal
     }
 }
 
+#define SOFTGYM_FARGS lo, hi, n, L, bz, bzh, inv_dt, in, in_stride, sa_, chg_, neg2_, ka_, kt_, \
+    kb_, cs_, link_last, out
+#define SOFTGYM_FCOPY(suffix, s, g) \
+    static __attribute__((noinline)) void SOFTGYM_FCAT(SOFTGYM_FNAME, suffix)(SOFTGYM_FPARAMS) \
+    { \
+        SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(s, g, SOFTGYM_FARGS); \
+    }
+SOFTGYM_FCOPY(_mixed, 0, 0)
+SOFTGYM_FCOPY(_small, 1, 0)
+SOFTGYM_FCOPY(_neg2, 0, 1)
+SOFTGYM_FCOPY(_small_neg2, 1, 1)
+#undef SOFTGYM_FCOPY
 /* links lo..hi (one chunk), without the large-angle turn where all of them are in
-   small-angle mode (softgym_all_small) */
+   small-angle mode, without voxel 2's own force where all of them give it -F1 */
 static void SOFTGYM_FNAME(SOFTGYM_FPARAMS)
 {
-    if (softgym_all_small(sa_, lo, hi))
-        SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(1, lo, hi, n, L, bz, bzh, inv_dt, in, in_stride, sa_,
-                                           chg_, ka_, kt_, kb_, cs_, link_last, out);
+    const int all_small = softgym_all_nonzero(sa_, lo, hi);
+    const int all_neg2 = softgym_all_nonzero(neg2_, lo, hi);
+    if (all_small && all_neg2)
+        SOFTGYM_FCAT(SOFTGYM_FNAME, _small_neg2)(SOFTGYM_FARGS);
+    else if (all_small)
+        SOFTGYM_FCAT(SOFTGYM_FNAME, _small)(SOFTGYM_FARGS);
+    else if (all_neg2)
+        SOFTGYM_FCAT(SOFTGYM_FNAME, _neg2)(SOFTGYM_FARGS);
     else
-        SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(0, lo, hi, n, L, bz, bzh, inv_dt, in, in_stride, sa_,
-                                           chg_, ka_, kt_, kb_, cs_, link_last, out);
+        SOFTGYM_FCAT(SOFTGYM_FNAME, _mixed)(SOFTGYM_FARGS);
 }
+#undef SOFTGYM_FARGS
 #undef SOFTGYM_FPARAMS
 #undef SOFTGYM_FCAT
 #undef SOFTGYM_FCAT2
