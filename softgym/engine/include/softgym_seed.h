@@ -823,9 +823,10 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter8(const int ax, Py_ssize_t li,
         a[c] = softgym_v8_load(q + c * n);
     softgym_turn8(ax, R, a, wf1);
     if (neg2 == 0xFF) {
-        /* every voxel 2 takes -F1 (a single material, no mode change: most blocks): the
-           turn of -F1 is exactly minus F1's, so its rows are F1's negated (and a voxel's
-           sum is never -0.0, which is where the two could differ in sign) */
+        /* every voxel 2 takes -F1 (one material, or two with the same damping ends, or a
+           mode change: every block of a body of one tissue): the turn of -F1 is exactly
+           minus F1's, so its rows are F1's negated (a voxel's sum starts at +0.0 and is
+           never -0.0, the one case where the two could differ: the sign of a zero) */
         for (int k = 0; k < 4; k++)
             wf2[k] = (__m512d)(-(softgym_v8)wf1[k]);
     } else {

@@ -12,7 +12,8 @@
    large-angle link, without branches so the loop vectorises. Inputs: the
    frames' rows in + k SOFTGYM_FIN_STRIDE (P0, P1, P2, a1y, a1z, a2x, a2y, a2z, rw, ry,
    rz), the
-   mode (sa_: 1.0 small angle) and mode-change (chg_) rows, the link
+   mode (sa_: 1.0 small angle), mode-change (chg_) and voxel-2-takes-minus-F1 (neg2_,
+   the scratch's row 23) rows, the link
    constants (ka_, kt_, kb_; cs_: the 8 rows of c_seed, stride n) and memory
    (link_last, 9 rows of stride n). Outputs (double rows, for the scatter)
    what the scatter turns to the world and adds: voxel 1's force, voxel 2's
@@ -156,10 +157,12 @@ SOFTGYM_ALWAYS_INLINE void SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(const int all_smal
     }
 }
 
+/* the four copies, each a function of its own: inlined into one function, the mixed
+   copy's loop spilled 81 registers a 16-link iteration against 35 (port_bound.py) */
 #define SOFTGYM_FARGS lo, hi, n, L, bz, bzh, inv_dt, in, in_stride, sa_, chg_, neg2_, ka_, kt_, \
     kb_, cs_, link_last, out
 #define SOFTGYM_FCOPY(suffix, s, g) \
-    static __attribute__((noinline)) void SOFTGYM_FCAT(SOFTGYM_FNAME, suffix)(SOFTGYM_FPARAMS) \
+    SOFTGYM_NOINLINE void SOFTGYM_FCAT(SOFTGYM_FNAME, suffix)(SOFTGYM_FPARAMS) \
     { \
         SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(s, g, SOFTGYM_FARGS); \
     }

@@ -343,7 +343,9 @@ static inline softgym_v4 softgym_v4load(const double *row, Py_ssize_t li)
 
 #if defined(_MSC_VER)
 #define SOFTGYM_ALWAYS_INLINE static __forceinline
+#define SOFTGYM_NOINLINE static __declspec(noinline)
 #else
 #define SOFTGYM_ALWAYS_INLINE static inline __attribute__((always_inline))
+#define SOFTGYM_NOINLINE static __attribute__((noinline))
 #endif
 #endif  /* SOFTGYM_SIMD_H */
