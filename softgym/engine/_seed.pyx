@@ -333,10 +333,10 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     # run-time stride apart, took a register each and 108 KB for the reference
     # robot, walked each step). The geometry and the scatter split a chunk at the
     # axis runs; the modes, frames and forces passes need no axis. Each link's
-    # quantities are its own and the links are scattered in the same order, so the result is the one of running each pass
-    # over all the links, bit for bit (a strained link stops the step after the
-    # links before it, as the seed's scalar loop does; 3.0 % on an Intel Xeon,
-    # benchmarks/RESULTS.md). With link_precision "single" the
+    # quantities are its own and the links are scattered in the same order, so the
+    # result is the one of running each pass over all the links, bit for bit (a
+    # strained link stops the step after the links before it, as the seed's scalar
+    # loop does; 3.0 % on an Intel Xeon, benchmarks/RESULTS.md). With link_precision "single" the
     # frames and forces run in float (_seed_frames_forces32).
     # The bond frame is voxel 1's frame turned by the proper rotation P that
     # takes the link axis onto +x (the seed's ToXDirBond): (x, y, z) ->
