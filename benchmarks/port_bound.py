@@ -239,16 +239,32 @@ def _geometry_paths(rows, best) -> None:
 CLOCK_C = r"""
 #include <stdio.h>
 #include <x86intrin.h>
+/* core cycles per TSC cycle: 8 dependent integer additions (1 core cycle each); with
+   ZMM defined, a chain of dependent 512-bit multiply-adds (4 core cycles each on every
+   core with AVX-512 this project runs on: Intel since Skylake-SP, AMD Zen 4 and 5),
+   the clock while 512-bit arithmetic runs, which may be lower */
 int main(void)
 {
     unsigned long long x = 1, y = 3, best = ~0ull;
     const long n = 50000000;
     for (int rep = 0; rep < 5; rep++) {
         unsigned long long t0 = __rdtsc();
+#ifdef ZMM
+        __m512d a = _mm512_set1_pd(1.0), b = _mm512_set1_pd(0.999999), c = _mm512_set1_pd(1e-9);
+        for (long i = 0; i < n; i++) {  /* 2 dependent multiply-adds: 8 core cycles */
+            a = _mm512_fmadd_pd(a, b, c);
+            a = _mm512_fmadd_pd(a, b, c);
+            __asm__ volatile("" : "+v"(a));
+        }
+        double lanes[8];
+        _mm512_storeu_pd(lanes, a);
+        x += lanes[0] > 2.0;
+#else
         for (long i = 0; i < n; i++)  /* 8 dependent additions: 8 core cycles */
             __asm__ volatile("add %1, %0\n\tadd %1, %0\n\tadd %1, %0\n\tadd %1, %0\n\t"
                              "add %1, %0\n\tadd %1, %0\n\tadd %1, %0\n\tadd %1, %0"
                              : "+r"(x) : "r"(y));
+#endif
         unsigned long long t = __rdtsc() - t0;
         if (t < best)
             best = t;
@@ -259,19 +275,24 @@ int main(void)
 """
 
 
-def core_cycles_per_tsc() -> float | None:
+def core_cycles_per_tsc(zmm: bool = False) -> float | None:
     """Core cycles per time-stamp-counter cycle (the fastest of 5 timings), or None
-    without a C compiler."""
+    without a C compiler (``zmm``: under 512-bit multiply-adds, or None where the
+    compiler or the CPU has no AVX-512)."""
     cc = shutil.which("cc") or shutil.which("gcc")
     if cc is None:
         return None
+    flags = ["-DZMM", "-mavx512f", "-mfma"] if zmm else []
     with tempfile.TemporaryDirectory() as tmp:
         src, exe = Path(tmp) / "clock.c", Path(tmp) / "clock"
         src.write_text(CLOCK_C)
-        if subprocess.run([cc, "-O2", str(src), "-o", str(exe)], capture_output=True).returncode:
+        if subprocess.run([cc, "-O2", *flags, str(src), "-o", str(exe)],
+                          capture_output=True).returncode:
             return None
-        out = subprocess.run([str(exe)], capture_output=True, text=True).stdout
-    return float(out) if out.strip() else None
+        run = subprocess.run([str(exe)], capture_output=True, text=True)
+    if run.returncode not in (0, 1) or not run.stdout.strip():  # (an illegal instruction)
+        return None
+    return float(run.stdout)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -337,9 +358,18 @@ def main(argv: list[str] | None = None) -> int:
           "its simulated cycles an iteration; /vs: per voxel-step")
     if args.calibrate:
         ratio = core_cycles_per_tsc()
+        ratio512 = core_cycles_per_tsc(zmm=True)
         report["core_cycles_per_tsc"] = ratio
+        report["core_cycles_per_tsc_512"] = ratio512
         print("core cycles per time-stamp-counter cycle: "
               + (f"{ratio:.3f} (a chain of dependent additions)" if ratio else "no C compiler"))
+        if ratio512:
+            # the passes' loops run 512-bit arithmetic: their totals at that clock, in the
+            # unit of profile_engine.py --cycles
+            print(f"  under 512-bit multiply-adds: {ratio512:.3f} (a chain of dependent "
+                  f"multiply-adds); the totals in TSC cycles a voxel-step at that clock: "
+                  f"bound {total_b / ratio512:.1f}, sim {total_s / ratio512:.1f}")
+            report.update(total_bound_tsc=total_b / ratio512, total_sim_tsc=total_s / ratio512)
     if args.json:
         report.update(total_bound=total_b, total_sim=total_s)
         print(json.dumps(report))

@@ -31,6 +31,13 @@ def test_every_pass_has_a_loop_and_a_floor_under_its_simulated_cycles():
     out = json.loads(res.stdout.strip().splitlines()[-1])
     # a core runs between about 0.5 and 3 times its time-stamp counter's rate
     assert out["core_cycles_per_tsc"] is None or 0.3 < out["core_cycles_per_tsc"] < 4.0
+    # under 512-bit arithmetic the clock is the same or lower (None without AVX-512), and
+    # the totals are given in TSC cycles at that clock
+    r512 = out["core_cycles_per_tsc_512"]
+    if r512 is not None:
+        assert 0.3 < r512 <= 1.1 * out["core_cycles_per_tsc"]
+        assert out["total_bound_tsc"] == pytest.approx(out["total_bound"] / r512)
+        assert out["total_bound_tsc"] < out["total_sim_tsc"]
     passes = out["passes"]
     assert set(passes) >= {"geometry", "rows path", "gather path", "modes", "frames (float)",
                            "forces (float)", "scatter", "voxel update"}
