@@ -38,11 +38,15 @@ cdef int links_corotational(Batch* b, intp_t r) noexcept nogil:
         intp_t hi = b.link_start[r + 1]
         intp_t nx = b.link_axis_count[3 * r]
         intp_t ny = b.link_axis_count[3 * r + 1]
-    if _links_along(b, lo, lo + nx, 0) != STATUS_OK:
+    if COROT_ROWS_USED:
+        # the voxels' records as rows, once a step (softgym_corot_rows)
+        softgym_corot_rows(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.pos, b.vel,
+                           b.angvel, b.quat, b.rot, b.vox_out)
+    if _links_along(b, r, lo, lo + nx, 0) != STATUS_OK:
         return STATUS_STRAIN
-    if _links_along(b, lo + nx, lo + nx + ny, 1) != STATUS_OK:
+    if _links_along(b, r, lo + nx, lo + nx + ny, 1) != STATUS_OK:
         return STATUS_STRAIN
-    return _links_along(b, lo + nx + ny, hi, 2)
+    return _links_along(b, r, lo + nx + ny, hi, 2)
 
 
 cdef extern from "softgym_corot.h":
@@ -56,14 +60,21 @@ cdef extern from "softgym_corot.h":
                              const float64_t* scale, const float64_t* k_axial,
                              const float64_t* c_axial, const float64_t* k_bend,
                              const float64_t* c_bend, const float64_t* k_torsion,
-                             const float64_t* c_torsion, float64_t* o) noexcept nogil
+                             const float64_t* c_torsion, const float64_t* vr, intp_t vn,
+                             intp_t vend, float64_t* o) noexcept nogil
+    # the voxels' rows the kernel's 8-lane paths load (AVX-512 builds: SOFTGYM_COROT_ROWS
+    # rows of b.vox_out; elsewhere not built, and COROT_ROWS_USED is 0)
+    void softgym_corot_rows(intp_t lo, intp_t hi, intp_t n, const float64_t* pos,
+                            const float64_t* vel, const float64_t* av, const float64_t* quat,
+                            const float64_t* rot, float64_t* rows) noexcept nogil
+    enum: COROT_ROWS_USED
     # the strain check and the scatter in link order: hi, or the first strained link
     intp_t softgym_corot_scatter(intp_t lo, intp_t hi, intp_t n, float64_t max_ext,
                                  const intp_t* v1, const intp_t* v2, const float64_t* o,
                                  float64_t* force, float64_t* moment) noexcept nogil
 
 
-cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi, int ax) noexcept nogil:
+cdef inline int _links_along(Batch* b, intp_t r, intp_t lo, intp_t hi, int ax) noexcept nogil:
     # Links lo..hi along axis `ax`: the vectorised kernel, then the strain
     # check and the scatter of forces and moments in link order.
     cdef:
@@ -73,7 +84,8 @@ cdef inline int _links_along(Batch* b, intp_t lo, intp_t hi, int ax) noexcept no
         return STATUS_OK
     softgym_corot_links(ax, lo, hi, n, 1.0 / b.L, b.v1, b.v2, b.pos, b.vel, b.angvel, b.rot,
                         b.scale, b.k_axial, b.c_axial, b.k_bend, b.c_bend, b.k_torsion,
-                        b.c_torsion, o)
+                        b.c_torsion, b.vox_out if COROT_ROWS_USED else NULL, b.vox_stride,
+                        b.vox_start[r + 1], o)
     if softgym_corot_scatter(lo, hi, n, b.max_strain * b.L, b.v1, b.v2, o, b.force,
                              b.moment) < hi:
         return STATUS_STRAIN  # also for NaN

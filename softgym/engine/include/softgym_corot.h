@@ -11,13 +11,16 @@
 #include "softgym_simd.h"
 
 /* One link's kernel in type T (double, or softgym_vd for SOFTGYM_VLANES links at once:
-   SQRT, FABS T's square root and absolute value, PUT(row, li, v) storing v at row + li),
+   SQRT, FABS T's square root and absolute value, PUT(row, li, v) storing v at row + li,
+   RD(R, k) element k of a rotation matrix R: SOFTGYM_COROT_IDX where R is an array, a
+   load from the k-th row where it is the voxels' rows, which lets the compiler load each
+   where it is used instead of holding 18 in registers),
    from voxel 2's position and velocity relative to voxel 1's (d, dv), the voxels' sizes
    si, sj, rotation matrices R1, R2 (row-major: R1[3 r + c]), angular velocities w1, w2
    and the link's constants. (ax, p, q) is a cyclic permutation of (0, 1, 2), ax the
    link's lattice axis; inv_L = 1 / the nominal voxel size. Rows out: ext |axial
    extension|, f the force on voxel 2, m1, m2 the moments on voxels 1 and 2. */
-#define SOFTGYM_COROT_LINK_T(T, SQRT, FABS, PUT, li, ax, p, q, inv_L, dx, dy, dz, dvx, dvy, \
+#define SOFTGYM_COROT_LINK_T(T, SQRT, FABS, PUT, RD, li, ax, p, q, inv_L, dx, dy, dz, dvx, dvy, \
                              dvz, si, sj, R1, R2, w1x_, w1y_, w1z_, w2x_, w2y_, w2z_, k_ax, \
                              c_ax, k_b, c_b, k_t, c_t) do { \
         T ell = SQRT((((dx) * (dx)) + ((dy) * (dy))) + ((dz) * (dz))); \
@@ -30,8 +33,8 @@
         T ax_x = (-fa) * (dx), ax_y = (-fa) * (dy), ax_z = (-fa) * (dz); \
         /* the link's lattice axis in each voxel (column ax of its rotation) and the \
            link's frame axis r, their bisector */ \
-        T a1x = (R1)[ax], a1y = (R1)[3 + (ax)], a1z = (R1)[6 + (ax)]; \
-        T a2x = (R2)[ax], a2y = (R2)[3 + (ax)], a2z = (R2)[6 + (ax)]; \
+        T a1x = RD(R1, ax), a1y = RD(R1, 3 + (ax)), a1z = RD(R1, 6 + (ax)); \
+        T a2x = RD(R2, ax), a2y = RD(R2, 3 + (ax)), a2z = RD(R2, 6 + (ax)); \
         T rx = a1x + a2x, ry = a1y + a2y, rz = a1z + a2z; \
         /* 1 / |a1 + a2| by one Newton step from 1/2 (|a1 + a2|^2 = 4 - |a1 - a2|^2 is \
            near 4): relative error 0.14 % at 0.5 rad of relative bending */ \
@@ -51,9 +54,9 @@
         T hz = ((a1x * a2y) - (a1y * a2x)) * inv_r; \
         /* twist of voxel 2 relative to voxel 1 about the link: with y, z the voxels' \
            two other lattice axes, sin(twist) = (z1 . y2 - y1 . z2) / 2 */ \
-        T tw = 0.5 * (((((((R1)[q] * (R2)[p]) + ((R1)[3 + (q)] * (R2)[3 + (p)])) \
-                         + ((R1)[6 + (q)] * (R2)[6 + (p)])) - ((R1)[p] * (R2)[q])) \
-                       - ((R1)[3 + (p)] * (R2)[3 + (q)])) - ((R1)[6 + (p)] * (R2)[6 + (q)])); \
+        T tw = 0.5 * ((((((RD(R1, q) * RD(R2, p)) + (RD(R1, 3 + (q)) * RD(R2, 3 + (p)))) \
+                         + (RD(R1, 6 + (q)) * RD(R2, 6 + (p)))) - (RD(R1, p) * RD(R2, q))) \
+                       - (RD(R1, 3 + (p)) * RD(R2, 3 + (q)))) - (RD(R1, 6 + (p)) * RD(R2, 6 + (q)))); \
         /* rates: transverse angle (wc = r x dv / L), the voxels' angular velocities \
            across the link (w_i minus its part along r) and twist */ \
         T wcx = ((ry * (dvz)) - (rz * (dvy))) * (inv_L); \
@@ -126,9 +129,88 @@ static inline void softgym_corot_gather4(const Py_ssize_t *idx, const double *po
 }
 #endif
 
+/* element k of a rotation matrix held as an array (SOFTGYM_COROT_LINK_T's RD) */
+#define SOFTGYM_COROT_IDX(R, k) ((R)[k])
+#if defined(SOFTGYM_VLANES) && SOFTGYM_VLANES == 8
+#define SOFTGYM_COROT_ROWS 18
+/* voxels lo..hi's records as rows (n apart, indexed by voxel), the order
+   softgym_corot_gather4 gives them: position 0-2, velocity 3-5, angular velocity 6-8,
+   rotation matrix 9-17 (row-major); once a step, so that the links' 8-lane paths load a
+   voxel's 18 numbers as 18 rows of 8 voxels (no transposes a link). The matrices of
+   8-voxel blocks are computed in the lanes from the quaternions (the formula that
+   stored rot, softgym_quat_matrix: the same bits; copying rot's records of 9 took
+   scalar loads), the rest copied */
+static void softgym_corot_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const double *pos,
+                               const double *vel, const double *av, const double *quat,
+                               const double *rot, double *rows)
+{
+    Py_ssize_t i = lo;
+    for (; i + 8 <= hi; i += 8) {
+        softgym_v8 r[4], R[9];
+        const double *rec[3] = {pos, vel, av};
+        for (int k = 0; k < 3; k++) {
+            softgym_v8_load3(rec[k] + 3 * i, &r[0], &r[1], &r[2]);
+            for (int c = 0; c < 3; c++)
+                memcpy(rows + (3 * k + c) * n + i, &r[c], sizeof r[c]);
+        }
+        softgym_v8_load4x4(quat + 4 * i, r);
+        SOFTGYM_QUAT_MATRIX(r[0], r[1], r[2], r[3], R);
+        for (int k = 0; k < 9; k++)
+            memcpy(rows + (9 + k) * n + i, &R[k], sizeof R[k]);
+    }
+    for (; i < hi; i++) {
+        for (int c = 0; c < 3; c++) {
+            rows[c * n + i] = pos[3 * i + c];
+            rows[(3 + c) * n + i] = vel[3 * i + c];
+            rows[(6 + c) * n + i] = av[3 * i + c];
+        }
+        for (int k = 0; k < 9; k++)
+            rows[(9 + k) * n + i] = rot[9 * i + k];
+    }
+}
+/* links whose voxels all lie in the 16 voxels from the first link's voxel 1 (a
+   lattice's links along its fastest axis): 1 and each link's voxels' places in that
+   window (ia: voxel 1's, ib: voxel 2's; indices below vend, the robot's end), else 0 */
+static inline int softgym_window8_index(const Py_ssize_t *a, const Py_ssize_t *b,
+                                        Py_ssize_t vend, __m512i *ia, __m512i *ib)
+{
+    Py_ssize_t base = a[0];
+    if (base + 16 > vend)
+        return 0;
+    __m512i vbase = _mm512_set1_epi64((long long)base), sixteen = _mm512_set1_epi64(16);
+    *ia = _mm512_sub_epi64(_mm512_loadu_si512((const void *)a), vbase);
+    *ib = _mm512_sub_epi64(_mm512_loadu_si512((const void *)b), vbase);
+    return (_mm512_cmplt_epu64_mask(*ia, sixteen) & _mm512_cmplt_epu64_mask(*ib, sixteen))
+           == 0xFF;
+}
+#endif
+
+#if defined(SOFTGYM_VLANES)
+/* links li .. li + 3 from their voxels' gathered records, 4 lanes (in
+   softgym_corot_links_ax) */
+#define SOFTGYM_COROT_GATHER4(li) do { \
+        __m256d gi[19], gj[19]; \
+        softgym_corot_gather4(v1 + (li), pos, vel, av, rot, scale, gi); \
+        softgym_corot_gather4(v2 + (li), pos, vel, av, rot, scale, gj); \
+        softgym_v4 dx = gj[0] - gi[0], dy = gj[1] - gi[1], dz = gj[2] - gi[2]; \
+        softgym_v4 dvx = gj[3] - gi[3], dvy = gj[4] - gi[4], dvz = gj[5] - gi[5]; \
+        SOFTGYM_COROT_LINK_T(softgym_v4, SOFTGYM_V4SQRT, softgym_v4abs, SOFTGYM_V4PUT, \
+                             SOFTGYM_COROT_IDX, (li), ax, \
+                             p, q, inv_L, dx, dy, dz, dvx, dvy, dvz, (softgym_v4)gi[18], \
+                             (softgym_v4)gj[18], ((softgym_v4 *)gi + 9), \
+                             ((softgym_v4 *)gj + 9), (softgym_v4)gi[6], (softgym_v4)gi[7], \
+                             (softgym_v4)gi[8], (softgym_v4)gj[6], (softgym_v4)gj[7], \
+                             (softgym_v4)gj[8], softgym_v4load(k_axial, (li)), \
+                             softgym_v4load(c_axial, (li)), softgym_v4load(k_bend, (li)), \
+                             softgym_v4load(c_bend, (li)), softgym_v4load(k_torsion, (li)), \
+                             softgym_v4load(c_torsion, (li))); \
+    } while (0)
+#endif
+
 /* links lo..hi, all along axis ax (a compile-time constant in each copy), into the
    rows of the scratch o (stride n): 0 |axial extension|, 1-3 the force on voxel 2,
-   4-6 voxel 1's moment, 7-9 voxel 2's */
+   4-6 voxel 1's moment, 7-9 voxel 2's. vr: the voxels' rows of softgym_corot_rows (vn
+   apart; NULL: none), vend the robot's end of voxels */
 SOFTGYM_ALWAYS_INLINE void softgym_corot_links_ax(
     const int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double inv_L,
     const Py_ssize_t *__restrict__ v1, const Py_ssize_t *__restrict__ v2,
@@ -137,7 +219,8 @@ SOFTGYM_ALWAYS_INLINE void softgym_corot_links_ax(
     const double *__restrict__ scale, const double *__restrict__ k_axial,
     const double *__restrict__ c_axial, const double *__restrict__ k_bend,
     const double *__restrict__ c_bend, const double *__restrict__ k_torsion,
-    const double *__restrict__ c_torsion, double *o)
+    const double *__restrict__ c_torsion, const double *__restrict__ vr, Py_ssize_t vn,
+    Py_ssize_t vend, double *o)
 {
     const int p = (ax + 1) % 3, q = (ax + 2) % 3;
     double *__restrict__ o_ext = o, *__restrict__ o_fx = o + n, *__restrict__ o_fy = o + 2 * n;
@@ -146,23 +229,85 @@ SOFTGYM_ALWAYS_INLINE void softgym_corot_links_ax(
     double *__restrict__ o_m2x = o + 7 * n, *__restrict__ o_m2y = o + 8 * n;
     double *__restrict__ o_m2z = o + 9 * n;
     Py_ssize_t li = lo;
-#if defined(SOFTGYM_VLANES)
-    /* 4 links a vector also with AVX-512: 8 spilled (38 rows live; measured 5 % slower) */
-    for (; li + 4 <= hi; li += 4) {
-        __m256d gi[19], gj[19];
-        softgym_corot_gather4(v1 + li, pos, vel, av, rot, scale, gi);
-        softgym_corot_gather4(v2 + li, pos, vel, av, rot, scale, gj);
-        softgym_v4 dx = gj[0] - gi[0], dy = gj[1] - gi[1], dz = gj[2] - gi[2];
-        softgym_v4 dvx = gj[3] - gi[3], dvy = gj[4] - gi[4], dvz = gj[5] - gi[5];
-        SOFTGYM_COROT_LINK_T(softgym_v4, SOFTGYM_V4SQRT, softgym_v4abs, SOFTGYM_V4PUT, li, ax, p,
-                             q, inv_L, dx, dy, dz, dvx, dvy, dvz, (softgym_v4)gi[18],
-                             (softgym_v4)gj[18], ((softgym_v4 *)gi + 9), ((softgym_v4 *)gj + 9),
-                             (softgym_v4)gi[6], (softgym_v4)gi[7], (softgym_v4)gi[8],
-                             (softgym_v4)gj[6], (softgym_v4)gj[7], (softgym_v4)gj[8],
-                             softgym_v4load(k_axial, li), softgym_v4load(c_axial, li),
-                             softgym_v4load(k_bend, li), softgym_v4load(c_bend, li),
-                             softgym_v4load(k_torsion, li), softgym_v4load(c_torsion, li));
+#if defined(SOFTGYM_COROT_ROWS)
+    /* with AVX-512, 8 links a vector where their voxels' rows load without transposes:
+       runs of consecutive voxels (the links along a lattice's slower axes) or a window of
+       16 (its fastest axis); the arithmetic is the macro's, lane by lane: the same bits */
+    if (vr != NULL) {
+        /* row k of voxels v .. v + 7; element k of the matrix whose first row is R */
+#define SOFTGYM_COROT_ROW(k, v) softgym_v8_load(vr + (k) * vn + (v))
+#define SOFTGYM_COROT_RD8(R, k) softgym_v8_load((R) + (k) * vn)
+        for (; li + 8 <= hi; li += 8) {
+            if (softgym_run8(v1 + li) & softgym_run8(v2 + li)) {
+                /* runs: every number loaded where the kernel uses it */
+                const Py_ssize_t i1 = v1[li], i2 = v2[li];
+                softgym_vd dx = SOFTGYM_COROT_ROW(0, i2) - SOFTGYM_COROT_ROW(0, i1);
+                softgym_vd dy = SOFTGYM_COROT_ROW(1, i2) - SOFTGYM_COROT_ROW(1, i1);
+                softgym_vd dz = SOFTGYM_COROT_ROW(2, i2) - SOFTGYM_COROT_ROW(2, i1);
+                softgym_vd dvx = SOFTGYM_COROT_ROW(3, i2) - SOFTGYM_COROT_ROW(3, i1);
+                softgym_vd dvy = SOFTGYM_COROT_ROW(4, i2) - SOFTGYM_COROT_ROW(4, i1);
+                softgym_vd dvz = SOFTGYM_COROT_ROW(5, i2) - SOFTGYM_COROT_ROW(5, i1);
+                SOFTGYM_COROT_LINK_T(softgym_vd, SOFTGYM_VSQRT, softgym_vabs, SOFTGYM_VPUT,
+                                     SOFTGYM_COROT_RD8, li, ax, p, q, inv_L, dx, dy, dz, dvx,
+                                     dvy, dvz, softgym_v8_load(scale + i1),
+                                     softgym_v8_load(scale + i2), (vr + 9 * vn + i1),
+                                     (vr + 9 * vn + i2), SOFTGYM_COROT_ROW(6, i1),
+                                     SOFTGYM_COROT_ROW(7, i1), SOFTGYM_COROT_ROW(8, i1),
+                                     SOFTGYM_COROT_ROW(6, i2), SOFTGYM_COROT_ROW(7, i2),
+                                     SOFTGYM_COROT_ROW(8, i2), softgym_v8_load(k_axial + li),
+                                     softgym_v8_load(c_axial + li), softgym_v8_load(k_bend + li),
+                                     softgym_v8_load(c_bend + li),
+                                     softgym_v8_load(k_torsion + li),
+                                     softgym_v8_load(c_torsion + li));
+                continue;
+            }
+            __m512i ia, ib;
+            const Py_ssize_t base = v1[li];
+            if (softgym_window8_index(v1 + li, v2 + li, vend, &ia, &ib)) {
+                /* a window of 16 voxels from base: each number picked for the 8 links from
+                   the window's two vectors of its row where the kernel uses it */
+#define SOFTGYM_COROT_WIN(k, idx) ((softgym_vd)_mm512_permutex2var_pd( \
+                    _mm512_loadu_pd(vr + (k) * vn + base), (idx), \
+                    _mm512_loadu_pd(vr + (k) * vn + base + 8)))
+#define SOFTGYM_COROT_WRD(idx, k) SOFTGYM_COROT_WIN(9 + (k), idx)
+                softgym_vd dx = SOFTGYM_COROT_WIN(0, ib) - SOFTGYM_COROT_WIN(0, ia);
+                softgym_vd dy = SOFTGYM_COROT_WIN(1, ib) - SOFTGYM_COROT_WIN(1, ia);
+                softgym_vd dz = SOFTGYM_COROT_WIN(2, ib) - SOFTGYM_COROT_WIN(2, ia);
+                softgym_vd dvx = SOFTGYM_COROT_WIN(3, ib) - SOFTGYM_COROT_WIN(3, ia);
+                softgym_vd dvy = SOFTGYM_COROT_WIN(4, ib) - SOFTGYM_COROT_WIN(4, ia);
+                softgym_vd dvz = SOFTGYM_COROT_WIN(5, ib) - SOFTGYM_COROT_WIN(5, ia);
+                __m512d slo = _mm512_loadu_pd(scale + base), shi = _mm512_loadu_pd(scale + base + 8);
+                SOFTGYM_COROT_LINK_T(softgym_vd, SOFTGYM_VSQRT, softgym_vabs, SOFTGYM_VPUT,
+                                     SOFTGYM_COROT_WRD, li, ax, p, q, inv_L, dx, dy, dz, dvx,
+                                     dvy, dvz, (softgym_vd)_mm512_permutex2var_pd(slo, ia, shi),
+                                     (softgym_vd)_mm512_permutex2var_pd(slo, ib, shi), ia, ib,
+                                     SOFTGYM_COROT_WIN(6, ia), SOFTGYM_COROT_WIN(7, ia),
+                                     SOFTGYM_COROT_WIN(8, ia), SOFTGYM_COROT_WIN(6, ib),
+                                     SOFTGYM_COROT_WIN(7, ib), SOFTGYM_COROT_WIN(8, ib),
+                                     softgym_v8_load(k_axial + li), softgym_v8_load(c_axial + li),
+                                     softgym_v8_load(k_bend + li), softgym_v8_load(c_bend + li),
+                                     softgym_v8_load(k_torsion + li),
+                                     softgym_v8_load(c_torsion + li));
+#undef SOFTGYM_COROT_WRD
+#undef SOFTGYM_COROT_WIN
+                continue;
+            }
+            SOFTGYM_COROT_GATHER4(li);
+            SOFTGYM_COROT_GATHER4(li + 4);
+        }
+#undef SOFTGYM_COROT_ROW
+#undef SOFTGYM_COROT_RD8
     }
+#else
+    (void)vr;
+    (void)vn;
+    (void)vend;
+#endif
+#if defined(SOFTGYM_VLANES)
+    /* 4 links a vector from gathered records (8 with AVX-512 spilled: 38 rows live,
+       measured 5 % slower) */
+    for (; li + 4 <= hi; li += 4)
+        SOFTGYM_COROT_GATHER4(li);
 #endif
     /* the rest (and every link without AVX): the compiler's vectoriser */
     SOFTGYM_IVDEP
@@ -170,7 +315,8 @@ SOFTGYM_ALWAYS_INLINE void softgym_corot_links_ax(
         Py_ssize_t i = v1[li], j = v2[li];
         SOFTGYM_DIFF3(pos, i, j, dx, dy, dz);
         SOFTGYM_DIFF3(vel, i, j, dvx, dvy, dvz);
-        SOFTGYM_COROT_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, li, ax, p, q, inv_L, dx, dy, dz,
+        SOFTGYM_COROT_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, SOFTGYM_COROT_IDX, li, ax, p, q,
+                             inv_L, dx, dy, dz,
                              dvx, dvy, dvz, scale[i], scale[j], (rot + 9 * i), (rot + 9 * j),
                              av[3 * i], av[3 * i + 1], av[3 * i + 2], av[3 * j], av[3 * j + 1],
                              av[3 * j + 2], k_axial[li], c_axial[li], k_bend[li], c_bend[li],
@@ -183,10 +329,12 @@ static void softgym_corot_links(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t
                                 const double *rot, const double *scale, const double *k_axial,
                                 const double *c_axial, const double *k_bend,
                                 const double *c_bend, const double *k_torsion,
-                                const double *c_torsion, double *o)
+                                const double *c_torsion, const double *vr, Py_ssize_t vn,
+                                Py_ssize_t vend, double *o)
 {
     SOFTGYM_BY_AXIS(ax, softgym_corot_links_ax, lo, hi, n, inv_L, v1, v2, pos, vel, av, rot,
-                    scale, k_axial, c_axial, k_bend, c_bend, k_torsion, c_torsion, o);
+                    scale, k_axial, c_axial, k_bend, c_bend, k_torsion, c_torsion, vr, vn, vend,
+                    o);
 }
 
 /* The strain check and the scatter of links lo..hi in link order, from the kernel's rows
@@ -289,5 +437,19 @@ static Py_ssize_t softgym_corot_scatter(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t
     }
     return hi;
 }
+
+/* whether the build has the rows path (the Cython side's COROT_ROWS_USED) */
+#if defined(SOFTGYM_COROT_ROWS)
+#define COROT_ROWS_USED 1
+#else
+#define COROT_ROWS_USED 0
+static void softgym_corot_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const double *pos,
+                               const double *vel, const double *av, const double *quat,
+                               const double *rot, double *rows)
+{
+    (void)lo; (void)hi; (void)n; (void)pos; (void)vel; (void)av; (void)quat; (void)rot;
+    (void)rows;
+}
+#endif
 
 #endif  /* SOFTGYM_COROT_H */

@@ -24,8 +24,10 @@
    AVX-512 builds (SOFTGYM_SEED_R_USED) rows 0-3 and the positions (x, y, z) in rows 4-6
    are the voxels' quaternions and positions throughout its step loop, which the link
    geometry loads 8 voxels to a vector without transposing records
-   (include/softgym_orient.h: softgym_voxel_rows) */
-#define SOFTGYM_VOXEL_ROWS 7
+   (include/softgym_orient.h: softgym_voxel_rows); in the corotational model's AVX-512
+   builds, rows 0-17 hold the voxels' positions, velocities, angular velocities and
+   rotation matrices during its links pass (include/softgym_corot.h: softgym_corot_rows) */
+#define SOFTGYM_VOXEL_ROWS 18
 /* c ? a : b on the bits: compilers keep it a blend (a select before a
    store may otherwise become a masked store, slow on some cores) */
 static inline double softgym_pick(long long c, double a, double b)
