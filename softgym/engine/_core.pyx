@@ -229,6 +229,9 @@ cdef int advance_robot(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
                 c.stale = 1
         b.steps[r] += 1
         record(b, r)
+    # the rotation matrices, where the step leaves them (its links read rows computed
+    # from the quaternions): up to date whenever the kernel returns
+    refresh_robot_rotations(b, r)
     return status
 
 

@@ -41,7 +41,7 @@ cdef int links_corotational(Batch* b, intp_t r) noexcept nogil:
     if COROT_ROWS_USED:
         # the voxels' records as rows, once a step (softgym_corot_rows)
         softgym_corot_rows(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.pos, b.vel,
-                           b.angvel, b.quat, b.rot, b.vox_out)
+                           b.angvel, b.quat, b.vox_out)
     if _links_along(b, r, lo, lo + nx, 0) != STATUS_OK:
         return STATUS_STRAIN
     if _links_along(b, r, lo + nx, lo + nx + ny, 1) != STATUS_OK:
@@ -66,7 +66,7 @@ cdef extern from "softgym_corot.h":
     # rows of b.vox_out; elsewhere not built, and COROT_ROWS_USED is 0)
     void softgym_corot_rows(intp_t lo, intp_t hi, intp_t n, const float64_t* pos,
                             const float64_t* vel, const float64_t* av, const float64_t* quat,
-                            const float64_t* rot, float64_t* rows) noexcept nogil
+                            float64_t* rows) noexcept nogil
     enum: COROT_ROWS_USED
     # the strain check and the scatter in link order: hi, or the first strained link
     intp_t softgym_corot_scatter(intp_t lo, intp_t hi, intp_t n, float64_t max_ext,

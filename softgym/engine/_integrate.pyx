@@ -21,10 +21,14 @@ cdef float64_t RUNAWAY = 1.0e6  # |coordinate| (m) beyond which a robot diverged
 cdef extern from "softgym_simd.h":
     # R = the rotation matrix of the unit quaternion q = (w, x, y, z), row-major
     void _rotation_matrix "softgym_quat_matrix" (const float64_t* q, float64_t* R) noexcept nogil
-    # 1 where the seed model's step does not read the voxels' rotation matrices (its
-    # scatter takes voxel 1's from the geometry's rows): the seed voxel update does not
-    # store them, refresh_robot_rotations does at the end of advance_robot
+    # 1 where the seed model's step reads the voxel rows (rows 0-6 of vox_out:
+    # quaternions, positions) that the seed voxel update keeps
     enum: SOFTGYM_SEED_R_USED
+    # 1 where neither model's step reads the voxels' rotation matrices (the seed's
+    # scatter takes voxel 1's from the geometry's rows, the corotational links from rows
+    # computed from the quaternions): the voxel updates do not store them,
+    # refresh_robot_rotations does at the end of advance_robot
+    enum: SOFTGYM_ROT_DEFERRED
     # |v|^2 with the same bits in every build that inlines it
     float64_t speed_squared "softgym_speed2" (float64_t vx, float64_t vy, float64_t vz) noexcept nogil
 
@@ -277,10 +281,11 @@ cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int
         softgym_seed_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
     else:
         softgym_corot_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
-    # (the seed model's rotation matrices: refresh_robot_rotations, where its step does
-    # not read them; it reads the voxel rows instead, kept here)
-    if seed and SOFTGYM_SEED_R_USED:
-        softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat, NULL, b.pos)
+    # (the rotation matrices: refresh_robot_rotations, where the step does not read them;
+    # the seed's reads the voxel rows instead, kept here)
+    if SOFTGYM_ROT_DEFERRED:
+        softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat, NULL,
+                             b.pos if seed and SOFTGYM_SEED_R_USED else NULL)
     else:
         softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat, b.rot, NULL)
 
@@ -293,9 +298,9 @@ cdef void seed_voxel_rows(Batch* b, intp_t r) noexcept nogil:
 
 
 cdef void refresh_robot_rotations(Batch* b, intp_t r) noexcept nogil:
-    # robot r's rotation matrices from its quaternions (where the seed step leaves them)
+    # robot r's rotation matrices from its quaternions (where the step leaves them)
     cdef intp_t i
-    if not SOFTGYM_SEED_R_USED:
+    if not SOFTGYM_ROT_DEFERRED:
         return
     for i in range(b.vox_start[r], b.vox_start[r + 1]):
         _rotation_matrix(b.quat + 4 * i, b.rot + 9 * i)

@@ -279,7 +279,7 @@ int main(void)
         }
         sc[i] = 0.01 * (1.0 + 0.1 * urand());
     }
-    softgym_corot_rows(0, NV, NV, pos, vel, av, quat, rot, vr);
+    softgym_corot_rows(0, NV, NV, pos, vel, av, quat, vr);
     for (int li = 0; li < N; li++) {
         ka[li] = 1e4 * (1.0 + urand()), ca[li] = 1.0 + urand(), kb[li] = 0.1 * (1.0 + urand());
         cb[li] = 1e-4 * (1.0 + urand()), kt[li] = 0.05 * (1.0 + urand());

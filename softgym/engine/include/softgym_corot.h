@@ -136,13 +136,14 @@ static inline void softgym_corot_gather4(const Py_ssize_t *idx, const double *po
 /* voxels lo..hi's records as rows (n apart, indexed by voxel), the order
    softgym_corot_gather4 gives them: position 0-2, velocity 3-5, angular velocity 6-8,
    rotation matrix 9-17 (row-major); once a step, so that the links' 8-lane paths load a
-   voxel's 18 numbers as 18 rows of 8 voxels (no transposes a link). The matrices of
-   8-voxel blocks are computed in the lanes from the quaternions (the formula that
-   stored rot, softgym_quat_matrix: the same bits; copying rot's records of 9 took
-   scalar loads), the rest copied */
+   voxel's 18 numbers as 18 rows of 8 voxels (no transposes a link). The matrices are
+   computed from the quaternions (the formula that stores rot, softgym_quat_matrix: the
+   same bits in the lanes as one by one; copying rot's records of 9 took scalar loads),
+   so the step does not read rot, which advance_robot refreshes when it returns
+   (SOFTGYM_ROT_DEFERRED) */
 static void softgym_corot_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const double *pos,
                                const double *vel, const double *av, const double *quat,
-                               const double *rot, double *rows)
+                               double *rows)
 {
     Py_ssize_t i = lo;
     for (; i + 8 <= hi; i += 8) {
@@ -164,8 +165,10 @@ static void softgym_corot_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const
             rows[(3 + c) * n + i] = vel[3 * i + c];
             rows[(6 + c) * n + i] = av[3 * i + c];
         }
+        double R[9];
+        softgym_quat_matrix(quat + 4 * i, R);
         for (int k = 0; k < 9; k++)
-            rows[(9 + k) * n + i] = rot[9 * i + k];
+            rows[(9 + k) * n + i] = R[k];
     }
 }
 /* links whose voxels all lie in the 16 voxels from the first link's voxel 1 (a
@@ -185,27 +188,6 @@ static inline int softgym_window8_index(const Py_ssize_t *a, const Py_ssize_t *b
 }
 #endif
 
-#if defined(SOFTGYM_VLANES)
-/* links li .. li + 3 from their voxels' gathered records, 4 lanes (in
-   softgym_corot_links_ax) */
-#define SOFTGYM_COROT_GATHER4(li) do { \
-        __m256d gi[19], gj[19]; \
-        softgym_corot_gather4(v1 + (li), pos, vel, av, rot, scale, gi); \
-        softgym_corot_gather4(v2 + (li), pos, vel, av, rot, scale, gj); \
-        softgym_v4 dx = gj[0] - gi[0], dy = gj[1] - gi[1], dz = gj[2] - gi[2]; \
-        softgym_v4 dvx = gj[3] - gi[3], dvy = gj[4] - gi[4], dvz = gj[5] - gi[5]; \
-        SOFTGYM_COROT_LINK_T(softgym_v4, SOFTGYM_V4SQRT, softgym_v4abs, SOFTGYM_V4PUT, \
-                             SOFTGYM_COROT_IDX, (li), ax, \
-                             p, q, inv_L, dx, dy, dz, dvx, dvy, dvz, (softgym_v4)gi[18], \
-                             (softgym_v4)gj[18], ((softgym_v4 *)gi + 9), \
-                             ((softgym_v4 *)gj + 9), (softgym_v4)gi[6], (softgym_v4)gi[7], \
-                             (softgym_v4)gi[8], (softgym_v4)gj[6], (softgym_v4)gj[7], \
-                             (softgym_v4)gj[8], softgym_v4load(k_axial, (li)), \
-                             softgym_v4load(c_axial, (li)), softgym_v4load(k_bend, (li)), \
-                             softgym_v4load(c_bend, (li)), softgym_v4load(k_torsion, (li)), \
-                             softgym_v4load(c_torsion, (li))); \
-    } while (0)
-#endif
 
 /* links lo..hi, all along axis ax (a compile-time constant in each copy), into the
    rows of the scratch o (stride n): 0 |axial extension|, 1-3 the force on voxel 2,
@@ -234,69 +216,87 @@ SOFTGYM_ALWAYS_INLINE void softgym_corot_links_ax(
        runs of consecutive voxels (the links along a lattice's slower axes) or a window of
        16 (its fastest axis); the arithmetic is the macro's, lane by lane: the same bits */
     if (vr != NULL) {
-        /* row k of voxels v .. v + 7; element k of the matrix whose first row is R */
-#define SOFTGYM_COROT_ROW(k, v) softgym_v8_load(vr + (k) * vn + (v))
-#define SOFTGYM_COROT_RD8(R, k) softgym_v8_load((R) + (k) * vn)
+        /* every number a link reads through an accessor of its voxel's handle h (the first
+           voxel of a run, or a vector of voxel indices): ROW(k, h) row k, RD(h, k) element
+           k of the rotation matrix; loaded where the kernel uses it (held all at once, the
+           38 spilled) */
+#define SOFTGYM_COROT_LINK_ROWS(T, PUT, ROW, RD, SCALE, h1, h2) do { \
+            T dx = ROW(0, h2) - ROW(0, h1), dy = ROW(1, h2) - ROW(1, h1); \
+            T dz = ROW(2, h2) - ROW(2, h1), dvx = ROW(3, h2) - ROW(3, h1); \
+            T dvy = ROW(4, h2) - ROW(4, h1), dvz = ROW(5, h2) - ROW(5, h1); \
+            SOFTGYM_COROT_LINK_T(T, SQRT_, FABS_, PUT, RD, li, ax, p, q, inv_L, dx, dy, dz, dvx, \
+                                 dvy, dvz, SCALE(h1), SCALE(h2), h1, h2, ROW(6, h1), ROW(7, h1), \
+                                 ROW(8, h1), ROW(6, h2), ROW(7, h2), ROW(8, h2), LD_(k_axial), \
+                                 LD_(c_axial), LD_(k_bend), LD_(c_bend), LD_(k_torsion), \
+                                 LD_(c_torsion)); \
+        } while (0)
+#define SQRT_ SOFTGYM_VSQRT
+#define FABS_ softgym_vabs
+#define LD_(a) softgym_v8_load((a) + li)
+        /* runs of 8 consecutive voxels (h: the first) */
+#define SOFTGYM_COROT_RUN(k, h) softgym_v8_load(vr + (k) * vn + (h))
+#define SOFTGYM_COROT_RUN_RD(h, k) SOFTGYM_COROT_RUN(9 + (k), h)
+#define SOFTGYM_COROT_RUN_S(h) softgym_v8_load(scale + (h))
+        /* a window of 16 voxels from base (h: the links' places in it), each number picked
+           from the window's two vectors of its row */
+#define SOFTGYM_COROT_WIN(k, h) ((softgym_vd)_mm512_permutex2var_pd( \
+            _mm512_loadu_pd(vr + (k) * vn + base), (h), _mm512_loadu_pd(vr + (k) * vn + base + 8)))
+#define SOFTGYM_COROT_WIN_RD(h, k) SOFTGYM_COROT_WIN(9 + (k), h)
+#define SOFTGYM_COROT_WIN_S(h) ((softgym_vd)_mm512_permutex2var_pd( \
+            _mm512_loadu_pd(scale + base), (h), _mm512_loadu_pd(scale + base + 8)))
+        /* any 8 voxels (h: their indices), gathered */
+#define SOFTGYM_COROT_GAT(k, h) ((softgym_vd)_mm512_i64gather_pd((h), vr + (k) * vn, 8))
+#define SOFTGYM_COROT_GAT_RD(h, k) SOFTGYM_COROT_GAT(9 + (k), h)
+#define SOFTGYM_COROT_GAT_S(h) ((softgym_vd)_mm512_i64gather_pd((h), scale, 8))
         for (; li + 8 <= hi; li += 8) {
-            if (softgym_run8(v1 + li) & softgym_run8(v2 + li)) {
-                /* runs: every number loaded where the kernel uses it */
-                const Py_ssize_t i1 = v1[li], i2 = v2[li];
-                softgym_vd dx = SOFTGYM_COROT_ROW(0, i2) - SOFTGYM_COROT_ROW(0, i1);
-                softgym_vd dy = SOFTGYM_COROT_ROW(1, i2) - SOFTGYM_COROT_ROW(1, i1);
-                softgym_vd dz = SOFTGYM_COROT_ROW(2, i2) - SOFTGYM_COROT_ROW(2, i1);
-                softgym_vd dvx = SOFTGYM_COROT_ROW(3, i2) - SOFTGYM_COROT_ROW(3, i1);
-                softgym_vd dvy = SOFTGYM_COROT_ROW(4, i2) - SOFTGYM_COROT_ROW(4, i1);
-                softgym_vd dvz = SOFTGYM_COROT_ROW(5, i2) - SOFTGYM_COROT_ROW(5, i1);
-                SOFTGYM_COROT_LINK_T(softgym_vd, SOFTGYM_VSQRT, softgym_vabs, SOFTGYM_VPUT,
-                                     SOFTGYM_COROT_RD8, li, ax, p, q, inv_L, dx, dy, dz, dvx,
-                                     dvy, dvz, softgym_v8_load(scale + i1),
-                                     softgym_v8_load(scale + i2), (vr + 9 * vn + i1),
-                                     (vr + 9 * vn + i2), SOFTGYM_COROT_ROW(6, i1),
-                                     SOFTGYM_COROT_ROW(7, i1), SOFTGYM_COROT_ROW(8, i1),
-                                     SOFTGYM_COROT_ROW(6, i2), SOFTGYM_COROT_ROW(7, i2),
-                                     SOFTGYM_COROT_ROW(8, i2), softgym_v8_load(k_axial + li),
-                                     softgym_v8_load(c_axial + li), softgym_v8_load(k_bend + li),
-                                     softgym_v8_load(c_bend + li),
-                                     softgym_v8_load(k_torsion + li),
-                                     softgym_v8_load(c_torsion + li));
-                continue;
-            }
-            __m512i ia, ib;
             const Py_ssize_t base = v1[li];
-            if (softgym_window8_index(v1 + li, v2 + li, vend, &ia, &ib)) {
-                /* a window of 16 voxels from base: each number picked for the 8 links from
-                   the window's two vectors of its row where the kernel uses it */
-#define SOFTGYM_COROT_WIN(k, idx) ((softgym_vd)_mm512_permutex2var_pd( \
-                    _mm512_loadu_pd(vr + (k) * vn + base), (idx), \
-                    _mm512_loadu_pd(vr + (k) * vn + base + 8)))
-#define SOFTGYM_COROT_WRD(idx, k) SOFTGYM_COROT_WIN(9 + (k), idx)
-                softgym_vd dx = SOFTGYM_COROT_WIN(0, ib) - SOFTGYM_COROT_WIN(0, ia);
-                softgym_vd dy = SOFTGYM_COROT_WIN(1, ib) - SOFTGYM_COROT_WIN(1, ia);
-                softgym_vd dz = SOFTGYM_COROT_WIN(2, ib) - SOFTGYM_COROT_WIN(2, ia);
-                softgym_vd dvx = SOFTGYM_COROT_WIN(3, ib) - SOFTGYM_COROT_WIN(3, ia);
-                softgym_vd dvy = SOFTGYM_COROT_WIN(4, ib) - SOFTGYM_COROT_WIN(4, ia);
-                softgym_vd dvz = SOFTGYM_COROT_WIN(5, ib) - SOFTGYM_COROT_WIN(5, ia);
-                __m512d slo = _mm512_loadu_pd(scale + base), shi = _mm512_loadu_pd(scale + base + 8);
-                SOFTGYM_COROT_LINK_T(softgym_vd, SOFTGYM_VSQRT, softgym_vabs, SOFTGYM_VPUT,
-                                     SOFTGYM_COROT_WRD, li, ax, p, q, inv_L, dx, dy, dz, dvx,
-                                     dvy, dvz, (softgym_vd)_mm512_permutex2var_pd(slo, ia, shi),
-                                     (softgym_vd)_mm512_permutex2var_pd(slo, ib, shi), ia, ib,
-                                     SOFTGYM_COROT_WIN(6, ia), SOFTGYM_COROT_WIN(7, ia),
-                                     SOFTGYM_COROT_WIN(8, ia), SOFTGYM_COROT_WIN(6, ib),
-                                     SOFTGYM_COROT_WIN(7, ib), SOFTGYM_COROT_WIN(8, ib),
-                                     softgym_v8_load(k_axial + li), softgym_v8_load(c_axial + li),
-                                     softgym_v8_load(k_bend + li), softgym_v8_load(c_bend + li),
-                                     softgym_v8_load(k_torsion + li),
-                                     softgym_v8_load(c_torsion + li));
-#undef SOFTGYM_COROT_WRD
-#undef SOFTGYM_COROT_WIN
-                continue;
+            __m512i ia, ib;
+            if (softgym_run8(v1 + li) & softgym_run8(v2 + li)) {
+                const Py_ssize_t i1 = base, i2 = v2[li];
+                SOFTGYM_COROT_LINK_ROWS(softgym_vd, SOFTGYM_VPUT, SOFTGYM_COROT_RUN,
+                                        SOFTGYM_COROT_RUN_RD, SOFTGYM_COROT_RUN_S, i1, i2);
+            } else if (softgym_window8_index(v1 + li, v2 + li, vend, &ia, &ib)) {
+                SOFTGYM_COROT_LINK_ROWS(softgym_vd, SOFTGYM_VPUT, SOFTGYM_COROT_WIN,
+                                        SOFTGYM_COROT_WIN_RD, SOFTGYM_COROT_WIN_S, ia, ib);
+            } else {
+                ia = _mm512_loadu_si512((const void *)(v1 + li));
+                ib = _mm512_loadu_si512((const void *)(v2 + li));
+                SOFTGYM_COROT_LINK_ROWS(softgym_vd, SOFTGYM_VPUT, SOFTGYM_COROT_GAT,
+                                        SOFTGYM_COROT_GAT_RD, SOFTGYM_COROT_GAT_S, ia, ib);
             }
-            SOFTGYM_COROT_GATHER4(li);
-            SOFTGYM_COROT_GATHER4(li + 4);
         }
-#undef SOFTGYM_COROT_ROW
-#undef SOFTGYM_COROT_RD8
+#undef SQRT_
+#undef FABS_
+#undef LD_
+        /* the rest, one link at a time from the rows */
+#define SQRT_ sqrt
+#define FABS_ fabs
+#define LD_(a) ((a)[li])
+#define SOFTGYM_COROT_ONE(k, h) (vr[(k) * vn + (h)])
+#define SOFTGYM_COROT_ONE_RD(h, k) SOFTGYM_COROT_ONE(9 + (k), h)
+#define SOFTGYM_COROT_ONE_S(h) (scale[h])
+        for (; li < hi; li++) {
+            const Py_ssize_t i1 = v1[li], i2 = v2[li];
+            SOFTGYM_COROT_LINK_ROWS(double, SOFTGYM_PUT1, SOFTGYM_COROT_ONE,
+                                    SOFTGYM_COROT_ONE_RD, SOFTGYM_COROT_ONE_S, i1, i2);
+        }
+#undef SQRT_
+#undef FABS_
+#undef LD_
+#undef SOFTGYM_COROT_ONE
+#undef SOFTGYM_COROT_ONE_RD
+#undef SOFTGYM_COROT_ONE_S
+#undef SOFTGYM_COROT_GAT
+#undef SOFTGYM_COROT_GAT_RD
+#undef SOFTGYM_COROT_GAT_S
+#undef SOFTGYM_COROT_WIN
+#undef SOFTGYM_COROT_WIN_RD
+#undef SOFTGYM_COROT_WIN_S
+#undef SOFTGYM_COROT_RUN
+#undef SOFTGYM_COROT_RUN_RD
+#undef SOFTGYM_COROT_RUN_S
+#undef SOFTGYM_COROT_LINK_ROWS
+        return;  /* (rot is not read: the rows' matrices come from the quaternions) */
     }
 #else
     (void)vr;
@@ -306,8 +306,22 @@ SOFTGYM_ALWAYS_INLINE void softgym_corot_links_ax(
 #if defined(SOFTGYM_VLANES)
     /* 4 links a vector from gathered records (8 with AVX-512 spilled: 38 rows live,
        measured 5 % slower) */
-    for (; li + 4 <= hi; li += 4)
-        SOFTGYM_COROT_GATHER4(li);
+    for (; li + 4 <= hi; li += 4) {
+        __m256d gi[19], gj[19];
+        softgym_corot_gather4(v1 + li, pos, vel, av, rot, scale, gi);
+        softgym_corot_gather4(v2 + li, pos, vel, av, rot, scale, gj);
+        softgym_v4 dx = gj[0] - gi[0], dy = gj[1] - gi[1], dz = gj[2] - gi[2];
+        softgym_v4 dvx = gj[3] - gi[3], dvy = gj[4] - gi[4], dvz = gj[5] - gi[5];
+        SOFTGYM_COROT_LINK_T(softgym_v4, SOFTGYM_V4SQRT, softgym_v4abs, SOFTGYM_V4PUT,
+                             SOFTGYM_COROT_IDX, li, ax, p, q, inv_L, dx, dy, dz, dvx, dvy, dvz,
+                             (softgym_v4)gi[18], (softgym_v4)gj[18], ((softgym_v4 *)gi + 9),
+                             ((softgym_v4 *)gj + 9), (softgym_v4)gi[6], (softgym_v4)gi[7],
+                             (softgym_v4)gi[8], (softgym_v4)gj[6], (softgym_v4)gj[7],
+                             (softgym_v4)gj[8], softgym_v4load(k_axial, li),
+                             softgym_v4load(c_axial, li), softgym_v4load(k_bend, li),
+                             softgym_v4load(c_bend, li), softgym_v4load(k_torsion, li),
+                             softgym_v4load(c_torsion, li));
+    }
 #endif
     /* the rest (and every link without AVX): the compiler's vectoriser */
     SOFTGYM_IVDEP
@@ -445,10 +459,9 @@ static Py_ssize_t softgym_corot_scatter(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t
 #define COROT_ROWS_USED 0
 static void softgym_corot_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const double *pos,
                                const double *vel, const double *av, const double *quat,
-                               const double *rot, double *rows)
+                               double *rows)
 {
-    (void)lo; (void)hi; (void)n; (void)pos; (void)vel; (void)av; (void)quat; (void)rot;
-    (void)rows;
+    (void)lo; (void)hi; (void)n; (void)pos; (void)vel; (void)av; (void)quat; (void)rows;
 }
 #endif
 

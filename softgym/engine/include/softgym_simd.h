@@ -342,6 +342,11 @@ static inline softgym_v4 softgym_v4load(const double *row, Py_ssize_t li)
 #else
 #define SOFTGYM_SEED_R_USED 0
 #endif
+/* 1 where neither model's step loop reads the voxels' rotation matrices (Batch.rot): the
+   seed's (SOFTGYM_SEED_R_USED) and the corotational links', which read rows of matrices
+   computed from the quaternions (softgym_corot.h: softgym_corot_rows); the voxel updates
+   then do not store them, and advance_robot refreshes them when it returns */
+#define SOFTGYM_ROT_DEFERRED SOFTGYM_SEED_R_USED
 
 #if defined(_MSC_VER)
 #define SOFTGYM_ALWAYS_INLINE static __forceinline
