@@ -69,7 +69,7 @@ SEED_PASSES = {
     "voxel update": ("softgym_seed_voxels8", "softgym_v8_finish"),
 }
 COROT_PASSES = {
-    "links": ("softgym_corot_links_ax", "softgym_corot_gather4"),
+    "links": ("softgym_corot_links_ax",),
     "scatter": ("softgym_corot_scatter",),
     "voxel update": ("softgym_corot_voxels8", "softgym_v8_finish"),
 }
@@ -85,7 +85,7 @@ MODELS = {
 # model where they differ: the seed scatter's loop takes 8 links, the corotational one's 1)
 PER_ITERATION = {"geometry": 8, "  rows path": 8, "  gather path": 8, "modes": 8,
                  "frames (float)": 16, "forces (float)": 16, "scatter": 8, "voxel update": 8,
-                 "links": 4}
+                 "links": 8}
 PER_ITERATION_OF = {"seed": PER_ITERATION, "corotational": {**PER_ITERATION, "scatter": 1}}
 
 
@@ -198,11 +198,22 @@ def find_loops(tree: Path, model: str = "seed") -> dict[str, tuple] | None:
         for s, e in innermost_loops(rows):
             name = pass_of(rows, s, e, passes)
             body = loop_body(rows, s, e)
+            if name == "links" and not _corot_rows_loop(body):
+                continue  # the 4-lane gathers, which the x86-64-v4 build no longer runs
             if name and (name not in best or len(body) > len(best[name][0])):
                 best[name] = (body, rows[s][0])
         if mod == "_seed":
             _geometry_paths(rows, best)
     return best
+
+
+def _corot_rows_loop(body) -> bool:
+    """Whether a loop of the corotational links is its 8-lane path over runs of voxels (the
+    one the reference robot's links along y and z take: 512-bit arithmetic on the voxels'
+    rows, no permutes, no gathers), not its window, gather or 4-lane paths."""
+    zmm = sum("zmm" in t for t in body)
+    return (zmm > len(body) // 2
+            and not any(t.startswith(("vpermt2pd", "vpermi2pd", "vgather")) for t in body))
 
 
 _ROWS_ONLY = ("softgym_seed_rows8", "softgym_v8_load3", "softgym_v8_load4x4",
