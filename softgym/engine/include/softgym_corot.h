@@ -171,21 +171,6 @@ static void softgym_corot_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const
             rows[(9 + k) * n + i] = R[k];
     }
 }
-/* links whose voxels all lie in the 16 voxels from the first link's voxel 1 (a
-   lattice's links along its fastest axis): 1 and each link's voxels' places in that
-   window (ia: voxel 1's, ib: voxel 2's; indices below vend, the robot's end), else 0 */
-static inline int softgym_window8_index(const Py_ssize_t *a, const Py_ssize_t *b,
-                                        Py_ssize_t vend, __m512i *ia, __m512i *ib)
-{
-    Py_ssize_t base = a[0];
-    if (base + 16 > vend)
-        return 0;
-    __m512i vbase = _mm512_set1_epi64((long long)base), sixteen = _mm512_set1_epi64(16);
-    *ia = _mm512_sub_epi64(_mm512_loadu_si512((const void *)a), vbase);
-    *ib = _mm512_sub_epi64(_mm512_loadu_si512((const void *)b), vbase);
-    return (_mm512_cmplt_epu64_mask(*ia, sixteen) & _mm512_cmplt_epu64_mask(*ib, sixteen))
-           == 0xFF;
-}
 #endif
 
 

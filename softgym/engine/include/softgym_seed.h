@@ -147,21 +147,16 @@ static inline void softgym_seed_rows8(Py_ssize_t v, const double *vr, Py_ssize_t
         r[3 + k] = softgym_v8_load(vr + k * vn + v);
     memcpy(&r[7], scale + v, sizeof r[7]);
 }
-/* links whose voxels all lie in the 16 voxels from voxel 1 of the first (a[0]: the
-   links along a lattice's fastest axis, and most blocks of a sparse body): those 16
-   voxels' records as rows, each link's voxels picked from them by a two-source permute
-   (the voxels' indices below vend, the end of the records). 0 when they do not fit. */
+/* links whose voxels all lie in the 16 voxels from voxel 1 of the first (a[0]:
+   softgym_window8_index): those 16 voxels' records as rows, each link's voxels picked
+   from them by a two-source permute. 0 when they do not fit. */
 static inline int softgym_seed_window8(const Py_ssize_t *a, const Py_ssize_t *b,
                                        Py_ssize_t vend, const double *vr, Py_ssize_t vn,
                                        const double *scale, softgym_vd *gi, softgym_vd *gj)
 {
     Py_ssize_t base = a[0];
-    if (base + 16 > vend)
-        return 0;
-    __m512i vbase = _mm512_set1_epi64((long long)base), sixteen = _mm512_set1_epi64(16);
-    __m512i ia = _mm512_sub_epi64(_mm512_loadu_si512((const void *)a), vbase);
-    __m512i ib = _mm512_sub_epi64(_mm512_loadu_si512((const void *)b), vbase);
-    if ((_mm512_cmplt_epu64_mask(ia, sixteen) & _mm512_cmplt_epu64_mask(ib, sixteen)) != 0xFF)
+    __m512i ia, ib;
+    if (!softgym_window8_index(a, b, vend, &ia, &ib))
         return 0;
     softgym_vd lo[8], hi[8];
     softgym_seed_rows8(base, vr, vn, scale, lo);

@@ -245,6 +245,23 @@ static inline int softgym_run8(const Py_ssize_t *v)
                                  _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0));
     return _mm512_cmpeq_epi64_mask(a, e) == 0xFF;
 }
+/* 8 links whose voxels all lie in the 16 voxels from the first link's voxel 1 a[0] (a
+   lattice's links along its fastest axis, and most blocks of a sparse body): 1 and each
+   link's voxels' places in that window (ia: voxel 1's a[k], ib: voxel 2's b[k]; indices
+   below vend, the end of the voxels' records), else 0; both models' link passes then
+   pick each link's numbers from the window's two vectors of a row (a two-source permute) */
+static inline int softgym_window8_index(const Py_ssize_t *a, const Py_ssize_t *b,
+                                        Py_ssize_t vend, __m512i *ia, __m512i *ib)
+{
+    Py_ssize_t base = a[0];
+    if (base + 16 > vend)
+        return 0;
+    __m512i vbase = _mm512_set1_epi64((long long)base), sixteen = _mm512_set1_epi64(16);
+    *ia = _mm512_sub_epi64(_mm512_loadu_si512((const void *)a), vbase);
+    *ib = _mm512_sub_epi64(_mm512_loadu_si512((const void *)b), vbase);
+    return (_mm512_cmplt_epu64_mask(*ia, sixteen) & _mm512_cmplt_epu64_mask(*ib, sixteen))
+           == 0xFF;
+}
 
 #else
 #define SOFTGYM_VLANES 4
