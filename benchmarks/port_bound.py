@@ -81,12 +81,13 @@ MODELS = {
     "seed": (SEED_PASSES, "_seed", "integrate_integrate_seed"),
     "corotational": (COROT_PASSES, "_corotational", "integrate_integrate_corotational"),
 }
-# what one iteration of a pass's main loop handles: links, except the voxel update (per
-# model where they differ: the seed scatter's loop takes 8 links, the corotational one's 1)
+# what one iteration of a pass's main loop handles: links, except the voxel update (both
+# models' scatters take blocks of 8 links with AVX-512; the corotational links 8 a vector
+# from its voxels' rows)
 PER_ITERATION = {"geometry": 8, "  rows path": 8, "  gather path": 8, "modes": 8,
                  "frames (float)": 16, "forces (float)": 16, "scatter": 8, "voxel update": 8,
                  "links": 8}
-PER_ITERATION_OF = {"seed": PER_ITERATION, "corotational": {**PER_ITERATION, "scatter": 1}}
+PER_ITERATION_OF = {"seed": PER_ITERATION, "corotational": PER_ITERATION}
 
 
 def build_copy(dest: Path) -> Path:
