@@ -197,9 +197,10 @@ SOFTGYM_ALWAYS_INLINE void softgym_corot_links_ax(
     double *__restrict__ o_m2z = o + 9 * n;
     Py_ssize_t li = lo;
 #if defined(SOFTGYM_COROT_ROWS)
-    /* with AVX-512, 8 links a vector where their voxels' rows load without transposes:
-       runs of consecutive voxels (the links along a lattice's slower axes) or a window of
-       16 (its fastest axis); the arithmetic is the macro's, lane by lane: the same bits */
+    /* with AVX-512, 8 links a vector from the voxels' rows: runs of consecutive voxels
+       (the links along a lattice's slower axes) by plain loads, a window of 16 voxels (its
+       fastest axis) by two-source permutes, any others by gathers; the last links one by
+       one; the arithmetic is the macro's, lane by lane: the same bits */
     if (vr != NULL) {
         /* every number a link reads through an accessor of its voxel's handle h (the first
            voxel of a run, or a vector of voxel indices): ROW(k, h) row k, RD(h, k) element
@@ -289,8 +290,8 @@ SOFTGYM_ALWAYS_INLINE void softgym_corot_links_ax(
     (void)vend;
 #endif
 #if defined(SOFTGYM_VLANES)
-    /* 4 links a vector from gathered records (8 with AVX-512 spilled: 38 rows live,
-       measured 5 % slower) */
+    /* with AVX2 (and where no rows are given), 4 links a vector from gathered records
+       (8 lanes from gathered records spilled: 38 rows live, measured 5 % slower) */
     for (; li + 4 <= hi; li += 4) {
         __m256d gi[19], gj[19];
         softgym_corot_gather4(v1 + li, pos, vel, av, rot, scale, gi);
