@@ -63,7 +63,7 @@ cdef extern from "softgym_corot.h":
                              const float64_t* c_torsion, const float64_t* vr, intp_t vn,
                              intp_t vend, float64_t* o) noexcept nogil
     # the voxels' rows the kernel's 8-lane paths load (AVX-512 builds: SOFTGYM_COROT_ROWS
-    # rows of b.vox_out; elsewhere not built, and COROT_ROWS_USED is 0)
+    # rows of b.vox_out; elsewhere a no-op, and COROT_ROWS_USED is 0)
     void softgym_corot_rows(intp_t lo, intp_t hi, intp_t n, const float64_t* pos,
                             const float64_t* vel, const float64_t* av, const float64_t* quat,
                             float64_t* rows) noexcept nogil
