@@ -59,15 +59,15 @@
     softgym_v8_load4_fm(force + SOFTGYM_FM_STRIDE * i, &F0, &F1, &F2); \
     softgym_v8 cg = softgym_v8_load(c_global + i), m = softgym_v8_load(mass + i)
 
-/* the largest lane of v above *best, as the scalar loop's "if v > best" (NaN never) */
+/* the largest lane of v above *best, as the scalar loop's "if v > best": the lanes'
+   maximum by a vector reduction (the same value; its callers' lanes are squares of
+   finite numbers, past the runaway check, never NaN, where the reduction and the
+   scalar loop could differ) */
 static inline void softgym_v8_raise_max(softgym_v8 v, double *best)
 {
-    double t[8], b = *best;
-    memcpy(t, &v, sizeof t);
-    for (int k = 0; k < 8; k++)
-        if (t[k] > b)
-            b = t[k];
-    *best = b;
+    double m = _mm512_reduce_max_pd((__m512d)v);
+    if (m > *best)
+        *best = m;
 }
 
 /* both models' step after the forces (f) and the floor (v possibly stopped): the
