@@ -132,25 +132,23 @@ cdef extern from "softgym_voxels.h":
         const float64_t* inv_mass, const float64_t* inv_inertia, const float64_t* rot_damp,
         const float64_t* scale, const float64_t* k_floor, const float64_t* c_floor,
         const float64_t* mu_s, const float64_t* mu_k, const flag_t* fixed,
-        const float64_t* ref, const float64_t* c, int track_speed, float64_t runaway,
+        const float64_t* ref, float64_t* c, int track_speed, float64_t runaway,
         float64_t* dmax, float64_t* vmax2) noexcept nogil
 
 
 cdef inline intp_t _scalar_run(Batch* b, intp_t r, intp_t* lo, int seed, const float64_t* ref,
-                               const float64_t* c, float64_t* dmax,
+                               float64_t* c, float64_t* dmax,
                                float64_t* vmax2) noexcept nogil:
     # The voxel updates' schedule from voxel lo[0] on: blocks of 8 go to the vector lanes
     # while they take them (where the build has them and the robot has no fluid and no
-    # terrain box; lo[0] moves past each block stepped), after the robot's first voxel
-    # where it sets c (a drift reference, ref, to measure from); returns the end of the
-    # run the scalar loop must do from lo[0]: that first voxel, a block the lanes left (a
-    # fixed or runaway voxel), or the rest
+    # terrain box; lo[0] moves past each block stepped; the block from the robot's first
+    # voxel sets c, the drift reference's offset, as the scalar loop would); returns the
+    # end of the run the scalar loop must do from lo[0]: a block the lanes left (a fixed
+    # or runaway voxel), or the rest
     cdef:
         intp_t vs = b.vox_start[r], ve = b.vox_start[r + 1]
     if not SOFTGYM_VOXELS8 or b.fluid_drag > 0.0 or b.box_start[r] != b.box_start[r + 1]:
         return ve
-    if lo[0] == vs and ref != NULL:
-        return vs + 1
     while lo[0] + 8 <= ve:
         if not voxels8(seed, lo[0], vs, b.dt[r], b.gravity, b.floor[r], b.pos, b.vel, b.angvel, b.force,
                      b.moment, b.ext_force, b.c_global, b.mass, b.inv_mass, b.inv_inertia,

@@ -16,9 +16,9 @@
 #include "softgym_simd.h"
 
 /* the arguments of softgym_seed_voxels8 and softgym_corot_voxels8: voxels i..i+7 of a
-   robot whose first voxel is vs (i > vs where ref is set), the robot's time step,
-   gravity and floor flag, the state and per-voxel constants (the Batch's arrays), the
-   drift reference (ref and the first voxel's displacement c; ref NULL: none), whether to
+   robot whose first voxel is vs, the robot's time step, gravity and floor flag, the state
+   and per-voxel constants (the Batch's arrays), the drift reference (ref and the first
+   voxel's displacement c, which the block from vs sets; ref NULL: none), whether to
    track the fastest speed, the runaway bound, and the running maxima of drift and speed
    squared (raised) */
 #define SOFTGYM_VOXELS8_PARAMS \
@@ -27,7 +27,7 @@
     const double *c_global, const double *mass, const double *inv_mass, \
     const double *inv_inertia, const double *rot_damp, const double *scale, \
     const double *k_floor, const double *c_floor, const double *mu_s, const double *mu_k, \
-    const signed char *fixed, const double *ref, const double *c, int track_speed, \
+    const signed char *fixed, const double *ref, double *c, int track_speed, \
     double runaway, double *dmax, double *vmax2
 
 #define SOFTGYM_VOXELS8_ARGS i, vs, dt, g, has_floor, pos, vel, av, force, moment, ext, \
@@ -93,7 +93,14 @@ static inline int softgym_v8_finish(SOFTGYM_VOXELS8_PARAMS, softgym_v8 v0, softg
     if (ref != NULL) {
         softgym_v8 r0, r1, r2;
         softgym_v8_load3(ref + 3 * (i - vs), &r0, &r1, &r2);
-        softgym_v8 d0 = (px - r0) - c[0], d1 = (py - r1) - c[1], d2 = (pz - r2) - c[2];
+        softgym_v8 e0 = px - r0, e1 = py - r1, e2 = pz - r2;
+        if (i == vs) {
+            /* the robot's first voxel's displacement, lane 0 (the scalar loop's c) */
+            c[0] = e0[0];
+            c[1] = e1[0];
+            c[2] = e2[0];
+        }
+        softgym_v8 d0 = e0 - c[0], d1 = e1 - c[1], d2 = e2 - c[2];
         softgym_v8_raise_max(((d0 * d0) + (d1 * d1)) + (d2 * d2), dmax);
     }
     if (track_speed) {
