@@ -180,31 +180,15 @@ cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
         b.steps[r] += 1
         record(b, r)
         softgym_prof_add(4, t0)
-    # the rotation matrices, where the seed step leaves them (its scatter takes voxel 1's
-    # from the geometry): up to date whenever the kernel returns
-    refresh_robot_rotations(b, r)
     return status
 
 
-cdef int advance_robot(Batch* b, intp_t r, step_t target, Contacts* c) noexcept nogil:
-    """Step robot r until steps[r] == target, or until it diverges.
-
-    Modifies in place every per-voxel state array of the robot, its step count,
-    traces and divergence flags, and its self-collision candidates ``c``
-    (kept between calls; the wrapper marks them stale when it moves voxels).
-    Returns a STATUS_* code.
-    """
+cdef int _advance_corotational(Batch* b, intp_t r, step_t target,
+                               Contacts* c) noexcept nogil:
+    # advance_robot for model 1: drive, links, contacts, voxels
     cdef:
         int status = STATUS_OK
-        intp_t vs = b.vox_start[r]
-        intp_t ve = b.vox_start[r + 1]
         float64_t smax, dmax2 = 0.0
-    if b.diverged[r]:
-        return STATUS_OK
-    if b.steps[r] == 0:
-        record(b, r)
-    if b.model == 0:
-        return _advance_seed(b, r, target, c)
     while b.steps[r] < target:
         # force and moment scratch are zero here: integrate_corotational clears them
         smax = _actuate(b, r)
@@ -229,8 +213,29 @@ cdef int advance_robot(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
                 c.stale = 1
         b.steps[r] += 1
         record(b, r)
-    # the rotation matrices, where the step leaves them (its links read rows computed
-    # from the quaternions): up to date whenever the kernel returns
+    return status
+
+
+cdef int advance_robot(Batch* b, intp_t r, step_t target, Contacts* c) noexcept nogil:
+    """Step robot r until steps[r] == target, or until it diverges.
+
+    Modifies in place every per-voxel state array of the robot, its step count,
+    traces and divergence flags, and its self-collision candidates ``c``
+    (kept between calls; the wrapper marks them stale when it moves voxels).
+    Returns a STATUS_* code.
+    """
+    cdef int status
+    if b.diverged[r]:
+        return STATUS_OK
+    if b.steps[r] == 0:
+        record(b, r)
+    if b.model == 0:
+        status = _advance_seed(b, r, target, c)
+    else:
+        status = _advance_corotational(b, r, target, c)
+    # the rotation matrices, where the AVX-512 steps leave them (neither model's reads
+    # them: the seed's scatter takes voxel 1's from its geometry, the corotational links
+    # rows computed from the quaternions): up to date whenever the kernel returns
     refresh_robot_rotations(b, r)
     return status
 

@@ -282,8 +282,7 @@ cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int
     # (the rotation matrices: refresh_robot_rotations, where the step does not read them;
     # the seed's reads the voxel rows instead, kept here)
     if SOFTGYM_ROT_DEFERRED:
-        softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat, NULL,
-                             b.pos if seed and SOFTGYM_SEED_R_USED else NULL)
+        softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat, NULL, b.pos if seed else NULL)
     else:
         softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat, b.rot, NULL)
 
