@@ -57,7 +57,7 @@ ROOT = Path(__file__).resolve().parent.parent
 # helpers shared by several passes (the record/row transposes) count for none
 SEED_PASSES = {
     "geometry": ("softgym_seed_geom_ax", "softgym_seed_gather", "softgym_seed_gather4",
-                 "softgym_seed_rows8"),
+                 "softgym_seed_gather_rows", "softgym_seed_rows8"),
     "modes": ("softgym_seed_modes",),
     "frames (float)": ("softgym_seed_frames32_impl", "softgym_rotvec_k32",
                        "softgym_rotvec_k32_acos"),
@@ -219,23 +219,28 @@ def _corot_rows_loop(body) -> bool:
 
 _ROWS_ONLY = ("softgym_seed_rows8", "softgym_v8_load3", "softgym_v8_load4x4",
               "_mm512_permutex2var_pd", "_mm512_loadu_pd")
-_GATHER_ONLY = ("softgym_seed_gather", "softgym_seed_gather4", "_mm512_insertf64x4",
-                "_mm512_castpd256_pd512")
+_GATHER_ONLY = ("softgym_seed_gather", "softgym_seed_gather4", "softgym_seed_gather_rows",
+                "_mm512_i64gather_pd", "_mm512_insertf64x4", "_mm512_castpd256_pd512")
+# the gather path's loads: from the voxel rows where the seed step keeps its state there
+# (AVX-512 builds), else from the records
+_GATHER_FNS = ("softgym_seed_gather_rows", "softgym_seed_gather4")
 
 
 def _geometry_paths(rows, best) -> None:
     """The geometry's rows path (the innermost loop of softgym_seed_rows8) and its gather
     path: GCC folds the gathers, the scalar remainder and the rows loop into one loop nest,
     so the gather path is taken as the rows loop's arithmetic with the gathers (the
-    instructions of softgym_seed_gather4 and its intrinsics in the smallest loop around
-    them) in place of the rows' loads."""
+    instructions of softgym_seed_gather_rows, or softgym_seed_gather4 where the build
+    gathers from the records, and their intrinsics in the smallest loop around them) in
+    place of the rows' loads."""
     loops = all_loops(rows)
 
     def has(s, e, fn_name):
         return any(fn == fn_name for _a, _sym, fn, _t in rows[s:e + 1])
 
     inner = [(s, e) for s, e in innermost_loops(rows) if has(s, e, "softgym_seed_rows8")]
-    outer = [(s, e) for s, e in loops if has(s, e, "softgym_seed_gather4")]
+    outer = next(([(s, e) for s, e in loops if has(s, e, fn)] for fn in _GATHER_FNS
+                  if any(has(s, e, fn) for s, e in loops)), [])
     if not inner or not outer:
         return
     s, e = max(inner, key=lambda r: r[1] - r[0])

@@ -2,7 +2,7 @@
 # flat structure-of-arrays state of a whole batch, the status codes the nogil
 # kernels return, and the scratch layout. Arrays are C-contiguous float64
 # unless said otherwise; "(n, 3)" means n rows of 3 stored row-major. Units
-# are SI. Types only: no module behind this file.
+# are SI. Types and two inline accessors only: no module behind this file.
 
 from softgym.engine._typedefs cimport float64_t, intp_t, step_t, int32, flag_t, lane_flag_t
 
@@ -74,6 +74,10 @@ cdef struct Batch:
                              #   voxel i at vox_out[k * vox_stride + i], i among the robot's
                              #   voxels (include/softgym_simd.h)
     intp_t vox_stride        # its row stride (the most voxels of one robot)
+    float64_t* state_rows    # NULL, or b.vox_out while the seed step loop of an AVX-512
+                             #   build (SOFTGYM_SEED_R_USED) keeps the voxels' state in its
+                             #   rows (include/softgym_simd.h): pos, quat, vel and angvel are
+                             #   stale then; voxel_pos / voxel_quat read either
     float64_t* ext_force     # (n_voxels, 3) constant external force (N)
     float64_t* mass          # (n_voxels,) rho L^3 (kg)
     float64_t* inv_mass      # (n_voxels,) 1 / mass
@@ -163,6 +167,26 @@ cdef extern from "softgym_simd.h":
     # rows of the per-voxel scratch, Batch.vox_out (the voxel update's quaternions; the
     # seed step's voxel rows)
     enum: SOFTGYM_VOXEL_ROWS
+    # the rows of the seed step's quaternions and positions there
+    enum: SOFTGYM_ROW_QUAT
+    enum: SOFTGYM_ROW_POS
+
+
+cdef inline float64_t voxel_pos(const Batch* b, intp_t i, int k) noexcept nogil:
+    # component k of voxel i's position, from the records or the state rows
+    if b.state_rows != NULL:
+        return b.state_rows[(SOFTGYM_ROW_POS + k) * b.vox_stride + i]
+    return b.pos[3 * i + k]
+
+
+cdef inline void voxel_quat(const Batch* b, intp_t i, float64_t* q) noexcept nogil:
+    # q[0:4] = voxel i's quaternion (w, x, y, z), from the records or the state rows
+    cdef int k
+    for k in range(4):
+        if b.state_rows != NULL:
+            q[k] = b.state_rows[(SOFTGYM_ROW_QUAT + k) * b.vox_stride + i]
+        else:
+            q[k] = b.quat[4 * i + k]
 
 
 cdef extern from *:

@@ -18,7 +18,8 @@ from libc.stdint cimport int64_t
 from libc.stdlib cimport malloc, realloc, qsort
 from libc.string cimport memcpy, memset
 
-from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_MEMORY, SOFTGYM_FM_STRIDE
+from softgym.engine._batch cimport (Batch, STATUS_OK, STATUS_MEMORY, SOFTGYM_FM_STRIDE,
+                                    voxel_pos)
 from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t, lane_flag_t
 
 # ---------------------------------------------------------------------------
@@ -438,9 +439,9 @@ cdef int contacts_seed(Batch* b, intp_t r, Contacts* c, int32 snapshot) noexcept
         return STATUS_MEMORY
     if snapshot:
         for i in range(vs, ve):
-            R[4 * i] = b.pos[3 * i]
-            R[4 * i + 1] = b.pos[3 * i + 1]
-            R[4 * i + 2] = b.pos[3 * i + 2]
+            R[4 * i] = voxel_pos(b, i, 0)
+            R[4 * i + 1] = voxel_pos(b, i, 1)
+            R[4 * i + 2] = voxel_pos(b, i, 2)
             R[4 * i + 3] = b.scale[i]
     c.stale = 0
     c.n_pairs = 0
@@ -535,9 +536,9 @@ cdef void collide_obstacles(Batch* b, Contacts* c) noexcept nogil:
     for k in range(c.n_opairs):
         i = c.opairs[2 * k]
         m = c.opairs[2 * k + 1]
-        dx = b.pos[3 * i] - b.obs[4 * m]
-        dy = b.pos[3 * i + 1] - b.obs[4 * m + 1]
-        dz = b.pos[3 * i + 2] - b.obs[4 * m + 2]
+        dx = voxel_pos(b, i, 0) - b.obs[4 * m]
+        dy = voxel_pos(b, i, 1) - b.obs[4 * m + 1]
+        dz = voxel_pos(b, i, 2) - b.obs[4 * m + 2]
         d2 = dx * dx + dy * dy + dz * dz
         env = 0.75 * (b.scale[i] + b.L)
         if d2 >= env * env or d2 == 0.0:
@@ -555,13 +556,12 @@ cdef void collide(Batch* b, Contacts* c) noexcept nogil:
     cdef:
         intp_t k, i, j
         float64_t dx, dy, dz, d2, env, dist, kk, fmag
-        const float64_t* P = b.pos
     for k in range(c.n_pairs):
         i = c.pairs[2 * k]
         j = c.pairs[2 * k + 1]
-        dx = P[3 * j] - P[3 * i]
-        dy = P[3 * j + 1] - P[3 * i + 1]
-        dz = P[3 * j + 2] - P[3 * i + 2]
+        dx = voxel_pos(b, j, 0) - voxel_pos(b, i, 0)
+        dy = voxel_pos(b, j, 1) - voxel_pos(b, i, 1)
+        dz = voxel_pos(b, j, 2) - voxel_pos(b, i, 2)
         d2 = dx * dx + dy * dy + dz * dz
         env = 0.75 * (b.scale[i] + b.scale[j])
         if d2 >= env * env or d2 == 0.0:

@@ -133,7 +133,7 @@ cdef extern from "softgym_voxels.h":
         const float64_t* scale, const float64_t* k_floor, const float64_t* c_floor,
         const float64_t* mu_s, const float64_t* mu_k, const flag_t* fixed,
         const float64_t* ref, float64_t* c, int track_speed, float64_t runaway,
-        float64_t* dmax, float64_t* vmax2) noexcept nogil
+        float64_t* dmax, float64_t* vmax2, float64_t* rows, intp_t rn) noexcept nogil
 
 
 cdef inline intp_t _scalar_run(Batch* b, intp_t r, intp_t* lo, int seed, const float64_t* ref,
@@ -153,7 +153,8 @@ cdef inline intp_t _scalar_run(Batch* b, intp_t r, intp_t* lo, int seed, const f
         if not voxels8(seed, lo[0], vs, b.dt[r], b.gravity, b.floor[r], b.pos, b.vel, b.angvel, b.force,
                      b.moment, b.ext_force, b.c_global, b.mass, b.inv_mass, b.inv_inertia,
                      b.rot_damp, b.scale, b.k_floor, b.c_floor, b.mu_s, b.mu_k, b.fixed, ref,
-                     c, b.self_collision and seed, RUNAWAY, dmax, vmax2):
+                     c, b.self_collision and seed, RUNAWAY, dmax, vmax2, b.vox_out,
+                     b.vox_stride):
             return lo[0] + 8
         lo[0] += 8
     return ve
@@ -256,16 +257,23 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
 
 cdef extern from "softgym_orient.h":
     # the voxels' orientation step of both models (C, for the vectorising pragma;
-    # documented in include/softgym_orient.h)
+    # documented in include/softgym_orient.h), and the seed step's state in the voxel rows
     void softgym_seed_quats(intp_t lo, intp_t hi, intp_t n, float64_t dt, const float64_t* av,
                             const float64_t* quat, float64_t* q_out) noexcept nogil
+    void softgym_seed_quats_rows(intp_t lo, intp_t hi, intp_t n, float64_t dt,
+                                 const flag_t* fixed, const float64_t* quat,
+                                 float64_t* rows) noexcept nogil
     void softgym_corot_quats(intp_t lo, intp_t hi, intp_t n, float64_t dt, const float64_t* av,
                              const float64_t* quat, float64_t* q_out) noexcept nogil
     void softgym_orient_store(intp_t lo, intp_t hi, intp_t n, float64_t* q_out,
-                              const flag_t* fixed, float64_t* quat, float64_t* rot,
-                              const float64_t* pos) noexcept nogil
-    void softgym_voxel_rows(intp_t lo, intp_t hi, intp_t n, const float64_t* pos,
-                            const float64_t* quat, float64_t* rows) noexcept nogil
+                              const flag_t* fixed, float64_t* quat, float64_t* rot) noexcept nogil
+    void softgym_seed_state_rows(intp_t lo, intp_t hi, intp_t n, const float64_t* pos,
+                                 const float64_t* quat, const float64_t* vel,
+                                 const float64_t* av, const float64_t* ext,
+                                 float64_t* rows) noexcept nogil
+    void softgym_seed_state_back(intp_t lo, intp_t hi, intp_t n, const float64_t* rows,
+                                 float64_t* pos, float64_t* quat, float64_t* vel,
+                                 float64_t* av) noexcept nogil
 
 
 cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int seed) noexcept nogil:
@@ -275,23 +283,31 @@ cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int
     cdef:
         intp_t n = b.vox_stride  # the scratch's row stride
         float64_t* qo = b.vox_out
+    if seed and SOFTGYM_SEED_R_USED:
+        # the seed step's state in the voxel rows: the quaternion rows updated in place
+        # (the rotation matrices: refresh_robot_rotations, when the step loop returns)
+        softgym_seed_quats_rows(lo, hi, n, dt, b.fixed, b.quat, qo)
+        return
     if seed:
         softgym_seed_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
     else:
         softgym_corot_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
-    # (the rotation matrices: refresh_robot_rotations, where the step does not read them;
-    # the seed's reads the voxel rows instead, kept here)
-    if SOFTGYM_ROT_DEFERRED:
-        softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat, NULL, b.pos if seed else NULL)
-    else:
-        softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat, b.rot, NULL)
+    # (the rotation matrices: refresh_robot_rotations, where the step does not read them)
+    softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat, NULL if SOFTGYM_ROT_DEFERRED else b.rot)
 
 
 cdef void seed_voxel_rows(Batch* b, intp_t r) noexcept nogil:
-    # robot r's voxel rows from quat and pos (_integrate.pxd)
+    # robot r's state into the voxel rows (_integrate.pxd)
     if SOFTGYM_SEED_R_USED:
-        softgym_voxel_rows(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.pos, b.quat,
-                           b.vox_out)
+        softgym_seed_state_rows(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.pos, b.quat,
+                                b.vel, b.angvel, b.ext_force, b.vox_out)
+
+
+cdef void seed_state_back(Batch* b, intp_t r) noexcept nogil:
+    # robot r's state from the voxel rows back into its records (_integrate.pxd)
+    if SOFTGYM_SEED_R_USED:
+        softgym_seed_state_back(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.vox_out,
+                                b.pos, b.quat, b.vel, b.angvel)
 
 
 cdef void refresh_robot_rotations(Batch* b, intp_t r) noexcept nogil:
@@ -338,6 +354,10 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
     lo = vs  # (blocks of 8 voxels in vector lanes where they can: _scalar_run)
     while lo < ve:
         hi = _scalar_run(b, r, &lo, 1, ref, c, &dmax, &vmax2)
+        if SOFTGYM_SEED_R_USED and lo < hi:
+            # the scalar loop's voxels' state from the rows (the step's), back to them
+            # after it
+            softgym_seed_state_back(lo, hi, b.vox_stride, b.vox_out, pos, b.quat, vel, av)
         for i in range(lo, hi):
             if b.fixed[i]:
                 for k in range(3):
@@ -361,12 +381,17 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
             if has_floor:
                 seed_floor(b, i, dt, f)
             if not (_translate(vel + 3 * i, pos + 3 * i, f, dt * b.inv_mass[i], dt) < RUNAWAY):
+                if SOFTGYM_SEED_R_USED:
+                    softgym_seed_state_rows(lo, hi, b.vox_stride, pos, b.quat, vel, av, NULL,
+                                            b.vox_out)
                 return _ran_away(b, r, i, dt, 1, dmax, dmax2)
             if ref != NULL:
                 dmax = _raise(dmax, _drift2(pos, ref, i, vs, c))
             if track_speed:
                 vmax2 = _raise(vmax2, speed_squared(vel[3 * i], vel[3 * i + 1], vel[3 * i + 2]))
             _spin(b, i, dt, mx, my, mz)
+        if SOFTGYM_SEED_R_USED and lo < hi:
+            softgym_seed_state_rows(lo, hi, b.vox_stride, pos, b.quat, vel, av, NULL, b.vox_out)
         lo = hi
     dmax2[0] = dmax
     softgym_prof_add(0, t0)

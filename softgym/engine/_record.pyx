@@ -4,7 +4,7 @@
 
 from libc.math cimport sqrt
 
-from softgym.engine._batch cimport Batch, N_AUX
+from softgym.engine._batch cimport Batch, N_AUX, voxel_pos, voxel_quat
 from softgym.engine._contact cimport box_penetration
 from softgym.engine._typedefs cimport float64_t, intp_t, int32
 
@@ -21,9 +21,9 @@ cdef void robot_cm(Batch* b, intp_t r, float64_t* out) noexcept nogil:
         float64_t sx = 0.0, sy = 0.0, sz = 0.0, m
     for i in range(b.vox_start[r], b.body_end[r]):  # its objects excluded
         m = b.mass[i]
-        sx += m * b.pos[3 * i]
-        sy += m * b.pos[3 * i + 1]
-        sz += m * b.pos[3 * i + 2]
+        sx += m * voxel_pos(b, i, 0)
+        sy += m * voxel_pos(b, i, 1)
+        sz += m * voxel_pos(b, i, 2)
     m = 1.0 / b.mass_total[r]
     out[0] = sx * m
     out[1] = sy * m
@@ -38,36 +38,38 @@ cdef void robot_aux(Batch* b, intp_t r, float64_t* out) noexcept nogil:
         intp_t be = b.body_end[r]
         float64_t m, mo = 0.0
         float64_t R[9]
+        float64_t q[4]
     for k in range(N_AUX):
         out[k] = 0.0
-    out[5] = b.pos[3 * b.vox_start[r]]
+    out[5] = voxel_pos(b, b.vox_start[r], 0)
     out[6] = out[5]
-    out[7] = b.pos[3 * b.vox_start[r] + 1]
+    out[7] = voxel_pos(b, b.vox_start[r], 1)
     out[8] = out[7]
-    out[9] = b.pos[3 * b.vox_start[r] + 2]
+    out[9] = voxel_pos(b, b.vox_start[r], 2)
     for i in range(b.vox_start[r], be):
         m = b.mass[i]
         # the heading from the quaternion (rot is not up to date within a seed step's
         # run where the build's seed step does not read it): the same bits
-        _rotation_matrix(b.quat + 4 * i, R)
+        voxel_quat(b, i, q)
+        _rotation_matrix(q, R)
         out[3] += m * R[0]
         out[4] += m * R[3]
-        if b.pos[3 * i] < out[5]:
-            out[5] = b.pos[3 * i]
-        if b.pos[3 * i] > out[6]:
-            out[6] = b.pos[3 * i]
-        if b.pos[3 * i + 1] < out[7]:
-            out[7] = b.pos[3 * i + 1]
-        if b.pos[3 * i + 1] > out[8]:
-            out[8] = b.pos[3 * i + 1]
-        if b.pos[3 * i + 2] > out[9]:
-            out[9] = b.pos[3 * i + 2]
+        if voxel_pos(b, i, 0) < out[5]:
+            out[5] = voxel_pos(b, i, 0)
+        if voxel_pos(b, i, 0) > out[6]:
+            out[6] = voxel_pos(b, i, 0)
+        if voxel_pos(b, i, 1) < out[7]:
+            out[7] = voxel_pos(b, i, 1)
+        if voxel_pos(b, i, 1) > out[8]:
+            out[8] = voxel_pos(b, i, 1)
+        if voxel_pos(b, i, 2) > out[9]:
+            out[9] = voxel_pos(b, i, 2)
     for i in range(be, b.vox_start[r + 1]):
         m = b.mass[i]
         mo += m
-        out[0] += m * b.pos[3 * i]
-        out[1] += m * b.pos[3 * i + 1]
-        out[2] += m * b.pos[3 * i + 2]
+        out[0] += m * voxel_pos(b, i, 0)
+        out[1] += m * voxel_pos(b, i, 1)
+        out[2] += m * voxel_pos(b, i, 2)
     if mo > 0.0:
         mo = 1.0 / mo
         out[0] *= mo

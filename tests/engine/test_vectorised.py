@@ -164,9 +164,12 @@ HARNESS = _c_harness("softgym_seed.h", r"""
    against SOFTGYM_SEED_GEOM_LINK, one link at a time; and, run a chunk at a time as the
    engine does, the rotation rows it leaves for the scatter (AVX-512) against voxel 1's
    matrix. The runs and windows load the voxel rows vr (quaternions in rows 0-3, positions
-   in 4-6, VN apart), which the engine keeps equal to the records */
+   in 4-6, VN apart); in the builds whose seed step keeps its state there
+   (SOFTGYM_SEED_R_USED) every path does, and the records it is given are NaN (stale during
+   that step); elsewhere they are the records' copy */
 enum { VN = 216 };
 static double rr[SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE], vr[SOFTGYM_VOXEL_ROWS * VN];
+static double pos_rec[3 * VN], quat_rec[4 * VN];  /* the records softgym_seed_geom gets */
 SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, Py_ssize_t n, const Py_ssize_t *v1,
                                     const Py_ssize_t *v2, Py_ssize_t nv, const double *pos,
                                     const double *quat, const double *sc, double *o, double *r)
@@ -175,7 +178,7 @@ SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, Py_ssize_t n, const Py_ssize_t
     for (Py_ssize_t c0 = 0; c0 < n; c0 += SOFTGYM_CHUNK_LINKS) {
         Py_ssize_t c1 = c0 + SOFTGYM_CHUNK_LINKS < n ? c0 + SOFTGYM_CHUNK_LINKS : n;
         double *R = rr + SOFTGYM_SEED_R_ROWS * SOFTGYM_CHUNK_STRIDE;
-        softgym_seed_geom(ax, c0, c1, n, v1, v2, nv, pos, quat, vr, VN, sc, o, R - c0);
+        softgym_seed_geom(ax, c0, c1, n, v1, v2, nv, pos_rec, quat_rec, vr, VN, sc, o, R - c0);
         for (Py_ssize_t li = c0; li < c1 && SOFTGYM_SEED_R_USED; li++) {  /* (where written) */
             double m[9];
             softgym_quat_matrix(quat + 4 * v1[li], m);
@@ -183,7 +186,7 @@ SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, Py_ssize_t n, const Py_ssize_t
                 bad += memcmp(&m[k], R + k * SOFTGYM_CHUNK_STRIDE + li - c0, sizeof(double)) != 0;
         }
     }
-    softgym_seed_geom(ax, 0, n, n, v1, v2, nv, pos, quat, vr, VN, sc, o, (double *)0);
+    softgym_seed_geom(ax, 0, n, n, v1, v2, nv, pos_rec, quat_rec, vr, VN, sc, o, (double *)0);
     SOFTGYM_SEED_GEOM_AXIS(ax);
     SOFTGYM_SEED_GEOM_OUT(r, n);
     for (Py_ssize_t li = 0; li < n; li++) {
@@ -209,6 +212,8 @@ int main(void)
         sc[i] = 0.01 * (1.0 + 0.1 * urand());
         for (int k = 0; k < 4; k++) vr[k * VN + i] = quat[4 * i + k];
         for (int k = 0; k < 3; k++) vr[(4 + k) * VN + i] = pos[3 * i + k];
+        for (int k = 0; k < 3; k++) pos_rec[3 * i + k] = SOFTGYM_SEED_R_USED ? NAN : pos[3 * i + k];
+        for (int k = 0; k < 4; k++) quat_rec[4 * i + k] = SOFTGYM_SEED_R_USED ? NAN : quat[4 * i + k];
     }
     for (int pattern = 0; pattern < 3; pattern++) {
         for (int li = 0; li < N; li++) {

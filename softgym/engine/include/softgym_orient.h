@@ -1,7 +1,9 @@
 /* The voxels' orientation step of both models (softgym/engine/_integrate.pyx), in C for
    the vectorising pragma: q + (w dt / 2) x q (w the new angular velocity), renormalised,
-   into the scratch rows q_out (4, n); the voxel update copies them back and derives the
-   rotation matrices. The same IEEE operations as the scalar code they replaced; one
+   into the scratch rows q_out (4, n), which softgym_orient_store copies back (deriving the
+   rotation matrices where the build's steps read them); in the seed step of AVX-512 builds,
+   whose state lives in the voxel rows, in place there (softgym_seed_quats_rows), with the
+   helpers that move that state between the records and the rows. The same IEEE operations as the scalar code they replaced; one
    voxel's no longer waits on the previous voxel's. Py_ssize_t comes from Python.h,
    which Cython includes first. */
 #ifndef SOFTGYM_ORIENT_H
@@ -15,16 +17,22 @@
    identity at w >= 1, or the corotational model's one Newton step of 1 / sqrt from 1
    (|q|^2 is 1 + O((w dt)^2), so the step is exact to rounding) */
 SOFTGYM_ALWAYS_INLINE void softgym_quats_impl(const int seed, Py_ssize_t lo, Py_ssize_t hi,
-                                              Py_ssize_t n, double dt, const double *av,
-                                              const double *quat, double *q_out)
+                                              Py_ssize_t n, double dt, const double *ax,
+                                              const double *ay, const double *az,
+                                              const Py_ssize_t as, const double *quat,
+                                              const Py_ssize_t qs, const Py_ssize_t qc,
+                                              double *q_out)
 {
+    /* angular velocity component c of voxel i at (ax, ay, az)[as i], quaternion component k
+       at quat[qs i + qc k] (q_out may be quat's rows: each voxel's is read, then written) */
     Py_ssize_t i;
     SOFTGYM_IVDEP
     for (i = lo; i < hi; i++) {
-        double wx = av[3 * i] * 0.5 * dt;
-        double wy = av[3 * i + 1] * 0.5 * dt;
-        double wz = av[3 * i + 2] * 0.5 * dt;
-        double q0 = quat[4 * i], q1 = quat[4 * i + 1], q2 = quat[4 * i + 2], q3 = quat[4 * i + 3];
+        double wx = ax[as * i] * 0.5 * dt;
+        double wy = ay[as * i] * 0.5 * dt;
+        double wz = az[as * i] * 0.5 * dt;
+        double q0 = quat[qs * i], q1 = quat[qs * i + qc], q2 = quat[qs * i + 2 * qc];
+        double q3 = quat[qs * i + 3 * qc];
         double qw = q0 - wx * q1 - wy * q2 - wz * q3;
         double qx = q1 + wx * q0 + wy * q3 - wz * q2;
         double qy = q2 + wy * q0 + wz * q1 - wx * q3;
@@ -60,13 +68,77 @@ SOFTGYM_ALWAYS_INLINE void softgym_quats_impl(const int seed, Py_ssize_t lo, Py_
 static void softgym_seed_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,
                                const double *av, const double *quat, double *q_out)
 {
-    softgym_quats_impl(1, lo, hi, n, dt, av, quat, q_out);
+    softgym_quats_impl(1, lo, hi, n, dt, av, av + 1, av + 2, 3, quat, 4, 1, q_out);
+}
+/* the same on the voxel rows, the seed step's state in SOFTGYM_SEED_R_USED builds: the
+   angular velocities from rows SOFTGYM_ROW_AV, the quaternions of rows SOFTGYM_ROW_QUAT
+   updated in place, then the fixed voxels' put back from their records quat (a fixed
+   voxel's quaternion never changes, so its record is its row; selecting them in the loop
+   made it 1.6 times slower) */
+static void softgym_seed_quats_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,
+                                    const signed char *fixed, const double *quat, double *rows)
+{
+    const double *r = rows + SOFTGYM_ROW_AV * n;
+    double *q = rows + SOFTGYM_ROW_QUAT * n;
+    softgym_quats_impl(1, lo, hi, n, dt, r, r + n, r + 2 * n, 1, q, 1, n, q);
+    for (Py_ssize_t i = lo; i < hi; i++)
+        if (fixed[i])
+            for (int k = 0; k < 4; k++)
+                q[k * n + i] = quat[4 * i + k];
 }
 /* model 1 (corotational) */
 static void softgym_corot_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,
                                 const double *av, const double *quat, double *q_out)
 {
-    softgym_quats_impl(0, lo, hi, n, dt, av, quat, q_out);
+    softgym_quats_impl(0, lo, hi, n, dt, av, av + 1, av + 2, 3, quat, 4, 1, q_out);
+}
+
+/* The seed step's state in the voxel rows (SOFTGYM_SEED_R_USED builds; rows
+   SOFTGYM_ROW_QUAT, SOFTGYM_ROW_POS, SOFTGYM_ROW_VEL, SOFTGYM_ROW_AV, SOFTGYM_ROW_EXT of
+   softgym_simd.h, n apart, indexed by voxel): voxels lo..hi from their records (ext NULL:
+   not the external forces), and back (the external forces are constant) */
+static void softgym_seed_state_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const double *pos,
+                                    const double *quat, const double *vel, const double *av,
+                                    const double *ext, double *rows)
+{
+    for (int k = 0; k < 4; k++) {
+        double *rq = rows + (SOFTGYM_ROW_QUAT + k) * n;
+        for (Py_ssize_t i = lo; i < hi; i++)
+            rq[i] = quat[4 * i + k];
+    }
+    for (int k = 0; k < 3; k++) {
+        double *rp = rows + (SOFTGYM_ROW_POS + k) * n, *rv = rows + (SOFTGYM_ROW_VEL + k) * n;
+        double *ra = rows + (SOFTGYM_ROW_AV + k) * n;
+        for (Py_ssize_t i = lo; i < hi; i++) {
+            rp[i] = pos[3 * i + k];
+            rv[i] = vel[3 * i + k];
+            ra[i] = av[3 * i + k];
+        }
+        if (ext != NULL) {
+            double *re = rows + (SOFTGYM_ROW_EXT + k) * n;
+            for (Py_ssize_t i = lo; i < hi; i++)
+                re[i] = ext[3 * i + k];
+        }
+    }
+}
+static void softgym_seed_state_back(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const double *rows,
+                                    double *pos, double *quat, double *vel, double *av)
+{
+    for (int k = 0; k < 4; k++) {
+        const double *rq = rows + (SOFTGYM_ROW_QUAT + k) * n;
+        for (Py_ssize_t i = lo; i < hi; i++)
+            quat[4 * i + k] = rq[i];
+    }
+    for (int k = 0; k < 3; k++) {
+        const double *rp = rows + (SOFTGYM_ROW_POS + k) * n;
+        const double *rv = rows + (SOFTGYM_ROW_VEL + k) * n;
+        const double *ra = rows + (SOFTGYM_ROW_AV + k) * n;
+        for (Py_ssize_t i = lo; i < hi; i++) {
+            pos[3 * i + k] = rp[i];
+            vel[3 * i + k] = rv[i];
+            av[3 * i + k] = ra[i];
+        }
+    }
 }
 
 /* voxel i's (not fixed), its matrix into R unless R is NULL */
@@ -81,25 +153,8 @@ static void softgym_corot_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, doub
         if ((R) != NULL) \
             softgym_quat_matrix_wxyz(w_, x_, y_, z_, (R) + 9 * (i)); \
     } while (0)
-/* voxels lo..hi: their quaternions and positions into rows 0-6 of the voxel scratch rows
-   (SOFTGYM_VOXEL_ROWS, n apart, indexed by voxel), as the seed step's geometry reads them */
-static void softgym_voxel_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const double *pos,
-                               const double *quat, double *rows)
-{
-    Py_ssize_t i;
-    for (int k = 0; k < 4; k++)
-        for (i = lo; i < hi; i++)
-            rows[k * n + i] = quat[4 * i + k];
-    for (int k = 0; k < 3; k++)
-        for (i = lo; i < hi; i++)
-            rows[(4 + k) * n + i] = pos[3 * i + k];
-}
 /* voxels lo..hi but the fixed: the new quaternions from the rows q_out into quat, and their
    rotation matrices into rot (softgym_quat_matrix_wxyz, from registers; rot NULL: none).
-   With pos not NULL, the rows are kept as softgym_voxel_rows leaves them: 8 voxels'
-   positions turned into rows 4-6 with the quaternions' transpose, softgym_voxel_rows for
-   the voxels the transpose does not take (a block with a fixed voxel, whose quaternion
-   stays as it was, and the voxels after the last block).
    Scalar stores: GCC packed each matrix into a 512-bit register with seven shuffles and
    stored it across two cache lines (a voxel's matrix is 72 bytes), and on an Intel Xeon
    the loop waited on that (perf annotate) */
@@ -107,31 +162,21 @@ static void softgym_voxel_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const
 __attribute__((optimize("no-tree-slp-vectorize")))
 #endif
 static void softgym_orient_store(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double *q_out,
-                                 const signed char *fixed, double *quat, double *rot,
-                                 const double *pos)
+                                 const signed char *fixed, double *quat, double *rot)
 {
     Py_ssize_t i = lo;
 #if defined(SOFTGYM_VLANES) && SOFTGYM_VLANES == 8
-    /* without matrices (the seed step that does not read them), 8 voxels at a time: their
-       rows turned back into records where none of them is fixed (2.4 cycles a voxel-step
-       one by one on an Intel Xeon), their positions' records into rows */
+    /* without matrices (the corotational step, which does not read them), 8 voxels at a
+       time: their rows turned back into records where none of them is fixed (2.4 cycles a
+       voxel-step one by one on an Intel Xeon) */
     if (rot == NULL) {
         for (; i + 8 <= hi; i += 8) {
-            if (pos != NULL) {
-                softgym_v8 x, y, z;
-                softgym_v8_load3(pos + 3 * i, &x, &y, &z);
-                memcpy(q_out + 4 * n + i, &x, sizeof x);
-                memcpy(q_out + 5 * n + i, &y, sizeof y);
-                memcpy(q_out + 6 * n + i, &z, sizeof z);
-            }
             long long fx;
             memcpy(&fx, fixed + i, sizeof fx);
             if (fx != 0) {
                 for (Py_ssize_t k = i; k < i + 8; k++)
                     if (!fixed[k])
                         SOFTGYM_ORIENT_STORE1(k, (double *)0);
-                if (pos != NULL)
-                    softgym_voxel_rows(i, i + 8, n, pos, quat, q_out);
                 continue;
             }
             softgym_v8 r[4];
@@ -141,12 +186,9 @@ static void softgym_orient_store(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, dou
         }
     }
 #endif
-    Py_ssize_t rest = i;
     for (; i < hi; i++)
         if (!fixed[i])
             SOFTGYM_ORIENT_STORE1(i, rot);
-    if (pos != NULL)
-        softgym_voxel_rows(rest, hi, n, pos, quat, q_out);
 }
 #undef SOFTGYM_ORIENT_STORE1
 

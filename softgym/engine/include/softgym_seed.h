@@ -147,6 +147,18 @@ static inline void softgym_seed_rows8(Py_ssize_t v, const double *vr, Py_ssize_t
         r[3 + k] = softgym_v8_load(vr + k * vn + v);
     memcpy(&r[7], scale + v, sizeof r[7]);
 }
+/* the same for any 8 voxels idx[0..7], gathered from the voxels' rows (the seed step's
+   state in SOFTGYM_SEED_R_USED builds: the records are not up to date during it) */
+static inline void softgym_seed_gather_rows(const Py_ssize_t *idx, const double *vr,
+                                            Py_ssize_t vn, const double *scale, softgym_vd *r)
+{
+    __m512i ix = _mm512_loadu_si512((const void *)idx);
+    for (int k = 0; k < 3; k++)
+        r[k] = (softgym_vd)_mm512_i64gather_pd(ix, vr + (SOFTGYM_ROW_POS + k) * vn, 8);
+    for (int k = 0; k < 4; k++)
+        r[3 + k] = (softgym_vd)_mm512_i64gather_pd(ix, vr + (SOFTGYM_ROW_QUAT + k) * vn, 8);
+    r[7] = (softgym_vd)_mm512_i64gather_pd(ix, scale, 8);
+}
 /* links whose voxels all lie in the 16 voxels from voxel 1 of the first (a[0]:
    softgym_window8_index): those 16 voxels' records as rows, each link's voxels picked
    from them by a two-source permute. 0 when they do not fit. */
@@ -169,22 +181,40 @@ static inline int softgym_seed_window8(const Py_ssize_t *a, const Py_ssize_t *b,
 }
 #endif
 #endif
-/* links lo..hi by the formula on doubles, in a loop the compiler vectorises */
+/* links lo..hi by the formula on doubles, in a loop the compiler vectorises; the voxels'
+   positions and quaternions from their records, or in the builds whose seed step keeps
+   them in the voxel rows (SOFTGYM_SEED_R_USED: its state there) from the rows vr */
+#if SOFTGYM_SEED_R_USED
+#define SOFTGYM_GEOM_POS(i, k) vr[(SOFTGYM_ROW_POS + (k)) * vn + (i)]
+#define SOFTGYM_GEOM_QUAT(i, k) vr[(SOFTGYM_ROW_QUAT + (k)) * vn + (i)]
+#else
+#define SOFTGYM_GEOM_POS(i, k) pos[3 * (i) + (k)]
+#define SOFTGYM_GEOM_QUAT(i, k) quat[4 * (i) + (k)]
+#endif
 SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_scalar(const int ax, Py_ssize_t lo, Py_ssize_t hi,
                                                     Py_ssize_t n, const Py_ssize_t *v1,
                                                     const Py_ssize_t *v2, const double *pos,
-                                                    const double *quat, const double *scale,
+                                                    const double *quat, const double *vr,
+                                                    Py_ssize_t vn, const double *scale,
                                                     double *o, double *rr)
 {
     SOFTGYM_SEED_GEOM_AXIS(ax);
     SOFTGYM_SEED_GEOM_OUT(o, n);
     Py_ssize_t li;
+    (void)pos;
+    (void)quat;
+    (void)vr;
+    (void)vn;
     SOFTGYM_IVDEP
     for (li = lo; li < hi; li++) {
         Py_ssize_t i = v1[li], j = v2[li];
-        SOFTGYM_DIFF3(pos, i, j, dx, dy, dz);
-        double w = quat[4 * i], x = quat[4 * i + 1], y = quat[4 * i + 2], z = quat[4 * i + 3];
-        double wj = quat[4 * j], xj = quat[4 * j + 1], yj = quat[4 * j + 2], zj = quat[4 * j + 3];
+        double dx = SOFTGYM_GEOM_POS(j, 0) - SOFTGYM_GEOM_POS(i, 0);
+        double dy = SOFTGYM_GEOM_POS(j, 1) - SOFTGYM_GEOM_POS(i, 1);
+        double dz = SOFTGYM_GEOM_POS(j, 2) - SOFTGYM_GEOM_POS(i, 2);
+        double w = SOFTGYM_GEOM_QUAT(i, 0), x = SOFTGYM_GEOM_QUAT(i, 1);
+        double y = SOFTGYM_GEOM_QUAT(i, 2), z = SOFTGYM_GEOM_QUAT(i, 3);
+        double wj = SOFTGYM_GEOM_QUAT(j, 0), xj = SOFTGYM_GEOM_QUAT(j, 1);
+        double yj = SOFTGYM_GEOM_QUAT(j, 2), zj = SOFTGYM_GEOM_QUAT(j, 3);
         SOFTGYM_SEED_GEOM_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, li, dx, dy, dz, w, x, y, z,
                                  wj, xj, yj, zj, scale[i], scale[j], rr);
     }
@@ -209,7 +239,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
     while (al < hi && ((uintptr_t)(o + al) & 63) != 0)
         al++;
     if (al + SOFTGYM_VLANES <= hi) {
-        softgym_seed_geom_scalar(ax, lo, al, n, v1, v2, pos, quat, scale, o, rr);
+        softgym_seed_geom_scalar(ax, lo, al, n, v1, v2, pos, quat, vr, vn, scale, o, rr);
         li = al;
     }
     for (; li + SOFTGYM_VLANES <= hi; li += SOFTGYM_VLANES) {
@@ -223,8 +253,13 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
         } else if (!softgym_seed_window8(v1 + li, v2 + li, vend, vr, vn, scale, gi, gj))
 #endif
         {
+#if SOFTGYM_SEED_R_USED
+            softgym_seed_gather_rows(v1 + li, vr, vn, scale, gi);
+            softgym_seed_gather_rows(v2 + li, vr, vn, scale, gj);
+#else
             softgym_seed_gather(v1 + li, pos, quat, scale, gi);
             softgym_seed_gather(v2 + li, pos, quat, scale, gj);
+#endif
         }
         softgym_vd dx = gj[0] - gi[0], dy = gj[1] - gi[1], dz = gj[2] - gi[2];
         SOFTGYM_SEED_GEOM_LINK_T(softgym_vd, SOFTGYM_VSQRT, softgym_vabs, SOFTGYM_VPUT, li, dx,
@@ -233,11 +268,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
     }
 #endif
     /* the rest (and every link without AVX): the compiler's vectoriser */
-    softgym_seed_geom_scalar(ax, li, hi, n, v1, v2, pos, quat, scale, o, rr);
-#if !(defined(SOFTGYM_VLANES) && SOFTGYM_VLANES == 8)
-    (void)vr;
-    (void)vn;
-#endif
+    softgym_seed_geom_scalar(ax, li, hi, n, v1, v2, pos, quat, vr, vn, scale, o, rr);
 }
 /* vend: the end of the voxel records (voxel indices below it may be read); vr: the
    voxels' rows (SOFTGYM_VOXEL_ROWS: the same quaternions and positions as quat and pos,

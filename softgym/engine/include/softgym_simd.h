@@ -20,14 +20,23 @@
    vector scatter adds its force and moment to a voxel in one 8-lane read-add-write */
 #define SOFTGYM_FM_STRIDE 8
 /* Rows of the per-thread voxel scratch (Batch.vox_out: row k of voxel i at k vox_stride +
-   i): the voxel update's new quaternions (w, x, y, z) in rows 0-3; in the seed model's
-   AVX-512 builds (SOFTGYM_SEED_R_USED) rows 0-3 and the positions (x, y, z) in rows 4-6
-   are the voxels' quaternions and positions throughout its step loop, which the link
-   geometry loads 8 voxels to a vector without transposing records
-   (include/softgym_orient.h: softgym_voxel_rows); in the corotational model's AVX-512
-   builds, rows 0-17 hold the voxels' positions, velocities, angular velocities and
-   rotation matrices during its links pass (include/softgym_corot.h: softgym_corot_rows) */
+   i): the voxel update's new quaternions (w, x, y, z) in rows 0-3 (the corotational
+   model, and the seed model without AVX-512); in the seed model's AVX-512 builds the
+   voxels' state (below); in the corotational model's AVX-512 builds, rows 0-17 hold the
+   voxels' positions, velocities, angular velocities and rotation matrices during its
+   links pass (include/softgym_corot.h: softgym_corot_rows) */
 #define SOFTGYM_VOXEL_ROWS 18
+/* In the seed model's AVX-512 builds the rows are the voxels' state throughout its step
+   loop (_core._advance_seed; written back to the records when it returns,
+   include/softgym_orient.h: softgym_seed_state_rows, softgym_seed_state_back), which its
+   8-voxel blocks and link geometry load and store without transposing records:
+   quaternions (w, x, y, z) in rows 0-3, positions 4-6, velocities 7-9, angular
+   velocities 10-12, and a copy of the external forces in 13-15 */
+#define SOFTGYM_ROW_QUAT 0
+#define SOFTGYM_ROW_POS 4
+#define SOFTGYM_ROW_VEL 7
+#define SOFTGYM_ROW_AV 10
+#define SOFTGYM_ROW_EXT 13
 /* c ? a : b on the bits: compilers keep it a blend (a select before a
    store may otherwise become a masked store, slow on some cores) */
 static inline double softgym_pick(long long c, double a, double b)
