@@ -38,8 +38,9 @@ cdef struct Contacts:
                              #   voxels' x, y, z and size
     intp_t* sur_idx          # (2, n_voxels_r) scratch: their voxel indices, then their
                              #   ranks in the seed's order
-    lane_flag_t* hit         # (n_voxels_r,) scratch: 1 where a pair is a candidate (64-bit:
-                             #   softgym_pair_hits' vector lanes)
+    lane_flag_t* hit         # (n_voxels_r + 8,) scratch: 1 where a pair is a candidate
+                             #   (64-bit: softgym_pair_hits' vector lanes), or with AVX-512
+                             #   the candidates' indices (softgym_pair_idx)
 
 
 # The spatial hash of the candidate lists (_contact.pyx, _hash_*): points in

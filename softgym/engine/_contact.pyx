@@ -211,7 +211,8 @@ cdef inline int _alloc_lists(Contacts* c, intp_t n) noexcept nogil:
         c.ref = <float64_t*> malloc(3 * n * sizeof(float64_t))
         c.sur = <float64_t*> malloc(4 * n * sizeof(float64_t))
         c.sur_idx = <intp_t*> malloc(2 * n * sizeof(intp_t))
-        c.hit = <lane_flag_t*> malloc(n * sizeof(lane_flag_t))
+        # (8 more: softgym_pair_idx stores whole vectors of 8 indices)
+        c.hit = <lane_flag_t*> malloc((n + 8) * sizeof(lane_flag_t))
         if c.cells == NULL or c.row == NULL or c.ref == NULL or c.sur == NULL \
                 or c.sur_idx == NULL or c.hit == NULL:
             return STATUS_MEMORY
@@ -225,6 +226,12 @@ cdef extern from "softgym_pairs.h":
                            const float64_t* y, const float64_t* z, const float64_t* s,
                            const intp_t* rank, float64_t lim2,
                            lane_flag_t* hit) noexcept nogil
+    # with AVX-512 (SOFTGYM_PAIR_IDX 1): the same test, the candidates' indices compressed
+    intp_t softgym_pair_idx(int seed_rule, intp_t a, intp_t n, const float64_t* x,
+                            const float64_t* y, const float64_t* z, const float64_t* s,
+                            const intp_t* rank, float64_t lim2,
+                            lane_flag_t* idx) noexcept nogil
+    enum: SOFTGYM_PAIR_IDX
 
 
 # robots with at most this many surface voxels get the all-pairs test
@@ -294,9 +301,28 @@ cdef inline int _voxel_pairs_all(Batch* b, intp_t r, Contacts* c, const float64_
         ns += 1
     lim2 = 9.0 * L * L if seed_rule else horizon * horizon
     for a in range(ns):
-        last = softgym_pair_hits(seed_rule, a, ns, X, Y, Z, S, RK, lim2, c.hit)
         i = c.sur_idx[a]
         n_row = 0
+        if SOFTGYM_PAIR_IDX:
+            # the candidates' indices, compressed in the vector lanes (c.hit holds them),
+            # each against i's sorted exclusion row in one walk
+            last = softgym_pair_idx(seed_rule, a, ns, X, Y, Z, S, RK, lim2, c.hit)
+            e = b.excl_start[i]
+            e_end = b.excl_start[i + 1]
+            for k in range(last):
+                j = c.sur_idx[c.hit[k]]
+                while e < e_end and b.excl_idx[e] < j:
+                    e += 1
+                if e < e_end and b.excl_idx[e] == j:
+                    continue
+                c.row[n_row] = j
+                n_row += 1
+            if n_row:
+                status = _append_row(c, i, n_row)
+                if status != STATUS_OK:
+                    return status
+            continue
+        last = softgym_pair_hits(seed_rule, a, ns, X, Y, Z, S, RK, lim2, c.hit)
         # the hits come in increasing j (sur_idx is in voxel order) and i's exclusion
         # row is sorted: one walk along it (e) instead of a binary search per hit,
         # whose branches the predictor could not learn; the walk over the flags ends
