@@ -185,9 +185,9 @@ int main(int argc, char **argv)
         softgym_quat_matrix(quat + 4 * i, rot + 9 * i);
         scale[i] = L * (1.0 + 0.01 * urand());
         for (int k = 0; k < 4; k++)
-            vr[k * vn + i] = quat[4 * i + k];
+            vr[(SOFTGYM_ROW_QUAT + k) * vn + i] = quat[4 * i + k];
         for (int k = 0; k < 3; k++)
-            vr[(4 + k) * vn + i] = pos[3 * i + k];
+            vr[(SOFTGYM_ROW_POS + k) * vn + i] = pos[3 * i + k];
     }
     /* empty cells: the identity orientation, unit size (their slots are never used) */
     for (int c = 0; c < NC; c++) {

@@ -74,9 +74,9 @@ cdef struct Batch:
                              #   voxel i at vox_out[k * vox_stride + i], i among the robot's
                              #   voxels (include/softgym_simd.h)
     intp_t vox_stride        # its row stride (the most voxels of one robot)
-    float64_t* state_rows    # NULL, or b.vox_out while the seed step loop of an AVX-512
-                             #   build (SOFTGYM_SEED_R_USED) keeps the voxels' state in its
-                             #   rows (include/softgym_simd.h): pos, quat, vel and angvel are
+    float64_t* state_rows    # NULL, or b.vox_out while a step loop of an AVX-512 build
+                             #   (SOFTGYM_STATE_ROWS) keeps the voxels' state in its rows
+                             #   (include/softgym_simd.h): pos, quat, vel and angvel are
                              #   stale then; voxel_pos / voxel_quat read either
     float64_t* ext_force     # (n_voxels, 3) constant external force (N)
     float64_t* mass          # (n_voxels,) rho L^3 (kg)
@@ -167,7 +167,7 @@ cdef extern from "softgym_simd.h":
     # rows of the per-voxel scratch, Batch.vox_out (the voxel update's quaternions; the
     # seed step's voxel rows)
     enum: SOFTGYM_VOXEL_ROWS
-    # the rows of the seed step's quaternions and positions there
+    # the rows of the step loops' quaternions and positions there
     enum: SOFTGYM_ROW_QUAT
     enum: SOFTGYM_ROW_POS
 

@@ -16,7 +16,7 @@
 from libc.math cimport sqrt, floor
 from libc.stdint cimport int64_t
 from libc.stdlib cimport malloc, realloc, qsort
-from libc.string cimport memcpy, memset
+from libc.string cimport memset
 
 from softgym.engine._batch cimport (Batch, STATUS_OK, STATUS_MEMORY, SOFTGYM_FM_STRIDE,
                                     voxel_pos)
@@ -432,7 +432,11 @@ cdef int contacts_corotational(Batch* b, intp_t r, Contacts* c) noexcept nogil:
         float64_t smax = L, env, horizon
     if _alloc_lists(c, n) != STATUS_OK:
         return STATUS_MEMORY
-    memcpy(c.ref, b.pos + 3 * vs, 3 * n * sizeof(float64_t))
+    # the positions now (the records, or the step loop's state rows: voxel_pos)
+    for i in range(n):
+        c.ref[3 * i] = voxel_pos(b, vs + i, 0)
+        c.ref[3 * i + 1] = voxel_pos(b, vs + i, 1)
+        c.ref[3 * i + 2] = voxel_pos(b, vs + i, 2)
     for i in range(vs, ve):
         if b.scale[i] > smax:
             smax = b.scale[i]
@@ -442,7 +446,7 @@ cdef int contacts_corotational(Batch* b, intp_t r, Contacts* c) noexcept nogil:
     c.built_scale = smax
     c.stale = 0
     c.n_pairs = 0
-    return _voxel_pairs(b, r, c, b.pos, 3, horizon, 0)
+    return _voxel_pairs(b, r, c, c.ref - 3 * vs, 3, horizon, 0)  # (indexed by voxel)
 
 
 cdef int contacts_seed(Batch* b, intp_t r, Contacts* c, int32 snapshot) noexcept nogil:

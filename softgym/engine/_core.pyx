@@ -30,8 +30,8 @@ from softgym.engine._contact cimport (Contacts, contacts_corotational, contacts_
                                       collide_obstacles)
 from softgym.engine._corotational cimport links_corotational
 from softgym.engine._integrate cimport (integrate_corotational, integrate_seed, clear_robot,
-                                       refresh_robot_rotations, seed_voxel_rows,
-                                       seed_state_back)
+                                       refresh_robot_rotations, voxel_state_rows,
+                                       voxel_state_back)
 from softgym.engine._record cimport record, robot_aux, robot_energy
 from softgym.engine._prof cimport softgym_prof_tsc, softgym_prof_add, prof_counts
 from softgym.engine._seed cimport (links_seed, SOFTGYM_CHUNK_STRIDE, SOFTGYM_CHUNK_ROWS,
@@ -134,8 +134,9 @@ def cycle_counts(bint reset=False):
 
 
 cdef extern from "softgym_simd.h":
-    # 1 where the seed step keeps the voxels' state in the voxel rows (AVX-512 builds)
-    enum: SOFTGYM_SEED_R_USED
+    # 1 where both models' step loops keep the voxels' state in the voxel rows (AVX-512
+    # builds)
+    enum: SOFTGYM_STATE_ROWS
 
 
 cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept nogil:
@@ -146,12 +147,12 @@ cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
         int status = STATUS_OK
         float64_t dmax2 = 0.0
         unsigned long long t0
-    # the voxels' state into the voxel rows, where the build's seed step keeps it there
-    # through the loop (SOFTGYM_SEED_R_USED: the geometry and the voxel update read and
-    # write the rows; everything else reads positions and quaternions through
+    # the voxels' state into the voxel rows, where the build keeps it there through the
+    # loop (SOFTGYM_STATE_ROWS: the geometry, the voxel update and the orientation read
+    # and write the rows; everything else reads positions and quaternions through
     # voxel_pos / voxel_quat, _batch.pxd)
-    seed_voxel_rows(b, r)
-    if SOFTGYM_SEED_R_USED:
+    voxel_state_rows(b, r)
+    if SOFTGYM_STATE_ROWS:
         b.state_rows = b.vox_out
     while b.steps[r] < target:
         t0 = softgym_prof_tsc()
@@ -192,7 +193,7 @@ cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
         record(b, r)
         softgym_prof_add(4, t0)
     # the state back into the records
-    seed_state_back(b, r)
+    voxel_state_back(b, r)
     b.state_rows = NULL
     return status
 
@@ -203,6 +204,11 @@ cdef int _advance_corotational(Batch* b, intp_t r, step_t target,
     cdef:
         int status = STATUS_OK
         float64_t smax, dmax2 = 0.0
+    # the voxels' state into the voxel rows for the loop, as _advance_seed (the link
+    # kernel, the voxel update and the orientation read and write the rows)
+    voxel_state_rows(b, r)
+    if SOFTGYM_STATE_ROWS:
+        b.state_rows = b.vox_out
     while b.steps[r] < target:
         # force and moment scratch are zero here: integrate_corotational clears them
         smax = _actuate(b, r)
@@ -227,6 +233,8 @@ cdef int _advance_corotational(Batch* b, intp_t r, step_t target,
                 c.stale = 1
         b.steps[r] += 1
         record(b, r)
+    voxel_state_back(b, r)
+    b.state_rows = NULL
     return status
 
 
@@ -363,7 +371,7 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.rot = _f(a, "rot")
     b.force = _f(a, "force")
     b.vox_out = NULL  # per thread, set by advance
-    b.state_rows = NULL  # set by _advance_seed while its state is in the voxel rows
+    b.state_rows = NULL  # set by the step loops while the state is in the voxel rows
     b.chunk_out = NULL
     b.chunk_f32 = NULL
     b.chunk_link = NULL

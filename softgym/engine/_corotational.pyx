@@ -39,9 +39,9 @@ cdef int links_corotational(Batch* b, intp_t r) noexcept nogil:
         intp_t nx = b.link_axis_count[3 * r]
         intp_t ny = b.link_axis_count[3 * r + 1]
     if COROT_ROWS_USED:
-        # the voxels' records as rows, once a step (softgym_corot_rows)
-        softgym_corot_rows(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.pos, b.vel,
-                           b.angvel, b.quat, b.vox_out)
+        # the voxels' rotation matrices as rows from their quaternion rows, once a step (the
+        # rest of the rows the kernel reads is the step loop's state: softgym_corot_rows)
+        softgym_corot_rows(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.vox_out)
     if _links_along(b, r, lo, lo + nx, 0) != STATUS_OK:
         return STATUS_STRAIN
     if _links_along(b, r, lo + nx, lo + nx + ny, 1) != STATUS_OK:
@@ -64,9 +64,7 @@ cdef extern from "softgym_corot.h":
                              intp_t vend, float64_t* o) noexcept nogil
     # the voxels' rows the kernel's 8-lane paths load (AVX-512 builds: SOFTGYM_COROT_ROWS
     # rows of b.vox_out; elsewhere a no-op, and COROT_ROWS_USED is 0)
-    void softgym_corot_rows(intp_t lo, intp_t hi, intp_t n, const float64_t* pos,
-                            const float64_t* vel, const float64_t* av, const float64_t* quat,
-                            float64_t* rows) noexcept nogil
+    void softgym_corot_rows(intp_t lo, intp_t hi, intp_t n, float64_t* rows) noexcept nogil
     enum: COROT_ROWS_USED
     # the strain check and the scatter in link order: hi, or the first strained link
     intp_t softgym_corot_scatter(intp_t lo, intp_t hi, intp_t n, float64_t max_ext,

@@ -13,16 +13,16 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
 cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
                         float64_t* dmax2) noexcept nogil
     # model 0 (the seed's EulerStep), same contract (rot: as integrate_corotational).
-cdef void seed_voxel_rows(Batch* b, intp_t r) noexcept nogil
-    # robot r's voxel rows (rows 0-6 of b.vox_out: quaternions, positions; 7-15:
-    # velocities, angular velocities, external forces) from quat, pos, vel, angvel and
-    # ext_force, where the build's seed step reads them (SOFTGYM_SEED_R_USED; else
-    # nothing): before its first step of a call, integrate_seed keeps them after each.
-    # The velocity and angular velocity rows are then the robot's state (integrate_seed
-    # reads and writes them, not vel and angvel) until seed_state_back
-cdef void seed_state_back(Batch* b, intp_t r) noexcept nogil
-    # robot r's vel and angvel from the voxel rows, when the seed step loop returns
-    # (SOFTGYM_SEED_R_USED; else nothing)
+cdef void voxel_state_rows(Batch* b, intp_t r) noexcept nogil
+    # robot r's state into the voxel rows of b.vox_out (positions, velocities, angular
+    # velocities, quaternions, and a copy of the external forces: include/softgym_simd.h,
+    # SOFTGYM_ROW_*) from pos, vel, angvel, quat and ext_force, where the build's step
+    # loops keep it there (SOFTGYM_STATE_ROWS; else nothing): before the first step of a
+    # call. The rows are then the robot's state (both models' voxel updates, orientation
+    # steps and link kernels read and write them, not the records) until voxel_state_back
+cdef void voxel_state_back(Batch* b, intp_t r) noexcept nogil
+    # robot r's pos, quat, vel and angvel from the voxel rows, when the step loop returns
+    # (SOFTGYM_STATE_ROWS; else nothing)
 cdef void refresh_robot_rotations(Batch* b, intp_t r) noexcept nogil
     # robot r's rot from its quat where the voxel updates leave it
     # (SOFTGYM_ROT_DEFERRED; else nothing)

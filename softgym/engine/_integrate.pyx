@@ -21,9 +21,9 @@ cdef float64_t RUNAWAY = 1.0e6  # |coordinate| (m) beyond which a robot diverged
 cdef extern from "softgym_simd.h":
     # R = the rotation matrix of the unit quaternion q = (w, x, y, z), row-major
     void _rotation_matrix "softgym_quat_matrix" (const float64_t* q, float64_t* R) noexcept nogil
-    # 1 where the seed model's step reads the voxel rows (rows 0-6 of vox_out:
-    # quaternions, positions) that the seed voxel update keeps
-    enum: SOFTGYM_SEED_R_USED
+    # 1 where both models' step loops keep the voxels' state in the voxel rows of vox_out
+    # (include/softgym_simd.h: SOFTGYM_ROW_POS ...)
+    enum: SOFTGYM_STATE_ROWS
     # 1 where neither model's step reads the voxels' rotation matrices (the seed's
     # scatter takes voxel 1's from the geometry's rows, the corotational links from rows
     # computed from the quaternions): the voxel updates do not store them,
@@ -215,6 +215,9 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
     lo = vs  # (blocks of 8 voxels in vector lanes where they can: _scalar_run)
     while lo < ve:
         hi = _scalar_run(b, r, &lo, 0, ref, c, &dmax, &vmax2)
+        if SOFTGYM_STATE_ROWS and lo < hi:
+            # (as integrate_seed's: the run's state from the rows, back to them after it)
+            softgym_state_back(lo, hi, b.vox_stride, b.vox_out, pos, b.quat, vel, av)
         for i in range(lo, hi):
             if b.fixed[i]:
                 vel[3 * i] = 0.0
@@ -243,12 +246,17 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
                     surface_contact(b, i, 0.0, 0.0, 1.0, pen, dt, f)
             _box_contacts(b, i, k0, k1, dt, f)
             if not (_translate(vel + 3 * i, pos + 3 * i, f, dt * b.inv_mass[i], dt) < RUNAWAY):
+                if SOFTGYM_STATE_ROWS:
+                    softgym_state_rows(lo, hi, b.vox_stride, pos, b.quat, vel, av, NULL,
+                                            b.vox_out)
                 return _ran_away(b, r, i, dt, 0, dmax, dmax2)
             if ref != NULL:
                 dmax = _raise(dmax, _drift2(pos, ref, i, vs, c))
             # rotation: w += M dt / I, global damping; q += 0.5 dt (0, w) q after
             # the loop (_orient: no voxel's update reads another's orientation)
             _spin(b, i, dt, mx, my, mz)
+        if SOFTGYM_STATE_ROWS and lo < hi:
+            softgym_state_rows(lo, hi, b.vox_stride, pos, b.quat, vel, av, NULL, b.vox_out)
         lo = hi
     dmax2[0] = dmax
     _orient(b, vs, ve, dt, 0)
@@ -265,13 +273,16 @@ cdef extern from "softgym_orient.h":
                                  float64_t* rows) noexcept nogil
     void softgym_corot_quats(intp_t lo, intp_t hi, intp_t n, float64_t dt, const float64_t* av,
                              const float64_t* quat, float64_t* q_out) noexcept nogil
+    void softgym_corot_quats_rows(intp_t lo, intp_t hi, intp_t n, float64_t dt,
+                                  const flag_t* fixed, const float64_t* quat,
+                                  float64_t* rows) noexcept nogil
     void softgym_orient_store(intp_t lo, intp_t hi, intp_t n, float64_t* q_out,
                               const flag_t* fixed, float64_t* quat, float64_t* rot) noexcept nogil
-    void softgym_seed_state_rows(intp_t lo, intp_t hi, intp_t n, const float64_t* pos,
+    void softgym_state_rows(intp_t lo, intp_t hi, intp_t n, const float64_t* pos,
                                  const float64_t* quat, const float64_t* vel,
                                  const float64_t* av, const float64_t* ext,
                                  float64_t* rows) noexcept nogil
-    void softgym_seed_state_back(intp_t lo, intp_t hi, intp_t n, const float64_t* rows,
+    void softgym_state_back(intp_t lo, intp_t hi, intp_t n, const float64_t* rows,
                                  float64_t* pos, float64_t* quat, float64_t* vel,
                                  float64_t* av) noexcept nogil
 
@@ -283,10 +294,13 @@ cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int
     cdef:
         intp_t n = b.vox_stride  # the scratch's row stride
         float64_t* qo = b.vox_out
-    if seed and SOFTGYM_SEED_R_USED:
-        # the seed step's state in the voxel rows: the quaternion rows updated in place
-        # (the rotation matrices: refresh_robot_rotations, when the step loop returns)
-        softgym_seed_quats_rows(lo, hi, n, dt, b.fixed, b.quat, qo)
+    if SOFTGYM_STATE_ROWS:
+        # the step's state in the voxel rows: the quaternion rows updated in place (the
+        # rotation matrices: refresh_robot_rotations, when the step loop returns)
+        if seed:
+            softgym_seed_quats_rows(lo, hi, n, dt, b.fixed, b.quat, qo)
+        else:
+            softgym_corot_quats_rows(lo, hi, n, dt, b.fixed, b.quat, qo)
         return
     if seed:
         softgym_seed_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
@@ -296,17 +310,17 @@ cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int
     softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat, NULL if SOFTGYM_ROT_DEFERRED else b.rot)
 
 
-cdef void seed_voxel_rows(Batch* b, intp_t r) noexcept nogil:
+cdef void voxel_state_rows(Batch* b, intp_t r) noexcept nogil:
     # robot r's state into the voxel rows (_integrate.pxd)
-    if SOFTGYM_SEED_R_USED:
-        softgym_seed_state_rows(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.pos, b.quat,
+    if SOFTGYM_STATE_ROWS:
+        softgym_state_rows(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.pos, b.quat,
                                 b.vel, b.angvel, b.ext_force, b.vox_out)
 
 
-cdef void seed_state_back(Batch* b, intp_t r) noexcept nogil:
+cdef void voxel_state_back(Batch* b, intp_t r) noexcept nogil:
     # robot r's state from the voxel rows back into its records (_integrate.pxd)
-    if SOFTGYM_SEED_R_USED:
-        softgym_seed_state_back(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.vox_out,
+    if SOFTGYM_STATE_ROWS:
+        softgym_state_back(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.vox_out,
                                 b.pos, b.quat, b.vel, b.angvel)
 
 
@@ -354,10 +368,10 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
     lo = vs  # (blocks of 8 voxels in vector lanes where they can: _scalar_run)
     while lo < ve:
         hi = _scalar_run(b, r, &lo, 1, ref, c, &dmax, &vmax2)
-        if SOFTGYM_SEED_R_USED and lo < hi:
+        if SOFTGYM_STATE_ROWS and lo < hi:
             # the scalar loop's voxels' state from the rows (the step's), back to them
             # after it
-            softgym_seed_state_back(lo, hi, b.vox_stride, b.vox_out, pos, b.quat, vel, av)
+            softgym_state_back(lo, hi, b.vox_stride, b.vox_out, pos, b.quat, vel, av)
         for i in range(lo, hi):
             if b.fixed[i]:
                 for k in range(3):
@@ -381,8 +395,8 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
             if has_floor:
                 seed_floor(b, i, dt, f)
             if not (_translate(vel + 3 * i, pos + 3 * i, f, dt * b.inv_mass[i], dt) < RUNAWAY):
-                if SOFTGYM_SEED_R_USED:
-                    softgym_seed_state_rows(lo, hi, b.vox_stride, pos, b.quat, vel, av, NULL,
+                if SOFTGYM_STATE_ROWS:
+                    softgym_state_rows(lo, hi, b.vox_stride, pos, b.quat, vel, av, NULL,
                                             b.vox_out)
                 return _ran_away(b, r, i, dt, 1, dmax, dmax2)
             if ref != NULL:
@@ -390,8 +404,8 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
             if track_speed:
                 vmax2 = _raise(vmax2, speed_squared(vel[3 * i], vel[3 * i + 1], vel[3 * i + 2]))
             _spin(b, i, dt, mx, my, mz)
-        if SOFTGYM_SEED_R_USED and lo < hi:
-            softgym_seed_state_rows(lo, hi, b.vox_stride, pos, b.quat, vel, av, NULL, b.vox_out)
+        if SOFTGYM_STATE_ROWS and lo < hi:
+            softgym_state_rows(lo, hi, b.vox_stride, pos, b.quat, vel, av, NULL, b.vox_out)
         lo = hi
     dmax2[0] = dmax
     softgym_prof_add(0, t0)

@@ -163,9 +163,9 @@ HARNESS = _c_harness("softgym_seed.h", r"""
    three ways of loading the voxels: runs, windows of 16, gathers; and its remainder)
    against SOFTGYM_SEED_GEOM_LINK, one link at a time; and, run a chunk at a time as the
    engine does, the rotation rows it leaves for the scatter (AVX-512) against voxel 1's
-   matrix. The runs and windows load the voxel rows vr (quaternions in rows 0-3, positions
-   in 4-6, VN apart); in the builds whose seed step keeps its state there
-   (SOFTGYM_SEED_R_USED) every path does, and the records it is given are NaN (stale during
+   matrix. The runs and windows load the voxel rows vr (quaternions in rows
+   SOFTGYM_ROW_QUAT.., positions in SOFTGYM_ROW_POS.., VN apart); in the builds whose seed step keeps its state there
+   (SOFTGYM_STATE_ROWS) every path does, and the records it is given are NaN (stale during
    that step); elsewhere they are the records' copy */
 enum { VN = 216 };
 static double rr[SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE], vr[SOFTGYM_VOXEL_ROWS * VN];
@@ -210,10 +210,10 @@ int main(void)
         urand_quat(quat + 4 * i);
         for (int k = 0; k < 3; k++) pos[3 * i + k] = 0.01 * (i % 7 + urand());
         sc[i] = 0.01 * (1.0 + 0.1 * urand());
-        for (int k = 0; k < 4; k++) vr[k * VN + i] = quat[4 * i + k];
-        for (int k = 0; k < 3; k++) vr[(4 + k) * VN + i] = pos[3 * i + k];
-        for (int k = 0; k < 3; k++) pos_rec[3 * i + k] = SOFTGYM_SEED_R_USED ? NAN : pos[3 * i + k];
-        for (int k = 0; k < 4; k++) quat_rec[4 * i + k] = SOFTGYM_SEED_R_USED ? NAN : quat[4 * i + k];
+        for (int k = 0; k < 4; k++) vr[(SOFTGYM_ROW_QUAT + k) * VN + i] = quat[4 * i + k];
+        for (int k = 0; k < 3; k++) vr[(SOFTGYM_ROW_POS + k) * VN + i] = pos[3 * i + k];
+        for (int k = 0; k < 3; k++) pos_rec[3 * i + k] = SOFTGYM_STATE_ROWS ? NAN : pos[3 * i + k];
+        for (int k = 0; k < 4; k++) quat_rec[4 * i + k] = SOFTGYM_STATE_ROWS ? NAN : quat[4 * i + k];
     }
     for (int pattern = 0; pattern < 3; pattern++) {
         for (int li = 0; li < N; li++) {
@@ -241,8 +241,9 @@ int main(void)
 COROT_HARNESS = _c_harness("softgym_corot.h", r"""
 /* links along each axis through softgym_corot_links (its 8-lane paths where the build has
    AVX-512: voxel runs, a window of 16 voxels, gathers; its 4-lane gathers; its remainder),
-   with the voxels' rows of softgym_corot_rows, against SOFTGYM_COROT_LINK_T on doubles, one
-   link at a time, for the three link patterns of link_pattern */
+   with the voxels' rows (the step loop's state, the matrices from softgym_corot_rows),
+   against SOFTGYM_COROT_LINK_T on doubles, one link at a time, for the three link patterns
+   of link_pattern */
 enum { NV = 260, N = 203 };  /* N: not a multiple of the lanes */
 static double pos[3 * NV], vel[3 * NV], av[3 * NV], quat[4 * NV], rot[9 * NV], sc[NV];
 static double vr[SOFTGYM_VOXEL_ROWS * NV];
@@ -284,7 +285,17 @@ int main(void)
         }
         sc[i] = 0.01 * (1.0 + 0.1 * urand());
     }
-    softgym_corot_rows(0, NV, NV, pos, vel, av, quat, vr);
+    /* the step loop's state rows, and the matrices softgym_corot_rows derives from them */
+    for (int i = 0; i < NV; i++) {
+        for (int k = 0; k < 3; k++) {
+            vr[(SOFTGYM_ROW_POS + k) * NV + i] = pos[3 * i + k];
+            vr[(SOFTGYM_ROW_VEL + k) * NV + i] = vel[3 * i + k];
+            vr[(SOFTGYM_ROW_AV + k) * NV + i] = av[3 * i + k];
+        }
+        for (int k = 0; k < 4; k++)
+            vr[(SOFTGYM_ROW_QUAT + k) * NV + i] = quat[4 * i + k];
+    }
+    softgym_corot_rows(0, NV, NV, vr);
     for (int li = 0; li < N; li++) {
         ka[li] = 1e4 * (1.0 + urand()), ca[li] = 1.0 + urand(), kb[li] = 0.1 * (1.0 + urand());
         cb[li] = 1e-4 * (1.0 + urand()), kt[li] = 0.05 * (1.0 + urand());

@@ -133,40 +133,28 @@ static inline void softgym_corot_gather4(const Py_ssize_t *idx, const double *po
 #define SOFTGYM_COROT_IDX(R, k) ((R)[k])
 #if defined(SOFTGYM_VLANES) && SOFTGYM_VLANES == 8
 #define SOFTGYM_COROT_ROWS 18
-/* voxels lo..hi's records as rows (n apart, indexed by voxel), the order
-   softgym_corot_gather4 gives them: position 0-2, velocity 3-5, angular velocity 6-8,
-   rotation matrix 9-17 (row-major); once a step, so that the links' 8-lane paths load a
-   voxel's 18 numbers as 18 rows of 8 voxels (no transposes a link). The matrices are
-   computed from the quaternions (the formula that stores rot, softgym_quat_matrix: the
-   same bits in the lanes as one by one; copying rot's records of 9 took scalar loads),
-   so the step does not read rot, which advance_robot refreshes when it returns
-   (SOFTGYM_ROT_DEFERRED) */
-static void softgym_corot_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const double *pos,
-                               const double *vel, const double *av, const double *quat,
-                               double *rows)
+/* the voxels' rotation matrices as rows 9-17 of the voxel rows (n apart, indexed by
+   voxel; row-major), computed from their quaternions in rows SOFTGYM_ROW_QUAT (the
+   formula that stores rot, softgym_quat_matrix: the same bits in the lanes as one by one),
+   once a step, so that the links' 8-lane paths load a voxel's 18 numbers (position,
+   velocity, angular velocity in rows 0-8, the step loop's state: include/softgym_simd.h)
+   as 18 rows of 8 voxels (no transposes a link). The step does not read rot, which
+   advance_robot refreshes when it returns (SOFTGYM_ROT_DEFERRED) */
+static void softgym_corot_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double *rows)
 {
     Py_ssize_t i = lo;
+    const double *q = rows + SOFTGYM_ROW_QUAT * n;
     for (; i + 8 <= hi; i += 8) {
-        softgym_v8 r[4], R[9];
-        const double *rec[3] = {pos, vel, av};
-        for (int k = 0; k < 3; k++) {
-            softgym_v8_load3(rec[k] + 3 * i, &r[0], &r[1], &r[2]);
-            for (int c = 0; c < 3; c++)
-                memcpy(rows + (3 * k + c) * n + i, &r[c], sizeof r[c]);
-        }
-        softgym_v8_load4x4(quat + 4 * i, r);
-        SOFTGYM_QUAT_MATRIX(r[0], r[1], r[2], r[3], R);
+        softgym_v8 R[9];
+        softgym_v8 w = softgym_v8_load(q + i), x = softgym_v8_load(q + n + i);
+        softgym_v8 y = softgym_v8_load(q + 2 * n + i), z = softgym_v8_load(q + 3 * n + i);
+        SOFTGYM_QUAT_MATRIX(w, x, y, z, R);
         for (int k = 0; k < 9; k++)
             memcpy(rows + (9 + k) * n + i, &R[k], sizeof R[k]);
     }
     for (; i < hi; i++) {
-        for (int c = 0; c < 3; c++) {
-            rows[c * n + i] = pos[3 * i + c];
-            rows[(3 + c) * n + i] = vel[3 * i + c];
-            rows[(6 + c) * n + i] = av[3 * i + c];
-        }
         double R[9];
-        softgym_quat_matrix(quat + 4 * i, R);
+        softgym_quat_matrix_wxyz(q[i], q[n + i], q[2 * n + i], q[3 * n + i], R);
         for (int k = 0; k < 9; k++)
             rows[(9 + k) * n + i] = R[k];
     }
@@ -176,7 +164,8 @@ static void softgym_corot_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const
 
 /* links lo..hi, all along axis ax (a compile-time constant in each copy), into the
    rows of the scratch o (stride n): 0 |axial extension|, 1-3 the force on voxel 2,
-   4-6 voxel 1's moment, 7-9 voxel 2's. vr: the voxels' rows of softgym_corot_rows (vn
+   4-6 voxel 1's moment, 7-9 voxel 2's. vr: the voxels' rows (the step loop's state and
+   the matrices of softgym_corot_rows: vn
    apart; NULL: none), vend the robot's end of voxels */
 SOFTGYM_ALWAYS_INLINE void softgym_corot_links_ax(
     const int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double inv_L,
@@ -443,11 +432,9 @@ static Py_ssize_t softgym_corot_scatter(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t
 #define COROT_ROWS_USED 1
 #else
 #define COROT_ROWS_USED 0
-static void softgym_corot_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const double *pos,
-                               const double *vel, const double *av, const double *quat,
-                               double *rows)
+static void softgym_corot_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double *rows)
 {
-    (void)lo; (void)hi; (void)n; (void)pos; (void)vel; (void)av; (void)quat; (void)rows;
+    (void)lo; (void)hi; (void)n; (void)rows;
 }
 #endif
 

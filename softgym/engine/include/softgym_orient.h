@@ -1,10 +1,11 @@
 /* The voxels' orientation step of both models (softgym/engine/_integrate.pyx), in C for
    the vectorising pragma: q + (w dt / 2) x q (w the new angular velocity), renormalised,
    into the scratch rows q_out (4, n), which softgym_orient_store copies back (deriving the
-   rotation matrices where the build's steps read them); in the seed step of AVX-512 builds,
-   whose state lives in the voxel rows, in place there (softgym_seed_quats_rows), with the
-   helpers that move that state between the records and the rows. The same IEEE operations as the scalar code they replaced; one
-   voxel's no longer waits on the previous voxel's. Py_ssize_t comes from Python.h,
+   rotation matrices where the build's steps read them); in AVX-512 builds, whose step
+   loops keep the voxels' state in the voxel rows (SOFTGYM_STATE_ROWS), in place there
+   (softgym_seed_quats_rows, softgym_corot_quats_rows), with the helpers that move that
+   state between the records and the rows. The same IEEE operations as the scalar code
+   they replaced; one voxel's no longer waits on the previous voxel's. Py_ssize_t comes from Python.h,
    which Cython includes first. */
 #ifndef SOFTGYM_ORIENT_H
 #define SOFTGYM_ORIENT_H
@@ -70,7 +71,7 @@ static void softgym_seed_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, doubl
 {
     softgym_quats_impl(1, lo, hi, n, dt, av, av + 1, av + 2, 3, quat, 4, 1, q_out);
 }
-/* the same on the voxel rows, the seed step's state in SOFTGYM_SEED_R_USED builds: the
+/* the same on the voxel rows, the step loop's state in SOFTGYM_STATE_ROWS builds: the
    angular velocities from rows SOFTGYM_ROW_AV, the quaternions of rows SOFTGYM_ROW_QUAT
    updated in place, then the fixed voxels' put back from their records quat (a fixed
    voxel's quaternion never changes, so its record is its row; selecting them in the loop
@@ -92,12 +93,24 @@ static void softgym_corot_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, doub
 {
     softgym_quats_impl(0, lo, hi, n, dt, av, av + 1, av + 2, 3, quat, 4, 1, q_out);
 }
+/* the same on the voxel rows, as softgym_seed_quats_rows */
+static void softgym_corot_quats_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,
+                                     const signed char *fixed, const double *quat, double *rows)
+{
+    const double *r = rows + SOFTGYM_ROW_AV * n;
+    double *q = rows + SOFTGYM_ROW_QUAT * n;
+    softgym_quats_impl(0, lo, hi, n, dt, r, r + n, r + 2 * n, 1, q, 1, n, q);
+    for (Py_ssize_t i = lo; i < hi; i++)
+        if (fixed[i])
+            for (int k = 0; k < 4; k++)
+                q[k * n + i] = quat[4 * i + k];
+}
 
-/* The seed step's state in the voxel rows (SOFTGYM_SEED_R_USED builds; rows
+/* The step loops' state in the voxel rows (SOFTGYM_STATE_ROWS builds; rows
    SOFTGYM_ROW_QUAT, SOFTGYM_ROW_POS, SOFTGYM_ROW_VEL, SOFTGYM_ROW_AV, SOFTGYM_ROW_EXT of
    softgym_simd.h, n apart, indexed by voxel): voxels lo..hi from their records (ext NULL:
    not the external forces), and back (the external forces are constant) */
-static void softgym_seed_state_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const double *pos,
+static void softgym_state_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const double *pos,
                                     const double *quat, const double *vel, const double *av,
                                     const double *ext, double *rows)
 {
@@ -121,7 +134,7 @@ static void softgym_seed_state_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, 
         }
     }
 }
-static void softgym_seed_state_back(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const double *rows,
+static void softgym_state_back(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const double *rows,
                                     double *pos, double *quat, double *vel, double *av)
 {
     for (int k = 0; k < 4; k++) {

@@ -142,13 +142,13 @@ static inline void softgym_seed_rows8(Py_ssize_t v, const double *vr, Py_ssize_t
                                       const double *scale, softgym_vd *r)
 {
     for (int k = 0; k < 3; k++)
-        r[k] = softgym_v8_load(vr + (4 + k) * vn + v);
+        r[k] = softgym_v8_load(vr + (SOFTGYM_ROW_POS + k) * vn + v);
     for (int k = 0; k < 4; k++)
-        r[3 + k] = softgym_v8_load(vr + k * vn + v);
+        r[3 + k] = softgym_v8_load(vr + (SOFTGYM_ROW_QUAT + k) * vn + v);
     memcpy(&r[7], scale + v, sizeof r[7]);
 }
 /* the same for any 8 voxels idx[0..7], gathered from the voxels' rows (the seed step's
-   state in SOFTGYM_SEED_R_USED builds: the records are not up to date during it) */
+   state in SOFTGYM_STATE_ROWS builds: the records are not up to date during it) */
 static inline void softgym_seed_gather_rows(const Py_ssize_t *idx, const double *vr,
                                             Py_ssize_t vn, const double *scale, softgym_vd *r)
 {
@@ -183,8 +183,8 @@ static inline int softgym_seed_window8(const Py_ssize_t *a, const Py_ssize_t *b,
 #endif
 /* links lo..hi by the formula on doubles, in a loop the compiler vectorises; the voxels'
    positions and quaternions from their records, or in the builds whose seed step keeps
-   them in the voxel rows (SOFTGYM_SEED_R_USED: its state there) from the rows vr */
-#if SOFTGYM_SEED_R_USED
+   them in the voxel rows (SOFTGYM_STATE_ROWS: its state there) from the rows vr */
+#if SOFTGYM_STATE_ROWS
 #define SOFTGYM_GEOM_POS(i, k) vr[(SOFTGYM_ROW_POS + (k)) * vn + (i)]
 #define SOFTGYM_GEOM_QUAT(i, k) vr[(SOFTGYM_ROW_QUAT + (k)) * vn + (i)]
 #else
@@ -253,7 +253,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
         } else if (!softgym_seed_window8(v1 + li, v2 + li, vend, vr, vn, scale, gi, gj))
 #endif
         {
-#if SOFTGYM_SEED_R_USED
+#if SOFTGYM_STATE_ROWS
             softgym_seed_gather_rows(v1 + li, vr, vn, scale, gi);
             softgym_seed_gather_rows(v2 + li, vr, vn, scale, gj);
 #else

@@ -25,18 +25,20 @@
    voxels' state (below); in the corotational model's AVX-512 builds, rows 0-17 hold the
    voxels' positions, velocities, angular velocities and rotation matrices during its
    links pass (include/softgym_corot.h: softgym_corot_rows) */
-#define SOFTGYM_VOXEL_ROWS 18
-/* In the seed model's AVX-512 builds the rows are the voxels' state throughout its step
-   loop (_core._advance_seed; written back to the records when it returns,
-   include/softgym_orient.h: softgym_seed_state_rows, softgym_seed_state_back), which its
-   8-voxel blocks and link geometry load and store without transposing records:
-   quaternions (w, x, y, z) in rows 0-3, positions 4-6, velocities 7-9, angular
-   velocities 10-12, and a copy of the external forces in 13-15 */
-#define SOFTGYM_ROW_QUAT 0
-#define SOFTGYM_ROW_POS 4
-#define SOFTGYM_ROW_VEL 7
-#define SOFTGYM_ROW_AV 10
-#define SOFTGYM_ROW_EXT 13
+#define SOFTGYM_VOXEL_ROWS 25
+/* In AVX-512 builds the rows are the voxels' state throughout both models' step loops
+   (_core._advance_seed, _advance_corotational; written back to the records when they
+   return, include/softgym_orient.h: softgym_state_rows, softgym_state_back),
+   which the 8-voxel blocks, the orientation step and the link kernels load and store
+   without transposing records: positions (x, y, z) in rows 0-2, velocities 3-5, angular
+   velocities 6-8 (the order the corotational link kernel reads them in, with the rotation
+   matrices it computes from the quaternions each step in rows 9-17), quaternions (w, x,
+   y, z) 18-21, and a copy of the external forces in 22-24 */
+#define SOFTGYM_ROW_POS 0
+#define SOFTGYM_ROW_VEL 3
+#define SOFTGYM_ROW_AV 6
+#define SOFTGYM_ROW_QUAT 18
+#define SOFTGYM_ROW_EXT 22
 /* c ? a : b on the bits: compilers keep it a blend (a select before a
    store may otherwise become a masked store, slow on some cores) */
 static inline double softgym_pick(long long c, double a, double b)
@@ -373,6 +375,9 @@ static inline softgym_v4 softgym_v4load(const double *row, Py_ssize_t li)
    computed from the quaternions (softgym_corot.h: softgym_corot_rows); the voxel updates
    then do not store them, and advance_robot refreshes them when it returns */
 #define SOFTGYM_ROT_DEFERRED SOFTGYM_SEED_R_USED
+/* 1 where both models' step loops keep the voxels' state in the voxel rows
+   (SOFTGYM_ROW_POS ...: the AVX-512 builds) */
+#define SOFTGYM_STATE_ROWS SOFTGYM_SEED_R_USED
 
 #if defined(_MSC_VER)
 #define SOFTGYM_ALWAYS_INLINE static __forceinline

@@ -1,11 +1,12 @@
-/* The seed model's voxel update (softgym/engine/_integrate.pyx, integrate_seed) for 8
-   voxels at once, in the lanes of AVX-512: the same IEEE operations as the scalar loop,
-   lane by lane, each expression written in the scalar code's shape (so the build fuses
-   the same multiply-adds), the seed's floor with every branch computed and one selected.
-   The voxels' records (position, velocity, angular velocity and external force: 3
-   doubles each; force and moment: halves of one row of SOFTGYM_FM_STRIDE) are turned
-   into rows of 8 lanes and back by two-source permutes. Only for the common block: no
-   fixed voxel, no fluid, no terrain box; a block where a voxel runs away is left to the scalar loop untouched
+/* Both models' voxel updates (softgym/engine/_integrate.pyx, integrate_seed and
+   integrate_corotational) for 8 voxels at once, in the lanes of AVX-512: the same IEEE
+   operations as the scalar loop, lane by lane, each expression written in the scalar
+   code's shape (so the build fuses the same multiply-adds), the seed's floor with every
+   branch computed and one selected. The positions, velocities, angular velocities and
+   external forces come from the voxel rows (the step loops' state in these builds), the
+   force and moment (halves of one row of SOFTGYM_FM_STRIDE a voxel) are turned into rows
+   of 8 lanes by two-source permutes. Only for the common block: no fixed voxel, no fluid,
+   no terrain box; a block where a voxel runs away is left to the scalar loop untouched
    (nothing is stored before the check), which then stops where the seed's loop stops.
    Py_ssize_t comes from Python.h, which Cython includes first. */
 #ifndef SOFTGYM_VOXELS_H
@@ -20,11 +21,10 @@
    and per-voxel constants (the Batch's arrays), the drift reference (ref and the first
    voxel's displacement c, which the block from vs sets; ref NULL: none), whether to
    track the fastest speed, the runaway bound, the running maxima of drift and speed
-   squared (raised), and the voxel rows (rn apart): the seed model's blocks (seed = 1)
-   read and write the positions, velocities and angular velocities in rows
-   SOFTGYM_ROW_POS, SOFTGYM_ROW_VEL and SOFTGYM_ROW_AV (its state there during its step
-   loop) and read the external forces from rows SOFTGYM_ROW_EXT, instead of pos, vel, av
-   and ext */
+   squared (raised), and the voxel rows (rn apart), where both models keep the voxels'
+   positions, velocities and angular velocities during their step loops (rows
+   SOFTGYM_ROW_POS, SOFTGYM_ROW_VEL, SOFTGYM_ROW_AV; a copy of the external forces in
+   SOFTGYM_ROW_EXT): the blocks read and write those, not pos, vel, av and ext */
 #define SOFTGYM_VOXELS8_PARAMS \
     Py_ssize_t i, Py_ssize_t vs, double dt, double g, int has_floor, double *pos, \
     double *vel, double *av, double *force, double *moment, const double *ext, \
@@ -59,28 +59,19 @@
         _mm512_storeu_pd(rows + ((k) + 1) * rn + i, (__m512d)(b)); \
         _mm512_storeu_pd(rows + ((k) + 2) * rn + i, (__m512d)(c)); \
     } while (0)
-/* the block's velocity, position, external force and force as rows (the seed model's
-   velocities, positions and external forces from the voxel rows, the rest transposed from
-   the records); 0 when a voxel of the block is fixed (the scalar loop's case). The moment is
-   loaded by softgym_v8_finish, where it is used (its rows' registers free for the floor's
-   arithmetic before) */
-#define SOFTGYM_VOXELS8_LOAD(seed) \
+/* the block's velocity, position and external force from the voxel rows (the step's
+   state), its force as rows from the records; 0 when a voxel of the block is fixed (the
+   scalar loop's case). The moment is loaded by softgym_v8_finish, where it is used (its
+   rows' registers free for the floor's arithmetic before) */
+#define SOFTGYM_VOXELS8_LOAD \
     long long fx_; \
     memcpy(&fx_, fixed + i, sizeof fx_); \
     if (fx_ != 0) \
         return 0; \
     softgym_v8 v0, v1, v2, p0, p1, p2, F0, F1, F2, E0, E1, E2; \
-    if (seed) { \
-        SOFTGYM_V8_ROWS3(SOFTGYM_ROW_VEL, v0, v1, v2); \
-        SOFTGYM_V8_ROWS3(SOFTGYM_ROW_EXT, E0, E1, E2); \
-    } else { \
-        softgym_v8_load3(vel + 3 * i, &v0, &v1, &v2); \
-        softgym_v8_load3(ext + 3 * i, &E0, &E1, &E2); \
-    } \
-    if (seed) \
-        SOFTGYM_V8_ROWS3(SOFTGYM_ROW_POS, p0, p1, p2); \
-    else \
-        softgym_v8_load3(pos + 3 * i, &p0, &p1, &p2); \
+    SOFTGYM_V8_ROWS3(SOFTGYM_ROW_VEL, v0, v1, v2); \
+    SOFTGYM_V8_ROWS3(SOFTGYM_ROW_EXT, E0, E1, E2); \
+    SOFTGYM_V8_ROWS3(SOFTGYM_ROW_POS, p0, p1, p2); \
     softgym_v8_load4_fm(force + SOFTGYM_FM_STRIDE * i, &F0, &F1, &F2); \
     softgym_v8 cg = softgym_v8_load(c_global + i), m = softgym_v8_load(mass + i)
 
@@ -97,9 +88,9 @@ static inline void softgym_v8_raise_max(softgym_v8 v, double *best)
 
 /* both models' step after the forces (f) and the floor (v possibly stopped): the
    translation, the runaway check (0 and nothing stored when a voxel ran away), the
-   stores, the drift and speed maxima, the angular velocity (velocities and angular
-   velocities in the voxel rows for the seed model: SOFTGYM_VOXELS8_LOAD); returns 1 */
-SOFTGYM_ALWAYS_INLINE int softgym_v8_finish(const int seed, SOFTGYM_VOXELS8_PARAMS,
+   stores, the drift and speed maxima, the angular velocity (positions, velocities and
+   angular velocities in the voxel rows); returns 1 */
+SOFTGYM_ALWAYS_INLINE int softgym_v8_finish(SOFTGYM_VOXELS8_PARAMS,
                                     softgym_v8 v0, softgym_v8 v1,
                                     softgym_v8 v2, softgym_v8 p0, softgym_v8 p1, softgym_v8 p2,
                                     softgym_v8 f0, softgym_v8 f1, softgym_v8 f2)
@@ -113,13 +104,8 @@ SOFTGYM_ALWAYS_INLINE int softgym_v8_finish(const int seed, SOFTGYM_VOXELS8_PARA
     if ((SOFTGYM_V8_LT(run, _mm512_set1_pd(runaway)) & 0xFF) != 0xFF)
         return 0;
     /* the block is stepped: from here on, stores */
-    if (seed) {
-        SOFTGYM_V8_STORE_ROWS3(SOFTGYM_ROW_VEL, vx, vy, vz);
-        SOFTGYM_V8_STORE_ROWS3(SOFTGYM_ROW_POS, px, py, pz);
-    } else {
-        softgym_v8_store3(vel + 3 * i, vx, vy, vz);
-        softgym_v8_store3(pos + 3 * i, px, py, pz);
-    }
+    SOFTGYM_V8_STORE_ROWS3(SOFTGYM_ROW_VEL, vx, vy, vz);
+    SOFTGYM_V8_STORE_ROWS3(SOFTGYM_ROW_POS, px, py, pz);
     /* the 8 voxels' force and moment rows, padding included */
     memset(force + SOFTGYM_FM_STRIDE * i, 0, 8 * SOFTGYM_FM_STRIDE * sizeof(double));
     if (ref != NULL) {
@@ -147,28 +133,22 @@ SOFTGYM_ALWAYS_INLINE int softgym_v8_finish(const int seed, SOFTGYM_VOXELS8_PARA
         softgym_v8_raise_max(s2, vmax2);
     }
     softgym_v8 w0, w1, w2;
-    if (seed)
-        SOFTGYM_V8_ROWS3(SOFTGYM_ROW_AV, w0, w1, w2);
-    else
-        softgym_v8_load3(av + 3 * i, &w0, &w1, &w2);
+    SOFTGYM_V8_ROWS3(SOFTGYM_ROW_AV, w0, w1, w2);
     softgym_v8 hi = dt * softgym_v8_load(inv_inertia + i), rd = softgym_v8_load(rot_damp + i);
     w0 = (w0 + (M0 * hi)) * rd;
     w1 = (w1 + (M1 * hi)) * rd;
     w2 = (w2 + (M2 * hi)) * rd;
-    if (seed)
-        SOFTGYM_V8_STORE_ROWS3(SOFTGYM_ROW_AV, w0, w1, w2);
-    else
-        softgym_v8_store3(av + 3 * i, w0, w1, w2);
+    SOFTGYM_V8_STORE_ROWS3(SOFTGYM_ROW_AV, w0, w1, w2);
     return 1;
 }
-#define SOFTGYM_VOXELS8_FINISH(seed) \
-    return softgym_v8_finish(seed, SOFTGYM_VOXELS8_ARGS, v0, v1, v2, p0, p1, p2, f0, f1, f2)
+#define SOFTGYM_VOXELS8_FINISH \
+    return softgym_v8_finish(SOFTGYM_VOXELS8_ARGS, v0, v1, v2, p0, p1, p2, f0, f1, f2)
 
 /* model 0 (integrate_seed): 1 when voxels i..i+7 were stepped, 0 when nothing was
    written (a fixed voxel in the block, or a runaway one) */
 static int softgym_seed_voxels8(SOFTGYM_VOXELS8_PARAMS)
 {
-    SOFTGYM_VOXELS8_LOAD(1);
+    SOFTGYM_VOXELS8_LOAD;
     softgym_v8 f0 = (((-cg) * v0) + F0) + E0;
     softgym_v8 f1 = (((-cg) * v1) + F1) + E1;
     softgym_v8 f2 = ((((-cg) * v2) + F2) + (m * g)) + E2;
@@ -207,14 +187,14 @@ static int softgym_seed_voxels8(SOFTGYM_VOXELS8_PARAMS)
             f1 = SOFTGYM_V8_PICK(stick, (softgym_v8){0}, f1);
         }
     }
-    SOFTGYM_VOXELS8_FINISH(1);
+    SOFTGYM_VOXELS8_FINISH;
 }
 
 /* model 1 (integrate_corotational: its floor is the common surface contact with the
    normal (0, 0, 1), applied before any box), as softgym_seed_voxels8 */
 static int softgym_corot_voxels8(SOFTGYM_VOXELS8_PARAMS)
 {
-    SOFTGYM_VOXELS8_LOAD(0);
+    SOFTGYM_VOXELS8_LOAD;
     softgym_v8 f0 = (F0 + E0) - (cg * v0);
     softgym_v8 f1 = (F1 + E1) - (cg * v1);
     softgym_v8 f2 = ((F2 + E2) - (cg * v2)) + (m * g);
@@ -273,7 +253,7 @@ static int softgym_corot_voxels8(SOFTGYM_VOXELS8_PARAMS)
             }
         }
     }
-    SOFTGYM_VOXELS8_FINISH(0);
+    SOFTGYM_VOXELS8_FINISH;
 }
 #else
 #define SOFTGYM_VOXELS8 0
