@@ -270,6 +270,14 @@ cdef inline int _append_row(Contacts* c, intp_t i, intp_t n_row) noexcept nogil:
     return STATUS_OK
 
 
+cdef inline bint _not_excluded(Batch* b, intp_t* e, intp_t e_end, intp_t j) noexcept nogil:
+    # whether voxel j is not in the sorted exclusion row b.excl_idx[e[0]..e_end) (e[0]
+    # moves past the entries below j: the caller asks in increasing j)
+    while e[0] < e_end and b.excl_idx[e[0]] < j:
+        e[0] += 1
+    return not (e[0] < e_end and b.excl_idx[e[0]] == j)
+
+
 cdef inline int _voxel_pairs_all(Batch* b, intp_t r, Contacts* c, const float64_t* P,
                                  intp_t stride, float64_t horizon,
                                  const int32 seed_rule) noexcept nogil:
@@ -303,41 +311,28 @@ cdef inline int _voxel_pairs_all(Batch* b, intp_t r, Contacts* c, const float64_
     for a in range(ns):
         i = c.sur_idx[a]
         n_row = 0
-        if SOFTGYM_PAIR_IDX:
-            # the candidates' indices, compressed in the vector lanes (c.hit holds them),
-            # each against i's sorted exclusion row in one walk
-            last = softgym_pair_idx(seed_rule, a, ns, X, Y, Z, S, RK, lim2, c.hit)
-            e = b.excl_start[i]
-            e_end = b.excl_start[i + 1]
-            for k in range(last):
-                j = c.sur_idx[c.hit[k]]
-                while e < e_end and b.excl_idx[e] < j:
-                    e += 1
-                if e < e_end and b.excl_idx[e] == j:
-                    continue
-                c.row[n_row] = j
-                n_row += 1
-            if n_row:
-                status = _append_row(c, i, n_row)
-                if status != STATUS_OK:
-                    return status
-            continue
-        last = softgym_pair_hits(seed_rule, a, ns, X, Y, Z, S, RK, lim2, c.hit)
-        # the hits come in increasing j (sur_idx is in voxel order) and i's exclusion
-        # row is sorted: one walk along it (e) instead of a binary search per hit,
-        # whose branches the predictor could not learn; the walk over the flags ends
-        # at the last hit
+        # the candidates come in increasing j (sur_idx is in voxel order) and i's
+        # exclusion row is sorted: one walk along it (e) instead of a binary search per
+        # candidate, whose branches the predictor could not learn (_not_excluded)
         e = b.excl_start[i]
         e_end = b.excl_start[i + 1]
-        for k in range(a + 1, last + 1):
-            if c.hit[k]:
-                j = c.sur_idx[k]
-                while e < e_end and b.excl_idx[e] < j:
-                    e += 1
-                if e < e_end and b.excl_idx[e] == j:
-                    continue
-                c.row[n_row] = j
-                n_row += 1
+        if SOFTGYM_PAIR_IDX:
+            # the candidates' indices, compressed in the vector lanes (c.hit holds them)
+            last = softgym_pair_idx(seed_rule, a, ns, X, Y, Z, S, RK, lim2, c.hit)
+            for k in range(last):
+                j = c.sur_idx[c.hit[k]]
+                if _not_excluded(b, &e, e_end, j):
+                    c.row[n_row] = j
+                    n_row += 1
+        else:
+            # a flag a pair; the walk over them ends at the last candidate
+            last = softgym_pair_hits(seed_rule, a, ns, X, Y, Z, S, RK, lim2, c.hit)
+            for k in range(a + 1, last + 1):
+                if c.hit[k]:
+                    j = c.sur_idx[k]
+                    if _not_excluded(b, &e, e_end, j):
+                        c.row[n_row] = j
+                        n_row += 1
         if n_row:
             status = _append_row(c, i, n_row)
             if status != STATUS_OK:

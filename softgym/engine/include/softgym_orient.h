@@ -71,21 +71,29 @@ static void softgym_seed_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, doubl
 {
     softgym_quats_impl(1, lo, hi, n, dt, av, av + 1, av + 2, 3, quat, 4, 1, q_out);
 }
-/* the same on the voxel rows, the step loop's state in SOFTGYM_STATE_ROWS builds: the
-   angular velocities from rows SOFTGYM_ROW_AV, the quaternions of rows SOFTGYM_ROW_QUAT
-   updated in place, then the fixed voxels' put back from their records quat (a fixed
-   voxel's quaternion never changes, so its record is its row; selecting them in the loop
-   made it 1.6 times slower) */
-static void softgym_seed_quats_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,
-                                    const signed char *fixed, const double *quat, double *rows)
+/* the same on the voxel rows, the step loop's state in SOFTGYM_STATE_ROWS builds (seed: a
+   compile-time constant, as softgym_quats_impl's): the angular velocities from rows
+   SOFTGYM_ROW_AV, the quaternions of rows SOFTGYM_ROW_QUAT updated in place, then the
+   fixed voxels' put back from their records quat (a fixed voxel's quaternion never
+   changes, so its record is its row; selecting them in the loop made it 1.6 times
+   slower) */
+SOFTGYM_ALWAYS_INLINE void softgym_quats_rows_impl(const int seed, Py_ssize_t lo, Py_ssize_t hi,
+                                                   Py_ssize_t n, double dt,
+                                                   const signed char *fixed, const double *quat,
+                                                   double *rows)
 {
     const double *r = rows + SOFTGYM_ROW_AV * n;
     double *q = rows + SOFTGYM_ROW_QUAT * n;
-    softgym_quats_impl(1, lo, hi, n, dt, r, r + n, r + 2 * n, 1, q, 1, n, q);
+    softgym_quats_impl(seed, lo, hi, n, dt, r, r + n, r + 2 * n, 1, q, 1, n, q);
     for (Py_ssize_t i = lo; i < hi; i++)
         if (fixed[i])
             for (int k = 0; k < 4; k++)
                 q[k * n + i] = quat[4 * i + k];
+}
+static void softgym_seed_quats_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,
+                                    const signed char *fixed, const double *quat, double *rows)
+{
+    softgym_quats_rows_impl(1, lo, hi, n, dt, fixed, quat, rows);
 }
 /* model 1 (corotational) */
 static void softgym_corot_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,
@@ -93,17 +101,10 @@ static void softgym_corot_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, doub
 {
     softgym_quats_impl(0, lo, hi, n, dt, av, av + 1, av + 2, 3, quat, 4, 1, q_out);
 }
-/* the same on the voxel rows, as softgym_seed_quats_rows */
 static void softgym_corot_quats_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,
                                      const signed char *fixed, const double *quat, double *rows)
 {
-    const double *r = rows + SOFTGYM_ROW_AV * n;
-    double *q = rows + SOFTGYM_ROW_QUAT * n;
-    softgym_quats_impl(0, lo, hi, n, dt, r, r + n, r + 2 * n, 1, q, 1, n, q);
-    for (Py_ssize_t i = lo; i < hi; i++)
-        if (fixed[i])
-            for (int k = 0; k < 4; k++)
-                q[k * n + i] = quat[4 * i + k];
+    softgym_quats_rows_impl(0, lo, hi, n, dt, fixed, quat, rows);
 }
 
 /* The step loops' state in the voxel rows (SOFTGYM_STATE_ROWS builds; rows
