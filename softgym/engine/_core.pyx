@@ -31,7 +31,8 @@ from softgym.engine._contact cimport (Contacts, contacts_corotational, contacts_
 from softgym.engine._corotational cimport links_corotational
 from softgym.engine._integrate cimport (integrate_corotational, integrate_seed, clear_robot,
                                        refresh_robot_rotations, voxel_state_rows,
-                                       voxel_state_back)
+                                       voxel_state_back, voxel_state_in_rows,
+                                       voxel_link_rows)
 from softgym.engine._record cimport record, robot_aux, robot_energy
 from softgym.engine._prof cimport softgym_prof_tsc, softgym_prof_add, prof_counts
 from softgym.engine._seed cimport (links_seed, SOFTGYM_CHUNK_STRIDE, SOFTGYM_CHUNK_ROWS,
@@ -147,15 +148,19 @@ cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
         int status = STATUS_OK
         float64_t dmax2 = 0.0
         unsigned long long t0
+        bint in_rows = voxel_state_in_rows(b, r)
     # the voxels' state into the voxel rows, where the build keeps it there through the
-    # loop (SOFTGYM_STATE_ROWS: the geometry, the voxel update and the orientation read
+    # loop (voxel_state_in_rows: the geometry, the voxel update and the orientation read
     # and write the rows; everything else reads positions and quaternions through
-    # voxel_pos / voxel_quat, _batch.pxd)
+    # voxel_pos / voxel_quat, _batch.pxd); else the rows are filled from the records
+    # once a step
     voxel_state_rows(b, r)
-    if SOFTGYM_STATE_ROWS:
+    if in_rows:
         b.state_rows = b.vox_out
     while b.steps[r] < target:
         t0 = softgym_prof_tsc()
+        if SOFTGYM_STATE_ROWS and not in_rows:
+            voxel_link_rows(b, r, 1)  # (the records are the state: the geometry's rows)
         if b.self_collision:
             # the seed's schedule: rebuild once the fastest voxel may have
             # covered half a voxel since the last rebuild
@@ -193,7 +198,8 @@ cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
         record(b, r)
         softgym_prof_add(4, t0)
     # the state back into the records
-    voxel_state_back(b, r)
+    if in_rows:
+        voxel_state_back(b, r)
     b.state_rows = NULL
     return status
 
@@ -204,14 +210,17 @@ cdef int _advance_corotational(Batch* b, intp_t r, step_t target,
     cdef:
         int status = STATUS_OK
         float64_t smax, dmax2 = 0.0
+        bint in_rows = voxel_state_in_rows(b, r)
     # the voxels' state into the voxel rows for the loop, as _advance_seed (the link
     # kernel, the voxel update and the orientation read and write the rows)
     voxel_state_rows(b, r)
-    if SOFTGYM_STATE_ROWS:
+    if in_rows:
         b.state_rows = b.vox_out
     while b.steps[r] < target:
         # force and moment scratch are zero here: integrate_corotational clears them
         smax = _actuate(b, r)
+        if SOFTGYM_STATE_ROWS and not in_rows:
+            voxel_link_rows(b, r, 0)  # (the records are the state: the link kernel's rows)
         status = links_corotational(b, r)
         if status == STATUS_OK and b.self_collision:
             if c.stale or smax > c.built_scale:
@@ -233,7 +242,8 @@ cdef int _advance_corotational(Batch* b, intp_t r, step_t target,
                 c.stale = 1
         b.steps[r] += 1
         record(b, r)
-    voxel_state_back(b, r)
+    if in_rows:
+        voxel_state_back(b, r)
     b.state_rows = NULL
     return status
 

@@ -20,6 +20,16 @@ cdef void voxel_state_rows(Batch* b, intp_t r) noexcept nogil
     # loops keep it there (SOFTGYM_STATE_ROWS; else nothing): before the first step of a
     # call. The rows are then the robot's state (both models' voxel updates, orientation
     # steps and link kernels read and write them, not the records) until voxel_state_back
+cdef void voxel_link_rows(Batch* b, intp_t r, int seed) noexcept nogil
+    # where the records are robot r's state (not voxel_state_in_rows) in a build with the
+    # rows: the rows its link kernels read (seed: positions and quaternions; else also
+    # velocities and angular velocities), from the records
+cdef bint voxel_state_in_rows(Batch* b, intp_t r) noexcept nogil
+    # whether robot r's step loop keeps its state in the voxel rows: in the builds that do
+    # (SOFTGYM_STATE_ROWS), where its voxel update runs 8-voxel blocks (no fluid, no
+    # terrain box); else the records are its state, and the link kernels' rows are filled
+    # from them (voxel_link_rows) once a step, as the scalar voxel loop would otherwise copy
+    # its run to the records and back every step
 cdef void voxel_state_back(Batch* b, intp_t r) noexcept nogil
     # robot r's pos, quat, vel and angvel from the voxel rows, when the step loop returns
     # (SOFTGYM_STATE_ROWS; else nothing)

@@ -112,26 +112,40 @@ static void softgym_corot_quats_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
    softgym_simd.h, n apart, indexed by voxel): voxels lo..hi from their records (ext NULL:
    not the external forces), and back (the external forces are constant) */
 static void softgym_state_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, const double *pos,
-                                    const double *quat, const double *vel, const double *av,
-                                    const double *ext, double *rows)
+                               const double *quat, const double *vel, const double *av,
+                               const double *ext, double *rows)
 {
-    for (int k = 0; k < 4; k++) {
-        double *rq = rows + (SOFTGYM_ROW_QUAT + k) * n;
-        for (Py_ssize_t i = lo; i < hi; i++)
-            rq[i] = quat[4 * i + k];
-    }
-    for (int k = 0; k < 3; k++) {
-        double *rp = rows + (SOFTGYM_ROW_POS + k) * n, *rv = rows + (SOFTGYM_ROW_VEL + k) * n;
-        double *ra = rows + (SOFTGYM_ROW_AV + k) * n;
-        for (Py_ssize_t i = lo; i < hi; i++) {
-            rp[i] = pos[3 * i + k];
-            rv[i] = vel[3 * i + k];
-            ra[i] = av[3 * i + k];
+    /* (vel and av NULL: the positions and quaternions only) */
+    Py_ssize_t i = lo;
+#if defined(SOFTGYM_VLANES) && SOFTGYM_VLANES == 8
+    /* 8 voxels at a time, their records turned into rows of 8 lanes */
+    for (; i + 8 <= hi; i += 8) {
+        softgym_v8 r[4];
+        const double *rec[4] = {pos, vel, av, ext};
+        const int row[4] = {SOFTGYM_ROW_POS, SOFTGYM_ROW_VEL, SOFTGYM_ROW_AV, SOFTGYM_ROW_EXT};
+        for (int m = 0; m < 4; m++) {
+            if (rec[m] == NULL)
+                continue;
+            softgym_v8_load3(rec[m] + 3 * i, &r[0], &r[1], &r[2]);
+            for (int c = 0; c < 3; c++)
+                memcpy(rows + (row[m] + c) * n + i, &r[c], sizeof r[c]);
         }
-        if (ext != NULL) {
-            double *re = rows + (SOFTGYM_ROW_EXT + k) * n;
-            for (Py_ssize_t i = lo; i < hi; i++)
-                re[i] = ext[3 * i + k];
+        softgym_v8_load4x4(quat + 4 * i, r);
+        for (int k = 0; k < 4; k++)
+            memcpy(rows + (SOFTGYM_ROW_QUAT + k) * n + i, &r[k], sizeof r[k]);
+    }
+#endif
+    for (; i < hi; i++) {
+        for (int k = 0; k < 4; k++)
+            rows[(SOFTGYM_ROW_QUAT + k) * n + i] = quat[4 * i + k];
+        for (int k = 0; k < 3; k++) {
+            rows[(SOFTGYM_ROW_POS + k) * n + i] = pos[3 * i + k];
+            if (vel != NULL) {
+                rows[(SOFTGYM_ROW_VEL + k) * n + i] = vel[3 * i + k];
+                rows[(SOFTGYM_ROW_AV + k) * n + i] = av[3 * i + k];
+            }
+            if (ext != NULL)
+                rows[(SOFTGYM_ROW_EXT + k) * n + i] = ext[3 * i + k];
         }
     }
 }
