@@ -16,6 +16,11 @@ Each tree must be a checkout whose extensions are built in place
 
     python benchmarks/compare_builds.py /tmp/before . --rounds 10
     python benchmarks/compare_builds.py /tmp/before . --model corotational
+    python benchmarks/compare_builds.py /tmp/before . --box-fence   # the scalar voxel loop
+
+``--box-fence`` runs the robot in the seed's fence as terrain boxes with surface contact
+(``Terrain.fence()``, ``box_contact="surface"``): a robot with terrain boxes steps every
+voxel in the voxel update's scalar loop, which the reference run does not exercise.
 """
 
 from __future__ import annotations
@@ -35,10 +40,15 @@ import softgym
 from bench_engine import reference_design
 from softgym.engine import SimConfig, Simulation
 design = reference_design()
+terrain = None
+if {box_fence!r}:
+    import dataclasses
+    from softgym.terrain import Terrain
+    terrain = dataclasses.replace(Terrain.fence(), box_contact="surface")
 best = float("inf")
 for _ in range({runs}):
     sim = Simulation([design.to_body()], SimConfig(self_collision=True, model={model!r}),
-                     n_threads=1)
+                     terrain=terrain, n_threads=1)
     t0 = time.perf_counter()
     sim.run({seconds})
     best = min(best, time.perf_counter() - t0)
@@ -46,9 +56,12 @@ print("RESULT " + json.dumps({{"best": best, "module": softgym.__file__, "model"
 """
 
 
-def run_once(tree: Path, runs: int, seconds: float, model: str = "seed") -> float:
-    """The quickest of ``runs`` runs of the reference robot with the softgym of ``tree`` (s)."""
-    code = CHILD.format(bench=str(tree / "benchmarks"), runs=runs, seconds=seconds, model=model)
+def run_once(tree: Path, runs: int, seconds: float, model: str = "seed",
+             box_fence: bool = False) -> float:
+    """The quickest of ``runs`` runs of the reference robot with the softgym of ``tree`` (s);
+    with ``box_fence``, in the seed's fence as terrain boxes."""
+    code = CHILD.format(bench=str(tree / "benchmarks"), runs=runs, seconds=seconds, model=model,
+                        box_fence=bool(box_fence))
     out = run_in_tree(tree, code, "RESULT", "compare_builds", env={"OMP_NUM_THREADS": "1"})
     if out["model"] != model:
         raise SystemExit(f"compare_builds: the run in {tree} stepped {out['model']!r}, not {model!r}")
@@ -63,6 +76,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seconds", type=float, default=5.0, help="simulated time per run")
     ap.add_argument("--model", choices=("seed", "corotational"), default="seed",
                     help="the preset (SimConfig.model) to time")
+    ap.add_argument("--box-fence", action="store_true",
+                    help="the robot in the seed's fence as terrain boxes (the scalar voxel loop)")
     ap.add_argument("--json", action="store_true", help="print one JSON object as the last line")
     args = ap.parse_args(argv)
     trees = [Path(t).resolve() for t in args.trees]
@@ -72,7 +87,7 @@ def main(argv: list[str] | None = None) -> int:
         ap.error("--rounds and --runs must be >= 1, --seconds > 0")
     times: list[list[float]] = [[] for _ in trees]
     for k in range(args.rounds):
-        row = [run_once(t, args.runs, args.seconds, args.model) for t in trees]
+        row = [run_once(t, args.runs, args.seconds, args.model, args.box_fence) for t in trees]
         for col, t in zip(times, row):
             col.append(t)
         print(f"round {k + 1:3d}: " + "  ".join(f"{t:.4f} s" for t in row), flush=True)
@@ -86,7 +101,8 @@ def main(argv: list[str] | None = None) -> int:
               f"speed-up vs the first: {base_min / lo:.3f}x (minima), {base_med / med:.3f}x (medians)")
     if args.json:
         print(json.dumps({"rounds": args.rounds, "runs": args.runs, "seconds": args.seconds,
-                          "model": args.model, "builds": summary}))  # fmt: skip
+                          "model": args.model, "box_fence": args.box_fence,
+                          "builds": summary}))  # fmt: skip
     return 0
 
 

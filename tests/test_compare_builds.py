@@ -39,6 +39,14 @@ def test_the_corotational_preset_is_timed_on_request():
     assert bad.returncode == 2 and "--model" in bad.stderr
 
 
+def test_the_fence_as_terrain_boxes_is_timed_on_request():
+    res = _compare(ROOT, ROOT, "--rounds", 1, "--runs", 1, "--seconds", 0.02, "--box-fence",
+                   "--json")  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    out = json.loads(res.stdout.strip().splitlines()[-1])
+    assert out["box_fence"] is True and len(out["builds"]) == 2
+
+
 def test_a_tree_without_softgym_is_refused_with_the_reason(tmp_path):
     # softgym would come from the installed checkout, not from the tree asked for
     (tmp_path / "benchmarks").mkdir()
