@@ -127,8 +127,7 @@ cdef extern from "softgym_voxels.h":
     int SOFTGYM_VOXELS8
     int voxels8 "softgym_voxels8" (
         int seed, intp_t i, intp_t vs, float64_t dt, float64_t g, int has_floor,
-        float64_t* pos, float64_t* vel, float64_t* av, float64_t* force, float64_t* moment,
-        const float64_t* ext, const float64_t* c_global, const float64_t* mass,
+        float64_t* force, float64_t* moment, const float64_t* c_global, const float64_t* mass,
         const float64_t* inv_mass, const float64_t* inv_inertia, const float64_t* rot_damp,
         const float64_t* scale, const float64_t* k_floor, const float64_t* c_floor,
         const float64_t* mu_s, const float64_t* mu_k, const flag_t* fixed,
@@ -150,8 +149,8 @@ cdef inline intp_t _scalar_run(Batch* b, intp_t r, intp_t* lo, int seed, const f
     if not SOFTGYM_VOXELS8 or b.fluid_drag > 0.0 or b.box_start[r] != b.box_start[r + 1]:
         return ve
     while lo[0] + 8 <= ve:
-        if not voxels8(seed, lo[0], vs, b.dt[r], b.gravity, b.floor[r], b.pos, b.vel, b.angvel, b.force,
-                     b.moment, b.ext_force, b.c_global, b.mass, b.inv_mass, b.inv_inertia,
+        if not voxels8(seed, lo[0], vs, b.dt[r], b.gravity, b.floor[r], b.force, b.moment,
+                     b.c_global, b.mass, b.inv_mass, b.inv_inertia,
                      b.rot_damp, b.scale, b.k_floor, b.c_floor, b.mu_s, b.mu_k, b.fixed, ref,
                      c, b.self_collision and seed, RUNAWAY, dmax, vmax2, b.vox_out,
                      b.vox_stride):

@@ -24,19 +24,18 @@
    squared (raised), and the voxel rows (rn apart), where both models keep the voxels'
    positions, velocities and angular velocities during their step loops (rows
    SOFTGYM_ROW_POS, SOFTGYM_ROW_VEL, SOFTGYM_ROW_AV; a copy of the external forces in
-   SOFTGYM_ROW_EXT): the blocks read and write those, not pos, vel, av and ext */
+   SOFTGYM_ROW_EXT): the blocks read and write those, not the records */
 #define SOFTGYM_VOXELS8_PARAMS \
-    Py_ssize_t i, Py_ssize_t vs, double dt, double g, int has_floor, double *pos, \
-    double *vel, double *av, double *force, double *moment, const double *ext, \
-    const double *c_global, const double *mass, const double *inv_mass, \
+    Py_ssize_t i, Py_ssize_t vs, double dt, double g, int has_floor, double *force, \
+    double *moment, const double *c_global, const double *mass, const double *inv_mass, \
     const double *inv_inertia, const double *rot_damp, const double *scale, \
     const double *k_floor, const double *c_floor, const double *mu_s, const double *mu_k, \
     const signed char *fixed, const double *ref, double *c, int track_speed, \
     double runaway, double *dmax, double *vmax2, double *rows, Py_ssize_t rn
 
-#define SOFTGYM_VOXELS8_ARGS i, vs, dt, g, has_floor, pos, vel, av, force, moment, ext, \
-    c_global, mass, inv_mass, inv_inertia, rot_damp, scale, k_floor, c_floor, mu_s, mu_k, \
-    fixed, ref, c, track_speed, runaway, dmax, vmax2, rows, rn
+#define SOFTGYM_VOXELS8_ARGS i, vs, dt, g, has_floor, force, moment, c_global, mass, \
+    inv_mass, inv_inertia, rot_damp, scale, k_floor, c_floor, mu_s, mu_k, fixed, ref, c, \
+    track_speed, runaway, dmax, vmax2, rows, rn
 
 #if defined(__AVX512F__) && (defined(__GNUC__) || defined(__clang__))
 #define SOFTGYM_VOXELS8 1
