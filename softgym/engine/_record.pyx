@@ -37,6 +37,7 @@ cdef void robot_aux(Batch* b, intp_t r, float64_t* out) noexcept nogil:
         intp_t i, k
         intp_t be = b.body_end[r]
         float64_t m, mo = 0.0
+        float64_t x, y, z
         float64_t R[9]
         float64_t q[4]
     for k in range(N_AUX):
@@ -54,16 +55,19 @@ cdef void robot_aux(Batch* b, intp_t r, float64_t* out) noexcept nogil:
         _rotation_matrix(q, R)
         out[3] += m * R[0]
         out[4] += m * R[3]
-        if voxel_pos(b, i, 0) < out[5]:
-            out[5] = voxel_pos(b, i, 0)
-        if voxel_pos(b, i, 0) > out[6]:
-            out[6] = voxel_pos(b, i, 0)
-        if voxel_pos(b, i, 1) < out[7]:
-            out[7] = voxel_pos(b, i, 1)
-        if voxel_pos(b, i, 1) > out[8]:
-            out[8] = voxel_pos(b, i, 1)
-        if voxel_pos(b, i, 2) > out[9]:
-            out[9] = voxel_pos(b, i, 2)
+        x = voxel_pos(b, i, 0)
+        y = voxel_pos(b, i, 1)
+        z = voxel_pos(b, i, 2)
+        if x < out[5]:
+            out[5] = x
+        if x > out[6]:
+            out[6] = x
+        if y < out[7]:
+            out[7] = y
+        if y > out[8]:
+            out[8] = y
+        if z > out[9]:
+            out[9] = z
     for i in range(be, b.vox_start[r + 1]):
         m = b.mass[i]
         mo += m
