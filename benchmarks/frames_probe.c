@@ -13,7 +13,8 @@
    IN: the geometry as links_seed's rows 0-9 leave it for the frames pass (p0, p1, p2, qw,
    n1, n2, n3, nominal length, chord length, mode 1.0 small / 0.0 large), a little-endian
    int64 link count n (a multiple of SOFTGYM_CHUNK_LINKS) then 10 rows of n doubles.
-   OUT: the pass's 12 float rows (P0, P1, P2, a1y, a1z, a2x, a2y, a2z, rw, ry, rz, fix), 12
+   The probe adds row 10 as the modes pass leaves it (the axial displacement in the link's
+   mode). OUT: the pass's 12 float rows (P0, P1, P2, a1y, a1z, a2x, a2y, a2z, rw, ry, rz, fix), 12
    rows of n floats. Prints the quickest of REPS sweeps over the links in time-stamp
    counter cycles per 16 links. */
 #include <math.h>
@@ -25,6 +26,8 @@
 typedef long Py_ssize_t;
 #include "softgym_seed.h"
 
+/* the rows of a chunk's scratch the pass reads: the geometry's 0-9 and the modes pass's 10 */
+#define SOFTGYM_PROBE_ROWS 11
 /* the engine's constants (_seed.pyx: SMALL_ANGLE_RAD, ACOS2SQRT_W) */
 #define PROBE_SMALL_ANGLE_RAD 1.732e-2f
 #define PROBE_ACOS2SQRT_W 0.9988f
@@ -49,29 +52,35 @@ int main(int argc, char **argv)
         reps = 1;
     const Py_ssize_t nchunks = n / cl;
     /* each chunk's 10 rows of geometry, cs apart, as links_seed's scratch holds them */
-    double *geo = aligned_alloc(64, sizeof(double) * 10 * cs * nchunks);
+    double *geo = aligned_alloc(64, sizeof(double) * SOFTGYM_PROBE_ROWS * cs * nchunks);
     float *out = aligned_alloc(64, sizeof(float) * SOFTGYM_CHUNK_FROWS * fs);
     float *res = malloc(sizeof(float) * 12 * n);
     double *row = malloc(sizeof(double) * n);
     if (geo == NULL || out == NULL || res == NULL || row == NULL)
         return 2;
-    memset(geo, 0, sizeof(double) * 10 * cs * nchunks);
+    memset(geo, 0, sizeof(double) * SOFTGYM_PROBE_ROWS * cs * nchunks);
     for (int k = 0; k < 10; k++) {
         if (fread(row, sizeof(double), n, fin) != (size_t)n) {
             fprintf(stderr, "frames_probe: short input\n");
             return 2;
         }
         for (Py_ssize_t c = 0; c < nchunks; c++)
-            memcpy(geo + (c * 10 + k) * cs, row + c * cl, sizeof(double) * cl);
+            memcpy(geo + (c * SOFTGYM_PROBE_ROWS + k) * cs, row + c * cl, sizeof(double) * cl);
     }
     fclose(fin);
+    /* row 10 as the modes pass leaves it: the axial displacement in the link's mode */
+    for (Py_ssize_t c = 0; c < nchunks; c++) {
+        double *g = geo + c * SOFTGYM_PROBE_ROWS * cs;
+        for (Py_ssize_t li = 0; li < cl; li++)
+            g[10 * cs + li] = (g[9 * cs + li] != 0.0 ? g[li] : g[8 * cs + li]) - g[7 * cs + li];
+    }
     unsigned long long best = ~0ULL;
     int fixes = 0;
     for (long r = 0; r < reps; r++) {
         unsigned long long t0 = __rdtsc();
         for (Py_ssize_t c = 0; c < nchunks; c++)
             fixes += softgym_seed_frames32(0, cl, cs, PROBE_SMALL_ANGLE_RAD, PROBE_ACOS2SQRT_W,
-                                           geo + c * 10 * cs, out);
+                                           geo + c * SOFTGYM_PROBE_ROWS * cs, out);
         unsigned long long t = __rdtsc() - t0;
         if (t < best)
             best = t;
@@ -79,7 +88,7 @@ int main(int argc, char **argv)
     /* the results of one more sweep, chunk by chunk */
     for (Py_ssize_t c = 0; c < nchunks; c++) {
         softgym_seed_frames32(0, cl, cs, PROBE_SMALL_ANGLE_RAD, PROBE_ACOS2SQRT_W,
-                              geo + c * 10 * cs, out);
+                              geo + c * SOFTGYM_PROBE_ROWS * cs, out);
         for (int k = 0; k < 12; k++)
             memcpy(res + k * n + c * cl, out + k * fs, sizeof(float) * cl);
     }

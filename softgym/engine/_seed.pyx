@@ -424,6 +424,9 @@ def seed_frames(float64_t[:, ::1] geom, bint scalar=False, bint single=False):
     for k in range(10):
         for li in range(n):
             op[k * stride + li] = geom[k, li]
+    for li in range(n):  # row 10 as softgym_seed_modes leaves it: P0 in the link's mode
+        op[10 * stride + li] = (op[li] if op[9 * stride + li] != 0.0
+                                else op[8 * stride + li]) - op[7 * stride + li]
     with nogil:
         if single:
             c0 = 0

@@ -426,9 +426,10 @@ static int softgym_seed_frames(
    frames and forces passes in float, 16 lanes of AVX-512 instead of 8 and
    the divider's float rate, on quantities relative to voxel 1 (positions
    stay double; the geometry and mode passes stay double). The frames' float rows
-   take the first floats of the scratch's double rows 10-21; the forces pass
+   are a chunk's float scratch (SOFTGYM_CHUNK_FROWS rows); the forces pass
    leaves doubles for the scatter. Reformulated where float would cancel:
-   - the displacements p0 - nom and |p| - nom are taken in double, then rounded;
+   - the displacements p0 - nom and |p| - nom are taken in double (the modes pass
+     leaves the link's mode's one in row 10), then rounded;
    - the rotation vector of a unit quaternion (w, v) is k v with the seed's
      k = 2 sqrt((2 - 2w) / (1 - w^2)), which is 2 sqrt(2 / (1 + w)) exactly:
      that form, with no cancellation near w = 1 (the seed's own form loses
@@ -458,8 +459,8 @@ static inline float softgym_rotvec_k32_acos(float w, float w_acos)
 SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_impl(
     const int all_small, Py_ssize_t lo, Py_ssize_t hi, float sa_rad, float w_acos,
     const double *p0_, const double *p1_, const double *p2_, const double *qw_,
-    const double *n1_, const double *n2_, const double *n3_, const double *nom_,
-    const double *len_, const double *sa_, float *o_P0, float *o_P1, float *o_P2,
+    const double *n1_, const double *n2_, const double *n3_, const double *P0_,
+    const double *sa_, float *o_P0, float *o_P1, float *o_P2,
     float *o_a1y, float *o_a1z, float *o_a2x, float *o_a2y, float *o_a2z, float *o_rw,
     float *o_ry, float *o_rz, float *o_fix)
 {
@@ -467,8 +468,7 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_impl(
     int any_fix = 0;
     SOFTGYM_IVDEP
     for (li = lo; li < hi; li++) {
-        double p0d = p0_[li], nomd = nom_[li];
-        float p0 = (float)p0d, p1 = (float)p1_[li], p2 = (float)p2_[li];
+        float p0 = (float)p0_[li], p1 = (float)p1_[li], p2 = (float)p2_[li];
         float qw = (float)qw_[li], n1 = (float)n1_[li], n2 = (float)n2_[li];
         float n3 = (float)n3_[li];
         int is_sa = all_small ? 1 : sa_[li] != 0.0;
@@ -482,8 +482,7 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_impl(
         float w2 = is_sa ? qw : tw;
         float k2 = softgym_rotvec_k32_acos(w2, w_acos);
         fix |= w2 < 0.5f;
-        float P0_s = (float)(p0d - nomd), P0_l = (float)(len_[li] - nomd);
-        o_P0[li] = is_sa ? P0_s : P0_l;
+        o_P0[li] = (float)P0_[li];
         o_P1[li] = is_sa ? p1 : 0.0f;
         o_P2[li] = is_sa ? p2 : 0.0f;
         o_a1y[li] = (is_sa | zero) ? 0.0f : a1y;
@@ -499,8 +498,9 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_impl(
     }
     return any_fix;
 }
-/* the frames pass in float: rows in as softgym_seed_frames, float rows out (row k at f +
-   k SOFTGYM_CHUNK_FSTRIDE, indexed by link); returns whether any link got fix = 1 */
+/* the frames pass in float: rows in as softgym_seed_frames, but the axial displacement P0
+   from row 10 (softgym_seed_modes leaves it) instead of rows 7 and 8, float rows out (row k
+   at f + k SOFTGYM_CHUNK_FSTRIDE, indexed by link); returns whether any link got fix = 1 */
 static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, float sa_rad,
                                  float w_acos, const double *o, float *f)
 {
@@ -509,7 +509,7 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
     const int all_small = softgym_all_nonzero(sa_, lo, hi);
 #define SOFTGYM_FRAMES32(s) softgym_seed_frames32_impl( \
             s, lo, hi, sa_rad, w_acos, o, o + n, o + 2 * n, o + 3 * n, o + 4 * n, o + 5 * n, \
-            o + 6 * n, o + 7 * n, o + 8 * n, sa_, f, f + fs, f + 2 * fs, f + 3 * fs, \
+            o + 6 * n, o + 10 * n, sa_, f, f + fs, f + 2 * fs, f + 3 * fs, \
             f + 4 * fs, f + 5 * fs, f + 6 * fs, f + 7 * fs, f + 8 * fs, f + 9 * fs, \
             f + 10 * fs, f + 11 * fs)
     int any_fix = all_small ? SOFTGYM_FRAMES32(1) : SOFTGYM_FRAMES32(0);
@@ -549,8 +549,12 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
    so the loop vectorises: each link's mode, small or large angle, with the
    seed's hysteresis (updates link_sa), from the rows the geometry left
    (p0: row 0, qw: 3, nominal length: 7, chord length: 8, transverse ratio:
-   9). Row 9 becomes the mode as 1.0 / 0.0, row 22 1.0 on a mode-change
-   step, row 23 1.0 where voxel 2 takes -F1 (then or for a single material).
+   9). Row 9 becomes the mode as 1.0 / 0.0, row 10 the axial displacement P0
+   (p0 - nominal length in small-angle mode, chord - nominal length in large:
+   the strain check's, which the single-precision frames pass rounds to float
+   instead of taking both differences and selecting one), row 22 1.0 on a
+   mode-change step, row 23 1.0 where voxel 2 takes -F1 (then or for a single
+   material).
    Then the strain check: returns hi, or the first link whose extension is
    beyond max_ext (NaN included); the links after it keep their old mode
    (old = new xor changed), as in the seed's scalar loop, which stops there.
@@ -578,6 +582,7 @@ static Py_ssize_t softgym_seed_modes(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
         long long ch = enter | leave;
         long long s2 = sa ^ ch;
         double P0 = softgym_pick(s2, p0 - nom, len - nom);
+        o[10 * n + li] = P0;
         link_sa[li] = s2;
         o[9 * n + li] = softgym_pick(s2, 1.0, 0.0);
         o[22 * n + li] = softgym_pick(ch, 1.0, 0.0);
@@ -614,6 +619,7 @@ static Py_ssize_t softgym_seed_modes(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
         o[22 * n + li] = changed ? 1.0 : 0.0;
         o[23 * n + li] = (changed || homog[li]) ? 1.0 : 0.0;
         P0 = sa ? p0 - nom : o[8 * n + li] - nom;
+        o[10 * n + li] = P0;
         if (!(fabs(P0) <= max_ext))
             return li;  /* also catches NaN */
     }
