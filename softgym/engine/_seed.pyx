@@ -307,7 +307,9 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     #                        (once per axis: each run gets a copy with the axis
     #                        constant)
     #   softgym_seed_modes   the mode (link_sa; row 9 becomes 1.0 small / 0.0
-    #                        large angle), row 22 1.0 on a mode-change step,
+    #                        large angle), row 10 the axial displacement P0 in
+    #                        that mode (the single-precision frames read it),
+    #                        row 22 1.0 on a mode-change step,
     #                        row 23 1.0 where voxel 2 takes -F1, the strain
     #                        check (stops at the first strained link)
     #   softgym_seed_frames  rows 10-20: displacement P, rotation vectors a1
