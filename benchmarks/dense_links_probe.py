@@ -17,30 +17,14 @@ x86-64 only, needs a C compiler (``cc``). The probe's findings are in
 from __future__ import annotations
 
 import argparse
-import os
-import platform
-import shutil
 import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
-HERE = Path(__file__).resolve().parent
-INCLUDE = HERE.parent / "softgym" / "engine" / "include"
-FLAGS = ["-O3", "-ffp-contract=fast", "-fno-math-errno", "-fno-trapping-math"]
-LEVELS = {"baseline": [], "x86-64-v3": ["-march=x86-64-v3"], "x86-64-v4": ["-march=x86-64-v4"]}
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-
-def build(level: str, out: Path) -> Path | None:
-    """The probe compiled for ``level`` in ``out``, or None if the compiler refuses."""
-    exe = out / f"dense_links_probe_{level}"
-    cmd = [os.environ.get("CC", "cc"), *FLAGS, *LEVELS[level], f"-I{INCLUDE}",
-           str(HERE / "dense_links_probe.c"), "-o", str(exe), "-lm"]  # fmt: skip
-    res = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    if res.returncode != 0:
-        print(f"{level}: the compiler refused it ({res.stderr.strip().splitlines()[-1:]})")
-        return None
-    return exe
+from c_probe import LEVELS, build, unavailable  # noqa: E402
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -52,16 +36,14 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     if not 2 <= args.n <= 40 or not 0.0 < args.fill <= 1.0:
         ap.error("--n in [2, 40], --fill in (0, 1]")
-    if platform.machine().lower() not in {"x86_64", "amd64"}:
-        print("dense_links_probe: x86-64 only (it reads the time-stamp counter)")
-        return 2
-    if shutil.which(os.environ.get("CC", "cc")) is None:
-        print("dense_links_probe: no C compiler (cc) on PATH")
+    why = unavailable("dense_links_probe")
+    if why:
+        print(why)
         return 2
     status = 0
     with tempfile.TemporaryDirectory() as tmp:
         for level in args.levels:
-            exe = build(level, Path(tmp))
+            exe = build("dense_links_probe.c", level, Path(tmp))
             if exe is None:  # (the engine's headers changed under it: a failure)
                 status = 1
                 continue

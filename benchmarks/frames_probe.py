@@ -22,9 +22,6 @@ candidates; any mix computes both for every link. x86-64 only, needs a C compile
 from __future__ import annotations
 
 import argparse
-import os
-import platform
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -32,10 +29,10 @@ from pathlib import Path
 
 import numpy as np
 
-HERE = Path(__file__).resolve().parent
-INCLUDE = HERE.parent / "softgym" / "engine" / "include"
-FLAGS = ["-O3", "-ffp-contract=fast", "-fno-math-errno", "-fno-trapping-math"]
-LEVELS = {"baseline": [], "x86-64-v3": ["-march=x86-64-v3"], "x86-64-v4": ["-march=x86-64-v4"]}
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from c_probe import LEVELS, build, unavailable  # noqa: E402
+
 CHUNK = 64  # SOFTGYM_CHUNK_LINKS
 LINKS_PER_VOXEL = 2.5  # the 6^3 reference robot: 540 links, 216 voxels
 
@@ -59,18 +56,6 @@ def geometry(n: int, large: float, rng: np.random.Generator) -> np.ndarray:
     return np.vstack([p, q, nom, np.linalg.norm(p, axis=0), np.where(is_large, 0.0, 1.0)])
 
 
-def build(level: str, out: Path, extra: list[str]) -> Path | None:
-    """The probe compiled for ``level`` in ``out``, or None if the compiler refuses."""
-    exe = out / f"frames_probe_{level}"
-    cmd = [os.environ.get("CC", "cc"), *FLAGS, *LEVELS[level], *extra, f"-I{INCLUDE}",
-           str(HERE / "frames_probe.c"), "-o", str(exe), "-lm"]  # fmt: skip
-    res = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    if res.returncode != 0:
-        print(f"{level}: the compiler refused it ({res.stderr.strip().splitlines()[-1:]})")
-        return None
-    return exe
-
-
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--large", type=float, nargs="+", default=[0.0, 0.25, 0.5, 1.0],
@@ -88,11 +73,9 @@ def main(argv: list[str] | None = None) -> int:
         or not all(0.0 <= s <= 1.0 for s in args.large)
     ):
         ap.error("--chunks in [1, 4096], --reps >= 1, --large shares in [0, 1]")
-    if platform.machine().lower() not in {"x86_64", "amd64"}:
-        print("frames_probe: x86-64 only (it reads the time-stamp counter)")
-        return 2
-    if shutil.which(os.environ.get("CC", "cc")) is None:
-        print("frames_probe: no C compiler (cc) on PATH")
+    why = unavailable("frames_probe")
+    if why:
+        print(why)
         return 2
     from softgym.engine import _core
     from softgym.engine._dispatch import FUSED_KERNELS, kernel_build
@@ -111,7 +94,7 @@ def main(argv: list[str] | None = None) -> int:
                 fh.write(np.ascontiguousarray(geom, dtype="<f8").tobytes())
             inputs.append((share, geom, path))
         for level in args.levels:
-            exe = build(level, tmpd, args.flags)
+            exe = build("frames_probe.c", level, tmpd, args.flags)
             if exe is None:  # (the engine's headers changed under it: a failure)
                 status = 1
                 continue

@@ -4,25 +4,12 @@ headers and agrees with the engine's passes bit for bit.
 Run as a user runs it (a child process); skipped without a C compiler or off x86-64.
 """
 
-import os
-import platform
-import shutil
-import subprocess
-import sys
-from pathlib import Path
-
-import pytest
-
-ROOT = Path(__file__).resolve().parents[1]
-SCRIPT = ROOT / "benchmarks" / "dense_links_probe.py"
+from c_probes import needs_cc_on_x86_64, run_probe  # tests/c_probes.py
 
 
-@pytest.mark.skipif(shutil.which(os.environ.get("CC", "cc")) is None
-                    or platform.machine().lower() not in {"x86_64", "amd64"},
-                    reason="needs a C compiler on x86-64")  # fmt: skip
+@needs_cc_on_x86_64
 def test_the_probe_builds_and_matches_the_engine_bit_for_bit():
-    res = subprocess.run([sys.executable, str(SCRIPT), "--n", "3", "--fill", "0.8"],
-                         capture_output=True, text=True, timeout=600)  # fmt: skip
+    res = run_probe("dense_links_probe.py", "--n", "3", "--fill", "0.8")
     assert res.returncode == 0, res.stdout + res.stderr
     runs = [line for line in res.stdout.splitlines() if line.startswith("  bit identity:")]
     assert runs, res.stdout  # at least the portable build ran
