@@ -182,10 +182,11 @@ cdef inline float64_t voxel_pos(const Batch* b, intp_t i, int k) noexcept nogil:
 cdef inline void voxel_quat(const Batch* b, intp_t i, float64_t* q) noexcept nogil:
     # q[0:4] = voxel i's quaternion (w, x, y, z), from the records or the state rows
     cdef int k
-    for k in range(4):
-        if b.state_rows != NULL:
+    if b.state_rows != NULL:
+        for k in range(4):
             q[k] = b.state_rows[(SOFTGYM_ROW_QUAT + k) * b.vox_stride + i]
-        else:
+    else:
+        for k in range(4):
             q[k] = b.quat[4 * i + k]
 
 

@@ -30,9 +30,8 @@ from softgym.engine._contact cimport (Contacts, contacts_corotational, contacts_
                                       collide_obstacles)
 from softgym.engine._corotational cimport links_corotational
 from softgym.engine._integrate cimport (integrate_corotational, integrate_seed, clear_robot,
-                                       refresh_robot_rotations, voxel_state_rows,
-                                       voxel_state_back, voxel_state_in_rows,
-                                       voxel_link_rows)
+                                       refresh_robot_rotations, voxel_state_enter,
+                                       voxel_state_leave, voxel_link_rows)
 from softgym.engine._record cimport record, robot_aux, robot_energy
 from softgym.engine._prof cimport softgym_prof_tsc, softgym_prof_add, prof_counts
 from softgym.engine._seed cimport (links_seed, SOFTGYM_CHUNK_STRIDE, SOFTGYM_CHUNK_ROWS,
@@ -134,12 +133,6 @@ def cycle_counts(bint reset=False):
     return out
 
 
-cdef extern from "softgym_simd.h":
-    # 1 where both models' step loops keep the voxels' state in the voxel rows (AVX-512
-    # builds)
-    enum: SOFTGYM_STATE_ROWS
-
-
 cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept nogil:
     # advance_robot for model 0: links, contacts, voxels, then the drive at
     # the step's start time sets the sizes the next step's links see
@@ -148,19 +141,14 @@ cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
         int status = STATUS_OK
         float64_t dmax2 = 0.0
         unsigned long long t0
-        bint in_rows = voxel_state_in_rows(b, r)
     # the voxels' state into the voxel rows, where the build keeps it there through the
-    # loop (voxel_state_in_rows: the geometry, the voxel update and the orientation read
-    # and write the rows; everything else reads positions and quaternions through
-    # voxel_pos / voxel_quat, _batch.pxd); else the rows are filled from the records
-    # once a step
-    voxel_state_rows(b, r)
-    if in_rows:
-        b.state_rows = b.vox_out
+    # loop (the geometry, the voxel update and the orientation read and write the rows;
+    # everything else reads positions and quaternions through voxel_pos / voxel_quat,
+    # _batch.pxd); else the rows are filled from the records once a step
+    voxel_state_enter(b, r)
     while b.steps[r] < target:
         t0 = softgym_prof_tsc()
-        if SOFTGYM_STATE_ROWS and not in_rows:
-            voxel_link_rows(b, r, 1)  # (the records are the state: the geometry's rows)
+        voxel_link_rows(b, r, 1)  # (where the records are the state: the geometry's rows)
         if b.self_collision:
             # the seed's schedule: rebuild once the fastest voxel may have
             # covered half a voxel since the last rebuild
@@ -197,10 +185,7 @@ cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
         b.steps[r] += 1
         record(b, r)
         softgym_prof_add(4, t0)
-    # the state back into the records
-    if in_rows:
-        voxel_state_back(b, r)
-    b.state_rows = NULL
+    voxel_state_leave(b, r)  # the state back into the records
     return status
 
 
@@ -210,17 +195,13 @@ cdef int _advance_corotational(Batch* b, intp_t r, step_t target,
     cdef:
         int status = STATUS_OK
         float64_t smax, dmax2 = 0.0
-        bint in_rows = voxel_state_in_rows(b, r)
     # the voxels' state into the voxel rows for the loop, as _advance_seed (the link
     # kernel, the voxel update and the orientation read and write the rows)
-    voxel_state_rows(b, r)
-    if in_rows:
-        b.state_rows = b.vox_out
+    voxel_state_enter(b, r)
     while b.steps[r] < target:
         # force and moment scratch are zero here: integrate_corotational clears them
         smax = _actuate(b, r)
-        if SOFTGYM_STATE_ROWS and not in_rows:
-            voxel_link_rows(b, r, 0)  # (the records are the state: the link kernel's rows)
+        voxel_link_rows(b, r, 0)  # (where the records are the state: the kernel's rows)
         status = links_corotational(b, r)
         if status == STATUS_OK and b.self_collision:
             if c.stale or smax > c.built_scale:
@@ -242,9 +223,7 @@ cdef int _advance_corotational(Batch* b, intp_t r, step_t target,
                 c.stale = 1
         b.steps[r] += 1
         record(b, r)
-    if in_rows:
-        voxel_state_back(b, r)
-    b.state_rows = NULL
+    voxel_state_leave(b, r)
     return status
 
 

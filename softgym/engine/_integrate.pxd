@@ -13,26 +13,24 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
 cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
                         float64_t* dmax2) noexcept nogil
     # model 0 (the seed's EulerStep), same contract (rot: as integrate_corotational).
-cdef void voxel_state_rows(Batch* b, intp_t r) noexcept nogil
-    # robot r's state into the voxel rows of b.vox_out (positions, velocities, angular
-    # velocities, quaternions, and a copy of the external forces: include/softgym_simd.h,
-    # SOFTGYM_ROW_*) from pos, vel, angvel, quat and ext_force, where the build's step
-    # loops keep it there (SOFTGYM_STATE_ROWS; else nothing): before the first step of a
-    # call. The rows are then the robot's state (both models' voxel updates, orientation
-    # steps and link kernels read and write them, not the records) until voxel_state_back
+cdef void voxel_state_enter(Batch* b, intp_t r) noexcept nogil
+    # before the first step of a call: where the build's step loops keep the voxels' state
+    # in the voxel rows of b.vox_out (SOFTGYM_STATE_ROWS) and robot r's voxel update runs
+    # 8-voxel blocks (no fluid, no terrain box), its state into them (positions,
+    # velocities, angular velocities, quaternions, and a copy of the external forces:
+    # include/softgym_simd.h, SOFTGYM_ROW_*), and b.state_rows set. The rows
+    # are then the robot's state (both models' voxel updates, orientation steps and link
+    # kernels read and write them, not the records) until voxel_state_leave. Else the
+    # records stay its state, and voxel_link_rows fills the link kernels' rows from them
+    # once a step (the scalar voxel loop would otherwise copy its run to the records and
+    # back every step)
 cdef void voxel_link_rows(Batch* b, intp_t r, int seed) noexcept nogil
-    # where the records are robot r's state (not voxel_state_in_rows) in a build with the
-    # rows: the rows its link kernels read (seed: positions and quaternions; else also
-    # velocities and angular velocities), from the records
-cdef bint voxel_state_in_rows(Batch* b, intp_t r) noexcept nogil
-    # whether robot r's step loop keeps its state in the voxel rows: in the builds that do
-    # (SOFTGYM_STATE_ROWS), where its voxel update runs 8-voxel blocks (no fluid, no
-    # terrain box); else the records are its state, and the link kernels' rows are filled
-    # from them (voxel_link_rows) once a step, as the scalar voxel loop would otherwise copy
-    # its run to the records and back every step
-cdef void voxel_state_back(Batch* b, intp_t r) noexcept nogil
-    # robot r's pos, quat, vel and angvel from the voxel rows, when the step loop returns
-    # (SOFTGYM_STATE_ROWS; else nothing)
+    # at each step's start: where the records are robot r's state (b.state_rows NULL) in a
+    # build with the rows, the rows its link kernels read (seed: positions and quaternions;
+    # else also velocities and angular velocities), from the records; else nothing
+cdef void voxel_state_leave(Batch* b, intp_t r) noexcept nogil
+    # when the step loop returns: robot r's pos, quat, vel and angvel from the voxel rows
+    # where voxel_state_enter put its state there; b.state_rows cleared
 cdef void refresh_robot_rotations(Batch* b, intp_t r) noexcept nogil
     # robot r's rot from its quat where the voxel updates leave it
     # (SOFTGYM_ROT_DEFERRED; else nothing)

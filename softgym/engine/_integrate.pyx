@@ -214,9 +214,7 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
     lo = vs  # (blocks of 8 voxels in vector lanes where they can: _scalar_run)
     while lo < ve:
         hi = _scalar_run(b, r, &lo, 0, ref, c, &dmax, &vmax2)
-        if b.state_rows != NULL and lo < hi:
-            # (as integrate_seed's: the run's state from the rows, back to them after it)
-            softgym_state_back(lo, hi, b.vox_stride, b.vox_out, pos, b.quat, vel, av)
+        _run_from_rows(b, lo, hi)  # (as integrate_seed's)
         for i in range(lo, hi):
             if b.fixed[i]:
                 vel[3 * i] = 0.0
@@ -245,17 +243,14 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
                     surface_contact(b, i, 0.0, 0.0, 1.0, pen, dt, f)
             _box_contacts(b, i, k0, k1, dt, f)
             if not (_translate(vel + 3 * i, pos + 3 * i, f, dt * b.inv_mass[i], dt) < RUNAWAY):
-                if b.state_rows != NULL:
-                    softgym_state_rows(lo, hi, b.vox_stride, pos, b.quat, vel, av, NULL,
-                                            b.vox_out)
+                _run_to_rows(b, lo, hi)
                 return _ran_away(b, r, i, dt, 0, dmax, dmax2)
             if ref != NULL:
                 dmax = _raise(dmax, _drift2(pos, ref, i, vs, c))
             # rotation: w += M dt / I, global damping; q += 0.5 dt (0, w) q after
             # the loop (_orient: no voxel's update reads another's orientation)
             _spin(b, i, dt, mx, my, mz)
-        if b.state_rows != NULL and lo < hi:
-            softgym_state_rows(lo, hi, b.vox_stride, pos, b.quat, vel, av, NULL, b.vox_out)
+        _run_to_rows(b, lo, hi)
         lo = hi
     dmax2[0] = dmax
     _orient(b, vs, ve, dt, 0)
@@ -309,35 +304,46 @@ cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int
     softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat, NULL if SOFTGYM_ROT_DEFERRED else b.rot)
 
 
-cdef void voxel_state_rows(Batch* b, intp_t r) noexcept nogil:
-    # robot r's state into the voxel rows (_integrate.pxd)
-    if SOFTGYM_STATE_ROWS:
+cdef inline void _run_from_rows(Batch* b, intp_t lo, intp_t hi) noexcept nogil:
+    # where the step's state is in the voxel rows: voxels lo..hi's state into their
+    # records, for the scalar voxel loop (which steps the records)
+    if b.state_rows != NULL and lo < hi:
+        softgym_state_back(lo, hi, b.vox_stride, b.vox_out, b.pos, b.quat, b.vel, b.angvel)
+
+
+cdef inline void _run_to_rows(Batch* b, intp_t lo, intp_t hi) noexcept nogil:
+    # the reverse, after the scalar loop (or where it stops)
+    if b.state_rows != NULL and lo < hi:
+        softgym_state_rows(lo, hi, b.vox_stride, b.pos, b.quat, b.vel, b.angvel, NULL,
+                           b.vox_out)
+
+
+cdef void voxel_state_enter(Batch* b, intp_t r) noexcept nogil:
+    # robot r's state into the voxel rows where its step loop keeps it there (_integrate.pxd)
+    if SOFTGYM_STATE_ROWS and b.fluid_drag <= 0.0 and b.box_start[r] == b.box_start[r + 1]:
         softgym_state_rows(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.pos, b.quat,
                            b.vel, b.angvel, b.ext_force, b.vox_out)
+        b.state_rows = b.vox_out
 
 
 cdef void voxel_link_rows(Batch* b, intp_t r, int seed) noexcept nogil:
     # robot r's voxel rows that its link kernels read, from the records (_integrate.pxd)
-    if SOFTGYM_STATE_ROWS:
-        if seed:
-            softgym_state_rows(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.pos, b.quat,
-                               NULL, NULL, NULL, b.vox_out)
-        else:
-            softgym_state_rows(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.pos, b.quat,
-                               b.vel, b.angvel, NULL, b.vox_out)
+    if not SOFTGYM_STATE_ROWS or b.state_rows != NULL:
+        return
+    if seed:
+        softgym_state_rows(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.pos, b.quat,
+                           NULL, NULL, NULL, b.vox_out)
+    else:
+        softgym_state_rows(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.pos, b.quat,
+                           b.vel, b.angvel, NULL, b.vox_out)
 
 
-cdef bint voxel_state_in_rows(Batch* b, intp_t r) noexcept nogil:
-    # whether robot r's step loop keeps its state in the voxel rows (_integrate.pxd)
-    return (SOFTGYM_STATE_ROWS and b.fluid_drag <= 0.0
-            and b.box_start[r] == b.box_start[r + 1])
-
-
-cdef void voxel_state_back(Batch* b, intp_t r) noexcept nogil:
+cdef void voxel_state_leave(Batch* b, intp_t r) noexcept nogil:
     # robot r's state from the voxel rows back into its records (_integrate.pxd)
-    if SOFTGYM_STATE_ROWS:
+    if b.state_rows != NULL:
         softgym_state_back(b.vox_start[r], b.vox_start[r + 1], b.vox_stride, b.vox_out,
                            b.pos, b.quat, b.vel, b.angvel)
+    b.state_rows = NULL
 
 
 cdef void refresh_robot_rotations(Batch* b, intp_t r) noexcept nogil:
@@ -384,10 +390,7 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
     lo = vs  # (blocks of 8 voxels in vector lanes where they can: _scalar_run)
     while lo < ve:
         hi = _scalar_run(b, r, &lo, 1, ref, c, &dmax, &vmax2)
-        if b.state_rows != NULL and lo < hi:
-            # the scalar loop's voxels' state from the rows (the step's), back to them
-            # after it
-            softgym_state_back(lo, hi, b.vox_stride, b.vox_out, pos, b.quat, vel, av)
+        _run_from_rows(b, lo, hi)  # the scalar loop's voxels' state, back after it
         for i in range(lo, hi):
             if b.fixed[i]:
                 for k in range(3):
@@ -411,17 +414,14 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
             if has_floor:
                 seed_floor(b, i, dt, f)
             if not (_translate(vel + 3 * i, pos + 3 * i, f, dt * b.inv_mass[i], dt) < RUNAWAY):
-                if b.state_rows != NULL:
-                    softgym_state_rows(lo, hi, b.vox_stride, pos, b.quat, vel, av, NULL,
-                                            b.vox_out)
+                _run_to_rows(b, lo, hi)
                 return _ran_away(b, r, i, dt, 1, dmax, dmax2)
             if ref != NULL:
                 dmax = _raise(dmax, _drift2(pos, ref, i, vs, c))
             if track_speed:
                 vmax2 = _raise(vmax2, speed_squared(vel[3 * i], vel[3 * i + 1], vel[3 * i + 2]))
             _spin(b, i, dt, mx, my, mz)
-        if b.state_rows != NULL and lo < hi:
-            softgym_state_rows(lo, hi, b.vox_stride, pos, b.quat, vel, av, NULL, b.vox_out)
+        _run_to_rows(b, lo, hi)
         lo = hi
     dmax2[0] = dmax
     softgym_prof_add(0, t0)

@@ -280,7 +280,7 @@ cdef inline intp_t _seed_geom_modes(Batch* b, int ax, intp_t lo, intp_t hi, intp
     t0 = softgym_prof_tsc()
     # vend: the robot's voxels end there (the geometry reads no other robot's records)
     # (b.vox_out: the voxel rows, the step's state in AVX-512 builds; _integrate.pxd
-    # voxel_state_rows)
+    # voxel_state_enter)
     softgym_seed_geom(ax, lo, hi, n, b.v1, b.v2, vend, b.pos, b.quat, b.vox_out, b.vox_stride,
                       b.scale, o, rr)
     softgym_prof_add(0, t0)
