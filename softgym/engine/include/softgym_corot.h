@@ -133,7 +133,7 @@ static inline void softgym_corot_gather4(const Py_ssize_t *idx, const double *po
 #define SOFTGYM_COROT_IDX(R, k) ((R)[k])
 #if defined(SOFTGYM_VLANES) && SOFTGYM_VLANES == 8
 #define SOFTGYM_COROT_ROWS 18
-/* the voxels' rotation matrices as rows 9-17 of the voxel rows (n apart, indexed by
+/* the voxels' rotation matrices as rows SOFTGYM_ROW_ROT .. + 8 (9-17) of the voxel rows (n apart, indexed by
    voxel; row-major), computed from their quaternions in rows SOFTGYM_ROW_QUAT (the
    formula that stores rot, softgym_quat_matrix: the same bits in the lanes as one by one),
    once a step, so that the links' 8-lane paths load a voxel's 18 numbers (position,
@@ -150,13 +150,13 @@ static void softgym_corot_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, doubl
         softgym_v8 y = softgym_v8_load(q + 2 * n + i), z = softgym_v8_load(q + 3 * n + i);
         SOFTGYM_QUAT_MATRIX(w, x, y, z, R);
         for (int k = 0; k < 9; k++)
-            memcpy(rows + (9 + k) * n + i, &R[k], sizeof R[k]);
+            memcpy(rows + (SOFTGYM_ROW_ROT + k) * n + i, &R[k], sizeof R[k]);
     }
     for (; i < hi; i++) {
         double R[9];
         softgym_quat_matrix_wxyz(q[i], q[n + i], q[2 * n + i], q[3 * n + i], R);
         for (int k = 0; k < 9; k++)
-            rows[(9 + k) * n + i] = R[k];
+            rows[(SOFTGYM_ROW_ROT + k) * n + i] = R[k];
     }
 }
 #endif
@@ -210,18 +210,18 @@ SOFTGYM_ALWAYS_INLINE void softgym_corot_links_ax(
 #define LD_(a) softgym_v8_load((a) + li)
         /* runs of 8 consecutive voxels (h: the first) */
 #define SOFTGYM_COROT_RUN(k, h) softgym_v8_load(vr + (k) * vn + (h))
-#define SOFTGYM_COROT_RUN_RD(h, k) SOFTGYM_COROT_RUN(9 + (k), h)
+#define SOFTGYM_COROT_RUN_RD(h, k) SOFTGYM_COROT_RUN(SOFTGYM_ROW_ROT + (k), h)
 #define SOFTGYM_COROT_RUN_S(h) softgym_v8_load(scale + (h))
         /* a window of 16 voxels from base (h: the links' places in it), each number picked
            from the window's two vectors of its row */
 #define SOFTGYM_COROT_WIN(k, h) ((softgym_vd)_mm512_permutex2var_pd( \
             _mm512_loadu_pd(vr + (k) * vn + base), (h), _mm512_loadu_pd(vr + (k) * vn + base + 8)))
-#define SOFTGYM_COROT_WIN_RD(h, k) SOFTGYM_COROT_WIN(9 + (k), h)
+#define SOFTGYM_COROT_WIN_RD(h, k) SOFTGYM_COROT_WIN(SOFTGYM_ROW_ROT + (k), h)
 #define SOFTGYM_COROT_WIN_S(h) ((softgym_vd)_mm512_permutex2var_pd( \
             _mm512_loadu_pd(scale + base), (h), _mm512_loadu_pd(scale + base + 8)))
         /* any 8 voxels (h: their indices), gathered */
 #define SOFTGYM_COROT_GAT(k, h) ((softgym_vd)_mm512_i64gather_pd((h), vr + (k) * vn, 8))
-#define SOFTGYM_COROT_GAT_RD(h, k) SOFTGYM_COROT_GAT(9 + (k), h)
+#define SOFTGYM_COROT_GAT_RD(h, k) SOFTGYM_COROT_GAT(SOFTGYM_ROW_ROT + (k), h)
 #define SOFTGYM_COROT_GAT_S(h) ((softgym_vd)_mm512_i64gather_pd((h), scale, 8))
         for (; li + 8 <= hi; li += 8) {
             const Py_ssize_t base = v1[li];
@@ -248,7 +248,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_corot_links_ax(
 #define FABS_ fabs
 #define LD_(a) ((a)[li])
 #define SOFTGYM_COROT_ONE(k, h) (vr[(k) * vn + (h)])
-#define SOFTGYM_COROT_ONE_RD(h, k) SOFTGYM_COROT_ONE(9 + (k), h)
+#define SOFTGYM_COROT_ONE_RD(h, k) SOFTGYM_COROT_ONE(SOFTGYM_ROW_ROT + (k), h)
 #define SOFTGYM_COROT_ONE_S(h) (scale[h])
         for (; li < hi; li++) {
             const Py_ssize_t i1 = v1[li], i2 = v2[li];

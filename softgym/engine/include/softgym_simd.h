@@ -37,6 +37,7 @@
 #define SOFTGYM_ROW_POS 0
 #define SOFTGYM_ROW_VEL 3
 #define SOFTGYM_ROW_AV 6
+#define SOFTGYM_ROW_ROT 9  /* the corotational step's rotation matrices, 9 rows */
 #define SOFTGYM_ROW_QUAT 18
 #define SOFTGYM_ROW_EXT 22
 /* c ? a : b on the bits: compilers keep it a blend (a select before a
