@@ -498,6 +498,137 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_impl(
     }
     return any_fix;
 }
+#if defined(__AVX512F__) && (defined(__GNUC__) || defined(__clang__))
+#define SOFTGYM_FRAMES32_X2 1
+/* The mixed loop of softgym_seed_frames32_impl for 32 links li..li + 31 (two blocks of 16
+   lanes, li on a row's cache line), written in the lanes of AVX-512 with every statement
+   made for both blocks before the next (SOFTGYM_X2): the same IEEE operations, lane by
+   lane, as the compiler's vectorised loop, which does one block's statements after the
+   other. The loop's chain of square roots and divisions (the chord, the frame, the two
+   rotation vectors' k) is about as long as the block's work on the ports, so with one
+   block in flight the core's scheduler fills with operations waiting on it; two blocks
+   side by side give it independent work (benchmarks/frames_probe.py, Intel Xeon: 113 ->
+   88 TSC cycles per 16 links of a mixed chunk). Its multiply-adds are written as the
+   compiler fused the loop's (tw, tx, ty, tz: the first product rounded, the next two
+   fused in order), checked bit for bit against that loop by frames_probe.py and
+   benchmarks/check_bitident.py. */
+typedef float softgym_v16f __attribute__((vector_size(64)));
+#define SOFTGYM_X2(stmt) do { \
+        for (int k_ = 0; k_ < 2; k_++) { \
+            stmt; \
+        } \
+    } while (0)
+/* 16 doubles at a, rounded to 16 floats */
+#define SOFTGYM_F16_LOAD(a) ((softgym_v16f)_mm512_insertf32x8( \
+        _mm512_castps256_ps512(_mm512_cvtpd_ps(_mm512_loadu_pd(a))), \
+        _mm512_cvtpd_ps(_mm512_loadu_pd((a) + 8)), 1))
+/* m ? a : b, lane by lane */
+#define SOFTGYM_F16_PICK(m, a, b) \
+    ((softgym_v16f)_mm512_mask_blend_ps((m), (__m512)(b), (__m512)(a)))
+#define SOFTGYM_F16_CMP(a, b, op) _mm512_cmp_ps_mask((__m512)(a), (__m512)(b), (op))
+#define SOFTGYM_F16_SET(c) ((softgym_v16f)_mm512_set1_ps(c))
+#define SOFTGYM_F16_FMA(a, b, c) \
+    ((softgym_v16f)_mm512_fmadd_ps((__m512)(a), (__m512)(b), (__m512)(c)))
+#define SOFTGYM_F16_FNMA(a, b, c) \
+    ((softgym_v16f)_mm512_fnmadd_ps((__m512)(a), (__m512)(b), (__m512)(c)))
+/* softgym_rotvec_k32_acos(w, w_acos) of 16 lanes */
+#define SOFTGYM_F16_ROTVEC_K(w, w_acos, k) do { \
+        softgym_v16f z_ = 0.5f * (1.0f - (w)); \
+        softgym_v16f p_ = (((4.2163199048e-2f * z_ + 2.4181311049e-2f) * z_ \
+                            + 4.5470025998e-2f) * z_ + 7.4953002686e-2f) * z_ \
+                          + 1.6666752422e-1f; \
+        softgym_v16f r_ = SOFTGYM_F16_PICK( \
+            SOFTGYM_F16_CMP((w), SOFTGYM_F16_SET(w_acos), _CMP_LE_OQ), 1.0f + z_ * p_, \
+            SOFTGYM_F16_SET(1.0f)); \
+        k = 2.0f * (softgym_v16f)_mm512_sqrt_ps((__m512)(2.0f / (1.0f + (w)))) * r_; \
+    } while (0)
+SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_x2(
+    Py_ssize_t li, float sa_rad, float w_acos, const double *p0_, const double *p1_,
+    const double *p2_, const double *qw_, const double *n1_, const double *n2_,
+    const double *n3_, const double *P0_, const double *sa_, float *o_P0, float *o_P1,
+    float *o_P2, float *o_a1y, float *o_a1z, float *o_a2x, float *o_a2y, float *o_a2z,
+    float *o_rw, float *o_ry, float *o_rz, float *o_fix)
+{
+    softgym_v16f p0[2], p1[2], p2[2], qw[2], n1[2], n2[2], n3[2];
+    softgym_v16f inv_p0[2], yx[2], zx[2], ry_s[2], rz_s[2], rw_s[2], ln[2], lp[2];
+    softgym_v16f inv_s[2], ch[2], ry_l[2], rz_l[2], rw[2], ry[2], rz[2], k1[2], k2[2];
+    softgym_v16f tw[2], tx[2], ty[2], tz[2], w2[2];
+    __mmask16 is_sa[2], zero[2], small[2], fix[2];
+    const softgym_v16f one = SOFTGYM_F16_SET(1.0f), nil = SOFTGYM_F16_SET(0.0f);
+    const __m512d dnil = _mm512_setzero_pd();
+#define SOFTGYM_L (li + 16 * k_)
+    SOFTGYM_X2(p0[k_] = SOFTGYM_F16_LOAD(p0_ + SOFTGYM_L));
+    SOFTGYM_X2(p1[k_] = SOFTGYM_F16_LOAD(p1_ + SOFTGYM_L));
+    SOFTGYM_X2(p2[k_] = SOFTGYM_F16_LOAD(p2_ + SOFTGYM_L));
+    SOFTGYM_X2(is_sa[k_] = _mm512_kunpackb(
+                   _mm512_cmp_pd_mask(_mm512_loadu_pd(sa_ + SOFTGYM_L + 8), dnil, _CMP_NEQ_UQ),
+                   _mm512_cmp_pd_mask(_mm512_loadu_pd(sa_ + SOFTGYM_L), dnil, _CMP_NEQ_UQ)));
+    /* SOFTGYM_CHORD_FRAME */
+    SOFTGYM_X2(zero[k_] = SOFTGYM_F16_CMP(p0[k_], nil, _CMP_EQ_OQ)
+                          & SOFTGYM_F16_CMP(p1[k_], nil, _CMP_EQ_OQ)
+                          & SOFTGYM_F16_CMP(p2[k_], nil, _CMP_EQ_OQ));
+    SOFTGYM_X2(inv_p0[k_] = 1.0f / p0[k_]);
+    SOFTGYM_X2(ln[k_] = (softgym_v16f)_mm512_sqrt_ps((__m512)SOFTGYM_F16_FMA(
+                   p2[k_], p2[k_], SOFTGYM_F16_FMA(p0[k_], p0[k_], p1[k_] * p1[k_]))));
+    SOFTGYM_X2(yx[k_] = p1[k_] * inv_p0[k_]);
+    SOFTGYM_X2(zx[k_] = p2[k_] * inv_p0[k_]);
+    SOFTGYM_X2(lp[k_] = ln[k_] + p0[k_]);
+    SOFTGYM_X2(small[k_] = SOFTGYM_F16_CMP(yx[k_], SOFTGYM_F16_SET(sa_rad), _CMP_LT_OQ)
+                           & SOFTGYM_F16_CMP(yx[k_], SOFTGYM_F16_SET(-sa_rad), _CMP_GT_OQ)
+                           & SOFTGYM_F16_CMP(zx[k_], SOFTGYM_F16_SET(sa_rad), _CMP_LT_OQ)
+                           & SOFTGYM_F16_CMP(zx[k_], SOFTGYM_F16_SET(-sa_rad), _CMP_GT_OQ));
+    SOFTGYM_X2(inv_s[k_] = 1.0f / (softgym_v16f)_mm512_sqrt_ps((__m512)(2.0f * ln[k_] * lp[k_])));
+    SOFTGYM_X2(ry_s[k_] = 0.5f * zx[k_]);
+    SOFTGYM_X2(rz_s[k_] = -0.5f * yx[k_]);
+    SOFTGYM_X2(rw_s[k_] = SOFTGYM_F16_FMA(
+                   SOFTGYM_F16_SET(0.5f),
+                   SOFTGYM_F16_FNMA(rz_s[k_], rz_s[k_], -ry_s[k_] * ry_s[k_]), one));
+    SOFTGYM_X2(qw[k_] = SOFTGYM_F16_LOAD(qw_ + SOFTGYM_L));
+    SOFTGYM_X2(n1[k_] = SOFTGYM_F16_LOAD(n1_ + SOFTGYM_L));
+    SOFTGYM_X2(ch[k_] = lp[k_] * inv_s[k_]);
+    SOFTGYM_X2(ry_l[k_] = p2[k_] * inv_s[k_]);
+    SOFTGYM_X2(rz_l[k_] = -p1[k_] * inv_s[k_]);
+    /* fix: a large-angle link (not zero) whose chord points backwards */
+    SOFTGYM_X2(fix[k_] = ~is_sa[k_] & ~zero[k_] & ~small[k_]
+                         & SOFTGYM_F16_CMP(p0[k_], -0.5f * ln[k_], _CMP_LT_OQ));
+    SOFTGYM_X2(rw[k_] = SOFTGYM_F16_PICK(zero[k_], one, SOFTGYM_F16_PICK(small[k_], rw_s[k_], ch[k_])));
+    SOFTGYM_X2(ry[k_] = SOFTGYM_F16_PICK(zero[k_], nil, SOFTGYM_F16_PICK(small[k_], ry_s[k_], ry_l[k_])));
+    SOFTGYM_X2(rz[k_] = SOFTGYM_F16_PICK(zero[k_], nil, SOFTGYM_F16_PICK(small[k_], rz_s[k_], rz_l[k_])));
+    SOFTGYM_X2(n2[k_] = SOFTGYM_F16_LOAD(n2_ + SOFTGYM_L));
+    SOFTGYM_X2(n3[k_] = SOFTGYM_F16_LOAD(n3_ + SOFTGYM_L));
+    SOFTGYM_X2(SOFTGYM_F16_ROTVEC_K(rw[k_], w_acos, k1[k_]));
+    SOFTGYM_X2(fix[k_] |= ~is_sa[k_] & ~zero[k_]
+                          & SOFTGYM_F16_CMP(rw[k_], SOFTGYM_F16_SET(0.5f), _CMP_LT_OQ));
+    /* SOFTGYM_TQ */
+    SOFTGYM_X2(tw[k_] = SOFTGYM_F16_FNMA(rz[k_], n3[k_], SOFTGYM_F16_FNMA(ry[k_], n2[k_], rw[k_] * qw[k_])));
+    SOFTGYM_X2(tx[k_] = SOFTGYM_F16_FNMA(rz[k_], n2[k_], SOFTGYM_F16_FMA(ry[k_], n3[k_], rw[k_] * n1[k_])));
+    SOFTGYM_X2(ty[k_] = SOFTGYM_F16_FMA(rz[k_], n1[k_], SOFTGYM_F16_FMA(ry[k_], qw[k_], rw[k_] * n2[k_])));
+    SOFTGYM_X2(tz[k_] = SOFTGYM_F16_FMA(rz[k_], qw[k_], SOFTGYM_F16_FNMA(ry[k_], n1[k_], rw[k_] * n3[k_])));
+    SOFTGYM_X2(w2[k_] = SOFTGYM_F16_PICK(is_sa[k_], qw[k_], tw[k_]));
+    SOFTGYM_X2(SOFTGYM_F16_ROTVEC_K(w2[k_], w_acos, k2[k_]));
+    SOFTGYM_X2(fix[k_] |= SOFTGYM_F16_CMP(w2[k_], SOFTGYM_F16_SET(0.5f), _CMP_LT_OQ));
+    /* the outputs, as softgym_seed_frames32_impl's */
+#define SOFTGYM_F16_OUT(row, v) SOFTGYM_X2(_mm512_storeu_ps((row) + SOFTGYM_L, (__m512)(v)))
+    SOFTGYM_F16_OUT(o_P0, SOFTGYM_F16_LOAD(P0_ + SOFTGYM_L));
+    SOFTGYM_F16_OUT(o_P1, SOFTGYM_F16_PICK(is_sa[k_], p1[k_], nil));
+    SOFTGYM_F16_OUT(o_P2, SOFTGYM_F16_PICK(is_sa[k_], p2[k_], nil));
+    SOFTGYM_F16_OUT(o_a1y, SOFTGYM_F16_PICK(is_sa[k_] | zero[k_], nil, ry[k_] * k1[k_]));
+    SOFTGYM_F16_OUT(o_a1z, SOFTGYM_F16_PICK(is_sa[k_] | zero[k_], nil, rz[k_] * k1[k_]));
+    SOFTGYM_F16_OUT(o_a2x, SOFTGYM_F16_PICK(is_sa[k_], n1[k_], tx[k_]) * k2[k_]);
+    SOFTGYM_F16_OUT(o_a2y, SOFTGYM_F16_PICK(is_sa[k_], n2[k_], ty[k_]) * k2[k_]);
+    SOFTGYM_F16_OUT(o_a2z, SOFTGYM_F16_PICK(is_sa[k_], n3[k_], tz[k_]) * k2[k_]);
+    SOFTGYM_F16_OUT(o_rw, SOFTGYM_F16_PICK(is_sa[k_], one, rw[k_]));
+    SOFTGYM_F16_OUT(o_ry, SOFTGYM_F16_PICK(is_sa[k_], nil, ry[k_]));
+    SOFTGYM_F16_OUT(o_rz, SOFTGYM_F16_PICK(is_sa[k_], nil, rz[k_]));
+    SOFTGYM_F16_OUT(o_fix, SOFTGYM_F16_PICK(fix[k_], one, nil));
+#undef SOFTGYM_F16_OUT
+#undef SOFTGYM_L
+    return (fix[0] | fix[1]) != 0;
+}
+#undef SOFTGYM_F16_ROTVEC_K
+#else
+#define SOFTGYM_FRAMES32_X2 0
+#endif
 /* the frames pass in float: rows in as softgym_seed_frames, but the axial displacement P0
    from row 10 (softgym_seed_modes leaves it) instead of rows 7 and 8, float rows out (row k
    at f + k SOFTGYM_CHUNK_FSTRIDE, indexed by link); returns whether any link got fix = 1 */
@@ -512,7 +643,23 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
             o + 6 * n, o + 10 * n, sa_, f, f + fs, f + 2 * fs, f + 3 * fs, \
             f + 4 * fs, f + 5 * fs, f + 6 * fs, f + 7 * fs, f + 8 * fs, f + 9 * fs, \
             f + 10 * fs, f + 11 * fs)
-    int any_fix = all_small ? SOFTGYM_FRAMES32(1) : SOFTGYM_FRAMES32(0);
+    int any_fix = 0;
+    if (all_small) {
+        any_fix = SOFTGYM_FRAMES32(1);
+    } else {
+#if SOFTGYM_FRAMES32_X2
+        /* 32 links at a time where they make whole pairs of blocks from lo (a chunk's rows
+           start on cache lines) */
+        for (; lo + 32 <= hi; lo += 32)
+            any_fix |= softgym_seed_frames32_x2(
+                lo, sa_rad, w_acos, o, o + n, o + 2 * n, o + 3 * n, o + 4 * n, o + 5 * n,
+                o + 6 * n, o + 10 * n, sa_, f, f + fs, f + 2 * fs, f + 3 * fs, f + 4 * fs,
+                f + 5 * fs, f + 6 * fs, f + 7 * fs, f + 8 * fs, f + 9 * fs, f + 10 * fs,
+                f + 11 * fs);
+        if (lo < hi)
+#endif
+            any_fix |= SOFTGYM_FRAMES32(0);
+    }
 #undef SOFTGYM_FRAMES32
     return any_fix != 0;
 }
