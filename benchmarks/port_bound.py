@@ -60,7 +60,7 @@ SEED_PASSES = {
                  "softgym_seed_gather_rows", "softgym_seed_rows8"),
     "modes": ("softgym_seed_modes",),
     "frames (float)": ("softgym_seed_frames32_impl", "softgym_rotvec_k32",
-                       "softgym_rotvec_k32_acos"),
+                       "softgym_rotvec_k32_acos", "softgym_seed_frames32_x2"),
     "forces (float)": ("softgym_seed_forces32", "softgym_seed_forces32_impl",
                        "softgym_seed_forces32_small", "softgym_seed_forces32_mixed",
                        "softgym_seed_forces32_neg2", "softgym_seed_forces32_small_neg2"),
@@ -83,9 +83,10 @@ MODELS = {
 }
 # what one iteration of a pass's main loop handles: links, except the voxel update (both
 # models' scatters take blocks of 8 links with AVX-512; the corotational links 8 a vector
-# from its voxels' rows)
+# from its voxels' rows; the float frames' main loop in the x86-64-v4 build is its pairs of
+# 16-lane blocks, softgym_seed_frames32_x2)
 PER_ITERATION = {"geometry": 8, "  rows path": 8, "  gather path": 8, "modes": 8,
-                 "frames (float)": 16, "forces (float)": 16, "scatter": 8, "voxel update": 8,
+                 "frames (float)": 32, "forces (float)": 16, "scatter": 8, "voxel update": 8,
                  "links": 8}
 PER_ITERATION_OF = {"seed": PER_ITERATION, "corotational": PER_ITERATION}
 
