@@ -95,10 +95,11 @@ def test_every_branch_of_the_pass_is_exercised_and_equal():
     assert (fast[1, 0], fast[2, 0]) == (0.001, -0.002)
 
 
-def _mixed_geometry(n, seed):
-    """n links of every kind the float pass meets: small-angle links; large-angle links
-    with chords along the axis (the small-ratio frame), tilted, backward or zero; turns
-    from none to past 120 degrees (the double-precision fix-up)."""
+def _mixed_geometry(n, seed, small_share=0.4):
+    """n links of every kind the float pass meets: small-angle links (a share
+    small_share); large-angle links with chords along the axis (the small-ratio frame),
+    tilted, backward or zero; turns from none to past 120 degrees (the double-precision
+    fix-up)."""
     rng = np.random.default_rng(seed)
     kind = rng.integers(0, 6, n)
     strain = rng.uniform(-0.3, 0.3, n)
@@ -115,7 +116,7 @@ def _mixed_geometry(n, seed):
     axis = rng.normal(size=(3, n))
     axis /= np.linalg.norm(axis, axis=0)
     q = np.vstack([np.cos(angle / 2), axis * np.sin(angle / 2)])
-    small = (rng.random(n) < 0.4).astype(float)
+    small = (rng.random(n) < small_share).astype(float)
     return np.ascontiguousarray(
         np.vstack([p, q, np.full(n, 0.01), np.linalg.norm(p, axis=0), small]))
 
@@ -124,11 +125,14 @@ def test_single_precision_pass_pairs_of_blocks_equal_its_loop():
     # The float pass takes a chunk's mixed links 32 at a time in paired 16-lane blocks
     # where the build has AVX-512 (softgym_seed_frames32_x2, its multiply-adds written out)
     # and the rest in the compiler's loop: a chunk of 64 links goes through the pairs, one
-    # of 28 through the loop. Their results are the same bits, link by link (elsewhere
-    # both are the loop).
+    # of 28 through the loop. Their results are the same bits, link by link (elsewhere,
+    # and for chunks all in small-angle mode, both are the loop).
     for seed in range(4):
-        geom = _mixed_geometry(64, seed)
-        both = _core.seed_frames(geom, single=True)
-        for lo in (0, 32):
-            part = _core.seed_frames(np.ascontiguousarray(geom[:, lo:lo + 28]), single=True)
-            assert np.array_equal(both[:, lo:lo + 28].view(np.uint64), part.view(np.uint64))
+        for small_share in (0.4, 1.0):
+            geom = _mixed_geometry(64, seed, small_share)
+            both = _core.seed_frames(geom, single=True)
+            for lo in (0, 32):
+                part = _core.seed_frames(np.ascontiguousarray(geom[:, lo:lo + 28]),
+                                         single=True)
+                assert np.array_equal(both[:, lo:lo + 28].view(np.uint64),
+                                      part.view(np.uint64))
