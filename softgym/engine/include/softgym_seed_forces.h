@@ -161,9 +161,20 @@ SOFTGYM_ALWAYS_INLINE void SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(const int all_smal
    copy's loop spilled 81 registers a 16-link iteration against 35 (port_bound.py) */
 #define SOFTGYM_FARGS lo, hi, n, L, bz, bzh, inv_dt, in, in_stride, sa_, chg_, neg2_, ka_, kt_, \
     kb_, cs_, link_last, out
+#if defined(SOFTGYM_FBLOCK)
+/* where the instantiation has one (softgym_seed.h: the float pass with AVX-512), the
+   16-lane blocks from lo by SOFTGYM_FBLOCK, the rest by the loop */
+#define SOFTGYM_FBLOCKS(s, g) \
+    for (; lo + 16 <= hi; lo += 16) \
+        SOFTGYM_FBLOCK(s, g, lo, n, L, bz, bzh, inv_dt, in, sa_, chg_, ka_, kt_, kb_, cs_, \
+                    link_last, out)
+#else
+#define SOFTGYM_FBLOCKS(s, g) (void)0
+#endif
 #define SOFTGYM_FCOPY(suffix, s, g) \
     SOFTGYM_NOINLINE void SOFTGYM_FCAT(SOFTGYM_FNAME, suffix)(SOFTGYM_FPARAMS) \
     { \
+        SOFTGYM_FBLOCKS(s, g); \
         SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(s, g, SOFTGYM_FARGS); \
     }
 SOFTGYM_FCOPY(_mixed, 0, 0)
@@ -171,6 +182,7 @@ SOFTGYM_FCOPY(_small, 1, 0)
 SOFTGYM_FCOPY(_neg2, 0, 1)
 SOFTGYM_FCOPY(_small_neg2, 1, 1)
 #undef SOFTGYM_FCOPY
+#undef SOFTGYM_FBLOCKS
 /* links lo..hi (one chunk), without the large-angle turn where all of them are in
    small-angle mode, without voxel 2's own force where all of them give it -F1 */
 static void SOFTGYM_FNAME(SOFTGYM_FPARAMS)
