@@ -577,7 +577,8 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_x2(
                            & SOFTGYM_F16_CMP(yx[k_], SOFTGYM_F16_SET(-sa_rad), _CMP_GT_OQ)
                            & SOFTGYM_F16_CMP(zx[k_], SOFTGYM_F16_SET(sa_rad), _CMP_LT_OQ)
                            & SOFTGYM_F16_CMP(zx[k_], SOFTGYM_F16_SET(-sa_rad), _CMP_GT_OQ));
-    SOFTGYM_X2(inv_s[k_] = 1.0f / (softgym_v16f)_mm512_sqrt_ps((__m512)(2.0f * ln[k_] * lp[k_])));
+    SOFTGYM_X2(inv_s[k_] = 1.0f / (softgym_v16f)_mm512_sqrt_ps(
+                   (__m512)(2.0f * ln[k_] * lp[k_])));
     SOFTGYM_X2(ry_s[k_] = 0.5f * zx[k_]);
     SOFTGYM_X2(rz_s[k_] = -0.5f * yx[k_]);
     SOFTGYM_X2(rw_s[k_] = SOFTGYM_F16_FMA(
@@ -591,19 +592,26 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_x2(
     /* fix: a large-angle link (not zero) whose chord points backwards */
     SOFTGYM_X2(fix[k_] = ~is_sa[k_] & ~zero[k_] & ~small[k_]
                          & SOFTGYM_F16_CMP(p0[k_], -0.5f * ln[k_], _CMP_LT_OQ));
-    SOFTGYM_X2(rw[k_] = SOFTGYM_F16_PICK(zero[k_], one, SOFTGYM_F16_PICK(small[k_], rw_s[k_], ch[k_])));
-    SOFTGYM_X2(ry[k_] = SOFTGYM_F16_PICK(zero[k_], nil, SOFTGYM_F16_PICK(small[k_], ry_s[k_], ry_l[k_])));
-    SOFTGYM_X2(rz[k_] = SOFTGYM_F16_PICK(zero[k_], nil, SOFTGYM_F16_PICK(small[k_], rz_s[k_], rz_l[k_])));
+    SOFTGYM_X2(rw[k_] = SOFTGYM_F16_PICK(zero[k_], one,
+                                         SOFTGYM_F16_PICK(small[k_], rw_s[k_], ch[k_])));
+    SOFTGYM_X2(ry[k_] = SOFTGYM_F16_PICK(zero[k_], nil,
+                                         SOFTGYM_F16_PICK(small[k_], ry_s[k_], ry_l[k_])));
+    SOFTGYM_X2(rz[k_] = SOFTGYM_F16_PICK(zero[k_], nil,
+                                         SOFTGYM_F16_PICK(small[k_], rz_s[k_], rz_l[k_])));
     SOFTGYM_X2(n2[k_] = SOFTGYM_F16_LOAD(n2_ + SOFTGYM_L));
     SOFTGYM_X2(n3[k_] = SOFTGYM_F16_LOAD(n3_ + SOFTGYM_L));
     SOFTGYM_X2(SOFTGYM_F16_ROTVEC_K(rw[k_], w_acos, k1[k_]));
     SOFTGYM_X2(fix[k_] |= ~is_sa[k_] & ~zero[k_]
                           & SOFTGYM_F16_CMP(rw[k_], SOFTGYM_F16_SET(0.5f), _CMP_LT_OQ));
     /* SOFTGYM_TQ */
-    SOFTGYM_X2(tw[k_] = SOFTGYM_F16_FNMA(rz[k_], n3[k_], SOFTGYM_F16_FNMA(ry[k_], n2[k_], rw[k_] * qw[k_])));
-    SOFTGYM_X2(tx[k_] = SOFTGYM_F16_FNMA(rz[k_], n2[k_], SOFTGYM_F16_FMA(ry[k_], n3[k_], rw[k_] * n1[k_])));
-    SOFTGYM_X2(ty[k_] = SOFTGYM_F16_FMA(rz[k_], n1[k_], SOFTGYM_F16_FMA(ry[k_], qw[k_], rw[k_] * n2[k_])));
-    SOFTGYM_X2(tz[k_] = SOFTGYM_F16_FMA(rz[k_], qw[k_], SOFTGYM_F16_FNMA(ry[k_], n1[k_], rw[k_] * n3[k_])));
+    SOFTGYM_X2(tw[k_] = SOFTGYM_F16_FNMA(rz[k_], n3[k_],
+                                         SOFTGYM_F16_FNMA(ry[k_], n2[k_], rw[k_] * qw[k_])));
+    SOFTGYM_X2(tx[k_] = SOFTGYM_F16_FNMA(rz[k_], n2[k_],
+                                         SOFTGYM_F16_FMA(ry[k_], n3[k_], rw[k_] * n1[k_])));
+    SOFTGYM_X2(ty[k_] = SOFTGYM_F16_FMA(rz[k_], n1[k_],
+                                        SOFTGYM_F16_FMA(ry[k_], qw[k_], rw[k_] * n2[k_])));
+    SOFTGYM_X2(tz[k_] = SOFTGYM_F16_FMA(rz[k_], qw[k_],
+                                        SOFTGYM_F16_FNMA(ry[k_], n1[k_], rw[k_] * n3[k_])));
     SOFTGYM_X2(w2[k_] = SOFTGYM_F16_PICK(is_sa[k_], qw[k_], tw[k_]));
     SOFTGYM_X2(SOFTGYM_F16_ROTVEC_K(w2[k_], w_acos, k2[k_]));
     SOFTGYM_X2(fix[k_] |= SOFTGYM_F16_CMP(w2[k_], SOFTGYM_F16_SET(0.5f), _CMP_LT_OQ));
@@ -715,6 +723,12 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
         _mm512_storeu_pd((out) + (li), _mm512_cvtps_pd(_mm512_castps512_ps256(v_))); \
         _mm512_storeu_pd((out) + (li) + 8, _mm512_cvtps_pd(_mm512_extractf32x8_ps(v_, 1))); \
     } while (0)
+/* the rate of the quantity x in memory row r, (x - last) inv_dt, and the row set to x where
+   the mode did not change */
+#define SOFTGYM_F16_MEMORY(r, x, rate) do { \
+        rate = vdt * ((x) - SOFTGYM_F16_ROW(SOFTGYM_MEM(r), SOFTGYM_L)); \
+        _mm512_mask_storeu_ps(SOFTGYM_MEM(r) + SOFTGYM_L, keep, (__m512)(x)); \
+    } while (0)
 SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
     const int all_small, const int all_neg2, Py_ssize_t li, Py_ssize_t n, float L, float bz,
     float bzh, float inv_dt, const float *in, const double *sa_, const double *chg_,
@@ -751,45 +765,25 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
     f1z = SOFTGYM_F16_FMA(P2, ka, b2 * (a1y + a2y));
     m1x = SOFTGYM_F16_ROW(kt_, SOFTGYM_L) * (nil - a2x);
     c0 = SOFTGYM_F16_ROW(kb_, SOFTGYM_L);
-    m1y = SOFTGYM_F16_FMA(P2, b2,
-                                         c0 * SOFTGYM_F16_FMA(a1y, two, a2y));
-    m1z = SOFTGYM_F16_FNMA(P1, b2,
-                                          c0 * SOFTGYM_F16_FMA(a1z, two, a2z));
-    m2y = SOFTGYM_F16_FMA(P2, b2,
-                                         c0 * SOFTGYM_F16_FMA(a2y, two, a1y));
-    m2z = SOFTGYM_F16_FNMA(P1, b2,
-                                          c0 * SOFTGYM_F16_FMA(a2z, two, a1z));
+    m1y = SOFTGYM_F16_FMA(P2, b2, c0 * SOFTGYM_F16_FMA(a1y, two, a2y));
+    m1z = SOFTGYM_F16_FNMA(P1, b2, c0 * SOFTGYM_F16_FMA(a1z, two, a2z));
+    m2y = SOFTGYM_F16_FMA(P2, b2, c0 * SOFTGYM_F16_FMA(a2y, two, a1y));
+    m2z = SOFTGYM_F16_FNMA(P1, b2, c0 * SOFTGYM_F16_FMA(a2z, two, a1z));
     m2x = -m1x;
     /* damping: rates from the memory of the last step, which is updated where the mode did
        not change */
-    c0 = SOFTGYM_F16_ROW(SOFTGYM_MEM(0), SOFTGYM_L);
-    vx = (P0 - c0) * vdt;
-    _mm512_mask_storeu_ps(SOFTGYM_MEM(0) + SOFTGYM_L, keep, (__m512)P0);
-    c0 = SOFTGYM_F16_ROW(SOFTGYM_MEM(1), SOFTGYM_L);
-    vy = vdt * (P1 - c0);
-    _mm512_mask_storeu_ps(SOFTGYM_MEM(1) + SOFTGYM_L, keep, (__m512)P1);
-    c0 = SOFTGYM_F16_ROW(SOFTGYM_MEM(2), SOFTGYM_L);
-    vz = vdt * (P2 - c0);
-    _mm512_mask_storeu_ps(SOFTGYM_MEM(2) + SOFTGYM_L, keep, (__m512)P2);
-    c0 = SOFTGYM_F16_ROW(SOFTGYM_MEM(3), SOFTGYM_L);
-    ra1x = vdt * (nil - c0);
-    _mm512_mask_storeu_ps(SOFTGYM_MEM(3) + SOFTGYM_L, keep, (__m512)nil);
-    c0 = SOFTGYM_F16_ROW(SOFTGYM_MEM(4), SOFTGYM_L);
-    ra1y = vdt * (a1y - c0);
-    _mm512_mask_storeu_ps(SOFTGYM_MEM(4) + SOFTGYM_L, keep, (__m512)a1y);
-    c0 = SOFTGYM_F16_ROW(SOFTGYM_MEM(5), SOFTGYM_L);
-    ra1z = vdt * (a1z - c0);
-    _mm512_mask_storeu_ps(SOFTGYM_MEM(5) + SOFTGYM_L, keep, (__m512)a1z);
+    SOFTGYM_F16_MEMORY(0, P0, vx);
+    SOFTGYM_F16_MEMORY(1, P1, vy);
+    SOFTGYM_F16_MEMORY(2, P2, vz);
+    SOFTGYM_F16_MEMORY(3, nil, ra1x);
+    SOFTGYM_F16_MEMORY(4, a1y, ra1y);
+    SOFTGYM_F16_MEMORY(5, a1z, ra1z);
     /* ra2x - ra1x, ra2x = inv_dt (a2x - l6) fused into the difference */
     c0 = SOFTGYM_F16_ROW(SOFTGYM_MEM(6), SOFTGYM_L);
     dax = SOFTGYM_F16_FMS(vdt, a2x - c0, ra1x);
     _mm512_mask_storeu_ps(SOFTGYM_MEM(6) + SOFTGYM_L, keep, (__m512)a2x);
-    c0 = SOFTGYM_F16_ROW(SOFTGYM_MEM(7), SOFTGYM_L);
-    ra2y = vdt * (a2y - c0);
-    _mm512_mask_storeu_ps(SOFTGYM_MEM(7) + SOFTGYM_L, keep, (__m512)a2y);
-    c0 = SOFTGYM_F16_ROW(SOFTGYM_MEM(8), SOFTGYM_L);
-    ra2z = vdt * (a2z - c0);
-    _mm512_mask_storeu_ps(SOFTGYM_MEM(8) + SOFTGYM_L, keep, (__m512)a2z);
+    SOFTGYM_F16_MEMORY(7, a2y, ra2y);
+    SOFTGYM_F16_MEMORY(8, a2z, ra2z);
     s1z = ra1z + ra2z;
     s1y = ra1y + ra2y;
     /* voxel 2's damped force (c_seed rows 4-7), where it is its own */
@@ -797,10 +791,8 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
         c0 = SOFTGYM_F16_ROW(cs_ + 4 * n, SOFTGYM_L);
         c1 = SOFTGYM_F16_ROW(cs_ + 5 * n, SOFTGYM_L);
         f2x = SOFTGYM_F16_FMS(vx * -c0, vbz, f1x);
-        f2y = SOFTGYM_F16_FMS(vbz, SOFTGYM_F16_FNMA(vy, c0, s1z * c1),
-                                            f1y);
-        f2z = SOFTGYM_F16_FMS(vbz, SOFTGYM_F16_FNMS(vz, c0, s1y * c1),
-                                            f1z);
+        f2y = SOFTGYM_F16_FMS(vbz, SOFTGYM_F16_FNMA(vy, c0, s1z * c1), f1y);
+        f2z = SOFTGYM_F16_FMS(vbz, SOFTGYM_F16_FNMS(vz, c0, s1y * c1), f1z);
     }
     /* voxel 1's damping (c_seed rows 0-3) */
     c0 = SOFTGYM_F16_ROW(cs_, SOFTGYM_L);
@@ -808,46 +800,33 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
     c2 = SOFTGYM_F16_ROW(cs_ + 2 * n, SOFTGYM_L);
     c3 = SOFTGYM_F16_ROW(cs_ + 3 * n, SOFTGYM_L);
     f1x = SOFTGYM_F16_DAMP(keep, f1x, vbz, vx * c0);
-    f1y = SOFTGYM_F16_DAMP(keep, f1y, vbz,
-                                          SOFTGYM_F16_FNMA(c1, s1z, vy * c0));
-    f1z = SOFTGYM_F16_DAMP(keep, f1z, vbz,
-                                          SOFTGYM_F16_FMA(c1, s1y, vz * c0));
+    f1y = SOFTGYM_F16_DAMP(keep, f1y, vbz, SOFTGYM_F16_FNMA(c1, s1z, vy * c0));
+    f1z = SOFTGYM_F16_DAMP(keep, f1z, vbz, SOFTGYM_F16_FMA(c1, s1y, vz * c0));
     /* m1x's damping: with all links in small-angle mode the compiler's loop fused its
        output's negation into the damping's multiply-add (-(d bzh) - m1x, which differs
        from -(d bzh + m1x) in the sign of a zero), elsewhere it negated the turned sum */
     d1 = dax * -c2;
     if (all_small)
-        nm1x = SOFTGYM_F16_PICK(keep, SOFTGYM_F16_FNMS(d1, vbzh, m1x),
-                                              m2x);
+        nm1x = SOFTGYM_F16_PICK(keep, SOFTGYM_F16_FNMS(d1, vbzh, m1x), m2x);
     d2 = SOFTGYM_F16_ROW(cs_ + 6 * n, SOFTGYM_L) * dax;
     /* voxel 2's: m2x + bzh ca2 (ra2x - ra1x) = bzh ca2 (...) - m1x, fused, from m1x
        before its damping (negated: m1x - bzh ca2 (...), where all links are small) */
     if (all_small)
-        nm2x = SOFTGYM_F16_PICK(keep, SOFTGYM_F16_FNMA(vbzh, d2, m1x),
-                                              m1x);
+        nm2x = SOFTGYM_F16_PICK(keep, SOFTGYM_F16_FNMA(vbzh, d2, m1x), m1x);
     else
-        m2x = SOFTGYM_F16_PICK(keep, SOFTGYM_F16_FMS(vbzh, d2, m1x),
-                                             m2x);
+        m2x = SOFTGYM_F16_PICK(keep, SOFTGYM_F16_FMS(vbzh, d2, m1x), m2x);
     m1x = SOFTGYM_F16_DAMP(keep, m1x, vbzh, d1);
-    m1y = SOFTGYM_F16_DAMP(
-                   keep, m1y, vbzh,
-                   SOFTGYM_F16_FMA(c3, SOFTGYM_F16_FMA(ra1y, two, ra2y),
-                                   vz * c1));
-    m1z = SOFTGYM_F16_DAMP(
-                   keep, m1z, vbzh,
-                   SOFTGYM_F16_FMA(c3, SOFTGYM_F16_FMA(ra1z, two, ra2z),
-                                   vy * -c1));
+    m1y = SOFTGYM_F16_DAMP(keep, m1y, vbzh,
+                           SOFTGYM_F16_FMA(c3, SOFTGYM_F16_FMA(ra1y, two, ra2y), vz * c1));
+    m1z = SOFTGYM_F16_DAMP(keep, m1z, vbzh,
+                           SOFTGYM_F16_FMA(c3, SOFTGYM_F16_FMA(ra1z, two, ra2z), vy * -c1));
     /* voxel 2's moment's damping (c_seed rows 5 and 7) */
     c1 = SOFTGYM_F16_ROW(cs_ + 5 * n, SOFTGYM_L);
     c3 = SOFTGYM_F16_ROW(cs_ + 7 * n, SOFTGYM_L);
-    m2y = SOFTGYM_F16_DAMP(
-                   keep, m2y, vbzh,
-                   SOFTGYM_F16_FMA(c3, SOFTGYM_F16_FMA(ra2y, two, ra1y),
-                                   vz * c1));
-    m2z = SOFTGYM_F16_DAMP(
-                   keep, m2z, vbzh,
-                   SOFTGYM_F16_FMA(c3, SOFTGYM_F16_FMA(ra2z, two, ra1z),
-                                   vy * -c1));
+    m2y = SOFTGYM_F16_DAMP(keep, m2y, vbzh,
+                           SOFTGYM_F16_FMA(c3, SOFTGYM_F16_FMA(ra2y, two, ra1y), vz * c1));
+    m2z = SOFTGYM_F16_DAMP(keep, m2z, vbzh,
+                           SOFTGYM_F16_FMA(c3, SOFTGYM_F16_FMA(ra2z, two, ra1z), vy * -c1));
     if (!all_small) {
         /* large angle: G = RQ^T v (RQ the matrix of rq over |rq|^2) */
         softgym_v16f r0, r1, r2, r4, r5, r8, yy, zz, g;
@@ -879,12 +858,9 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
             SOFTGYM_F16_UNTURN_Z(x, y, z); \
         } while (0)
 #define SOFTGYM_F16_UNTURN_Z(x, y, z) do { \
-            x = SOFTGYM_F16_PICK(large, \
-                                                SOFTGYM_F16_FNMA(r2, z, g), x); \
-            y = SOFTGYM_F16_PICK(large, \
-                                                SOFTGYM_F16_FMA(r5, z, yy), y); \
-            z = SOFTGYM_F16_PICK(large, \
-                                                SOFTGYM_F16_FMA(r8, z, zz), z); \
+            x = SOFTGYM_F16_PICK(large, SOFTGYM_F16_FNMA(r2, z, g), x); \
+            y = SOFTGYM_F16_PICK(large, SOFTGYM_F16_FMA(r5, z, yy), y); \
+            z = SOFTGYM_F16_PICK(large, SOFTGYM_F16_FMA(r8, z, zz), z); \
         } while (0)
         SOFTGYM_F16_UNTURN_X(f1x, f1y, f1z);
         SOFTGYM_F16_UNTURN_Y(m1x, m1y, m1z);
@@ -915,6 +891,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
         SOFTGYM_F16_PUT(out + 9 * os, SOFTGYM_L, -m2x);
     SOFTGYM_F16_PUT(out + 10 * os, SOFTGYM_L, -m2y);
     SOFTGYM_F16_PUT(out + 11 * os, SOFTGYM_L, -m2z);
+#undef SOFTGYM_F16_MEMORY
 #undef SOFTGYM_MEM
 #undef SOFTGYM_IN
 #undef SOFTGYM_L
