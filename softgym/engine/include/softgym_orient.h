@@ -11,7 +11,6 @@
 #define SOFTGYM_ORIENT_H
 
 #include <math.h>
-#include <string.h>
 #include "softgym_simd.h"
 
 /* voxels lo..hi: q + (w dt / 2) x q, then (seed, a compile-time constant in each copy)
@@ -90,13 +89,9 @@ SOFTGYM_ALWAYS_INLINE void softgym_quats_rows_impl(const int seed, Py_ssize_t lo
        is one test every 8 voxels, where a test a voxel took about a cycle each) */
     Py_ssize_t i = lo;
     while (i < hi) {
-        unsigned long long w8;
-        if (i + 8 <= hi) {
-            memcpy(&w8, fixed + i, sizeof w8);
-            if (w8 == 0) {
-                i += 8;
-                continue;
-            }
+        if (i + 8 <= hi && softgym_none8(fixed + i)) {
+            i += 8;
+            continue;
         }
         if (fixed[i])
             for (int k = 0; k < 4; k++)

@@ -499,7 +499,8 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_impl(
     return any_fix;
 }
 #if defined(__AVX512F__) && (defined(__GNUC__) || defined(__clang__))
-#define SOFTGYM_FRAMES32_X2 1
+/* the float passes' code of 16 lanes in intrinsics (the frames pairs, the forces blocks) */
+#define SOFTGYM_F16_LANES 1
 /* The mixed loop of softgym_seed_frames32_impl for 32 links li..li + 31 (two blocks of 16
    lanes, li on a row's cache line), written in the lanes of AVX-512 with every statement
    made for both blocks before the next (SOFTGYM_X2): the same IEEE operations, lane by
@@ -508,10 +509,11 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_impl(
    rotation vectors' k) is about as long as the block's work on the ports, so with one
    block in flight the core's scheduler fills with operations waiting on it; two blocks
    side by side give it independent work (benchmarks/frames_probe.py, Intel Xeon: 113 ->
-   88 TSC cycles per 16 links of a mixed chunk). Its multiply-adds are written as the
-   compiler fused the loop's (tw, tx, ty, tz: the first product rounded, the next two
-   fused in order), checked bit for bit against that loop by frames_probe.py and
-   benchmarks/check_bitident.py. */
+   88 TSC cycles per 16 links of a mixed chunk). Its multiply-adds with two products are
+   written out as the compiler fused the loop's (its widening_mul dump of the x86-64-v4
+   build: |p|^2, the small-ratio rw, tw, tx, ty, tz), the rest (one product and an add)
+   left to its contraction, which fuses those alike; checked bit for bit against that loop
+   by tests/engine/test_seed_frames.py, frames_probe.py and benchmarks/check_bitident.py. */
 typedef float softgym_v16f __attribute__((vector_size(64)));
 #define SOFTGYM_X2(stmt) do { \
         for (int k_ = 0; k_ < 2; k_++) { \
@@ -522,6 +524,11 @@ typedef float softgym_v16f __attribute__((vector_size(64)));
 #define SOFTGYM_F16_LOAD(a) ((softgym_v16f)_mm512_insertf32x8( \
         _mm512_castps256_ps512(_mm512_cvtpd_ps(_mm512_loadu_pd(a))), \
         _mm512_cvtpd_ps(_mm512_loadu_pd((a) + 8)), 1))
+/* 16 doubles of a row that holds 1.0 or 0.0 (or any value): the lanes that are not 0.0 */
+#define SOFTGYM_F16_NONZERO(row, li) _mm512_kunpackb( \
+        _mm512_cmp_pd_mask(_mm512_loadu_pd((row) + (li) + 8), _mm512_setzero_pd(), \
+                           _CMP_NEQ_UQ), \
+        _mm512_cmp_pd_mask(_mm512_loadu_pd((row) + (li)), _mm512_setzero_pd(), _CMP_NEQ_UQ))
 /* m ? a : b, lane by lane */
 #define SOFTGYM_F16_PICK(m, a, b) \
     ((softgym_v16f)_mm512_mask_blend_ps((m), (__m512)(b), (__m512)(a)))
@@ -555,14 +562,11 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_x2(
     softgym_v16f tw[2], tx[2], ty[2], tz[2], w2[2];
     __mmask16 is_sa[2], zero[2], small[2], fix[2];
     const softgym_v16f one = SOFTGYM_F16_SET(1.0f), nil = SOFTGYM_F16_SET(0.0f);
-    const __m512d dnil = _mm512_setzero_pd();
 #define SOFTGYM_L (li + 16 * k_)
     SOFTGYM_X2(p0[k_] = SOFTGYM_F16_LOAD(p0_ + SOFTGYM_L));
     SOFTGYM_X2(p1[k_] = SOFTGYM_F16_LOAD(p1_ + SOFTGYM_L));
     SOFTGYM_X2(p2[k_] = SOFTGYM_F16_LOAD(p2_ + SOFTGYM_L));
-    SOFTGYM_X2(is_sa[k_] = _mm512_kunpackb(
-                   _mm512_cmp_pd_mask(_mm512_loadu_pd(sa_ + SOFTGYM_L + 8), dnil, _CMP_NEQ_UQ),
-                   _mm512_cmp_pd_mask(_mm512_loadu_pd(sa_ + SOFTGYM_L), dnil, _CMP_NEQ_UQ)));
+    SOFTGYM_X2(is_sa[k_] = SOFTGYM_F16_NONZERO(sa_, SOFTGYM_L));
     /* SOFTGYM_CHORD_FRAME */
     SOFTGYM_X2(zero[k_] = SOFTGYM_F16_CMP(p0[k_], nil, _CMP_EQ_OQ)
                           & SOFTGYM_F16_CMP(p1[k_], nil, _CMP_EQ_OQ)
@@ -635,7 +639,7 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_x2(
 }
 #undef SOFTGYM_F16_ROTVEC_K
 #else
-#define SOFTGYM_FRAMES32_X2 0
+#define SOFTGYM_F16_LANES 0
 #endif
 /* the frames pass in float: rows in as softgym_seed_frames, but the axial displacement P0
    from row 10 (softgym_seed_modes leaves it) instead of rows 7 and 8, float rows out (row k
@@ -655,7 +659,7 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
     if (all_small) {
         any_fix = SOFTGYM_FRAMES32(1);
     } else {
-#if SOFTGYM_FRAMES32_X2
+#if SOFTGYM_F16_LANES
         /* 32 links at a time where they make whole pairs of blocks from lo (a chunk's rows
            start on cache lines) */
         for (; lo + 32 <= hi; lo += 32)
@@ -664,8 +668,8 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
                 o + 6 * n, o + 10 * n, sa_, f, f + fs, f + 2 * fs, f + 3 * fs, f + 4 * fs,
                 f + 5 * fs, f + 6 * fs, f + 7 * fs, f + 8 * fs, f + 9 * fs, f + 10 * fs,
                 f + 11 * fs);
-        if (lo < hi)
 #endif
+        if (lo < hi)
             any_fix |= SOFTGYM_FRAMES32(0);
     }
 #undef SOFTGYM_FRAMES32
@@ -688,7 +692,7 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
 #undef SOFTGYM_FIN_STRIDE
 #undef SOFTGYM_FPICK
 #undef SOFTGYM_FMASK
-#if SOFTGYM_FRAMES32_X2
+#if SOFTGYM_F16_LANES
 /* The single-precision forces pass (softgym_seed_forces.h) for the 16 links li..li + 15 in
    the lanes of AVX-512, written in intrinsics: the compiler's loop of the same pass took
    343 instructions a block, 82 of them loads and stores of spilled registers (with its
@@ -705,11 +709,6 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
    by side, as the frames pass's, were no faster (their registers spill). all_small,
    all_neg2 as softgym_seed_forces32_impl's. */
 #define SOFTGYM_F16_ROW(row, li) ((softgym_v16f)_mm512_loadu_ps((row) + (li)))
-/* 16 doubles of a row that holds 1.0 or 0.0 (or any value): the lanes that are not 0.0 */
-#define SOFTGYM_F16_NONZERO(row, li) _mm512_kunpackb( \
-        _mm512_cmp_pd_mask(_mm512_loadu_pd((row) + (li) + 8), _mm512_setzero_pd(), \
-                           _CMP_NEQ_UQ), \
-        _mm512_cmp_pd_mask(_mm512_loadu_pd((row) + (li)), _mm512_setzero_pd(), _CMP_NEQ_UQ))
 #define SOFTGYM_F16_FMS(a, b, c) \
     ((softgym_v16f)_mm512_fmsub_ps((__m512)(a), (__m512)(b), (__m512)(c)))
 #define SOFTGYM_F16_FNMS(a, b, c) \
@@ -726,8 +725,8 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
 /* the rate of the quantity x in memory row r, (x - last) inv_dt, and the row set to x where
    the mode did not change */
 #define SOFTGYM_F16_MEMORY(r, x, rate) do { \
-        rate = vdt * ((x) - SOFTGYM_F16_ROW(SOFTGYM_MEM(r), SOFTGYM_L)); \
-        _mm512_mask_storeu_ps(SOFTGYM_MEM(r) + SOFTGYM_L, keep, (__m512)(x)); \
+        rate = vdt * ((x) - SOFTGYM_F16_ROW(SOFTGYM_MEM(r), li)); \
+        _mm512_mask_storeu_ps(SOFTGYM_MEM(r) + li, keep, (__m512)(x)); \
     } while (0)
 SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
     const int all_small, const int all_neg2, Py_ssize_t li, Py_ssize_t n, float L, float bz,
@@ -745,8 +744,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
     const softgym_v16f two = SOFTGYM_F16_SET(2.0f), nil = SOFTGYM_F16_SET(0.0f);
     const softgym_v16f vdt = SOFTGYM_F16_SET(inv_dt), vbz = SOFTGYM_F16_SET(bz);
     const softgym_v16f vbzh = SOFTGYM_F16_SET(bzh);
-#define SOFTGYM_L li
-#define SOFTGYM_IN(r) SOFTGYM_F16_ROW(in + (r) * is, SOFTGYM_L)
+#define SOFTGYM_IN(r) SOFTGYM_F16_ROW(in + (r) * is, li)
 #define SOFTGYM_MEM(r) (link_last + (r) * n)
     P0 = SOFTGYM_IN(0);
     P1 = SOFTGYM_IN(1);
@@ -756,15 +754,15 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
     a2x = SOFTGYM_IN(5);
     a2y = SOFTGYM_IN(6);
     a2z = SOFTGYM_IN(7);
-    keep = (__mmask16)~SOFTGYM_F16_NONZERO(chg_, SOFTGYM_L);
-    ka = SOFTGYM_F16_ROW(ka_, SOFTGYM_L);
+    keep = (__mmask16)~SOFTGYM_F16_NONZERO(chg_, li);
+    ka = SOFTGYM_F16_ROW(ka_, li);
     /* stiffness */
     b2 = (ka * 0.5f) * L;
     f1x = P0 * ka;
     f1y = SOFTGYM_F16_FMS(P1, ka, b2 * (a1z + a2z));
     f1z = SOFTGYM_F16_FMA(P2, ka, b2 * (a1y + a2y));
-    m1x = SOFTGYM_F16_ROW(kt_, SOFTGYM_L) * (nil - a2x);
-    c0 = SOFTGYM_F16_ROW(kb_, SOFTGYM_L);
+    m1x = SOFTGYM_F16_ROW(kt_, li) * (nil - a2x);
+    c0 = SOFTGYM_F16_ROW(kb_, li);
     m1y = SOFTGYM_F16_FMA(P2, b2, c0 * SOFTGYM_F16_FMA(a1y, two, a2y));
     m1z = SOFTGYM_F16_FNMA(P1, b2, c0 * SOFTGYM_F16_FMA(a1z, two, a2z));
     m2y = SOFTGYM_F16_FMA(P2, b2, c0 * SOFTGYM_F16_FMA(a2y, two, a1y));
@@ -779,26 +777,26 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
     SOFTGYM_F16_MEMORY(4, a1y, ra1y);
     SOFTGYM_F16_MEMORY(5, a1z, ra1z);
     /* ra2x - ra1x, ra2x = inv_dt (a2x - l6) fused into the difference */
-    c0 = SOFTGYM_F16_ROW(SOFTGYM_MEM(6), SOFTGYM_L);
+    c0 = SOFTGYM_F16_ROW(SOFTGYM_MEM(6), li);
     dax = SOFTGYM_F16_FMS(vdt, a2x - c0, ra1x);
-    _mm512_mask_storeu_ps(SOFTGYM_MEM(6) + SOFTGYM_L, keep, (__m512)a2x);
+    _mm512_mask_storeu_ps(SOFTGYM_MEM(6) + li, keep, (__m512)a2x);
     SOFTGYM_F16_MEMORY(7, a2y, ra2y);
     SOFTGYM_F16_MEMORY(8, a2z, ra2z);
     s1z = ra1z + ra2z;
     s1y = ra1y + ra2y;
     /* voxel 2's damped force (c_seed rows 4-7), where it is its own */
     if (!all_neg2) {
-        c0 = SOFTGYM_F16_ROW(cs_ + 4 * n, SOFTGYM_L);
-        c1 = SOFTGYM_F16_ROW(cs_ + 5 * n, SOFTGYM_L);
+        c0 = SOFTGYM_F16_ROW(cs_ + 4 * n, li);
+        c1 = SOFTGYM_F16_ROW(cs_ + 5 * n, li);
         f2x = SOFTGYM_F16_FMS(vx * -c0, vbz, f1x);
         f2y = SOFTGYM_F16_FMS(vbz, SOFTGYM_F16_FNMA(vy, c0, s1z * c1), f1y);
         f2z = SOFTGYM_F16_FMS(vbz, SOFTGYM_F16_FNMS(vz, c0, s1y * c1), f1z);
     }
     /* voxel 1's damping (c_seed rows 0-3) */
-    c0 = SOFTGYM_F16_ROW(cs_, SOFTGYM_L);
-    c1 = SOFTGYM_F16_ROW(cs_ + n, SOFTGYM_L);
-    c2 = SOFTGYM_F16_ROW(cs_ + 2 * n, SOFTGYM_L);
-    c3 = SOFTGYM_F16_ROW(cs_ + 3 * n, SOFTGYM_L);
+    c0 = SOFTGYM_F16_ROW(cs_, li);
+    c1 = SOFTGYM_F16_ROW(cs_ + n, li);
+    c2 = SOFTGYM_F16_ROW(cs_ + 2 * n, li);
+    c3 = SOFTGYM_F16_ROW(cs_ + 3 * n, li);
     f1x = SOFTGYM_F16_DAMP(keep, f1x, vbz, vx * c0);
     f1y = SOFTGYM_F16_DAMP(keep, f1y, vbz, SOFTGYM_F16_FNMA(c1, s1z, vy * c0));
     f1z = SOFTGYM_F16_DAMP(keep, f1z, vbz, SOFTGYM_F16_FMA(c1, s1y, vz * c0));
@@ -808,7 +806,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
     d1 = dax * -c2;
     if (all_small)
         nm1x = SOFTGYM_F16_PICK(keep, SOFTGYM_F16_FNMS(d1, vbzh, m1x), m2x);
-    d2 = SOFTGYM_F16_ROW(cs_ + 6 * n, SOFTGYM_L) * dax;
+    d2 = SOFTGYM_F16_ROW(cs_ + 6 * n, li) * dax;
     /* voxel 2's: m2x + bzh ca2 (ra2x - ra1x) = bzh ca2 (...) - m1x, fused, from m1x
        before its damping (negated: m1x - bzh ca2 (...), where all links are small) */
     if (all_small)
@@ -821,8 +819,8 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
     m1z = SOFTGYM_F16_DAMP(keep, m1z, vbzh,
                            SOFTGYM_F16_FMA(c3, SOFTGYM_F16_FMA(ra1z, two, ra2z), vy * -c1));
     /* voxel 2's moment's damping (c_seed rows 5 and 7) */
-    c1 = SOFTGYM_F16_ROW(cs_ + 5 * n, SOFTGYM_L);
-    c3 = SOFTGYM_F16_ROW(cs_ + 7 * n, SOFTGYM_L);
+    c1 = SOFTGYM_F16_ROW(cs_ + 5 * n, li);
+    c3 = SOFTGYM_F16_ROW(cs_ + 7 * n, li);
     m2y = SOFTGYM_F16_DAMP(keep, m2y, vbzh,
                            SOFTGYM_F16_FMA(c3, SOFTGYM_F16_FMA(ra2y, two, ra1y), vz * c1));
     m2z = SOFTGYM_F16_DAMP(keep, m2z, vbzh,
@@ -830,7 +828,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
     if (!all_small) {
         /* large angle: G = RQ^T v (RQ the matrix of rq over |rq|^2) */
         softgym_v16f r0, r1, r2, r4, r5, r8, yy, zz, g;
-        large = (__mmask16)~SOFTGYM_F16_NONZERO(sa_, SOFTGYM_L);
+        large = (__mmask16)~SOFTGYM_F16_NONZERO(sa_, li);
         c0 = SOFTGYM_IN(8);   /* rw */
         c1 = SOFTGYM_IN(9);   /* ry */
         c2 = SOFTGYM_IN(10);  /* rz */
@@ -871,30 +869,29 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
 #undef SOFTGYM_F16_UNTURN_Y
 #undef SOFTGYM_F16_UNTURN_Z
     }
-    SOFTGYM_F16_PUT(out, SOFTGYM_L, f1x);
-    SOFTGYM_F16_PUT(out + os, SOFTGYM_L, f1y);
-    SOFTGYM_F16_PUT(out + 2 * os, SOFTGYM_L, f1z);
+    SOFTGYM_F16_PUT(out, li, f1x);
+    SOFTGYM_F16_PUT(out + os, li, f1y);
+    SOFTGYM_F16_PUT(out + 2 * os, li, f1z);
     if (!all_neg2) {
-        SOFTGYM_F16_PUT(out + 3 * os, SOFTGYM_L, f2x);
-        SOFTGYM_F16_PUT(out + 4 * os, SOFTGYM_L, f2y);
-        SOFTGYM_F16_PUT(out + 5 * os, SOFTGYM_L, f2z);
+        SOFTGYM_F16_PUT(out + 3 * os, li, f2x);
+        SOFTGYM_F16_PUT(out + 4 * os, li, f2y);
+        SOFTGYM_F16_PUT(out + 5 * os, li, f2z);
     }
     if (all_small)
-        SOFTGYM_F16_PUT(out + 6 * os, SOFTGYM_L, nm1x);
+        SOFTGYM_F16_PUT(out + 6 * os, li, nm1x);
     else
-        SOFTGYM_F16_PUT(out + 6 * os, SOFTGYM_L, -m1x);
-    SOFTGYM_F16_PUT(out + 7 * os, SOFTGYM_L, -m1y);
-    SOFTGYM_F16_PUT(out + 8 * os, SOFTGYM_L, -m1z);
+        SOFTGYM_F16_PUT(out + 6 * os, li, -m1x);
+    SOFTGYM_F16_PUT(out + 7 * os, li, -m1y);
+    SOFTGYM_F16_PUT(out + 8 * os, li, -m1z);
     if (all_small)
-        SOFTGYM_F16_PUT(out + 9 * os, SOFTGYM_L, nm2x);
+        SOFTGYM_F16_PUT(out + 9 * os, li, nm2x);
     else
-        SOFTGYM_F16_PUT(out + 9 * os, SOFTGYM_L, -m2x);
-    SOFTGYM_F16_PUT(out + 10 * os, SOFTGYM_L, -m2y);
-    SOFTGYM_F16_PUT(out + 11 * os, SOFTGYM_L, -m2z);
+        SOFTGYM_F16_PUT(out + 9 * os, li, -m2x);
+    SOFTGYM_F16_PUT(out + 10 * os, li, -m2y);
+    SOFTGYM_F16_PUT(out + 11 * os, li, -m2z);
 #undef SOFTGYM_F16_MEMORY
 #undef SOFTGYM_MEM
 #undef SOFTGYM_IN
-#undef SOFTGYM_L
 }
 #undef SOFTGYM_F16_PUT
 #undef SOFTGYM_F16_DAMP
@@ -905,7 +902,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
 #endif
 #define SOFTGYM_FT float
 #define SOFTGYM_FNAME softgym_seed_forces32
-#if SOFTGYM_FRAMES32_X2
+#if SOFTGYM_F16_LANES
 #define SOFTGYM_FBLOCK softgym_seed_forces32_block16
 #endif
 #define SOFTGYM_FIN_STRIDE SOFTGYM_CHUNK_FSTRIDE

@@ -40,6 +40,13 @@
 #define SOFTGYM_ROW_ROT 9  /* the corotational step's rotation matrices, 9 rows */
 #define SOFTGYM_ROW_QUAT 18
 #define SOFTGYM_ROW_EXT 22
+/* whether none of the 8 one-byte flags f[0..7] is set (one 64-bit test) */
+static inline int softgym_none8(const signed char *f)
+{
+    unsigned long long w;
+    memcpy(&w, f, sizeof w);
+    return w == 0;
+}
 /* c ? a : b on the bits: compilers keep it a blend (a select before a
    store may otherwise become a masked store, slow on some cores) */
 static inline double softgym_pick(long long c, double a, double b)

@@ -63,9 +63,7 @@
    scalar loop's case). The moment is loaded by softgym_v8_finish, where it is used (its
    rows' registers free for the floor's arithmetic before) */
 #define SOFTGYM_VOXELS8_LOAD \
-    long long fx_; \
-    memcpy(&fx_, fixed + i, sizeof fx_); \
-    if (fx_ != 0) \
+    if (!softgym_none8(fixed + i)) \
         return 0; \
     softgym_v8 v0, v1, v2, p0, p1, p2, F0, F1, F2, E0, E1, E2; \
     SOFTGYM_V8_ROWS3(SOFTGYM_ROW_VEL, v0, v1, v2); \
