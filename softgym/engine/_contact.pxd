@@ -5,7 +5,7 @@
 # per voxel (_integrate.pyx; box_penetration also _record.robot_energy).
 
 from libc.math cimport sqrt
-from libc.stdint cimport int64_t
+from libc.stdint cimport int64_t, uint64_t
 
 from softgym.engine._batch cimport Batch
 from softgym.engine._typedefs cimport float64_t, intp_t, int32, lane_flag_t
@@ -41,6 +41,10 @@ cdef struct Contacts:
     lane_flag_t* hit         # (n_voxels_r + 8,) scratch: 1 where a pair is a candidate
                              #   (64-bit: softgym_pair_hits' vector lanes), or with AVX-512
                              #   the candidates' indices (softgym_pair_idx)
+    uint64_t* xbits          # with AVX-512: the all-pairs test's exclusions, a row of bits
+                             #   per surface voxel (bit b of row a: surface voxels a and b are
+                             #   within collision_exclusion hops; _exclusion_bits), or NULL
+    intp_t xbits_n           # the surface voxels xbits was built for (0: not built)
 
 
 # The spatial hash of the candidate lists (_contact.pyx, _hash_*): points in

@@ -14,7 +14,7 @@
 # contact laws with the floor and terrain boxes are inline in _contact.pxd.
 
 from libc.math cimport sqrt, floor
-from libc.stdint cimport int64_t
+from libc.stdint cimport int64_t, uint64_t
 from libc.stdlib cimport malloc, realloc, qsort
 from libc.string cimport memset
 
@@ -229,7 +229,7 @@ cdef extern from "softgym_pairs.h":
     # with AVX-512 (SOFTGYM_PAIR_IDX 1): the same test, the candidates' indices compressed
     intp_t softgym_pair_idx(int seed_rule, intp_t a, intp_t n, const float64_t* x,
                             const float64_t* y, const float64_t* z, const float64_t* s,
-                            const intp_t* rank, float64_t lim2,
+                            const intp_t* rank, float64_t lim2, const uint64_t* xb,
                             lane_flag_t* idx) noexcept nogil
     enum: SOFTGYM_PAIR_IDX
 
@@ -278,6 +278,39 @@ cdef inline bint _not_excluded(Batch* b, intp_t* e, intp_t e_end, intp_t j) noex
     return not (e[0] < e_end and b.excl_idx[e[0]] == j)
 
 
+cdef int _exclusion_bits(Batch* b, intp_t r, Contacts* c, intp_t ns) noexcept nogil:
+    # c.xbits: for the ns surface voxels of c.sur_idx (in voxel order), row a's bit b set
+    # where surface voxels a and b are within collision_exclusion bond hops (b.excl_*),
+    # ns // 64 + 2 words a row (softgym_pair_idx reads a word past the last bit). The
+    # exclusion lists and the surface are the layout's, so the rows are built once.
+    # Uses c.row as scratch (a voxel's surface index, or -1). Returns a STATUS.
+    cdef:
+        intp_t vs = b.vox_start[r]
+        intp_t ve = b.vox_start[r + 1]
+        intp_t words = ns // 64 + 2
+        intp_t a, i, j, e, k
+        uint64_t* bits
+    bits = <uint64_t*> realloc(c.xbits, max(ns, 1) * words * sizeof(uint64_t))
+    if bits == NULL:
+        return STATUS_MEMORY
+    c.xbits = bits
+    memset(bits, 0, ns * words * sizeof(uint64_t))
+    for i in range(ve - vs):
+        c.row[i] = -1
+    for a in range(ns):
+        c.row[c.sur_idx[a] - vs] = a
+    for a in range(ns):
+        i = c.sur_idx[a]
+        for e in range(b.excl_start[i], b.excl_start[i + 1]):
+            j = b.excl_idx[e]
+            if vs <= j < ve:
+                k = c.row[j - vs]
+                if k >= 0:
+                    bits[a * words + k // 64] |= (<uint64_t> 1) << (k % 64)
+    c.xbits_n = ns
+    return STATUS_OK
+
+
 cdef inline int _voxel_pairs_all(Batch* b, intp_t r, Contacts* c, const float64_t* P,
                                  intp_t stride, float64_t horizon,
                                  const int32 seed_rule) noexcept nogil:
@@ -308,24 +341,28 @@ cdef inline int _voxel_pairs_all(Batch* b, intp_t r, Contacts* c, const float64_
         c.sur_idx[ns] = i
         ns += 1
     lim2 = 9.0 * L * L if seed_rule else horizon * horizon
+    if SOFTGYM_PAIR_IDX and c.xbits_n != ns:
+        status = _exclusion_bits(b, r, c, ns)
+        if status != STATUS_OK:
+            return status
     for a in range(ns):
         i = c.sur_idx[a]
         n_row = 0
-        # the candidates come in increasing j (sur_idx is in voxel order) and i's
-        # exclusion row is sorted: one walk along it (e) instead of a binary search per
-        # candidate, whose branches the predictor could not learn (_not_excluded)
-        e = b.excl_start[i]
-        e_end = b.excl_start[i + 1]
         if SOFTGYM_PAIR_IDX:
-            # the candidates' indices, compressed in the vector lanes (c.hit holds them)
-            last = softgym_pair_idx(seed_rule, a, ns, X, Y, Z, S, RK, lim2, c.hit)
+            # the candidates' indices, compressed in the vector lanes (c.hit holds them),
+            # the excluded pairs dropped there too (a's row of c.xbits)
+            last = softgym_pair_idx(seed_rule, a, ns, X, Y, Z, S, RK, lim2,
+                                    c.xbits + a * (ns // 64 + 2), c.hit)
             for k in range(last):
-                j = c.sur_idx[c.hit[k]]
-                if _not_excluded(b, &e, e_end, j):
-                    c.row[n_row] = j
-                    n_row += 1
+                c.row[k] = c.sur_idx[c.hit[k]]
+            n_row = last
         else:
-            # a flag a pair; the walk over them ends at the last candidate
+            # a flag a pair; the walk over them ends at the last candidate. The candidates
+            # come in increasing j (sur_idx is in voxel order) and i's exclusion row is
+            # sorted: one walk along it (e) instead of a binary search per candidate,
+            # whose branches the predictor could not learn (_not_excluded)
+            e = b.excl_start[i]
+            e_end = b.excl_start[i + 1]
             last = softgym_pair_hits(seed_rule, a, ns, X, Y, Z, S, RK, lim2, c.hit)
             for k in range(a + 1, last + 1):
                 if c.hit[k]:

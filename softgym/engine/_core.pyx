@@ -478,6 +478,7 @@ cdef class ContactCache:
                 free(self.items[r].sur)
                 free(self.items[r].sur_idx)
                 free(self.items[r].hit)
+                free(self.items[r].xbits)
             free(self.items)
         free(self.link_scratch)
 

@@ -60,12 +60,16 @@ SOFTGYM_ALWAYS_INLINE Py_ssize_t softgym_pair_hits_impl(const int seed_rule, Py_
    into idx[0..] in increasing order (a two-uop compress a vector where the caller walked
    every flag up to the last hit, a branch each: on an Intel Xeon a third of the list's
    rebuilds); returns how many. Each lane's decision is SOFTGYM_PAIR_OUT's, written in its
-   shape (so that the build fuses the same multiply-adds) */
+   shape (so that the build fuses the same multiply-adds). xb: voxel a's row of exclusion
+   bits (bit b set: a and b are within the exclusion hops; at least n / 64 + 2 words),
+   whose pairs are dropped with the others: the caller no longer walks a's exclusion list
+   candidate by candidate (that walk was a third of the list's rebuilds) */
 SOFTGYM_ALWAYS_INLINE Py_ssize_t softgym_pair_idx_impl(const int seed_rule, Py_ssize_t a,
                                                        Py_ssize_t n, const double *x,
                                                        const double *y, const double *z,
                                                        const double *s,
                                                        const Py_ssize_t *rank, double lim2,
+                                                       const unsigned long long *xb,
                                                        long long *idx)
 {
     const double xa = x[a], ya = y[a], za = z[a], sa = s[a];
@@ -86,6 +90,10 @@ SOFTGYM_ALWAYS_INLINE Py_ssize_t softgym_pair_idx_impl(const int seed_rule, Py_s
                 first, _mm512_loadu_pd(s + k), _mm512_set1_pd(sa));
             out |= _mm512_cmp_pd_mask((__m512d)d2, (__m512d)(act * act), _CMP_GE_OQ);
         }
+        /* bits k .. k + 7 of the exclusion row (the next word's low bits past its end) */
+        const int sh = (int)(k & 63);
+        const unsigned long long w0 = xb[k >> 6], w1 = xb[(k >> 6) + 1];
+        out |= (__mmask8)((w0 >> sh) | (sh ? w1 << (64 - sh) : 0));
         __mmask8 keep = ~out;
         _mm512_storeu_si512((void *)(idx + m), _mm512_maskz_compress_epi64(keep, kv));
         m += __builtin_popcount((unsigned)keep);
@@ -94,6 +102,7 @@ SOFTGYM_ALWAYS_INLINE Py_ssize_t softgym_pair_idx_impl(const int seed_rule, Py_s
     for (; k < n; k++) {
         long long out;
         SOFTGYM_PAIR_OUT(seed_rule, xa, ya, za, sa, ra, x, y, z, s, rank, k, lim2, out);
+        out |= (long long)((xb[k >> 6] >> (k & 63)) & 1);
         idx[m] = k;
         m += out == 0;
     }
@@ -101,20 +110,22 @@ SOFTGYM_ALWAYS_INLINE Py_ssize_t softgym_pair_idx_impl(const int seed_rule, Py_s
 }
 static Py_ssize_t softgym_pair_idx(int seed_rule, Py_ssize_t a, Py_ssize_t n, const double *x,
                                    const double *y, const double *z, const double *s,
-                                   const Py_ssize_t *rank, double lim2, long long *idx)
+                                   const Py_ssize_t *rank, double lim2,
+                                   const unsigned long long *xb, long long *idx)
 {
     if (seed_rule)
-        return softgym_pair_idx_impl(1, a, n, x, y, z, s, rank, lim2, idx);
-    return softgym_pair_idx_impl(0, a, n, x, y, z, s, rank, lim2, idx);
+        return softgym_pair_idx_impl(1, a, n, x, y, z, s, rank, lim2, xb, idx);
+    return softgym_pair_idx_impl(0, a, n, x, y, z, s, rank, lim2, xb, idx);
 }
 #else
 #define SOFTGYM_PAIR_IDX 0
 static Py_ssize_t softgym_pair_idx(int seed_rule, Py_ssize_t a, Py_ssize_t n, const double *x,
                                    const double *y, const double *z, const double *s,
-                                   const Py_ssize_t *rank, double lim2, long long *idx)
+                                   const Py_ssize_t *rank, double lim2,
+                                   const unsigned long long *xb, long long *idx)
 {
     (void)seed_rule; (void)a; (void)n; (void)x; (void)y; (void)z; (void)s; (void)rank;
-    (void)lim2; (void)idx;
+    (void)lim2; (void)xb; (void)idx;
     return 0;
 }
 #endif
