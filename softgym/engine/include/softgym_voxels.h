@@ -103,8 +103,11 @@ SOFTGYM_ALWAYS_INLINE int softgym_v8_finish(SOFTGYM_VOXELS8_PARAMS,
     /* the block is stepped: from here on, stores */
     SOFTGYM_V8_STORE_ROWS3(SOFTGYM_ROW_VEL, vx, vy, vz);
     SOFTGYM_V8_STORE_ROWS3(SOFTGYM_ROW_POS, px, py, pz);
-    /* the 8 voxels' force and moment rows, padding included */
-    memset(force + SOFTGYM_FM_STRIDE * i, 0, 8 * SOFTGYM_FM_STRIDE * sizeof(double));
+    /* the 8 voxels' force and moment rows, padding included: one aligned 64-byte store a
+       row (a memset of the 512 bytes compiled to `rep stos`, whose start-up took a sixth
+       of the voxel update on an Intel Xeon) */
+    for (int k = 0; k < 8; k++)
+        _mm512_store_pd(force + SOFTGYM_FM_STRIDE * (i + k), _mm512_setzero_pd());
     if (ref != NULL) {
         softgym_v8 r0, r1, r2;
         softgym_v8_load3(ref + 3 * (i - vs), &r0, &r1, &r2);
