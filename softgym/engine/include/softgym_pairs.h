@@ -95,8 +95,12 @@ SOFTGYM_ALWAYS_INLINE Py_ssize_t softgym_pair_idx_impl(const int seed_rule, Py_s
         const unsigned long long w0 = xb[k >> 6], w1 = xb[(k >> 6) + 1];
         out |= (__mmask8)((w0 >> sh) | (sh ? w1 << (64 - sh) : 0));
         __mmask8 keep = ~out;
-        _mm512_storeu_si512((void *)(idx + m), _mm512_maskz_compress_epi64(keep, kv));
-        m += __builtin_popcount((unsigned)keep);
+        /* most vectors keep no pair (the exclusions dropped): no store, and no step of the
+           chain through m (mask, count, add: its latency was the loop's bound) */
+        if (keep) {
+            _mm512_storeu_si512((void *)(idx + m), _mm512_maskz_compress_epi64(keep, kv));
+            m += __builtin_popcount((unsigned)keep);
+        }
         kv = _mm512_add_epi64(kv, eight);
     }
     for (; k < n; k++) {
