@@ -36,6 +36,18 @@ on a shared VM whose runs scatter by 5 %, the way to judge a change of a few per
 
     python benchmarks/profile_engine.py --cycles --repeats 8 --baseline HEAD
 
+``--perf`` finds the time outside the loops (the step's glue: set-up, remainders, tests,
+library calls), which the port model of the loops (``port_bound.py``) does not see: it
+runs the reference robot under ``perf record`` (sampling the build this machine loads),
+and prints for each of the engine's hottest functions its share of the engine's samples,
+the share of those outside its innermost loops (``objdump``'s disassembly of the module,
+a loop being a conditional jump back) and the hottest instructions there, each with the
+inlined function it came from. Sampled addresses skid to the instruction after the one
+that waited, so read them as places to look, and confirm a change with
+``compare_builds.py``. Needs ``perf`` and ``objdump`` (binutils):
+
+    python benchmarks/profile_engine.py --perf
+
 ``--modes`` prints how the reference robot's links split between the seed model's
 small- and large-angle modes over its run (sampled every 0.05 s from the state): the
 share of links in large-angle mode and of blocks of 16 links all in small-angle mode (the
@@ -74,6 +86,22 @@ print("STEPS", int(r.steps[0]), sim.n_voxels, sim.n_links, kernel_build())
 
 # the per-robot step function: everything the engine does per step runs under it
 TOGGLE = "*advance_robot*"
+
+# the child of --perf: the same robot, run `runs` times (enough samples), and where the
+# loaded kernel modules are
+PERF_CHILD = r"""
+import os, sys
+sys.path.insert(0, {bench!r})
+from bench_engine import reference_robot
+from softgym.engine import SimConfig, Simulation, kernel_build
+cfg = SimConfig(self_collision={coll}, model={model!r}, link_precision={prec!r})
+for _ in range({runs}):
+    r = Simulation([reference_robot({n})], cfg, n_threads=1).run({seconds})
+mod = [m for k, m in sys.modules.items() if k.endswith("._seed") and hasattr(m, "__file__")]
+print("KERNEL", kernel_build(), os.path.dirname(mod[0].__file__))
+"""
+# the engine's modules, by the start of their file names
+ENGINE_MODULES = ("_seed", "_integrate", "_contact", "_core", "_corotational", "_record")
 
 
 def demangle(name: str) -> str:
@@ -260,6 +288,82 @@ def print_cycles_against(p: dict, q: dict, baseline: str) -> None:
         print(f"{name:40s} {a:10.1f} {b:12.1f} {100 * (a - b) / b if b else 0.0:+7.1f}%")
 
 
+def split_by_loops(annotation: str, loops: list[tuple[int, int]], fn_at: dict[int, str],
+                   hottest: int = 3) -> dict:
+    """The per-instruction percentages of ``perf annotate --stdio`` text (lines
+    ``  PCT :   ADDR:   INSTRUCTION``), summed inside the address ranges ``loops`` (inclusive)
+    and outside them, with the ``hottest`` instructions outside as (percent, address,
+    inlined function from ``fn_at``, instruction)."""
+    inside = outside = 0.0
+    out = []
+    for line in annotation.splitlines():
+        m = re.match(r"\s+([0-9.]+) :\s+([0-9a-f]+):\s+(.*)$", line)
+        if not m:
+            continue
+        pct, addr, text = float(m.group(1)), int(m.group(2), 16), m.group(3).strip()
+        if any(lo <= addr <= hi for lo, hi in loops):
+            inside += pct
+        else:
+            outside += pct
+            out.append((pct, addr, fn_at.get(addr, "?"), text))
+    out.sort(key=lambda t: -t[0])
+    return {"inside": inside, "outside": outside, "hottest_outside": out[:hottest]}
+
+
+def perf_functions(report: str) -> list[tuple[float, str, str]]:
+    """(percent, module file, symbol) of the engine's functions in ``perf report --stdio
+    --sort dso,sym`` text, hottest first."""
+    rows = []
+    for line in report.splitlines():
+        m = re.match(r"\s+([0-9.]+)%\s+(\S+)\s+\[\.\]\s+(\S+)", line)
+        if m and m.group(2).startswith(tuple(f"{k}." for k in ENGINE_MODULES)):
+            rows.append((float(m.group(1)), m.group(2), m.group(3)))
+    return sorted(rows, key=lambda r: -r[0])
+
+
+def profile_perf(model: str, collisions: bool, seconds: float, n: int,
+                 precision: str | None = None, top: int = 8, runs: int = 20) -> dict:
+    """perf's samples of the reference robot, per engine function, split into its innermost
+    loops and the rest (split_by_loops)."""
+    for tool in ("perf", "objdump"):
+        if shutil.which(tool) is None:
+            raise SystemExit(f"profile_engine: --perf needs {tool}")
+    import port_bound
+
+    code = PERF_CHILD.format(bench=str(HERE), n=n, coll=collisions, model=model,
+                             seconds=seconds, prec=precision, runs=runs)
+    with tempfile.TemporaryDirectory(prefix="softgym-perf-") as tmp:
+        data = os.path.join(tmp, "perf.data")
+        res = subprocess.run(["perf", "record", "-q", "-F", "10000", "-o", data, sys.executable,
+                              "-c", code], capture_output=True, text=True, check=False)
+        m = re.search(r"KERNEL (\S+) (.+)", res.stdout)
+        if res.returncode != 0 or m is None:
+            raise SystemExit(f"profile_engine: the sampled run failed:\n{res.stderr[-2000:]}")
+        build, moddir = m.group(1), Path(m.group(2).strip())
+        report = subprocess.run(["perf", "report", "-i", data, "--no-children", "--sort",
+                                 "dso,sym", "--stdio"], capture_output=True, text=True,
+                                check=True).stdout  # fmt: skip
+        funcs = perf_functions(report)
+        engine = sum(f[0] for f in funcs) or 1.0
+        disasm: dict[str, tuple] = {}
+        rows = []
+        for pct, dso, sym in funcs[:top]:
+            if dso not in disasm:
+                so = moddir / dso
+                ins = port_bound.disassemble(so) if so.exists() else []
+                disasm[dso] = ([(ins[s][0], ins[e][0]) for s, e in port_bound.innermost_loops(ins)],
+                               {a: fn for a, _sym, fn, _t in ins})
+            loops, fn_at = disasm[dso]
+            ann = subprocess.run(["perf", "annotate", "-i", data, "--stdio", "-s", sym],
+                                 capture_output=True, text=True, check=False).stdout  # fmt: skip
+            split = split_by_loops(ann, loops, fn_at)
+            total = split["inside"] + split["outside"] or 1.0
+            rows.append({"symbol": sym, "module": dso, "share": pct / engine,
+                         "outside": split["outside"] / total,
+                         "hottest_outside": split["hottest_outside"]})
+    return {"kernel_build": build, "functions": rows}
+
+
 def link_modes(seconds: float, n: int, collisions: bool, precision: str | None = None,
                every: float = 0.05, block: int = 16) -> dict:
     """The reference robot's links by mode (seed preset) over ``seconds``, sampled every
@@ -301,7 +405,26 @@ def main(argv: list[str] | None = None) -> int:
                          "with the tree's, and each pass's change against it")
     ap.add_argument("--modes", action="store_true",
                     help="the links' small- and large-angle modes over the run (seed preset)")
+    ap.add_argument("--perf", action="store_true",
+                    help="perf's samples per engine function, inside its innermost loops and "
+                         "outside them (needs perf and objdump)")
     args = ap.parse_args(argv)
+    if args.perf:
+        got = profile_perf(args.model, not args.no_collision, args.seconds, args.size,
+                           args.link_precision)
+        print(f"{args.model} preset{precision_label(args.model, args.link_precision)}, kernel "
+              f"build {got['kernel_build']}, {args.size}^3 reference robot: perf's samples of "
+              f"the engine's hottest functions, and the share of each outside its innermost "
+              f"loops (skid: a sample lands after the instruction that waited)")
+        print(f"{'function':44s} {'share':>6s} {'outside':>8s}  hottest outside (inlined "
+              f"function: instruction)")
+        for f in got["functions"]:
+            hot = "; ".join(f"{p:.1f}% {fn}: {t[:40]}" for p, _a, fn, t in f["hottest_outside"])
+            print(f"{f['symbol'][:44]:44s} {100 * f['share']:5.1f}% {100 * f['outside']:7.1f}%  "
+                  f"{hot}")
+        if args.json:
+            print(json.dumps(got))
+        return 0
     if args.modes:
         if args.model != "seed":
             raise SystemExit("profile_engine: --modes counts the seed preset's link modes only")

@@ -1,13 +1,17 @@
-"""benchmarks/profile_engine.py --modes: the reference robot's links by mode (issue 29).
+"""benchmarks/profile_engine.py --modes and --perf (issue 29).
 
 Run as a user runs it (a child process). The instruction and cycle profiles need valgrind
-or a probed build of a copy of the tree (minutes) and are not run here.
+or a probed build of a copy of the tree (minutes) and are not run here; --perf runs where
+perf can sample (skipped elsewhere).
 """
 
 import json
+import shutil
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 SCRIPT = ROOT / "benchmarks" / "profile_engine.py"
@@ -37,3 +41,35 @@ def test_a_short_run_keeps_a_robot_at_rest_in_small_angle_mode():
     _, m = _modes("--seconds", 0.05)
     assert m["samples"] == 1
     assert m["large_angle_share"] < 0.05
+
+
+
+def _perf_works(tmp_path):
+    if shutil.which("perf") is None or shutil.which("objdump") is None:
+        return False
+    res = subprocess.run(["perf", "record", "-q", "-o", str(tmp_path / "probe.data"), "true"],
+                         capture_output=True, text=True)  # fmt: skip
+    return res.returncode == 0
+
+
+def test_perf_splits_the_engine_functions_at_their_loops(tmp_path):
+    # --perf: perf's samples of the engine's hottest functions, each split into its
+    # innermost loops and the rest (the step's glue); skipped where perf cannot sample
+    if not _perf_works(tmp_path):
+        pytest.skip("needs a working perf and objdump")
+    res = subprocess.run([sys.executable, str(SCRIPT), "--perf", "--json", "--seconds", "0.5"],
+                         capture_output=True, text=True)  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    lines = res.stdout.strip().splitlines()
+    got = json.loads(lines[-1])
+    funcs = got["functions"]
+    assert 1 <= len(funcs) <= 8 and "outside its innermost loops" in lines[0]
+    shares = [f["share"] for f in funcs]
+    assert shares == sorted(shares, reverse=True) and 0.0 < sum(shares) <= 1.0 + 1e-9
+    assert all(0.0 <= f["outside"] <= 1.0 for f in funcs)
+    # the seed step's link passes are among the hottest, and mostly in their loops
+    geom = [f for f in funcs if f["symbol"].startswith("softgym_seed_geom")]
+    assert geom and geom[0]["outside"] < 0.6
+    for f in funcs:
+        for pct, addr, fn, text in f["hottest_outside"]:
+            assert pct >= 0.0 and addr > 0 and fn and text
