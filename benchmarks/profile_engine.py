@@ -72,34 +72,27 @@ from tree_run import build_tree, copy_tree, run_in_tree
 
 HERE = Path(__file__).resolve().parent
 
-# the child: one reference robot, alone, one thread
+# the child: one reference robot, alone, one thread, run `runs` times (callgrind: once;
+# --perf: enough for its samples); it prints the steps, sizes, kernel build and the
+# folder of the loaded kernel modules
 CHILD = r"""
+import os
 import sys
-sys.path.insert(0, {bench!r})
-from bench_engine import reference_robot
-from softgym.engine import SimConfig, Simulation, kernel_build
-sim = Simulation([reference_robot({n})], SimConfig(self_collision={coll}, model={model!r},
-                 link_precision={prec!r}), n_threads=1)
-r = sim.run({seconds})
-print("STEPS", int(r.steps[0]), sim.n_voxels, sim.n_links, kernel_build())
-"""
-
-# the per-robot step function: everything the engine does per step runs under it
-TOGGLE = "*advance_robot*"
-
-# the child of --perf: the same robot, run `runs` times (enough samples), and where the
-# loaded kernel modules are
-PERF_CHILD = r"""
-import os, sys
 sys.path.insert(0, {bench!r})
 from bench_engine import reference_robot
 from softgym.engine import SimConfig, Simulation, kernel_build
 cfg = SimConfig(self_collision={coll}, model={model!r}, link_precision={prec!r})
 for _ in range({runs}):
-    r = Simulation([reference_robot({n})], cfg, n_threads=1).run({seconds})
+    sim = Simulation([reference_robot({n})], cfg, n_threads=1)
+    r = sim.run({seconds})
 mod = [m for k, m in sys.modules.items() if k.endswith("._seed") and hasattr(m, "__file__")]
-print("KERNEL", kernel_build(), os.path.dirname(mod[0].__file__))
+print("STEPS", int(r.steps[0]), sim.n_voxels, sim.n_links, kernel_build(),
+      os.path.dirname(mod[0].__file__))
 """
+
+# the per-robot step function: everything the engine does per step runs under it
+TOGGLE = "*advance_robot*"
+
 # the engine's modules, by the start of their file names
 ENGINE_MODULES = ("_seed", "_integrate", "_contact", "_core", "_corotational", "_record")
 
@@ -125,7 +118,7 @@ def profile(model: str, collisions: bool, seconds: float, n: int, toggle: str,
     with tempfile.TemporaryDirectory(prefix="softgym-cg-") as tmp:
         out = os.path.join(tmp, "cg.out")
         code = CHILD.format(bench=str(HERE), n=n, coll=collisions, model=model, seconds=seconds,
-                            prec=precision)
+                            prec=precision, runs=1)
         res = subprocess.run(
             ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}",
              f"--toggle-collect={toggle}", sys.executable, "-c", code],
@@ -330,13 +323,13 @@ def profile_perf(model: str, collisions: bool, seconds: float, n: int,
             raise SystemExit(f"profile_engine: --perf needs {tool}")
     import port_bound
 
-    code = PERF_CHILD.format(bench=str(HERE), n=n, coll=collisions, model=model,
-                             seconds=seconds, prec=precision, runs=runs)
+    code = CHILD.format(bench=str(HERE), n=n, coll=collisions, model=model, seconds=seconds,
+                        prec=precision, runs=runs)
     with tempfile.TemporaryDirectory(prefix="softgym-perf-") as tmp:
         data = os.path.join(tmp, "perf.data")
         res = subprocess.run(["perf", "record", "-q", "-F", "10000", "-o", data, sys.executable,
                               "-c", code], capture_output=True, text=True, check=False)
-        m = re.search(r"KERNEL (\S+) (.+)", res.stdout)
+        m = re.search(r"STEPS \d+ \d+ \d+ (\S+) (.+)", res.stdout)
         if res.returncode != 0 or m is None:
             raise SystemExit(f"profile_engine: the sampled run failed:\n{res.stderr[-2000:]}")
         build, moddir = m.group(1), Path(m.group(2).strip())
