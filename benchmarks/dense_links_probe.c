@@ -234,8 +234,9 @@ int main(int argc, char **argv)
         bd[ax][23 * nd + c] = neg2;
         valid[ax][c] = 1.0;
     }
-    /* the same rows as the engine's forces pass leaves them for its scatter: per chunk of
-       SOFTGYM_CHUNK_LINKS links, 12 rows SOFTGYM_CHUNK_STRIDE apart, then voxel 1's
+    /* the same rows as the engine's double-precision forces pass leaves them for its
+       scatter: per chunk of SOFTGYM_CHUNK_LINKS links, 12 rows SOFTGYM_CHUNK_STRIDE apart
+       (the single-precision pass's float rows hold the same values), then voxel 1's
        rotation in rows SOFTGYM_SEED_R_ROWS.. (the geometry's, in the AVX-512 builds) */
     Py_ssize_t nch = (nl + SOFTGYM_CHUNK_LINKS - 1) / SOFTGYM_CHUNK_LINKS;
     double *bc = aligned_alloc(64, nch * SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE * 8);
@@ -274,8 +275,8 @@ int main(int argc, char **argv)
                 Py_ssize_t a0 = start[ax] > c0 ? start[ax] : c0;
                 Py_ssize_t a1 = start[ax + 1] < c1 ? start[ax + 1] : c1;
                 if (a0 < a1)
-                    softgym_seed_scatter(ax, a0, a1, v1, v2, rot, chunk, bo + 23 * ne, fa,
-                                         fa + 4);
+                    softgym_seed_scatter(ax, a0, a1, v1, v2, rot, chunk, (const float *)0,
+                                         bo + 23 * ne, fa, fa + 4);
             }
         }
         t = __rdtsc() - t0;

@@ -114,8 +114,9 @@ cdef struct Batch:
     float64_t* chunk_link    # the seed model's link scratch for one chunk of links: N_LINK_OUT
                              #   rows, SOFTGYM_CHUNK_STRIDE apart, indexed by link from the chunk's
                              #   first (_seed.links_seed; per thread)
-    float* chunk_f32         # scratch of the seed model's single-precision frames: SOFTGYM_CHUNK_FROWS
-                             #   float rows, SOFTGYM_CHUNK_FSTRIDE apart, for one chunk of links
+    float* chunk_f32         # scratch of the seed model's single-precision frames and forces:
+                             #   SOFTGYM_CHUNK_FROWS float rows, SOFTGYM_CHUNK_FSTRIDE apart, for one
+                             #   chunk of links (the forces' from row SOFTGYM_CHUNK_FOUT)
     intp_t* v1               # (n_links,) voxel on the negative side
     intp_t* v2               # (n_links,) voxel on the positive side
     int32* axis              # (n_links,) 0, 1, 2 for x, y, z

@@ -19,3 +19,4 @@ cdef extern from "softgym_seed.h":
         SOFTGYM_CHUNK_ROWS
         SOFTGYM_CHUNK_FSTRIDE
         SOFTGYM_CHUNK_FROWS
+        SOFTGYM_CHUNK_FOUT

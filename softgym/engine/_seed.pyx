@@ -97,8 +97,9 @@ cdef extern from "softgym_seed.h":
                               float64_t st_out, float64_t ex_out, lane_flag_t* link_sa,
                               const lane_flag_t* homog, float64_t* o) noexcept nogil
     void softgym_seed_scatter(int ax, intp_t lo, intp_t hi, const intp_t* v1, const intp_t* v2,
-                              const float64_t* rot, const float64_t* o, const float64_t* neg2_row,
-                              float64_t* force, float64_t* moment) noexcept nogil
+                              const float64_t* rot, const float64_t* o, const float* of,
+                              const float64_t* neg2_row, float64_t* force,
+                              float64_t* moment) noexcept nogil
     # the rows of the chunk's scratch that hold voxel 1's rotation (the geometry writes
     # them, the scatter reads them, where the build's SOFTGYM_SEED_R_USED is 1: AVX-512)
     enum: SOFTGYM_SEED_R_ROWS
@@ -109,7 +110,7 @@ cdef extern from "softgym_seed.h":
                                const float64_t* sa_, const float64_t* chg_,
                                const float64_t* neg2_, const float* ka_,
                                const float* kt_, const float* kb_, const float* cs_,
-                               float* link_last, float64_t* out) noexcept nogil
+                               float* link_last, float* out) noexcept nogil
 
 
 #: the passes of links_seed that the cycle probes time, in slot order
@@ -212,8 +213,8 @@ cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end, float64_
                                        intp_t n, float64_t inv_dt) noexcept nogil:
     # links_seed's frames and forces passes in single precision
     # (SimConfig.link_precision = "single"; include/softgym_seed.h): the chunk's float
-    # rows in b.chunk_f32 from the frames, double rows of b.chunk_out from the forces for
-    # the scatter (links lo..end: one chunk)
+    # rows in b.chunk_f32 from the frames, and from the forces its rows SOFTGYM_CHUNK_FOUT
+    # on, which the scatter widens to doubles (links lo..end: one chunk)
     cdef:
         intp_t li
         int fix
@@ -235,7 +236,7 @@ cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end, float64_
                           <float> (0.25 * b.bond_zeta), <float> inv_dt, f, SOFTGYM_CHUNK_FSTRIDE,
                           o + 9 * n, o + 22 * n, o + 23 * n, k32, k32 + b.link_rows,
                           k32 + 2 * b.link_rows, k32 + 3 * b.link_rows, b.link_last32,
-                          b.chunk_out - lo)
+                          f + SOFTGYM_CHUNK_FOUT * SOFTGYM_CHUNK_FSTRIDE)
     softgym_prof_add(4, t0)
 
 
@@ -322,7 +323,9 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     #                        large angles, not computed where a chunk's links are
     #                        all in small-angle mode; voxel 2's own force left out
     #                        where they all give it -F1) into the 12 rows of
-    #                        b.chunk_out
+    #                        b.chunk_out (in single precision: 12 float rows of
+    #                        b.chunk_f32 from SOFTGYM_CHUNK_FOUT, which the
+    #                        scatter widens to doubles as it loads them)
     #   softgym_seed_scatter back to the world, scattered in link order (once
     #                        per axis; with AVX-512, 8 links at a time turned in
     #                        the lanes with voxel 1's rotation, which the geometry
@@ -357,6 +360,9 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
         float64_t* o
         # the geometry's rotation rows for the scatter (the chunk's)
         float64_t* rr = b.chunk_out + SOFTGYM_SEED_R_ROWS * SOFTGYM_CHUNK_STRIDE
+        # the scatter's forces and moments: the float forces pass's rows of the chunk's
+        # float scratch, indexed by link (NULL: the double pass's rows 0-11 of chunk_out)
+        const float* of = NULL
         unsigned long long t0
     if hi <= lo:
         return STATUS_OK
@@ -378,6 +384,7 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
                 end = c1
         if b.link_f32:
             _seed_frames_forces32(b, c0, end, o, n, inv_dt)
+            of = b.chunk_f32 + SOFTGYM_CHUNK_FOUT * SOFTGYM_CHUNK_FSTRIDE - c0
         else:
             _seed_frames_forces(b, c0, end, o, n, inv_dt)
         t0 = softgym_prof_tsc()
@@ -385,8 +392,8 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
             a0 = max(c0, run[ax])
             a1 = min(end, run[ax + 1])
             if a0 < a1:
-                softgym_seed_scatter(ax, a0, a1, b.v1, b.v2, b.rot,
-                                     b.chunk_out - c0, o + 23 * n, b.force, b.moment)
+                softgym_seed_scatter(ax, a0, a1, b.v1, b.v2, b.rot, b.chunk_out - c0, of,
+                                     o + 23 * n, b.force, b.moment)
         softgym_prof_add(5, t0)
         if end < c1:
             return STATUS_STRAIN

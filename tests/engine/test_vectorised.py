@@ -36,7 +36,7 @@ PASSES = {
                            "d, d, o, o);",
     "softgym_seed_frames32": "softgym_seed_frames32(0, n, n, 0.01f, 0.9988f, d, fo[0]);",
     "softgym_seed_forces32": "softgym_seed_forces32(0, n, n, 0.01f, 0.1f, 0.05f, 1e4f, fc, 0, d, d, "
-                             "d, fc, fc, fc, fc, fo[0], o);",
+                             "d, fc, fc, fc, fc, fo[0], fo[1]);",
     "softgym_seed_modes": "return (long)softgym_seed_modes(0, n, n, 0.3, 0.99, 0.98, 0.05, 1.3, "
                           "0.055, 1.43, lf, lf, o);",
     "softgym_seed_quats": "softgym_seed_quats(0, n, n, 1e-4, d, d, o);",
@@ -349,26 +349,44 @@ SCATTER_HARNESS = _c_harness("softgym_seed.h", r"""
    the lanes with the geometry's rotation rows, the links before and after them one by
    one) against softgym_seed_scatter_links (every link one by one, voxel 1's matrix from
    rot): the voxels' forces and moments (lanes 0-2 and 4-6 of their rows; 3 and 7 are
-   padding) */
+   padding); the forces and moments from the double rows of the chunk, and (f32) from the
+   single-precision forces pass's float rows, widened as they are loaded; with f32 the
+   double rows hold the floats' values too, so the two scatters must agree */
 enum { NV = 300, N = SOFTGYM_CHUNK_LINKS, FM = SOFTGYM_FM_STRIDE * NV };
 static double fm_a[FM] __attribute__((aligned(64))), fm_b[FM] __attribute__((aligned(64)));
+static double fm_c[FM] __attribute__((aligned(64)));
 static double rot[9 * NV], neg2[N];
 static double chunk[SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE] __attribute__((aligned(64)));
+static float chunk32[12 * SOFTGYM_CHUNK_FSTRIDE] __attribute__((aligned(64)));
 static Py_ssize_t v1[N], v2[N];
-SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi)
+SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, const int f32, Py_ssize_t lo, Py_ssize_t hi)
 {
-    for (int k = 0; k < 12 * SOFTGYM_CHUNK_STRIDE; k++)
-        chunk[k] = urand();
+    for (int k = 0; k < 12; k++)
+        for (int li = 0; li < SOFTGYM_CHUNK_STRIDE; li++) {
+            double v = urand();
+            if (f32 && li < N) {
+                chunk32[k * SOFTGYM_CHUNK_FSTRIDE + li] = (float)v;
+                v = (float)v;
+            }
+            chunk[k * SOFTGYM_CHUNK_STRIDE + li] = v;
+        }
     for (Py_ssize_t li = 0; li < N; li++) {
         neg2[li] = rand() % 3 == 0 ? 0.0 : 1.0;
         for (int k = 0; k < 9; k++)
             chunk[(SOFTGYM_SEED_R_ROWS + k) * SOFTGYM_CHUNK_STRIDE + li] = rot[9 * v1[li] + k];
     }
     urand_both(fm_a, fm_b, FM);
-    softgym_seed_scatter(ax, lo, hi, v1, v2, rot, chunk, neg2, fm_a, fm_a + 4);
-    SOFTGYM_BY_AXIS(ax, softgym_seed_scatter_links, lo, hi, v1, v2, rot, chunk, neg2, fm_b,
-                    fm_b + 4);
-    return rows_differ(fm_a, fm_b, NV);
+    memcpy(fm_c, fm_a, sizeof fm_c);
+    softgym_seed_scatter(ax, lo, hi, v1, v2, rot, chunk, f32 ? chunk32 : 0, neg2, fm_a,
+                         fm_a + 4);
+    SOFTGYM_BY_AXIS(ax, softgym_seed_scatter_links, f32, lo, hi, v1, v2, rot, chunk, chunk32,
+                    neg2, fm_b, fm_b + 4);
+    long bad = rows_differ(fm_a, fm_b, NV);
+    if (f32) {  /* the double rows' scatter of the same values */
+        softgym_seed_scatter(ax, lo, hi, v1, v2, rot, chunk, 0, neg2, fm_c, fm_c + 4);
+        bad += rows_differ(fm_a, fm_c, NV);
+    }
+    return bad;
 }
 int main(void)
 {
@@ -378,10 +396,12 @@ int main(void)
     long bad = 0;
     for (int pattern = 0; pattern < 3; pattern++) {
         link_pattern(pattern, v1, v2, N, NV);
-        for (int ax = 0; ax < 3; ax++) {
-            bad += check_ax(ax, 0, N);
-            bad += check_ax(ax, 3, N - 5);  /* links one by one before and after the blocks */
-        }
+        for (int ax = 0; ax < 3; ax++)
+            for (int f32 = 0; f32 < 2; f32++) {
+                bad += check_ax(ax, f32, 0, N);
+                /* links one by one before and after the blocks */
+                bad += check_ax(ax, f32, 3, N - 5);
+            }
     }
     printf("%ld\n", bad);
     return 0;

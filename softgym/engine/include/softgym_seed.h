@@ -28,9 +28,14 @@
    a2x, a2y, a2z, rw, ry, rz, fix) SOFTGYM_CHUNK_FSTRIDE floats apart (each row on a cache
    line of its own, consecutive rows on different sets), so the frames and forces passes
    address them from one pointer: with a pointer per row, the forces pass's 40-odd rows
-   outnumbered the general registers and spilled */
+   outnumbered the general registers and spilled; rows 12-23 (from SOFTGYM_CHUNK_FOUT) are
+   the single-precision forces pass's forces and moments, in the order of the double rows
+   0-11 of SOFTGYM_CHUNK_STRIDE (the scatter widens them to doubles as it loads them: a
+   float is exactly a double, and the forces pass, which had widened its 16 lanes a row
+   into two stores of 8 doubles, now stores them as they are) */
 #define SOFTGYM_CHUNK_FSTRIDE (SOFTGYM_CHUNK_LINKS + 16)
-#define SOFTGYM_CHUNK_FROWS 12
+#define SOFTGYM_CHUNK_FROWS 24
+#define SOFTGYM_CHUNK_FOUT 12
 
 /* The first pass of links_seed (_seed.pyx): links lo..hi (all along axis ax, a
    compile-time constant in each copy) measured in the bond frame, without
@@ -435,7 +440,8 @@ static int softgym_seed_frames(
    the divider's float rate, on quantities relative to voxel 1 (positions
    stay double; the geometry and mode passes stay double). The frames' float rows
    are a chunk's float scratch (SOFTGYM_CHUNK_FROWS rows); the forces pass
-   leaves doubles for the scatter. Reformulated where float would cancel:
+   leaves floats (rows SOFTGYM_CHUNK_FOUT on), which the scatter widens.
+   Reformulated where float would cancel:
    - the displacements p0 - nom and |p| - nom are taken in double (the modes pass
      leaves the link's mode's one in row 10), then rounded;
    - the rotation vector of a unit quaternion (w, v) is k v with the seed's
@@ -692,9 +698,13 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
 #define SOFTGYM_FT double
 #define SOFTGYM_FNAME softgym_seed_forces
 #define SOFTGYM_FIN_STRIDE in_stride
+#define SOFTGYM_FOUT_T double
+#define SOFTGYM_FOUT_STRIDE SOFTGYM_CHUNK_STRIDE
 #define SOFTGYM_FPICK softgym_pick
 #define SOFTGYM_FMASK long long
 #include "softgym_seed_forces.h"
+#undef SOFTGYM_FOUT_T
+#undef SOFTGYM_FOUT_STRIDE
 #undef SOFTGYM_FT
 #undef SOFTGYM_FNAME
 #undef SOFTGYM_FIN_STRIDE
@@ -724,12 +734,8 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
 /* x + s d where m (else x): the damping added where the mode did not change */
 #define SOFTGYM_F16_DAMP(m, x, s, d) \
     ((softgym_v16f)_mm512_mask3_fmadd_ps((__m512)(s), (__m512)(d), (__m512)(x), (m)))
-/* 16 floats v as 16 doubles at out + li */
-#define SOFTGYM_F16_PUT(out, li, v) do { \
-        __m512 v_ = (__m512)(v); \
-        _mm512_storeu_pd((out) + (li), _mm512_cvtps_pd(_mm512_castps512_ps256(v_))); \
-        _mm512_storeu_pd((out) + (li) + 8, _mm512_cvtps_pd(_mm512_extractf32x8_ps(v_, 1))); \
-    } while (0)
+/* 16 floats v at out + li (the scatter widens them to doubles as it loads them) */
+#define SOFTGYM_F16_PUT(out, li, v) _mm512_storeu_ps((out) + (li), (__m512)(v))
 /* the rate of the quantity x in memory row r, (x - last) inv_dt, and the row set to x where
    the mode did not change */
 #define SOFTGYM_F16_MEMORY(r, x, rate) do { \
@@ -740,9 +746,9 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
     const int all_small, const int all_neg2, Py_ssize_t li, Py_ssize_t n, float L, float bz,
     float bzh, float inv_dt, const float *in, const double *sa_, const double *chg_,
     const float *ka_, const float *kt_, const float *kb_, const float *cs_,
-    float *link_last, double *out)
+    float *link_last, float *out)
 {
-    const Py_ssize_t is = SOFTGYM_CHUNK_FSTRIDE, os = SOFTGYM_CHUNK_STRIDE;
+    const Py_ssize_t is = SOFTGYM_CHUNK_FSTRIDE, os = SOFTGYM_CHUNK_FSTRIDE;
     softgym_v16f P0, P1, P2, a1y, a1z, a2x, a2y, a2z;
     softgym_v16f ka, b2, f1x, f1y, f1z, m1x, m1y, m1z;
     softgym_v16f m2x, m2y, m2z, f2x, f2y, f2z;
@@ -914,9 +920,13 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
 #define SOFTGYM_FBLOCK softgym_seed_forces32_block16
 #endif
 #define SOFTGYM_FIN_STRIDE SOFTGYM_CHUNK_FSTRIDE
+#define SOFTGYM_FOUT_T float
+#define SOFTGYM_FOUT_STRIDE SOFTGYM_CHUNK_FSTRIDE
 #define SOFTGYM_FPICK(c, a, b) ((c) ? (a) : (b))
 #define SOFTGYM_FMASK int
 #include "softgym_seed_forces.h"
+#undef SOFTGYM_FOUT_T
+#undef SOFTGYM_FOUT_STRIDE
 #undef SOFTGYM_FBLOCK
 #undef SOFTGYM_FT
 #undef SOFTGYM_FNAME
@@ -1055,6 +1065,9 @@ typedef long long softgym_v4i __attribute__((vector_size(32)));
         (acc)[2] op w[2]; \
     } while (0)
 #endif
+/* row k of the link's forces and moments: the forces pass's doubles (o, SOFTGYM_CHUNK_STRIDE
+   apart), or (f32) its floats (of, SOFTGYM_CHUNK_FSTRIDE apart) widened: the same value */
+#define SOFTGYM_SQ(k) (f32 ? (double)qf[(k) * SOFTGYM_CHUNK_FSTRIDE] : q[(k) * n])
 #define SOFTGYM_SCATTER_TURN(acc, x, y, z) do { \
         SOFTGYM_SCATTER_W(x, y, z); \
         SOFTGYM_SCATTER_ACC(acc, +=); \
@@ -1070,14 +1083,15 @@ typedef long long softgym_v4i __attribute__((vector_size(32)));
             SOFTGYM_SCATTER_TURN(fj, x, y, z); \
         } \
     } while (0)
-SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_links(const int ax, Py_ssize_t lo,
+SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_links(const int ax, const int f32, Py_ssize_t lo,
                                                       Py_ssize_t hi, const Py_ssize_t *v1,
                                                       const Py_ssize_t *v2, const double *rot,
-                                                      const double *o,
+                                                      const double *o, const float *of,
                                                       const double *neg2_row, double *force,
                                                       double *moment)
 {
     const Py_ssize_t n = SOFTGYM_CHUNK_STRIDE;
+    (void)of;
     Py_ssize_t li;
 #if defined(SOFTGYM_SCATTER_V4)
     /* voxel 2's rows after the last link, kept in registers: where a link's
@@ -1122,6 +1136,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_links(const int ax, Py_ssize_t l
         double w[3];
 #endif
         const double *q = o + li;
+        const float *qf = f32 ? of + li : 0;
         /* neg2_row (row 23 of the scratch) holds exactly 1.0 or 0.0 (the modes pass): its
            bits, one integer test (a double's != 0.0 is two branches, for NaN) */
         unsigned long long neg2_bits;
@@ -1142,20 +1157,20 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_links(const int ax, Py_ssize_t l
         memcpy(&mj_v, mj, sizeof mj_v);
 #endif
         if (ax == 0) {
-            SOFTGYM_SCATTER_TURN(fi, q[0], q[n], q[2 * n]);
-            SOFTGYM_SCATTER_F2(q[3 * n], q[4 * n], q[5 * n]);
-            SOFTGYM_SCATTER_TURN(mi, q[6 * n], q[7 * n], q[8 * n]);
-            SOFTGYM_SCATTER_TURN(mj, q[9 * n], q[10 * n], q[11 * n]);
+            SOFTGYM_SCATTER_TURN(fi, SOFTGYM_SQ(0), SOFTGYM_SQ(1), SOFTGYM_SQ(2));
+            SOFTGYM_SCATTER_F2(SOFTGYM_SQ(3), SOFTGYM_SQ(4), SOFTGYM_SQ(5));
+            SOFTGYM_SCATTER_TURN(mi, SOFTGYM_SQ(6), SOFTGYM_SQ(7), SOFTGYM_SQ(8));
+            SOFTGYM_SCATTER_TURN(mj, SOFTGYM_SQ(9), SOFTGYM_SQ(10), SOFTGYM_SQ(11));
         } else if (ax == 1) {
-            SOFTGYM_SCATTER_TURN(fi, SOFTGYM_NEG1(q[n]), q[0], q[2 * n]);
-            SOFTGYM_SCATTER_F2(SOFTGYM_NEG1(q[4 * n]), q[3 * n], q[5 * n]);
-            SOFTGYM_SCATTER_TURN(mi, SOFTGYM_NEG1(q[7 * n]), q[6 * n], q[8 * n]);
-            SOFTGYM_SCATTER_TURN(mj, SOFTGYM_NEG1(q[10 * n]), q[9 * n], q[11 * n]);
+            SOFTGYM_SCATTER_TURN(fi, SOFTGYM_NEG1(SOFTGYM_SQ(1)), SOFTGYM_SQ(0), SOFTGYM_SQ(2));
+            SOFTGYM_SCATTER_F2(SOFTGYM_NEG1(SOFTGYM_SQ(4)), SOFTGYM_SQ(3), SOFTGYM_SQ(5));
+            SOFTGYM_SCATTER_TURN(mi, SOFTGYM_NEG1(SOFTGYM_SQ(7)), SOFTGYM_SQ(6), SOFTGYM_SQ(8));
+            SOFTGYM_SCATTER_TURN(mj, SOFTGYM_NEG1(SOFTGYM_SQ(10)), SOFTGYM_SQ(9), SOFTGYM_SQ(11));
         } else {
-            SOFTGYM_SCATTER_TURN(fi, SOFTGYM_NEG1(q[2 * n]), q[n], q[0]);
-            SOFTGYM_SCATTER_F2(SOFTGYM_NEG1(q[5 * n]), q[4 * n], q[3 * n]);
-            SOFTGYM_SCATTER_TURN(mi, SOFTGYM_NEG1(q[8 * n]), q[7 * n], q[6 * n]);
-            SOFTGYM_SCATTER_TURN(mj, SOFTGYM_NEG1(q[11 * n]), q[10 * n], q[9 * n]);
+            SOFTGYM_SCATTER_TURN(fi, SOFTGYM_NEG1(SOFTGYM_SQ(2)), SOFTGYM_SQ(1), SOFTGYM_SQ(0));
+            SOFTGYM_SCATTER_F2(SOFTGYM_NEG1(SOFTGYM_SQ(5)), SOFTGYM_SQ(4), SOFTGYM_SQ(3));
+            SOFTGYM_SCATTER_TURN(mi, SOFTGYM_NEG1(SOFTGYM_SQ(8)), SOFTGYM_SQ(7), SOFTGYM_SQ(6));
+            SOFTGYM_SCATTER_TURN(mj, SOFTGYM_NEG1(SOFTGYM_SQ(11)), SOFTGYM_SQ(10), SOFTGYM_SQ(9));
         }
 #if defined(SOFTGYM_SCATTER_V4)
         memcpy(fi, &fi_v, sizeof fi_v);
@@ -1168,6 +1183,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_links(const int ax, Py_ssize_t l
 #endif
     }
 }
+#undef SOFTGYM_SQ
 #undef SOFTGYM_SCATTER_F2
 #undef SOFTGYM_SCATTER_TURN
 #undef SOFTGYM_SCATTER_ACC
@@ -1212,13 +1228,19 @@ SOFTGYM_ALWAYS_INLINE void softgym_turn8(const int ax, const softgym_v8 *R, cons
    moment, force being the rows' start), link after link: each voxel's sum in the same
    order. Where voxel 2 takes -F1 (neg2_row), its force is the turn of -F1: exactly minus
    F1's, and adding it is subtracting F1's */
-SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter8(const int ax, Py_ssize_t li,
+SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter8(const int ax, const int f32, Py_ssize_t li,
                                                  const Py_ssize_t *v1, const Py_ssize_t *v2,
-                                                 const double *o, const double *neg2_row,
-                                                 double *force)
+                                                 const double *o, const float *of,
+                                                 const double *neg2_row, double *force)
 {
     const Py_ssize_t n = SOFTGYM_CHUNK_STRIDE;
     const double *q = o + li;
+    const float *qf = f32 ? of + li : 0;
+    (void)qf;
+    /* row k of the 8 links' forces and moments (softgym_seed_scatter_links's SOFTGYM_SQ):
+       the floats widened by the load (vcvtps2pd from memory: no shuffle of their own) */
+#define SOFTGYM_SQ8(k) (f32 ? (softgym_v8)_mm512_cvtps_pd(_mm256_loadu_ps(qf + (k) * SOFTGYM_CHUNK_FSTRIDE)) \
+                            : softgym_v8_load(q + (k) * n))
     softgym_v8 R[9], a[3], b[3];
     for (int k = 0; k < 9; k++)
         R[k] = softgym_v8_load(q + (SOFTGYM_SEED_R_ROWS + k) * n);
@@ -1231,7 +1253,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter8(const int ax, Py_ssize_t li,
                                              _mm512_setzero_si512());
     __m512d wf1[4], wf2[4], wm1[4], wm2[4];
     for (int c = 0; c < 3; c++)
-        a[c] = softgym_v8_load(q + c * n);
+        a[c] = SOFTGYM_SQ8(c);
     softgym_turn8(ax, R, a, wf1);
     if (neg2 == 0xFF) {
         /* every voxel 2 takes -F1 (one material, or two with the same damping ends, or a
@@ -1243,13 +1265,14 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter8(const int ax, Py_ssize_t li,
     } else {
         for (int c = 0; c < 3; c++)
             b[c] = (softgym_v8)_mm512_mask_blend_pd(
-                neg2, (__m512d)softgym_v8_load(q + (3 + c) * n), (__m512d)(-a[c]));
+                neg2, (__m512d)SOFTGYM_SQ8(3 + c), (__m512d)(-a[c]));
         softgym_turn8(ax, R, b, wf2);
     }
     for (int c = 0; c < 3; c++) {
-        a[c] = softgym_v8_load(q + (6 + c) * n);
-        b[c] = softgym_v8_load(q + (9 + c) * n);
+        a[c] = SOFTGYM_SQ8(6 + c);
+        b[c] = SOFTGYM_SQ8(9 + c);
     }
+#undef SOFTGYM_SQ8
     softgym_turn8(ax, R, a, wm1);
     softgym_turn8(ax, R, b, wm2);
     __m512d c = _mm512_setzero_pd();
@@ -1259,9 +1282,10 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter8(const int ax, Py_ssize_t li,
 #endif
 /* links lo..hi along ax: blocks of 8 whose rows start on a cache line through
    softgym_seed_scatter8 (with AVX-512), the others link by link */
-SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
-                                                   const Py_ssize_t *v1, const Py_ssize_t *v2,
-                                                   const double *rot, const double *o,
+SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, const int f32, Py_ssize_t lo,
+                                                   Py_ssize_t hi, const Py_ssize_t *v1,
+                                                   const Py_ssize_t *v2, const double *rot,
+                                                   const double *o, const float *of,
                                                    const double *neg2_row, double *force,
                                                    double *moment)
 {
@@ -1270,20 +1294,29 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, 
     while (al < hi && ((uintptr_t)(o + al) & 63) != 0)
         al++;
     if (al + 8 <= hi) {
-        softgym_seed_scatter_links(ax, lo, al, v1, v2, rot, o, neg2_row, force, moment);
+        softgym_seed_scatter_links(ax, f32, lo, al, v1, v2, rot, o, of, neg2_row, force,
+                                   moment);
         for (lo = al; lo + 8 <= hi; lo += 8)
-            softgym_seed_scatter8(ax, lo, v1, v2, o, neg2_row, force);
+            softgym_seed_scatter8(ax, f32, lo, v1, v2, o, of, neg2_row, force);
     }
 #endif
-    softgym_seed_scatter_links(ax, lo, hi, v1, v2, rot, o, neg2_row, force, moment);
+    softgym_seed_scatter_links(ax, f32, lo, hi, v1, v2, rot, o, of, neg2_row, force, moment);
 }
 
+/* of: NULL, the forces and moments in the double rows 0-11 of o (link_precision "double"),
+   else the single-precision forces pass's float rows (indexed by link, SOFTGYM_CHUNK_FSTRIDE
+   apart) */
 static void softgym_seed_scatter(int ax, Py_ssize_t lo, Py_ssize_t hi, const Py_ssize_t *v1,
                                  const Py_ssize_t *v2, const double *rot, const double *o,
-                                 const double *neg2_row, double *force, double *moment)
+                                 const float *of, const double *neg2_row, double *force,
+                                 double *moment)
 {
-    SOFTGYM_BY_AXIS(ax, softgym_seed_scatter_ax, lo, hi, v1, v2, rot, o, neg2_row, force,
-                    moment);
+    if (of)
+        SOFTGYM_BY_AXIS(ax, softgym_seed_scatter_ax, 1, lo, hi, v1, v2, rot, o, of, neg2_row,
+                        force, moment);
+    else
+        SOFTGYM_BY_AXIS(ax, softgym_seed_scatter_ax, 0, lo, hi, v1, v2, rot, o, of, neg2_row,
+                        force, moment);
 }
 
 #endif  /* SOFTGYM_SEED_H */

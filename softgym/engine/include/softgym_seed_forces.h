@@ -2,6 +2,7 @@
    softgym_seed.h includes this file twice, with SOFTGYM_FT (the arithmetic's
    type: double, or float for SimConfig.link_precision = "single"),
    SOFTGYM_FNAME (the function's name), SOFTGYM_FIN_STRIDE (its input rows' stride),
+   SOFTGYM_FOUT_T and SOFTGYM_FOUT_STRIDE (its output rows' type and stride),
    SOFTGYM_FPICK (c ? a : b in that
    type) and SOFTGYM_FMASK (the type of the lanes' conditions: as wide as
    SOFTGYM_FT) defined. No include guard, on purpose.
@@ -15,7 +16,8 @@
    mode (sa_: 1.0 small angle), mode-change (chg_) and voxel-2-takes-minus-F1 (neg2_,
    the scratch's row 23) rows, the link
    constants (ka_, kt_, kb_; cs_: the 8 rows of c_seed, stride n) and memory
-   (link_last, 9 rows of stride n). Outputs (double rows, for the scatter)
+   (link_last, 9 rows of stride n). Outputs (rows of SOFTGYM_FOUT_T: the arithmetic's
+   type, for the scatter, which widens floats to doubles as it loads them)
    what the scatter turns to the world and adds: voxel 1's force, voxel 2's
    damped force (read only where voxel 2 does not take -F1: two materials,
    no mode change; the scatter subtracts voxel 1's turned force otherwise),
@@ -30,7 +32,7 @@
     SOFTGYM_FT inv_dt, const SOFTGYM_FT *in, Py_ssize_t in_stride, const double *sa_, \
     const double *chg_, const double *neg2_, \
     const SOFTGYM_FT *ka_, const SOFTGYM_FT *kt_, const SOFTGYM_FT *kb_, const SOFTGYM_FT *cs_, \
-    SOFTGYM_FT *link_last, double *out
+    SOFTGYM_FT *link_last, SOFTGYM_FOUT_T *out
 /* all_small: every link of lo..hi is in small-angle mode (softgym_all_nonzero), so the
    large-angle turn by rq^-1, selected away in every lane, is not computed; all_neg2: every
    link's voxel 2 takes -F1 (row 23, neg2_), so voxel 2's own force is neither computed nor
@@ -48,10 +50,11 @@ SOFTGYM_ALWAYS_INLINE void SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(const int all_smal
     const T *a2z_ = in + 7 * is, *rw_ = in + 8 * is, *ry_ = in + 9 * is, *rz_ = in + 10 * is;
     /* the output rows from one pointer at a compile-time stride (one register, where 12
        row pointers spilled) */
-    const Py_ssize_t os = SOFTGYM_CHUNK_STRIDE;
-    double *o0 = out, *o1 = out + os, *o2 = out + 2 * os, *o3 = out + 3 * os;
-    double *o4 = out + 4 * os, *o5 = out + 5 * os, *o6 = out + 6 * os, *o7 = out + 7 * os;
-    double *o8 = out + 8 * os, *o9 = out + 9 * os, *o10 = out + 10 * os, *o11 = out + 11 * os;
+    const Py_ssize_t os = SOFTGYM_FOUT_STRIDE;
+    typedef SOFTGYM_FOUT_T OT;
+    OT *o0 = out, *o1 = out + os, *o2 = out + 2 * os, *o3 = out + 3 * os;
+    OT *o4 = out + 4 * os, *o5 = out + 5 * os, *o6 = out + 6 * os, *o7 = out + 7 * os;
+    OT *o8 = out + 8 * os, *o9 = out + 9 * os, *o10 = out + 10 * os, *o11 = out + 11 * os;
     const T two = (T)2.0, half = (T)0.5, zero = (T)0.0;
     Py_ssize_t li;
     SOFTGYM_IVDEP
