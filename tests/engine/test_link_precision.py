@@ -19,6 +19,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from softgym.design import RobotDesign
 from softgym.engine import Body, SimConfig, Simulation, _core
 from softgym.exceptions import InvalidParameterError
 from softgym.fidelity import case_design, cases_from_data
@@ -165,6 +166,30 @@ def test_single_precision_is_deterministic():
     double.advance(0.5)
     gap = np.abs(double.all_positions - single.all_positions).max()
     assert 0.0 < gap < 1e-8
+
+
+def test_links_turned_past_120_degrees_take_the_double_fix_up_in_the_step():
+    # three voxels turned 130-150 degrees against their neighbours: their links leave the
+    # float frames for _seed_frame_one in double (the reference runs never take it). The
+    # two precisions then agree to float accuracy, where a fix-up that read stale rows for
+    # those links put them 1e-3 apart (a version that kept p1, p2 and n in float only)
+    grid = np.full((6, 6, 6), 3, dtype=np.int8)
+    grid[3:] = 4
+    design = RobotDesign(grid)
+    runs = {}
+    for prec in ("single", "double"):
+        sim = Simulation([design.to_body()], SimConfig(self_collision=True, link_precision=prec),
+                         n_threads=1)  # fmt: skip
+        state = sim.get_state()
+        for v, ax, deg in ((100, 2, 150.0), (40, 0, 130.0), (7, 1, -140.0)):
+            q = np.zeros(4)
+            q[0], q[1 + ax] = np.cos(np.radians(deg) / 2), np.sin(np.radians(deg) / 2)
+            state["quat"][v] = q
+        sim.set_state(state)
+        sim.advance(40 * float(sim.dt[0]) * 0.999)
+        runs[prec] = (sim.positions(0).copy(), sim.orientations(0).copy())
+    assert np.abs(runs["single"][0] - runs["double"][0]).max() < 1e-8
+    assert np.abs(runs["single"][1] - runs["double"][1]).max() < 1e-6
 
 
 @given(st.one_of(st.text(max_size=8), st.integers(), st.none(), st.floats(), st.booleans()))
