@@ -170,8 +170,8 @@ print("CYCLES", json.dumps(dict(counts=_core.cycle_counts(), steps=int(r.steps[0
 CYCLE_ROWS = (
     ("contacts_seed (collision list)", "contacts", False),
     ("links_seed", "links", False),
-    ("softgym_seed_geom", "geometry", True),
-    ("softgym_seed_modes", "modes", True),
+    ("softgym_seed_geom (+ modes, AVX-512)", "geometry", True),
+    ("softgym_seed_modes (other builds)", "modes", True),
     ("softgym_seed_frames", "frames", True),
     ("_seed_frame_one (acos links)", "frames_acos", True),
     ("softgym_seed_forces", "forces", True),

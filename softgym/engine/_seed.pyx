@@ -72,10 +72,6 @@ cdef inline float64_t _rotvec_k(float64_t w) noexcept nogil:
 cdef extern from "softgym_seed.h":
     # the passes of links_seed (C, for the vectorising pragma and one
     # copy per link axis; documented in include/softgym_seed.h)
-    void softgym_seed_geom(int ax, intp_t lo, intp_t hi, intp_t n, const intp_t* v1,
-                           const intp_t* v2, intp_t vend, const float64_t* pos,
-                           const float64_t* quat, const float64_t* vr, intp_t vn,
-                           const float64_t* scale, float64_t* o, float64_t* rr) noexcept nogil
     # (the two frames passes return whether any link needs _seed_frame_one)
     int softgym_seed_frames(intp_t lo, intp_t hi, float64_t sa_rad, float64_t thr,
                             const float64_t* p0_, const float64_t* p1_, const float64_t* p2_,
@@ -92,10 +88,19 @@ cdef extern from "softgym_seed.h":
                              const float64_t* neg2_, const float64_t* ka_,
                              const float64_t* kt_, const float64_t* kb_, const float64_t* cs_,
                              float64_t* link_last, float64_t* out) noexcept nogil
-    intp_t softgym_seed_modes(intp_t lo, intp_t hi, intp_t n, float64_t max_ext,
-                              float64_t sa_w, float64_t sah_w, float64_t st_in, float64_t ex_in,
-                              float64_t st_out, float64_t ex_out, lane_flag_t* link_sa,
-                              const lane_flag_t* homog, float64_t* o) noexcept nogil
+    # the geometry and then the modes of links lo..hi along ax (softgym_seed_geom,
+    # softgym_seed_modes; with AVX-512 the modes of its vector blocks in its loop); m: the
+    # modes' thresholds and the links' state
+    ctypedef struct softgym_modes_args:
+        float64_t max_ext, sa_w, sah_w, st_in, ex_in, st_out, ex_out
+        lane_flag_t* link_sa
+        const lane_flag_t* homog
+        int keep_len
+    intp_t softgym_seed_geom_modes(int ax, intp_t lo, intp_t hi, intp_t n, const intp_t* v1,
+                                   const intp_t* v2, intp_t vend, const float64_t* pos,
+                                   const float64_t* quat, const float64_t* vr, intp_t vn,
+                                   const float64_t* scale, float64_t* o, float64_t* rr,
+                                   const softgym_modes_args* m) noexcept nogil
     void softgym_seed_scatter(int ax, intp_t lo, intp_t hi, const intp_t* v1, const intp_t* v2,
                               const float64_t* rot, const float64_t* o, const float* of,
                               const float64_t* neg2_row, float64_t* force,
@@ -183,7 +188,7 @@ cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n, float* f) noexcept 
         a2x = tx * k
         a2y = ty * k
         a2z = tz * k
-        P0 = o[8 * n + li] - nom
+        P0 = o[10 * n + li]  # the chord's length - nom, as the modes pass leaves it
         P1 = 0.0
         P2 = 0.0
     _put(o, n, f, 10, li, P0)
@@ -278,18 +283,25 @@ cdef inline intp_t _seed_geom_modes(Batch* b, int ax, intp_t lo, intp_t hi, intp
     cdef:
         intp_t end
         unsigned long long t0
+    cdef softgym_modes_args m
+    m.max_ext = b.max_strain * b.L
+    m.sa_w = SMALL_ANGLE_W
+    m.sah_w = SMALLISH_ANGLE_W
+    m.st_in = SA_BOND_BEND_RAD
+    m.ex_in = SA_BOND_EXT_PERC
+    m.st_out = HYSTERESIS * SA_BOND_BEND_RAD
+    m.ex_out = HYSTERESIS * SA_BOND_EXT_PERC
+    m.link_sa = b.link_sa
+    m.homog = b.homog
+    m.keep_len = not b.link_f32  # the double-precision frames pass reads the chord's length
     t0 = softgym_prof_tsc()
     # vend: the robot's voxels end there (the geometry reads no other robot's records)
     # (b.vox_out: the voxel rows, the step's state in AVX-512 builds; _integrate.pxd
-    # voxel_state_enter)
-    softgym_seed_geom(ax, lo, hi, n, b.v1, b.v2, vend, b.pos, b.quat, b.vox_out, b.vox_stride,
-                      b.scale, o, rr)
+    # voxel_state_enter). The modes are decided in the geometry's loop in AVX-512 builds
+    # (softgym_seed_geom_modes), so the probes charge them to the geometry's slot there
+    end = softgym_seed_geom_modes(ax, lo, hi, n, b.v1, b.v2, vend, b.pos, b.quat, b.vox_out,
+                                  b.vox_stride, b.scale, o, rr, &m)
     softgym_prof_add(0, t0)
-    t0 = softgym_prof_tsc()
-    end = softgym_seed_modes(lo, hi, n, b.max_strain * b.L, SMALL_ANGLE_W, SMALLISH_ANGLE_W,
-                             SA_BOND_BEND_RAD, SA_BOND_EXT_PERC, HYSTERESIS * SA_BOND_BEND_RAD,
-                             HYSTERESIS * SA_BOND_EXT_PERC, b.link_sa, b.homog, o)
-    softgym_prof_add(1, t0)
     return end
 
 
@@ -307,7 +319,12 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     #                        nominal length, chord length, transverse ratio
     #                        (once per axis: each run gets a copy with the axis
     #                        constant)
-    #   softgym_seed_modes   the mode (link_sa; row 9 becomes 1.0 small / 0.0
+    #   softgym_seed_modes   (both by softgym_seed_geom_modes, which in AVX-512
+    #                        builds decides the modes of each vector block of the
+    #                        geometry from its values in registers, the chord
+    #                        length and the transverse ratio stored only where the
+    #                        double-precision frames read row 8)
+    #                        the mode (link_sa; row 9 becomes 1.0 small / 0.0
     #                        large angle), row 10 the axial displacement P0 in
     #                        that mode (the single-precision frames read it),
     #                        row 22 1.0 on a mode-change step,

@@ -545,3 +545,91 @@ int main(void)
 def test_the_modes_pass_decides_as_the_seeds_scalar_loop(level, tmp_path):
     out = _run_harness(level, MODES_HARNESS, tmp_path)
     assert out == "0", f"{out} modes, rows or ends differ"
+
+
+GEOM_MODES_HARNESS = _c_harness("softgym_seed.h", r"""
+/* softgym_seed_geom_modes (with AVX-512 the modes of the geometry's vector blocks decided in
+   its loop, softgym_seed_modes8v, from the values in registers; the peel and the tail by
+   the modes loop) against softgym_seed_geom then softgym_seed_modes: where the step stops
+   (a strained link), every link's mode, and rows 0-7, 9, 10, 22, 23 (and 8 where kept) of
+   every link, over runs, windows and gathers, chunk by chunk from offsets that leave a peel */
+enum { NV = 200, N = 203, ROWS = 24 };
+static double pos[3 * NV], quat[4 * NV], sc[NV], vr[SOFTGYM_VOXEL_ROWS * NV];
+static double rows_a[ROWS * SOFTGYM_CHUNK_STRIDE] __attribute__((aligned(64)));
+static double rows_b[ROWS * SOFTGYM_CHUNK_STRIDE] __attribute__((aligned(64)));
+static long long sa_a[N], sa_b[N], homog[N];
+static Py_ssize_t v1[N], v2[N];
+/* links c1..c2 of the chunk from link c0 (c1 > c0: a run that starts mid-chunk, as the y
+   and z links do, so the vector loop has a peel) */
+static long check(int ax, double max_ext, int keep_len, Py_ssize_t c0, Py_ssize_t c1,
+                  Py_ssize_t c2)
+{
+    const Py_ssize_t n = SOFTGYM_CHUNK_STRIDE;
+    for (int k = 0; k < ROWS * SOFTGYM_CHUNK_STRIDE; k++)
+        rows_a[k] = rows_b[k] = urand();
+    for (Py_ssize_t li = 0; li < N; li++) {
+        sa_a[li] = sa_b[li] = rand() % 2;
+        homog[li] = rand() % 2;
+    }
+    double *oa = rows_a - c0, *ob = rows_b - c0;
+    softgym_modes_args m = {max_ext, 0.3, 0.2, 0.8, 1.6, 0.9, 2.0, sa_b, homog, keep_len};
+    softgym_seed_geom(ax, c1, c2, n, v1, v2, NV, pos, quat, vr, NV, sc, oa, (double *)0);
+    Py_ssize_t want = softgym_seed_modes(c1, c2, n, m.max_ext, m.sa_w, m.sah_w, m.st_in,
+                                         m.ex_in, m.st_out, m.ex_out, sa_a, homog, oa);
+    Py_ssize_t end = softgym_seed_geom_modes(ax, c1, c2, n, v1, v2, NV, pos, quat, vr, NV, sc,
+                                             ob, (double *)0, &m);
+    long bad = end != want;
+    for (Py_ssize_t li = c1; li < c2; li++) {
+        bad += sa_a[li] != sa_b[li];
+        for (int r = 0; r < ROWS; r++) {
+            if ((r == 8 && !keep_len) || (r > 10 && r < 22))
+                continue;
+            bad += memcmp(&oa[r * n + li], &ob[r * n + li], sizeof(double)) != 0;
+        }
+    }
+    return bad;
+}
+int main(void)
+{
+    for (int i = 0; i < NV; i++) {
+        urand_quat(quat + 4 * i);
+        for (int k = 0; k < 3; k++) pos[3 * i + k] = 0.01 * (i % 7 + urand());
+        sc[i] = 0.01 * (1.0 + 0.1 * urand());
+        for (int k = 0; k < 4; k++) vr[(SOFTGYM_ROW_QUAT + k) * NV + i] = quat[4 * i + k];
+        for (int k = 0; k < 3; k++) vr[(SOFTGYM_ROW_POS + k) * NV + i] = pos[3 * i + k];
+    }
+    long bad = 0;
+    for (int pattern = 0; pattern < 3; pattern++) {
+        for (int li = 0; li < N; li++) {
+            if (pattern == 0) {  /* random voxels: gathers */
+                v1[li] = rand() % NV;
+                v2[li] = (v1[li] + 1 + rand() % (NV - 1)) % NV;
+            } else if (pattern == 1) {  /* runs of consecutive voxels */
+                v1[li] = li % (NV - 7);
+                v2[li] = v1[li] + 7;
+            } else {  /* a lattice row's links with gaps: windows of 16 */
+                v1[li] = (li + li / 5) % (NV - 1);
+                v2[li] = v1[li] + 1;
+            }
+        }
+        for (int ax = 0; ax < 3; ax++)
+            for (int keep = 0; keep < 2; keep++) {
+                /* no link strained, some (the step stops at the first), offsets with a peel */
+                bad += check(ax, 1.0, keep, 0, 0, SOFTGYM_CHUNK_LINKS);
+                bad += check(ax, 0.03, keep, 64, 64, 64 + SOFTGYM_CHUNK_LINKS);
+                bad += check(ax, 1.0, keep, 128, 131, 128 + 61);
+                bad += check(ax, 0.03, keep, 128, 133, 128 + 63);
+                /* a run too short for the peel: its one vector block starts mid-line */
+                bad += check(ax, 1.0, keep, 128, 131, 141);
+            }
+    }
+    printf("%ld\n", bad);
+    return 0;
+}
+""")
+
+
+@pytest.mark.parametrize("level", ["x86-64-v3", "x86-64-v4"])
+def test_the_geometry_with_its_modes_is_the_geometry_then_the_modes(level, tmp_path):
+    out = _run_harness(level, GEOM_MODES_HARNESS, tmp_path)
+    assert out == "0", f"{out} modes, rows or ends differ"

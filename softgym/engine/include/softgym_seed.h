@@ -69,15 +69,18 @@
    below and benchmarks/dense_links_probe.c share it */
 #define SOFTGYM_SEED_GEOM_LINK(li, dx, dy, dz, w, x, y, z, wj, xj, yj, zj, si, sj) \
     SOFTGYM_SEED_GEOM_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, li, dx, dy, dz, w, x, y, z, \
-                             wj, xj, yj, zj, si, sj, (double *)0)
+                             wj, xj, yj, zj, si, sj, (double *)0, 3, (void)0)
 /* the same for any arithmetic type T (double, or a vector of doubles: then links li ..
    li + lanes - 1 at once, SQRT and FABS T's square root and absolute value, PUT(row,
    li, v) storing v at row + li); in builds whose scatter reads them (SOFTGYM_SEED_R_USED)
    and rr not NULL, also voxel 1's rotation matrix, element k in row rr + k
    SOFTGYM_CHUNK_STRIDE (the chunk's rows that softgym_seed_scatter8 turns the forces
-   with) */
+   with). KEEPLS: bit 0 stores the chord length (row 8), bit 1 the transverse ratio (row
+   9), which only the modes pass (and row 8 the double-precision frames pass) reads; AFTER:
+   a statement run with the link's values in scope (geo_p0, geo_qw, geo_nom, geo_len,
+   geo_st), where the geometry's vector loop decides their modes (softgym_seed_modes8v) */
 #define SOFTGYM_SEED_GEOM_LINK_T(T, SQRT, FABS, PUT, li, dx, dy, dz, w, x, y, z, wj, xj, yj, \
-                                 zj, si, sj, rr) do { \
+                                 zj, si, sj, rr, KEEPLS, AFTER) do { \
         T geo_R[9]; \
         SOFTGYM_QUAT_MATRIX(w, x, y, z, geo_R); \
         if (SOFTGYM_SEED_R_USED && (rr) != 0) { \
@@ -100,9 +103,15 @@
         PUT(o_n1, li, geo_qv[a0]); \
         PUT(o_n2, li, (s1 * geo_qv[a1])); \
         PUT(o_n3, li, (s2 * geo_qv[a2])); \
-        PUT(o_nom, li, (0.5 * ((si) + (sj)))); \
-        PUT(o_len, li, SQRT(((((dx) * (dx)) + ((dy) * (dy))) + ((dz) * (dz))))); \
-        PUT(o_st, li, ((FABS(geo_p2) + FABS(geo_p1)) / geo_p0)); \
+        T geo_nom = (0.5 * ((si) + (sj))); \
+        T geo_len = SQRT(((((dx) * (dx)) + ((dy) * (dy))) + ((dz) * (dz)))); \
+        T geo_st = ((FABS(geo_p2) + FABS(geo_p1)) / geo_p0); \
+        PUT(o_nom, li, geo_nom); \
+        if ((KEEPLS) & 1) \
+            PUT(o_len, li, geo_len); \
+        if ((KEEPLS) & 2) \
+            PUT(o_st, li, geo_st); \
+        AFTER; \
     } while (0)
 #if defined(SOFTGYM_VLANES)
 /* The geometry's loads in vector code of our own. GCC's vectoriser loaded the 16
@@ -186,6 +195,104 @@ static inline int softgym_seed_window8(const Py_ssize_t *a, const Py_ssize_t *b,
 }
 #endif
 #endif
+/* The modes pass's parts (softgym_seed_modes, below, which documents it), here so that
+   the geometry's vector loop can decide its blocks' modes while their rows are in
+   registers (softgym_seed_geom_modes) */
+/* the modes pass's thresholds and per-link state (softgym_seed_modes's arguments) */
+typedef struct {
+    double max_ext, sa_w, sah_w, st_in, ex_in, st_out, ex_out;
+    long long *link_sa;
+    const long long *homog;
+    int keep_len;  /* the chord length's row 8 is read after the modes (double-precision frames) */
+} softgym_modes_args;
+/* the loop of softgym_seed_modes without the strain check's stop: links lo..hi's modes and
+   rows; whether any of them is strained (or NaN) */
+static inline long long softgym_seed_modes_loop(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
+                                                double max_ext, double sa_w, double sah_w,
+                                                double st_in, double ex_in, double st_out,
+                                                double ex_out, long long *link_sa,
+                                                const long long *homog, double *o)
+{
+    Py_ssize_t li;
+    long long bad = 0;
+    SOFTGYM_IVDEP
+    for (li = lo; li < hi; li++) {
+        double p0 = o[li], qw = o[3 * n + li], nom = o[7 * n + li];
+        double len = o[8 * n + li], st = o[9 * n + li];
+        double ex = p0 / nom;
+        long long sa = link_sa[li] != 0;
+        long long enter = (sa == 0) & (qw > sa_w) & (st < st_in) & (ex < ex_in);
+        long long leave = sa & (!(qw > sah_w) | (st > st_out) | (ex > ex_out));
+        long long ch = enter | leave;
+        long long s2 = sa ^ ch;
+        double P0 = softgym_pick(s2, p0 - nom, len - nom);
+        o[10 * n + li] = P0;
+        link_sa[li] = s2;
+        o[9 * n + li] = softgym_pick(s2, 1.0, 0.0);
+        o[22 * n + li] = softgym_pick(ch, 1.0, 0.0);
+        o[23 * n + li] = softgym_pick(ch | (homog[li] != 0), 1.0, 0.0);
+        bad |= !(fabs(P0) <= max_ext);
+    }
+    return bad;
+}
+/* the strain check after the loop (bad: its result): hi, or the first strained link, the
+   links after it given back their old mode (old = new xor changed), as in the seed's
+   scalar loop, which stops there; row 10 holds each link's displacement P0 */
+static inline Py_ssize_t softgym_seed_modes_end(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
+                                                double max_ext, long long bad,
+                                                long long *link_sa, const double *o)
+{
+    Py_ssize_t li;
+    if (!bad)
+        return hi;
+    for (li = lo; li < hi; li++)
+        if (!(fabs(o[10 * n + li]) <= max_ext))
+            break;
+    for (Py_ssize_t k = li + 1; k < hi; k++)
+        link_sa[k] = link_sa[k] ^ (o[22 * n + k] != 0.0);
+    return li;
+}
+#if defined(__AVX512F__) && (defined(__GNUC__) || defined(__clang__))
+#define SOFTGYM_MODES8 1
+/* softgym_seed_modes_loop for the 8 links li..li + 7 in the lanes of AVX-512 (o + li on a
+   cache line, but for a run too short for its peel), from the geometry's values of their rows 0, 3, 7, 8 and 9 (p0, qw,
+   nom, len, st) in registers: the same IEEE operations (a division, subtractions,
+   ordered compares); returns the lanes that are strained (or NaN) */
+SOFTGYM_ALWAYS_INLINE __mmask8 softgym_seed_modes8v(Py_ssize_t li, Py_ssize_t n, __m512d p0,
+                                                    __m512d qw, __m512d nom, __m512d len,
+                                                    __m512d st, double max_ext,
+                                                    double sa_w, double sah_w, double st_in,
+                                                    double ex_in, double st_out, double ex_out,
+                                                    long long *link_sa, const long long *homog,
+                                                    double *o)
+{
+    const __m512d ex = _mm512_div_pd(p0, nom);
+    const __m512i zero = _mm512_setzero_si512();
+    const __mmask8 sa = _mm512_cmpneq_epi64_mask(_mm512_loadu_si512((const void *)(link_sa + li)),
+                                                 zero);
+    const __mmask8 enter = (__mmask8)~sa
+                           & _mm512_cmp_pd_mask(qw, _mm512_set1_pd(sa_w), _CMP_GT_OQ)
+                           & _mm512_cmp_pd_mask(st, _mm512_set1_pd(st_in), _CMP_LT_OQ)
+                           & _mm512_cmp_pd_mask(ex, _mm512_set1_pd(ex_in), _CMP_LT_OQ);
+    const __mmask8 leave = sa
+                           & ((__mmask8)~_mm512_cmp_pd_mask(qw, _mm512_set1_pd(sah_w), _CMP_GT_OQ)
+                              | _mm512_cmp_pd_mask(st, _mm512_set1_pd(st_out), _CMP_GT_OQ)
+                              | _mm512_cmp_pd_mask(ex, _mm512_set1_pd(ex_out), _CMP_GT_OQ));
+    const __mmask8 ch = enter | leave, s2 = sa ^ ch;
+    const __mmask8 hg = _mm512_cmpneq_epi64_mask(_mm512_loadu_si512((const void *)(homog + li)),
+                                                 zero);
+    const __m512d P0 = _mm512_mask_blend_pd(s2, _mm512_sub_pd(len, nom), _mm512_sub_pd(p0, nom));
+    const __m512d one = _mm512_set1_pd(1.0);
+    _mm512_storeu_pd(o + 10 * n + li, P0);
+    _mm512_storeu_si512((void *)(link_sa + li), _mm512_maskz_mov_epi64(s2, _mm512_set1_epi64(1)));
+    _mm512_storeu_pd(o + 9 * n + li, _mm512_maskz_mov_pd(s2, one));
+    _mm512_storeu_pd(o + 22 * n + li, _mm512_maskz_mov_pd(ch, one));
+    _mm512_storeu_pd(o + 23 * n + li, _mm512_maskz_mov_pd(ch | hg, one));
+    return (__mmask8)~_mm512_cmp_pd_mask(_mm512_abs_pd(P0), _mm512_set1_pd(max_ext), _CMP_LE_OQ);
+}
+#else
+#define SOFTGYM_MODES8 0
+#endif
 /* links lo..hi by the formula on doubles, in a loop the compiler vectorises; the voxels'
    positions and quaternions from their records, or in the builds whose seed step keeps
    them in the voxel rows (SOFTGYM_STATE_ROWS: its state there) from the rows vr */
@@ -221,17 +328,27 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_scalar(const int ax, Py_ssize_t lo,
         double wj = SOFTGYM_GEOM_QUAT(j, 0), xj = SOFTGYM_GEOM_QUAT(j, 1);
         double yj = SOFTGYM_GEOM_QUAT(j, 2), zj = SOFTGYM_GEOM_QUAT(j, 3);
         SOFTGYM_SEED_GEOM_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, li, dx, dy, dz, w, x, y, z,
-                                 wj, xj, yj, zj, scale[i], scale[j], rr);
+                                 wj, xj, yj, zj, scale[i], scale[j], rr, 3, (void)0);
     }
 }
+/* m not NULL (a compile-time constant where inlined): the modes of links lo..hi too, as
+   softgym_seed_modes_loop leaves them (whether any is strained or-ed into *bad), those of
+   the vector loop's blocks by softgym_seed_modes8 after each block's geometry */
 SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
                                                 Py_ssize_t n, const Py_ssize_t *v1,
                                                 const Py_ssize_t *v2, Py_ssize_t vend,
                                                 const double *pos, const double *quat,
                                                 const double *vr, Py_ssize_t vn,
-                                                const double *scale, double *o, double *rr)
+                                                const double *scale, double *o, double *rr,
+                                                const softgym_modes_args *m, long long *bad)
 {
     Py_ssize_t li = lo;
+#define SOFTGYM_GEOM_MODES(a, b) do { \
+        if (m) \
+            *bad |= softgym_seed_modes_loop((a), (b), n, m->max_ext, m->sa_w, m->sah_w, \
+                                            m->st_in, m->ex_in, m->st_out, m->ex_out, \
+                                            m->link_sa, m->homog, o); \
+    } while (0)
 #if defined(SOFTGYM_VLANES)
     SOFTGYM_SEED_GEOM_AXIS(ax);
     SOFTGYM_SEED_GEOM_OUT(o, n);
@@ -245,6 +362,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
         al++;
     if (al + SOFTGYM_VLANES <= hi) {
         softgym_seed_geom_scalar(ax, lo, al, n, v1, v2, pos, quat, vr, vn, scale, o, rr);
+        SOFTGYM_GEOM_MODES(lo, al);
         li = al;
     }
     for (; li + SOFTGYM_VLANES <= hi; li += SOFTGYM_VLANES) {
@@ -267,13 +385,30 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
 #endif
         }
         softgym_vd dx = gj[0] - gi[0], dy = gj[1] - gi[1], dz = gj[2] - gi[2];
+#if SOFTGYM_MODES8
+#define SOFTGYM_GEOM_AFTER do { \
+            if (m) \
+                *bad |= softgym_seed_modes8v(li, n, (__m512d)geo_p0, (__m512d)geo_qw, \
+                                             (__m512d)geo_nom, (__m512d)geo_len, \
+                                             (__m512d)geo_st, m->max_ext, m->sa_w, m->sah_w, \
+                                             m->st_in, m->ex_in, m->st_out, m->ex_out, \
+                                             m->link_sa, m->homog, o); \
+        } while (0)
+#else
+#define SOFTGYM_GEOM_AFTER SOFTGYM_GEOM_MODES(li, li + SOFTGYM_VLANES)
+#endif
         SOFTGYM_SEED_GEOM_LINK_T(softgym_vd, SOFTGYM_VSQRT, softgym_vabs, SOFTGYM_VPUT, li, dx,
                                  dy, dz, gi[3], gi[4], gi[5], gi[6], gj[3], gj[4], gj[5], gj[6],
-                                 gi[7], gj[7], rr);
+                                 gi[7], gj[7], rr,
+                                 SOFTGYM_MODES8 && m ? (m->keep_len ? 1 : 0) : 3,
+                                 SOFTGYM_GEOM_AFTER);
+#undef SOFTGYM_GEOM_AFTER
     }
 #endif
     /* the rest (and every link without AVX): the compiler's vectoriser */
     softgym_seed_geom_scalar(ax, li, hi, n, v1, v2, pos, quat, vr, vn, scale, o, rr);
+    SOFTGYM_GEOM_MODES(li, hi);
+#undef SOFTGYM_GEOM_MODES
 }
 /* vend: the end of the voxel records (voxel indices below it may be read); vr: the
    voxels' rows (SOFTGYM_VOXEL_ROWS: the same quaternions and positions as quat and pos,
@@ -286,7 +421,7 @@ static void softgym_seed_geom(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n
                               Py_ssize_t vn, const double *scale, double *o, double *rr)
 {
     SOFTGYM_BY_AXIS(ax, softgym_seed_geom_ax, lo, hi, n, v1, v2, vend, pos, quat, vr, vn, scale,
-                    o, rr);
+                    o, rr, (const softgym_modes_args *)0, (long long *)0);
 }
 
 /* The frames pass of links_seed, in C for one pragma: the bond-frame
@@ -957,40 +1092,14 @@ static Py_ssize_t softgym_seed_modes(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
                                      double ex_out, long long *link_sa,
                                      const long long *homog, double *o)
 {
-    Py_ssize_t li;
 #if defined(__AVX__)
-    Py_ssize_t bad = 0;
-    SOFTGYM_IVDEP
-    for (li = lo; li < hi; li++) {
-        double p0 = o[li], qw = o[3 * n + li], nom = o[7 * n + li];
-        double len = o[8 * n + li], st = o[9 * n + li];
-        double ex = p0 / nom;
-        long long sa = link_sa[li] != 0;
-        long long enter = (sa == 0) & (qw > sa_w) & (st < st_in) & (ex < ex_in);
-        long long leave = sa & (!(qw > sah_w) | (st > st_out) | (ex > ex_out));
-        long long ch = enter | leave;
-        long long s2 = sa ^ ch;
-        double P0 = softgym_pick(s2, p0 - nom, len - nom);
-        o[10 * n + li] = P0;
-        link_sa[li] = s2;
-        o[9 * n + li] = softgym_pick(s2, 1.0, 0.0);
-        o[22 * n + li] = softgym_pick(ch, 1.0, 0.0);
-        o[23 * n + li] = softgym_pick(ch | (homog[li] != 0), 1.0, 0.0);
-        bad |= !(fabs(P0) <= max_ext);
-    }
-    if (!bad)
-        return hi;
-    for (li = lo; li < hi; li++) {
-        double P0 = (o[9 * n + li] != 0.0 ? o[li] : o[8 * n + li]) - o[7 * n + li];
-        if (!(fabs(P0) <= max_ext))
-            break;
-    }
-    for (Py_ssize_t k = li + 1; k < hi; k++)
-        link_sa[k] = link_sa[k] ^ (o[22 * n + k] != 0.0);
-    return li;
+    long long bad = softgym_seed_modes_loop(lo, hi, n, max_ext, sa_w, sah_w, st_in, ex_in,
+                                            st_out, ex_out, link_sa, homog, o);
+    return softgym_seed_modes_end(lo, hi, n, max_ext, bad, link_sa, o);
 #else
     /* 2 lanes and no 64-bit compare (SSE2): the branchy scalar loop is
        faster (profiled: 75 against 168 instructions per voxel-step) */
+    Py_ssize_t li;
     for (li = lo; li < hi; li++) {
         double p0 = o[li], qw = o[3 * n + li], nom = o[7 * n + li];
         double st = o[9 * n + li];
@@ -1013,6 +1122,29 @@ static Py_ssize_t softgym_seed_modes(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
             return li;  /* also catches NaN */
     }
     return hi;
+#endif
+}
+
+/* softgym_seed_geom then softgym_seed_modes on links lo..hi along ax (the same results),
+   the modes of the geometry's vector blocks (AVX-512: softgym_seed_modes8) decided in
+   its loop while their rows are in the cache and its store buffer, without the modes
+   pass's own loop over them */
+static Py_ssize_t softgym_seed_geom_modes(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
+                                          const Py_ssize_t *v1, const Py_ssize_t *v2,
+                                          Py_ssize_t vend, const double *pos,
+                                          const double *quat, const double *vr, Py_ssize_t vn,
+                                          const double *scale, double *o, double *rr,
+                                          const softgym_modes_args *m)
+{
+#if SOFTGYM_MODES8
+    long long bad = 0;
+    SOFTGYM_BY_AXIS(ax, softgym_seed_geom_ax, lo, hi, n, v1, v2, vend, pos, quat, vr, vn, scale,
+                    o, rr, m, &bad);
+    return softgym_seed_modes_end(lo, hi, n, m->max_ext, bad, m->link_sa, o);
+#else
+    softgym_seed_geom(ax, lo, hi, n, v1, v2, vend, pos, quat, vr, vn, scale, o, rr);
+    return softgym_seed_modes(lo, hi, n, m->max_ext, m->sa_w, m->sah_w, m->st_in, m->ex_in,
+                              m->st_out, m->ex_out, m->link_sa, m->homog, o);
 #endif
 }
 
