@@ -137,7 +137,6 @@ cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n, float* f) noexcept 
         float64_t th_discard = SEED_PI - DISCARD_ANGLE_RAD
         float64_t p0 = o[li], p1 = o[n + li], p2 = o[2 * n + li], qw = o[3 * n + li]
         float64_t n1 = o[4 * n + li], n2 = o[5 * n + li], n3 = o[6 * n + li]
-        float64_t nom = o[7 * n + li]
         float64_t k, rw = 1.0, ry = 0.0, rz = 0.0, tw, tx, ty, tz
         float64_t a1y = 0.0, a1z = 0.0, a2x, a2y, a2z, P0, P1, P2
         float64_t len_, lp, inv_s, inv_p0, yx, zx
@@ -147,7 +146,7 @@ cdef void _seed_frame_one(intp_t li, float64_t* o, intp_t n, float* f) noexcept 
         a2x = n1 * k
         a2y = n2 * k
         a2z = n3 * k
-        P0 = p0 - nom
+        P0 = o[10 * n + li]  # p0 - nom, as the modes pass leaves it
         P1 = p1
         P2 = p2
     else:

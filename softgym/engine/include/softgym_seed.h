@@ -69,14 +69,15 @@
    below and benchmarks/dense_links_probe.c share it */
 #define SOFTGYM_SEED_GEOM_LINK(li, dx, dy, dz, w, x, y, z, wj, xj, yj, zj, si, sj) \
     SOFTGYM_SEED_GEOM_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, li, dx, dy, dz, w, x, y, z, \
-                             wj, xj, yj, zj, si, sj, (double *)0, 3, (void)0)
+                             wj, xj, yj, zj, si, sj, (double *)0, 7, (void)0)
 /* the same for any arithmetic type T (double, or a vector of doubles: then links li ..
    li + lanes - 1 at once, SQRT and FABS T's square root and absolute value, PUT(row,
    li, v) storing v at row + li); in builds whose scatter reads them (SOFTGYM_SEED_R_USED)
    and rr not NULL, also voxel 1's rotation matrix, element k in row rr + k
    SOFTGYM_CHUNK_STRIDE (the chunk's rows that softgym_seed_scatter8 turns the forces
    with). KEEPLS: bit 0 stores the chord length (row 8), bit 1 the transverse ratio (row
-   9), which only the modes pass (and row 8 the double-precision frames pass) reads; AFTER:
+   9), bit 2 the nominal length (row 7), which only the modes pass and the double-precision
+   frames pass (rows 7 and 8) read; AFTER:
    a statement run with the link's values in scope (geo_p0, geo_qw, geo_nom, geo_len,
    geo_st), where the geometry's vector loop decides their modes (softgym_seed_modes8v) */
 #define SOFTGYM_SEED_GEOM_LINK_T(T, SQRT, FABS, PUT, li, dx, dy, dz, w, x, y, z, wj, xj, yj, \
@@ -106,7 +107,8 @@
         T geo_nom = (0.5 * ((si) + (sj))); \
         T geo_len = SQRT(((((dx) * (dx)) + ((dy) * (dy))) + ((dz) * (dz)))); \
         T geo_st = ((FABS(geo_p2) + FABS(geo_p1)) / geo_p0); \
-        PUT(o_nom, li, geo_nom); \
+        if ((KEEPLS) & 4) \
+            PUT(o_nom, li, geo_nom); \
         if ((KEEPLS) & 1) \
             PUT(o_len, li, geo_len); \
         if ((KEEPLS) & 2) \
@@ -203,7 +205,8 @@ typedef struct {
     double max_ext, sa_w, sah_w, st_in, ex_in, st_out, ex_out;
     long long *link_sa;
     const long long *homog;
-    int keep_len;  /* the chord length's row 8 is read after the modes (double-precision frames) */
+    int keep_len;  /* rows 7 and 8 (nominal and chord length) are read after the modes (the
+                      double-precision frames) */
 } softgym_modes_args;
 /* the loop of softgym_seed_modes without the strain check's stop: links lo..hi's modes and
    rows; whether any of them is strained (or NaN) */
@@ -328,7 +331,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_scalar(const int ax, Py_ssize_t lo,
         double wj = SOFTGYM_GEOM_QUAT(j, 0), xj = SOFTGYM_GEOM_QUAT(j, 1);
         double yj = SOFTGYM_GEOM_QUAT(j, 2), zj = SOFTGYM_GEOM_QUAT(j, 3);
         SOFTGYM_SEED_GEOM_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, li, dx, dy, dz, w, x, y, z,
-                                 wj, xj, yj, zj, scale[i], scale[j], rr, 3, (void)0);
+                                 wj, xj, yj, zj, scale[i], scale[j], rr, 7, (void)0);
     }
 }
 /* m not NULL (a compile-time constant where inlined): the modes of links lo..hi too, as
@@ -400,7 +403,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
         SOFTGYM_SEED_GEOM_LINK_T(softgym_vd, SOFTGYM_VSQRT, softgym_vabs, SOFTGYM_VPUT, li, dx,
                                  dy, dz, gi[3], gi[4], gi[5], gi[6], gj[3], gj[4], gj[5], gj[6],
                                  gi[7], gj[7], rr,
-                                 SOFTGYM_MODES8 && m ? (m->keep_len ? 1 : 0) : 3,
+                                 SOFTGYM_MODES8 && m ? (m->keep_len ? 5 : 0) : 7,
                                  SOFTGYM_GEOM_AFTER);
 #undef SOFTGYM_GEOM_AFTER
     }
