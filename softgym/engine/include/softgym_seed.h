@@ -77,9 +77,9 @@
    SOFTGYM_CHUNK_STRIDE (the chunk's rows that softgym_seed_scatter8 turns the forces
    with). KEEPLS: bit 0 stores the chord length (row 8), bit 1 the transverse ratio (row
    9), bit 2 the nominal length (row 7), which only the modes pass and the double-precision
-   frames pass (rows 7 and 8) read; AFTER:
-   a statement run with the link's values in scope (geo_p0, geo_qw, geo_nom, geo_len,
-   geo_st), where the geometry's vector loop decides their modes (softgym_seed_modes8v) */
+   frames pass (rows 7 and 8) read; AFTER: a statement run with the link's values in scope
+   (geo_p0, geo_qw, geo_nom, geo_len, geo_st), where the geometry's vector loop decides
+   their modes (softgym_seed_modes8v) */
 #define SOFTGYM_SEED_GEOM_LINK_T(T, SQRT, FABS, PUT, li, dx, dy, dz, w, x, y, z, wj, xj, yj, \
                                  zj, si, sj, rr, KEEPLS, AFTER) do { \
         T geo_R[9]; \
@@ -258,9 +258,10 @@ static inline Py_ssize_t softgym_seed_modes_end(Py_ssize_t lo, Py_ssize_t hi, Py
 #if defined(__AVX512F__) && (defined(__GNUC__) || defined(__clang__))
 #define SOFTGYM_MODES8 1
 /* softgym_seed_modes_loop for the 8 links li..li + 7 in the lanes of AVX-512 (o + li on a
-   cache line, but for a run too short for its peel), from the geometry's values of their rows 0, 3, 7, 8 and 9 (p0, qw,
-   nom, len, st) in registers: the same IEEE operations (a division, subtractions,
-   ordered compares); returns the lanes that are strained (or NaN) */
+   cache line, but for a run too short for its peel: unaligned stores), from the
+   geometry's values of their rows 0, 3, 7, 8 and 9 (p0, qw, nom, len, st) in registers:
+   the same IEEE operations (a division, subtractions, ordered compares); returns the
+   lanes that are strained (or NaN) */
 SOFTGYM_ALWAYS_INLINE __mmask8 softgym_seed_modes8v(Py_ssize_t li, Py_ssize_t n, __m512d p0,
                                                     __m512d qw, __m512d nom, __m512d len,
                                                     __m512d st, double max_ext,
@@ -1088,7 +1089,10 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
    With AVX only (4 lanes, 64-bit compares); else that scalar loop. link_sa and
    homog are 64-bit: with 8-bit flags the loop took 64 links a vector iteration
    and left up to 63 of each run to its scalar remainder (profiled: 12.3 against
-   5.5 cycles per voxel-step). */
+   5.5 cycles per voxel-step). The loop and the check are softgym_seed_modes_loop and
+   softgym_seed_modes_end (above); links_seed runs the pass through
+   softgym_seed_geom_modes (below), which with AVX-512 decides the geometry's vector
+   blocks' modes in its loop. */
 static Py_ssize_t softgym_seed_modes(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
                                      double max_ext, double sa_w, double sah_w,
                                      double st_in, double ex_in, double st_out,
