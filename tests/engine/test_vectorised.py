@@ -118,7 +118,8 @@ def _c_harness(header: str, body: str) -> str:
     includes first), the kernel header ``header``, ``urand()`` (uniform in [-0.5, 0.5]) and
     ``urand_quat(q)`` (a random unit quaternion; ``URAND_ROT(R)`` its matrix),
     ``urand_both``, ``link_pattern`` and ``rows_differ`` (the scatters' links, force and
-    moment rows), then ``body``."""
+    moment rows), ``urand_voxels`` (the geometry harnesses' voxels and their rows), then
+    ``body``."""
     return ("#include <stdio.h>\n#include <stdlib.h>\n#include <string.h>\n"
             "typedef long Py_ssize_t;\n"
             f'#include "{header}"\n'
@@ -146,6 +147,16 @@ def _c_harness(header: str, body: str) -> str:
             "            v1[li] = rand() % nv;\n"
             "            v2[li] = (v1[li] + 1 + rand() % (nv - 1)) % nv;\n"
             "        }\n"
+            "    }\n"
+            "}\n"
+            "static inline void urand_voxels(int nv, double *pos, double *quat, double *sc,\n"
+            "                                double *vr, int vn) {  /* nv voxels, rows vn apart */\n"
+            "    for (int i = 0; i < nv; i++) {\n"
+            "        urand_quat(quat + 4 * i);\n"
+            "        for (int k = 0; k < 3; k++) pos[3 * i + k] = 0.01 * (i % 7 + urand());\n"
+            "        sc[i] = 0.01 * (1.0 + 0.1 * urand());\n"
+            "        for (int k = 0; k < 4; k++) vr[(SOFTGYM_ROW_QUAT + k) * vn + i] = quat[4 * i + k];\n"
+            "        for (int k = 0; k < 3; k++) vr[(SOFTGYM_ROW_POS + k) * vn + i] = pos[3 * i + k];\n"
             "    }\n"
             "}\n"
             "static inline long rows_differ(const double *a, const double *b, int nv) {\n"
@@ -206,12 +217,8 @@ int main(void)
     static double pos[3 * NV], quat[4 * NV], sc[NV], o[10 * N], r[10 * N];
     static Py_ssize_t v1[N], v2[N];
     long bad = 0;
+    urand_voxels(NV, pos, quat, sc, vr, VN);
     for (int i = 0; i < NV; i++) {
-        urand_quat(quat + 4 * i);
-        for (int k = 0; k < 3; k++) pos[3 * i + k] = 0.01 * (i % 7 + urand());
-        sc[i] = 0.01 * (1.0 + 0.1 * urand());
-        for (int k = 0; k < 4; k++) vr[(SOFTGYM_ROW_QUAT + k) * VN + i] = quat[4 * i + k];
-        for (int k = 0; k < 3; k++) vr[(SOFTGYM_ROW_POS + k) * VN + i] = pos[3 * i + k];
         for (int k = 0; k < 3; k++) pos_rec[3 * i + k] = SOFTGYM_STATE_ROWS ? NAN : pos[3 * i + k];
         for (int k = 0; k < 4; k++) quat_rec[4 * i + k] = SOFTGYM_STATE_ROWS ? NAN : quat[4 * i + k];
     }
@@ -541,12 +548,6 @@ int main(void)
 """)
 
 
-@pytest.mark.parametrize("level", ["x86-64-v3", "x86-64-v4"])
-def test_the_modes_pass_decides_as_the_seeds_scalar_loop(level, tmp_path):
-    out = _run_harness(level, MODES_HARNESS, tmp_path)
-    assert out == "0", f"{out} modes, rows or ends differ"
-
-
 GEOM_MODES_HARNESS = _c_harness("softgym_seed.h", r"""
 /* softgym_seed_geom_modes (with AVX-512 the modes of the geometry's vector blocks decided in
    its loop, softgym_seed_modes8v, from the values in registers; the peel and the tail by
@@ -591,13 +592,7 @@ static long check(int ax, double max_ext, int keep_len, Py_ssize_t c0, Py_ssize_
 }
 int main(void)
 {
-    for (int i = 0; i < NV; i++) {
-        urand_quat(quat + 4 * i);
-        for (int k = 0; k < 3; k++) pos[3 * i + k] = 0.01 * (i % 7 + urand());
-        sc[i] = 0.01 * (1.0 + 0.1 * urand());
-        for (int k = 0; k < 4; k++) vr[(SOFTGYM_ROW_QUAT + k) * NV + i] = quat[4 * i + k];
-        for (int k = 0; k < 3; k++) vr[(SOFTGYM_ROW_POS + k) * NV + i] = pos[3 * i + k];
-    }
+    urand_voxels(NV, pos, quat, sc, vr, NV);
     long bad = 0;
     for (int pattern = 0; pattern < 3; pattern++) {
         for (int li = 0; li < N; li++) {
@@ -630,6 +625,10 @@ int main(void)
 
 
 @pytest.mark.parametrize("level", ["x86-64-v3", "x86-64-v4"])
-def test_the_geometry_with_its_modes_is_the_geometry_then_the_modes(level, tmp_path):
-    out = _run_harness(level, GEOM_MODES_HARNESS, tmp_path)
+@pytest.mark.parametrize("harness", ["modes", "geometry_then_modes"])
+def test_the_modes_pass_decides_as_the_seeds_scalar_loop(harness, level, tmp_path):
+    # the modes pass against the seed's loop; the geometry with its modes (AVX-512: decided
+    # in the geometry's loop) against the geometry then the modes pass
+    text = MODES_HARNESS if harness == "modes" else GEOM_MODES_HARNESS
+    out = _run_harness(level, text, tmp_path)
     assert out == "0", f"{out} modes, rows or ends differ"
