@@ -276,13 +276,26 @@ cdef inline void _seed_frames_forces(Batch* b, intp_t lo, intp_t end, float64_t*
 
 
 cdef inline intp_t _seed_geom_modes(Batch* b, int ax, intp_t lo, intp_t hi, intp_t n,
-                                   float64_t* o, intp_t vend, float64_t* rr) noexcept nogil:
-    # the geometry and the modes of links lo..hi along axis ax, the modes while
-    # the geometry's rows are in the cache: hi, or the first strained link
+                                   float64_t* o, intp_t vend, float64_t* rr,
+                                   const softgym_modes_args* m) noexcept nogil:
+    # the geometry and the modes of links lo..hi along axis ax (m: _modes_args), the
+    # modes while the geometry's rows are in the cache: hi, or the first strained link
     cdef:
         intp_t end
         unsigned long long t0
-    cdef softgym_modes_args m
+    t0 = softgym_prof_tsc()
+    # vend: the robot's voxels end there (the geometry reads no other robot's records)
+    # (b.vox_out: the voxel rows, the step's state in AVX-512 builds; _integrate.pxd
+    # voxel_state_enter). The modes are decided in the geometry's loop in AVX-512 builds
+    # (softgym_seed_geom_modes), so the probes charge them to the geometry's slot there
+    end = softgym_seed_geom_modes(ax, lo, hi, n, b.v1, b.v2, vend, b.pos, b.quat, b.vox_out,
+                                  b.vox_stride, b.scale, o, rr, m)
+    softgym_prof_add(0, t0)
+    return end
+
+
+cdef inline void _modes_args(Batch* b, softgym_modes_args* m) noexcept nogil:
+    # the modes pass's thresholds and the links' state, for every axis run of a step
     m.max_ext = b.max_strain * b.L
     m.sa_w = SMALL_ANGLE_W
     m.sah_w = SMALLISH_ANGLE_W
@@ -292,16 +305,7 @@ cdef inline intp_t _seed_geom_modes(Batch* b, int ax, intp_t lo, intp_t hi, intp
     m.ex_out = HYSTERESIS * SA_BOND_EXT_PERC
     m.link_sa = b.link_sa
     m.homog = b.homog
-    m.keep_len = not b.link_f32  # the double-precision frames pass reads the chord's length
-    t0 = softgym_prof_tsc()
-    # vend: the robot's voxels end there (the geometry reads no other robot's records)
-    # (b.vox_out: the voxel rows, the step's state in AVX-512 builds; _integrate.pxd
-    # voxel_state_enter). The modes are decided in the geometry's loop in AVX-512 builds
-    # (softgym_seed_geom_modes), so the probes charge them to the geometry's slot there
-    end = softgym_seed_geom_modes(ax, lo, hi, n, b.v1, b.v2, vend, b.pos, b.quat, b.vox_out,
-                                  b.vox_stride, b.scale, o, rr, &m)
-    softgym_prof_add(0, t0)
-    return end
+    m.keep_len = not b.link_f32  # the double-precision frames pass reads rows 7 and 8
 
 
 cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
@@ -379,9 +383,11 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
         # the scatter's forces and moments: the float forces pass's rows of the chunk's
         # float scratch, indexed by link (NULL: the double pass's rows 0-11 of chunk_out)
         const float* of = NULL
+        softgym_modes_args m
         unsigned long long t0
     if hi <= lo:
         return STATUS_OK
+    _modes_args(b, &m)
     run[0] = lo
     for ax in range(3):
         run[ax + 1] = run[ax] + b.link_axis_count[3 * r + ax] if ax < 2 else hi
@@ -394,7 +400,7 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
             a0 = max(c0, run[ax])
             a1 = min(c1, run[ax + 1])
             if a0 < a1:
-                end = _seed_geom_modes(b, ax, a0, a1, n, o, b.vox_start[r + 1], rr - c0)
+                end = _seed_geom_modes(b, ax, a0, a1, n, o, b.vox_start[r + 1], rr - c0, &m)
                 if end < a1:
                     break  # a strained link: the links after it stay as they were
                 end = c1

@@ -335,7 +335,8 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_scalar(const int ax, Py_ssize_t lo,
                                  wj, xj, yj, zj, scale[i], scale[j], rr, 7, (void)0);
     }
 }
-/* m not NULL (a compile-time constant where inlined): the modes of links lo..hi too, as
+/* m not NULL (a compile-time constant where inlined; only in SOFTGYM_MODES8 builds, from
+   softgym_seed_geom_modes): the modes of links lo..hi too, as
    softgym_seed_modes_loop leaves them (whether any is strained or-ed into *bad), those of
    the vector loop's blocks by softgym_seed_modes8 after each block's geometry */
 SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
@@ -398,8 +399,8 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
                                              m->st_in, m->ex_in, m->st_out, m->ex_out, \
                                              m->link_sa, m->homog, o); \
         } while (0)
-#else
-#define SOFTGYM_GEOM_AFTER SOFTGYM_GEOM_MODES(li, li + SOFTGYM_VLANES)
+#else  /* (m is passed only where SOFTGYM_MODES8: softgym_seed_geom_modes) */
+#define SOFTGYM_GEOM_AFTER (void)0
 #endif
         SOFTGYM_SEED_GEOM_LINK_T(softgym_vd, SOFTGYM_VSQRT, softgym_vabs, SOFTGYM_VPUT, li, dx,
                                  dy, dz, gi[3], gi[4], gi[5], gi[6], gj[3], gj[4], gj[5], gj[6],
