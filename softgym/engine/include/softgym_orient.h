@@ -13,10 +13,38 @@
 #include <math.h>
 #include "softgym_simd.h"
 
+/* the seed's renormalisation by two Newton steps of 1 / sqrt from 1 where |q|^2 - 1 is
+   within +-SOFTGYM_QUAT_NEWTON_TOL (2^-14): the steps' relative error is then under
+   0.21 (|q|^2 - 1)^4 < 3e-18, below the rounding of the seed's square root and division,
+   which cost a 512-bit division unit two long operations per 8 voxels (the orientation
+   step's whole time). Further from 1 (a voxel turning faster than about 24 rad/s at the
+   seed's time step) the seed's exact square root and division, voxel by voxel */
+#define SOFTGYM_QUAT_NEWTON_TOL 6.103515625e-05
+/* the seed's exact renormalisation of voxel i's unnormalised quaternion in rows
+   q_out[k n + i], snapped to the identity at w >= 1 */
+static inline void softgym_quat_exact(Py_ssize_t i, Py_ssize_t n, double *q_out)
+{
+    double qw = q_out[i], qx = q_out[n + i], qy = q_out[2 * n + i], qz = q_out[3 * n + i];
+    double nq = sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
+    double inv = 1.0 / nq;
+    double nw = nq != 0.0 ? qw * inv : qw;
+    double nx = nq != 0.0 ? qx * inv : qx;
+    double ny = nq != 0.0 ? qy * inv : qy;
+    double nz = nq != 0.0 ? qz * inv : qz;
+    if (nw >= 1.0) {
+        nw = 1.0;
+        nx = ny = nz = 0.0;
+    }
+    q_out[i] = nw;
+    q_out[n + i] = nx;
+    q_out[2 * n + i] = ny;
+    q_out[3 * n + i] = nz;
+}
 /* voxels lo..hi: q + (w dt / 2) x q, then (seed, a compile-time constant in each copy)
-   the seed's exact renormalisation (its square root and division) snapped to the
-   identity at w >= 1, or the corotational model's one Newton step of 1 / sqrt from 1
-   (|q|^2 is 1 + O((w dt)^2), so the step is exact to rounding) */
+   the seed's renormalisation (two Newton steps near 1, above; else its square root and
+   division, by softgym_quat_exact on the unnormalised quaternion the loop leaves) snapped
+   to the identity at w >= 1, or the corotational model's one Newton step of 1 / sqrt
+   from 1 (|q|^2 is 1 + O((w dt)^2), so the step is exact to rounding) */
 SOFTGYM_ALWAYS_INLINE void softgym_quats_impl(const int seed, Py_ssize_t lo, Py_ssize_t hi,
                                               Py_ssize_t n, double dt, const double *ax,
                                               const double *ay, const double *az,
@@ -27,6 +55,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_quats_impl(const int seed, Py_ssize_t lo, Py_
     /* angular velocity component c of voxel i at (ax, ay, az)[as i], quaternion component k
        at quat[qs i + qc k] (q_out may be quat's rows: each voxel's is read, then written) */
     Py_ssize_t i;
+    long far = 0;
     SOFTGYM_IVDEP
     for (i = lo; i < hi; i++) {
         double wx = ax[as * i] * 0.5 * dt;
@@ -40,14 +69,18 @@ SOFTGYM_ALWAYS_INLINE void softgym_quats_impl(const int seed, Py_ssize_t lo, Py_
         double qz = q3 + wz * q0 + wx * q2 - wy * q1;
         double nw, nx, ny, nz;
         if (seed) {
-            double nq = sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
-            double inv = 1.0 / nq;
+            double s = qw * qw + qx * qx + qy * qy + qz * qz;
+            double y = 1.5 - 0.5 * s;
+            y = y * (1.5 - (0.5 * s) * (y * y));
+            long long out = fabs(s - 1.0) > SOFTGYM_QUAT_NEWTON_TOL || s != s;
             long long one;
-            nw = nq != 0.0 ? qw * inv : qw;
-            nx = nq != 0.0 ? qx * inv : qx;
-            ny = nq != 0.0 ? qy * inv : qy;
-            nz = nq != 0.0 ? qz * inv : qz;
-            one = nw >= 1.0;
+            far += out;
+            y = out ? 1.0 : y;  /* left unnormalised for softgym_quat_exact */
+            nw = qw * y;
+            nx = qx * y;
+            ny = qy * y;
+            nz = qz * y;
+            one = !out && nw >= 1.0;
             nw = one ? 1.0 : nw;
             nx = one ? 0.0 : nx;
             ny = one ? 0.0 : ny;
@@ -64,6 +97,16 @@ SOFTGYM_ALWAYS_INLINE void softgym_quats_impl(const int seed, Py_ssize_t lo, Py_
         q_out[2 * n + i] = ny;
         q_out[3 * n + i] = nz;
     }
+    if (seed && far)
+        for (i = lo; i < hi; i++) {
+            double qw = q_out[i], qx = q_out[n + i], qy = q_out[2 * n + i];
+            double qz = q_out[3 * n + i];
+            double s = qw * qw + qx * qx + qy * qy + qz * qz;
+            /* the loop's unnormalised ones (half the tolerance: the loop's |q|^2 may be
+               rounded otherwise; a renormalised one is within 1e-15 of 1) */
+            if (fabs(s - 1.0) > 0.5 * SOFTGYM_QUAT_NEWTON_TOL || s != s)
+                softgym_quat_exact(i, n, q_out);
+        }
 }
 /* model 0 (the seed's) */
 static void softgym_seed_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,

@@ -692,7 +692,20 @@ typedef float softgym_v16f __attribute__((vector_size(64)));
     ((softgym_v16f)_mm512_fmadd_ps((__m512)(a), (__m512)(b), (__m512)(c)))
 #define SOFTGYM_F16_FNMA(a, b, c) \
     ((softgym_v16f)_mm512_fnmadd_ps((__m512)(a), (__m512)(b), (__m512)(c)))
-/* softgym_rotvec_k32_acos(w, w_acos) of 16 lanes */
+/* 1 / sqrt(x) of 16 lanes: the 14-bit estimate (vrsqrt14ps) and one Newton step, within
+   about 2 float roundings of the square root and division it replaces, which kept the
+   core's division unit busy longer than the pair's ports (3 of the mixed block's 4
+   division and 4 square-root operations; the unit takes about 10 and 12 cycles for each
+   512-bit one). The float frames are an approximation of the seed's double operations
+   anyway (benchmarks/fidelity_seed.py proves them); this path is the x86-64-v4 build's
+   mixed blocks, the other paths and builds keep the division and square root */
+#define SOFTGYM_F16_RSQRT(x) softgym_f16_rsqrt((softgym_v16f)(x))
+static inline softgym_v16f softgym_f16_rsqrt(softgym_v16f x)
+{
+    softgym_v16f r = (softgym_v16f)_mm512_rsqrt14_ps((__m512)x);
+    return r * SOFTGYM_F16_FNMA(0.5f * x, r * r, SOFTGYM_F16_SET(1.5f));
+}
+/* softgym_rotvec_k32_acos(w, w_acos) of 16 lanes, k = 2 sqrt(2) / sqrt(1 + w) */
 #define SOFTGYM_F16_ROTVEC_K(w, w_acos, k) do { \
         softgym_v16f z_ = 0.5f * (1.0f - (w)); \
         softgym_v16f p_ = (((4.2163199048e-2f * z_ + 2.4181311049e-2f) * z_ \
@@ -701,7 +714,7 @@ typedef float softgym_v16f __attribute__((vector_size(64)));
         softgym_v16f r_ = SOFTGYM_F16_PICK( \
             SOFTGYM_F16_CMP((w), SOFTGYM_F16_SET(w_acos), _CMP_LE_OQ), 1.0f + z_ * p_, \
             SOFTGYM_F16_SET(1.0f)); \
-        k = 2.0f * (softgym_v16f)_mm512_sqrt_ps((__m512)(2.0f / (1.0f + (w)))) * r_; \
+        k = (2.8284271247f * SOFTGYM_F16_RSQRT(1.0f + (w))) * r_; \
     } while (0)
 SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_x2(
     Py_ssize_t li, float sa_rad, float w_acos, const double *p0_, const double *p1_,
@@ -735,8 +748,7 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_x2(
                            & SOFTGYM_F16_CMP(yx[k_], SOFTGYM_F16_SET(-sa_rad), _CMP_GT_OQ)
                            & SOFTGYM_F16_CMP(zx[k_], SOFTGYM_F16_SET(sa_rad), _CMP_LT_OQ)
                            & SOFTGYM_F16_CMP(zx[k_], SOFTGYM_F16_SET(-sa_rad), _CMP_GT_OQ));
-    SOFTGYM_X2(inv_s[k_] = 1.0f / (softgym_v16f)_mm512_sqrt_ps(
-                   (__m512)(2.0f * ln[k_] * lp[k_])));
+    SOFTGYM_X2(inv_s[k_] = SOFTGYM_F16_RSQRT(2.0f * ln[k_] * lp[k_]));
     SOFTGYM_X2(ry_s[k_] = 0.5f * zx[k_]);
     SOFTGYM_X2(rz_s[k_] = -0.5f * yx[k_]);
     SOFTGYM_X2(rw_s[k_] = SOFTGYM_F16_FMA(
@@ -792,6 +804,7 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_x2(
     return (fix[0] | fix[1]) != 0;
 }
 #undef SOFTGYM_F16_ROTVEC_K
+#undef SOFTGYM_F16_RSQRT
 #else
 #define SOFTGYM_F16_LANES 0
 #endif
