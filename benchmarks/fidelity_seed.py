@@ -26,6 +26,7 @@ oracle's sample steps, as a fraction of the oracle's displacement scale).
     python benchmarks/fidelity_seed.py --model corotational # the pre-fidelity step, for the "before" table
     python benchmarks/fidelity_seed.py --link-precision double  # the seed's own double link operations
     python benchmarks/fidelity_seed.py --json               # last line: the figures as JSON
+    python benchmarks/fidelity_seed.py --first-draw 7       # softgym's draws 7-9: another sample
 
 Values under 0.01 voxel lengths are raised to 0.01 before ratios are taken (a
 body that stays put in both engines agrees, whatever its 1e-4 wobble).
@@ -178,6 +179,10 @@ def main() -> int:
                     help="SimConfig.link_precision of the seed model")
     ap.add_argument("--sets", default="structured,random,fence")
     ap.add_argument("--draws", type=int, default=3, help="perturbed softgym draws per case (>= 3)")
+    ap.add_argument("--first-draw", type=int, default=1,
+                    help="softgym's first perturbed draw (draws k..k+draws-1: 7 takes three "
+                         "perturbations the oracle data has none of, another sample of the "
+                         "chaotic regimes' figures)")
     ap.add_argument("--quick", action="store_true", help="12 cases per set")
     ap.add_argument("--threads", type=int, default=None)
     ap.add_argument("--halves", default="1,2,3/4,5,6",
@@ -192,7 +197,9 @@ def main() -> int:
         for c in cases:
             by_set.setdefault(c.set, []).append(c)
         cases = [c for cs in by_set.values() for c in cs[:12]]
-    draws = list(range(1, a.draws + 1))
+    if a.first_draw < 1:
+        ap.error("--first-draw must be >= 1")
+    draws = list(range(a.first_draw, a.first_draw + a.draws))
     halves = tuple(tuple(int(x) for x in h.split(",")) for h in a.halves.split("/"))
     ours = run_softgym(cases, draws, a.model, a.threads, a.link_precision)
     prec = SimConfig(model=a.model, link_precision=a.link_precision).effective_link_precision

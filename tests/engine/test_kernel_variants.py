@@ -4,14 +4,9 @@ setup.py compiles the engine's kernel for the portable instruction set and for
 newer x86-64 levels; the newest one the CPU runs is loaded. Each build runs
 here in its own process (``SOFTGYM_KERNEL``) on the same bodies (both presets,
 self-collision on, large-angle links from a drop). The builds that fuse
-multiply-adds (x86-64-v3, v4) must give the same final state bit for bit, but for
-the seed preset's single-precision links, whose large-angle frames the x86-64-v4
-build takes through the 14-bit reciprocal square root estimate and a Newton step
-(within float rounding of the others' square root and division): there, as for the
-portable build, which rounds every product, the final states must stay within
-rounding-level distance (the bodies here are not chaotic over 0.4 s). The seed
-voxel update's corner cases run with double-precision links, so that the builds'
-voxel loops are compared bit for bit.
+multiply-adds (x86-64-v3, v4) must give the same final state bit for bit; the
+portable build, which rounds every product, must stay within rounding-level
+distance of them (the bodies here are not chaotic over 0.4 s).
 """
 
 import os
@@ -66,8 +61,7 @@ clamped = Body(grid=grid, youngs_modulus=[0.0, 5e6, 5e6], density=[0.0, 1e6, 1e6
 walker = default_walker().to_body()
 fence = Terrain.fence(inner=10, center=(3, 3))
 for model in ("seed", "corotational"):
-    # (double-precision links for the seed: the same link operations in every fused build)
-    cfg = SimConfig(model=model, self_collision=True, link_precision="double")
+    cfg = SimConfig(model=model, self_collision=True)
     sim = Simulation([clamped, walker, walker], cfg, n_threads=1)
     state = sim.get_state()
     state["vel"][sim.voxel_offsets[2] + 40] = [1e10, 0.0, 0.0]
@@ -117,12 +111,7 @@ def test_the_fused_builds_agree_bit_for_bit_and_the_portable_one_to_rounding(tmp
                                                err_msg=f"{name} {key}")  # fmt: skip
         else:
             for key in fused:
-                if key.startswith("seed/") and np.issubdtype(fused[key].dtype, np.floating):
-                    # single-precision links: x86-64-v4's frames differ in float rounding
-                    np.testing.assert_allclose(state[key], fused[key], rtol=1e-6, atol=1e-9,
-                                               err_msg=f"{name} {key}")  # fmt: skip
-                else:
-                    assert np.array_equal(state[key], fused[key], equal_nan=True), (name, key)
+                assert np.array_equal(state[key], fused[key], equal_nan=True), (name, key)
 
 
 def test_the_newest_available_build_is_used():

@@ -592,9 +592,31 @@ static int softgym_seed_frames(
      lanes for w >= 0.5 (softgym_rotvec_k32_acos).
    Links turned past 120 degrees (w < 0.5) or with a backward chord are redone
    in double by _seed_frame_one, as in double precision. */
+/* k = 2 sqrt(2 / (1 + w)) = 2 sqrt(2) / sqrt(x), x = 1 + w, without the division unit (which
+   bound the pass: each 512-bit float division or square root holds it about 10-12
+   cycles): for w >= 0.5 (the links the pass keeps: x in [1.5, 2]) the minimax cubic's
+   estimate of 1 / sqrt(x) (relative error 1.5e-5) and one Newton step, r + r (1/2 -
+   (x / 2) r^2), its multiply-adds fused where the build has FMA instructions (written out,
+   so that the compiler's loop and the AVX-512 blocks round alike): within 1.2 float
+   roundings of 1 / sqrt(x), k within 2.4 (the square root and division: 1.5). The lanes
+   with w < 0.5 are redone in double (the fix-up) */
+#define SOFTGYM_RSQ_C3 (-0.04495887491657028f)
+#define SOFTGYM_RSQ_C2 0.3299957526995059f
+#define SOFTGYM_RSQ_C1 (-0.9578919498396243f)
+#define SOFTGYM_RSQ_C0 1.6625683559094815f
+#define SOFTGYM_RSQ_K 2.8284271247461903f
+#if defined(__FMA__)
+#define SOFTGYM_FMAF(a, b, c) fmaf((a), (b), (c))
+#else
+#define SOFTGYM_FMAF(a, b, c) ((a) * (b) + (c))
+#endif
 static inline float softgym_rotvec_k32(float w)
 {
-    return 2.0f * sqrtf(2.0f / (1.0f + w));
+    float x = 1.0f + w, h = 0.5f * x;
+    float e = SOFTGYM_FMAF(SOFTGYM_FMAF(SOFTGYM_FMAF(SOFTGYM_RSQ_C3, x, SOFTGYM_RSQ_C2), x,
+                                        SOFTGYM_RSQ_C1), x, SOFTGYM_RSQ_C0);
+    float y = SOFTGYM_FMAF(e, SOFTGYM_FMAF(-h, e * e, 0.5f), e);
+    return SOFTGYM_RSQ_K * y;
 }
 /* k(w) in float for every w >= 0.5: past the seed's acos cut (w <= w_acos)
    its k = 2 acos(w) / sqrt(1 - w^2) is, with z = (1 - w) / 2 and u = sqrt(z),
@@ -692,20 +714,7 @@ typedef float softgym_v16f __attribute__((vector_size(64)));
     ((softgym_v16f)_mm512_fmadd_ps((__m512)(a), (__m512)(b), (__m512)(c)))
 #define SOFTGYM_F16_FNMA(a, b, c) \
     ((softgym_v16f)_mm512_fnmadd_ps((__m512)(a), (__m512)(b), (__m512)(c)))
-/* 1 / sqrt(x) of 16 lanes: the 14-bit estimate (vrsqrt14ps) and one Newton step, within
-   about 2 float roundings of the square root and division it replaces, which kept the
-   core's division unit busy longer than the pair's ports (3 of the mixed block's 4
-   division and 4 square-root operations; the unit takes about 10 and 12 cycles for each
-   512-bit one). The float frames are an approximation of the seed's double operations
-   anyway (benchmarks/fidelity_seed.py proves them); this path is the x86-64-v4 build's
-   mixed blocks, the other paths and builds keep the division and square root */
-#define SOFTGYM_F16_RSQRT(x) softgym_f16_rsqrt((softgym_v16f)(x))
-static inline softgym_v16f softgym_f16_rsqrt(softgym_v16f x)
-{
-    softgym_v16f r = (softgym_v16f)_mm512_rsqrt14_ps((__m512)x);
-    return r * SOFTGYM_F16_FNMA(0.5f * x, r * r, SOFTGYM_F16_SET(1.5f));
-}
-/* softgym_rotvec_k32_acos(w, w_acos) of 16 lanes, k = 2 sqrt(2) / sqrt(1 + w) */
+/* softgym_rotvec_k32_acos(w, w_acos) of 16 lanes (softgym_rotvec_k32's operations lane by lane) */
 #define SOFTGYM_F16_ROTVEC_K(w, w_acos, k) do { \
         softgym_v16f z_ = 0.5f * (1.0f - (w)); \
         softgym_v16f p_ = (((4.2163199048e-2f * z_ + 2.4181311049e-2f) * z_ \
@@ -714,7 +723,13 @@ static inline softgym_v16f softgym_f16_rsqrt(softgym_v16f x)
         softgym_v16f r_ = SOFTGYM_F16_PICK( \
             SOFTGYM_F16_CMP((w), SOFTGYM_F16_SET(w_acos), _CMP_LE_OQ), 1.0f + z_ * p_, \
             SOFTGYM_F16_SET(1.0f)); \
-        k = (2.8284271247f * SOFTGYM_F16_RSQRT(1.0f + (w))) * r_; \
+        softgym_v16f x_ = 1.0f + (w), h_ = 0.5f * x_; \
+        softgym_v16f e_ = SOFTGYM_F16_FMA(SOFTGYM_F16_FMA(SOFTGYM_F16_FMA( \
+            SOFTGYM_F16_SET(SOFTGYM_RSQ_C3), x_, SOFTGYM_F16_SET(SOFTGYM_RSQ_C2)), x_, \
+            SOFTGYM_F16_SET(SOFTGYM_RSQ_C1)), x_, SOFTGYM_F16_SET(SOFTGYM_RSQ_C0)); \
+        softgym_v16f y_ = SOFTGYM_F16_FMA(e_, SOFTGYM_F16_FNMA(h_, e_ * e_, SOFTGYM_F16_SET(0.5f)), \
+                                          e_); \
+        k = (SOFTGYM_RSQ_K * y_) * r_; \
     } while (0)
 SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_x2(
     Py_ssize_t li, float sa_rad, float w_acos, const double *p0_, const double *p1_,
@@ -748,7 +763,8 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_x2(
                            & SOFTGYM_F16_CMP(yx[k_], SOFTGYM_F16_SET(-sa_rad), _CMP_GT_OQ)
                            & SOFTGYM_F16_CMP(zx[k_], SOFTGYM_F16_SET(sa_rad), _CMP_LT_OQ)
                            & SOFTGYM_F16_CMP(zx[k_], SOFTGYM_F16_SET(-sa_rad), _CMP_GT_OQ));
-    SOFTGYM_X2(inv_s[k_] = SOFTGYM_F16_RSQRT(2.0f * ln[k_] * lp[k_]));
+    SOFTGYM_X2(inv_s[k_] = 1.0f / (softgym_v16f)_mm512_sqrt_ps(
+                   (__m512)(2.0f * ln[k_] * lp[k_])));
     SOFTGYM_X2(ry_s[k_] = 0.5f * zx[k_]);
     SOFTGYM_X2(rz_s[k_] = -0.5f * yx[k_]);
     SOFTGYM_X2(rw_s[k_] = SOFTGYM_F16_FMA(
@@ -804,7 +820,6 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_x2(
     return (fix[0] | fix[1]) != 0;
 }
 #undef SOFTGYM_F16_ROTVEC_K
-#undef SOFTGYM_F16_RSQRT
 #else
 #define SOFTGYM_F16_LANES 0
 #endif
