@@ -261,10 +261,10 @@ cdef extern from "softgym_orient.h":
     # the voxels' orientation step of both models (C, for the vectorising pragma;
     # documented in include/softgym_orient.h), and the seed step's state in the voxel rows
     void softgym_seed_quats(intp_t lo, intp_t hi, intp_t n, float64_t dt, const float64_t* av,
-                            const float64_t* quat, float64_t* q_out) noexcept nogil
+                            const float64_t* quat, float64_t* q_out, int newton) noexcept nogil
     void softgym_seed_quats_rows(intp_t lo, intp_t hi, intp_t n, float64_t dt,
                                  const flag_t* fixed, const float64_t* quat,
-                                 float64_t* rows) noexcept nogil
+                                 float64_t* rows, int newton) noexcept nogil
     void softgym_corot_quats(intp_t lo, intp_t hi, intp_t n, float64_t dt, const float64_t* av,
                              const float64_t* quat, float64_t* q_out) noexcept nogil
     void softgym_corot_quats_rows(intp_t lo, intp_t hi, intp_t n, float64_t dt,
@@ -283,8 +283,9 @@ cdef extern from "softgym_orient.h":
 
 cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int seed) noexcept nogil:
     # the orientation step of voxels lo..hi (fixed voxels keep theirs): new
-    # quaternions (the seed's exact renormalisation, or the corotational
-    # model's Newton step), then their rotation matrices
+    # quaternions (the seed's renormalisation: with double-precision links its exact
+    # square root and division, with single-precision ones two Newton steps near unit
+    # length; or the corotational model's Newton step), then their rotation matrices
     cdef:
         intp_t n = b.vox_stride  # the scratch's row stride
         float64_t* qo = b.vox_out
@@ -292,12 +293,12 @@ cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int
         # the step's state in the voxel rows: the quaternion rows updated in place (the
         # rotation matrices: refresh_robot_rotations, when the step loop returns)
         if seed:
-            softgym_seed_quats_rows(lo, hi, n, dt, b.fixed, b.quat, qo)
+            softgym_seed_quats_rows(lo, hi, n, dt, b.fixed, b.quat, qo, b.link_f32)
         else:
             softgym_corot_quats_rows(lo, hi, n, dt, b.fixed, b.quat, qo)
         return
     if seed:
-        softgym_seed_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
+        softgym_seed_quats(lo, hi, n, dt, b.angvel, b.quat, qo, b.link_f32)
     else:
         softgym_corot_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
     # (the rotation matrices: refresh_robot_rotations, where the step does not read them)

@@ -1,20 +1,23 @@
-"""The seed preset's orientation step: q + (w dt / 2) x q, renormalised.
+"""The seed model's orientation step: q + (w dt / 2) x q, renormalised.
 
-The seed renormalises with a square root and a division; softgym takes two Newton steps
-of 1 / sqrt from 1 where |q|^2 is within 2^-14 of 1 (softgym/engine/include/softgym_orient.h),
-whose error is then far below the pair's rounding, and the seed's square root and division
-further out (a voxel turning faster than about 24 rad/s at the seed's time step). Both are
-checked here against the formula in numpy, on voxels spinning from rest to far past the
-Newton steps' range: two steps from 1 alone would leave those off unit length by 1e-9 to
-1e-3, and steps from 1 diverge for |q|^2 >= 3.
+The seed renormalises with a square root and a division, which softgym keeps with
+double-precision links (the seed's own operations). With single-precision links (the
+default) it takes two Newton steps of 1 / sqrt from 1 where |q|^2 is within 2^-14 of 1
+(softgym/engine/include/softgym_orient.h), whose error is then far below the pair's
+rounding, and the seed's square root and division further out (a voxel turning faster than
+about 24 rad/s at the seed's time step). Both are checked here against the formula in
+numpy, on voxels spinning from rest to far past the Newton steps' range: two steps from 1
+alone would leave those off unit length by 1e-9 to 1e-3, and steps from 1 diverge for
+|q|^2 >= 3.
 """
 
 import numpy as np
+import pytest
 
 from softgym.engine import Body, SimConfig, Simulation
 
 
-def _plate():
+def _plate(link_precision=None):
     # voxels with no neighbour (a checkerboard): no link turns them, so each spins at its rate
     grid = np.zeros((9, 9, 1), dtype=np.int32)
     grid[::2, ::2] = 1
@@ -22,7 +25,8 @@ def _plate():
     body = Body(grid=grid, youngs_modulus=[0.0, 5e6], density=[0.0, 1e3], poisson=[0.0, 0.35],
                 cte=[0.0, 0.0], mu_static=[0.0, 1.0], mu_kinetic=[0.0, 0.5],
                 origin=(0.0, 0.0, 0.05))
-    return Simulation([body], SimConfig(model="seed"), n_threads=1)
+    return Simulation([body], SimConfig(model="seed", link_precision=link_precision),
+                      n_threads=1)
 
 
 def _seed_quat_step(q, w, dt):
@@ -38,8 +42,10 @@ def _seed_quat_step(q, w, dt):
     return out, s
 
 
-def test_the_renormalised_quaternions_are_the_seeds_near_and_far_from_unit_length():
-    sim = _plate()
+@pytest.mark.parametrize("link_precision", ["single", "double"])
+def test_the_renormalised_quaternions_are_the_seeds_near_and_far_from_unit_length(
+        link_precision):
+    sim = _plate(link_precision)
     dt = float(sim.dt[0])
     rng = np.random.default_rng(3)
     state = sim.get_state()
@@ -67,10 +73,11 @@ def test_the_renormalised_quaternions_are_the_seeds_near_and_far_from_unit_lengt
     np.testing.assert_allclose(np.linalg.norm(got, axis=1), 1.0, rtol=0, atol=4e-16)
 
 
-def test_a_voxel_turned_back_to_the_identity_snaps_to_it():
+@pytest.mark.parametrize("link_precision", ["single", "double"])
+def test_a_voxel_turned_back_to_the_identity_snaps_to_it(link_precision):
     # the seed snaps a renormalised quaternion whose w reaches 1 to the identity; a voxel at
     # rest stays exactly there (no Newton step leaves it off by an ulp)
-    sim = _plate()
+    sim = _plate(link_precision)
     sim.advance(float(sim.dt[0]) * 3)
     q = sim.get_state()["quat"]
     w = sim.get_state()["angvel"]

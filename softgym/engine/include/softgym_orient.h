@@ -41,10 +41,12 @@ static inline void softgym_quat_exact(Py_ssize_t i, Py_ssize_t n, double *q_out)
     q_out[3 * n + i] = nz;
 }
 /* voxels lo..hi: q + (w dt / 2) x q, then (seed, a compile-time constant in each copy)
-   the seed's renormalisation (two Newton steps near 1, above; else its square root and
-   division, by softgym_quat_exact on the unnormalised quaternion the loop leaves) snapped
-   to the identity at w >= 1, or the corotational model's one Newton step of 1 / sqrt
-   from 1 (|q|^2 is 1 + O((w dt)^2), so the step is exact to rounding) */
+   the seed's renormalisation snapped to the identity at w >= 1: 1, its square root and
+   division (the seed's own operations: the seed model with double-precision links); 2,
+   two Newton steps near 1 (above; its square root and division further out, by
+   softgym_quat_exact on the unnormalised quaternion the loop leaves: the seed model with
+   single-precision links, its default); or 0, the corotational model's one Newton step
+   of 1 / sqrt from 1 (|q|^2 is 1 + O((w dt)^2), so the step is exact to rounding) */
 SOFTGYM_ALWAYS_INLINE void softgym_quats_impl(const int seed, Py_ssize_t lo, Py_ssize_t hi,
                                               Py_ssize_t n, double dt, const double *ax,
                                               const double *ay, const double *az,
@@ -68,7 +70,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_quats_impl(const int seed, Py_ssize_t lo, Py_
         double qy = q2 + wy * q0 + wz * q1 - wx * q3;
         double qz = q3 + wz * q0 + wx * q2 - wy * q1;
         double nw, nx, ny, nz;
-        if (seed) {
+        if (seed == 2) {
             double s = qw * qw + qx * qx + qy * qy + qz * qz;
             double y = 1.5 - 0.5 * s;
             y = y * (1.5 - (0.5 * s) * (y * y));
@@ -85,6 +87,19 @@ SOFTGYM_ALWAYS_INLINE void softgym_quats_impl(const int seed, Py_ssize_t lo, Py_
             nx = one ? 0.0 : nx;
             ny = one ? 0.0 : ny;
             nz = one ? 0.0 : nz;
+        } else if (seed == 1) {
+            double nq = sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
+            double inv = 1.0 / nq;
+            long long one;
+            nw = nq != 0.0 ? qw * inv : qw;
+            nx = nq != 0.0 ? qx * inv : qx;
+            ny = nq != 0.0 ? qy * inv : qy;
+            nz = nq != 0.0 ? qz * inv : qz;
+            one = nw >= 1.0;
+            nw = one ? 1.0 : nw;
+            nx = one ? 0.0 : nx;
+            ny = one ? 0.0 : ny;
+            nz = one ? 0.0 : nz;
         } else {
             double nq = 1.5 - 0.5 * (qw * qw + qx * qx + qy * qy + qz * qz);
             nw = qw * nq;
@@ -97,7 +112,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_quats_impl(const int seed, Py_ssize_t lo, Py_
         q_out[2 * n + i] = ny;
         q_out[3 * n + i] = nz;
     }
-    if (seed && far)
+    if (seed == 2 && far)
         for (i = lo; i < hi; i++) {
             double qw = q_out[i], qx = q_out[n + i], qy = q_out[2 * n + i];
             double qz = q_out[3 * n + i];
@@ -108,11 +123,15 @@ SOFTGYM_ALWAYS_INLINE void softgym_quats_impl(const int seed, Py_ssize_t lo, Py_
                 softgym_quat_exact(i, n, q_out);
         }
 }
-/* model 0 (the seed's) */
+/* model 0 (the seed's; newton: its single-precision links' renormalisation, above) */
 static void softgym_seed_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,
-                               const double *av, const double *quat, double *q_out)
+                               const double *av, const double *quat, double *q_out,
+                               int newton)
 {
-    softgym_quats_impl(1, lo, hi, n, dt, av, av + 1, av + 2, 3, quat, 4, 1, q_out);
+    if (newton)
+        softgym_quats_impl(2, lo, hi, n, dt, av, av + 1, av + 2, 3, quat, 4, 1, q_out);
+    else
+        softgym_quats_impl(1, lo, hi, n, dt, av, av + 1, av + 2, 3, quat, 4, 1, q_out);
 }
 /* the same on the voxel rows, the step loop's state in SOFTGYM_STATE_ROWS builds (seed: a
    compile-time constant, as softgym_quats_impl's): the angular velocities from rows
@@ -143,9 +162,13 @@ SOFTGYM_ALWAYS_INLINE void softgym_quats_rows_impl(const int seed, Py_ssize_t lo
     }
 }
 static void softgym_seed_quats_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,
-                                    const signed char *fixed, const double *quat, double *rows)
+                                    const signed char *fixed, const double *quat, double *rows,
+                                    int newton)
 {
-    softgym_quats_rows_impl(1, lo, hi, n, dt, fixed, quat, rows);
+    if (newton)
+        softgym_quats_rows_impl(2, lo, hi, n, dt, fixed, quat, rows);
+    else
+        softgym_quats_rows_impl(1, lo, hi, n, dt, fixed, quat, rows);
 }
 /* model 1 (corotational) */
 static void softgym_corot_quats(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,
