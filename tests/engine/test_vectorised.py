@@ -39,7 +39,8 @@ PASSES = {
                              "d, fc, fc, fc, fc, fo[0], fo[1]);",
     "softgym_seed_modes": "return (long)softgym_seed_modes(0, n, n, 0.3, 0.99, 0.98, 0.05, 1.3, "
                           "0.055, 1.43, lf, lf, o);",
-    "softgym_seed_quats": "softgym_seed_quats(0, n, n, 1e-4, d, d, o);",
+    "softgym_seed_quats": "softgym_seed_quats(0, n, n, 1e-4, d, d, o, 1);",  # (the Newton form)
+    "softgym_seed_quats exact": "softgym_seed_quats(0, n, n, 1e-4, d, d, o, 0);",
     "softgym_corot_quats": "softgym_corot_quats(0, n, n, 1e-4, d, d, o);",
     "softgym_pair_hits": "softgym_pair_hits(ax, 0, n, d, d, d, d, ip, 1e-4, lf);",
 }
