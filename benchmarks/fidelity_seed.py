@@ -182,13 +182,16 @@ def main() -> int:
     ap.add_argument("--first-draw", type=int, default=1,
                     help="softgym's first perturbed draw (draws k..k+draws-1: 7 takes three "
                          "perturbations the oracle data has none of, another sample of the "
-                         "chaotic regimes' figures)")
+                         "chaotic regimes' figures; a body of fewer than 9 voxels wraps "
+                         "around to its first draws' voxels)")
     ap.add_argument("--quick", action="store_true", help="12 cases per set")
     ap.add_argument("--threads", type=int, default=None)
     ap.add_argument("--halves", default="1,2,3/4,5,6",
                     help="oracle draws of the two halves (a preview on partial data: 0/1)")
     ap.add_argument("--json", action="store_true")
     a = ap.parse_args()
+    if a.first_draw < 1:
+        ap.error("--first-draw must be >= 1")
     t0 = time.perf_counter()
     sets = [s for s in a.sets.split(",") if s]
     cases, oracle = load_oracle(sets)
@@ -197,8 +200,6 @@ def main() -> int:
         for c in cases:
             by_set.setdefault(c.set, []).append(c)
         cases = [c for cs in by_set.values() for c in cs[:12]]
-    if a.first_draw < 1:
-        ap.error("--first-draw must be >= 1")
     draws = list(range(a.first_draw, a.first_draw + a.draws))
     halves = tuple(tuple(int(x) for x in h.split(",")) for h in a.halves.split("/"))
     ours = run_softgym(cases, draws, a.model, a.threads, a.link_precision)

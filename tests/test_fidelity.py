@@ -1,6 +1,8 @@
 """softgym.fidelity: the seed-fidelity protocol's cases, perturbations and data readers."""
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -53,6 +55,25 @@ def test_draws_one_to_six_perturb_six_different_voxels_of_a_case():
     case = cases_from_data(STRUCTURED)[0]
     voxels = {perturbed_voxel(case, d) for d in range(1, 7)}
     assert len(voxels) == 6
+
+
+def test_draws_past_six_are_further_perturbations_the_oracle_has_not_run():
+    # benchmarks/fidelity_seed.py --first-draw 7 samples softgym on draws 7-9: other voxels
+    # than the oracle's six wherever a body has nine or more
+    for case in cases_from_data(STRUCTURED):
+        n = int(np.count_nonzero(case.design.grid))
+        voxels = [perturbed_voxel(case, d) for d in range(1, 10)]
+        assert len(set(voxels)) == min(n, 9), case.name
+        if n < 9:  # a small body's draws wrap around its voxels
+            assert voxels[n] == voxels[0]
+
+
+def test_the_fidelity_benchmark_refuses_a_first_draw_below_one():
+    script = Path(__file__).resolve().parents[1] / "benchmarks" / "fidelity_seed.py"
+    res = subprocess.run([sys.executable, str(script), "--first-draw", "0"], capture_output=True,
+                         text=True, timeout=120)
+    assert res.returncode == 2
+    assert "--first-draw must be >= 1" in res.stderr
 
 
 def test_a_case_design_carries_its_regimes_controller():
