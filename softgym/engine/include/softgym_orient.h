@@ -5,7 +5,9 @@
    loops keep the voxels' state in the voxel rows (SOFTGYM_STATE_ROWS), in place there
    (softgym_seed_quats_rows, softgym_corot_quats_rows), with the helpers that move that
    state between the records and the rows. The same IEEE operations as the scalar code
-   they replaced; one voxel's no longer waits on the previous voxel's. Py_ssize_t comes from Python.h,
+   they replaced (but for the seed model's renormalisation with single-precision links,
+   by Newton steps near unit length since issue 29's tenth session: softgym_quats_impl);
+   one voxel's no longer waits on the previous voxel's. Py_ssize_t comes from Python.h,
    which Cython includes first. */
 #ifndef SOFTGYM_ORIENT_H
 #define SOFTGYM_ORIENT_H
