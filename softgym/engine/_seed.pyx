@@ -93,8 +93,8 @@ cdef extern from "softgym_seed.h":
     # modes' thresholds and the links' state
     ctypedef struct softgym_modes_args:
         float64_t max_ext, sa_w, sah_w, st_in, ex_in, st_out, ex_out
-        lane_flag_t* link_sa
-        const lane_flag_t* homog
+        long long* link_sa  # (the header's type; lane_flag_t is the same 64 bits)
+        const long long* homog
         int keep_len
     intp_t softgym_seed_geom_modes(int ax, intp_t lo, intp_t hi, intp_t n, const intp_t* v1,
                                    const intp_t* v2, intp_t vend, const float64_t* pos,
@@ -303,8 +303,8 @@ cdef inline void _modes_args(Batch* b, softgym_modes_args* m) noexcept nogil:
     m.ex_in = SA_BOND_EXT_PERC
     m.st_out = HYSTERESIS * SA_BOND_BEND_RAD
     m.ex_out = HYSTERESIS * SA_BOND_EXT_PERC
-    m.link_sa = b.link_sa
-    m.homog = b.homog
+    m.link_sa = <long long*> b.link_sa
+    m.homog = <const long long*> b.homog
     m.keep_len = not b.link_f32  # the double-precision frames pass reads rows 7 and 8
 
 

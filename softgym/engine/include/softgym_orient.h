@@ -22,25 +22,31 @@
    step's whole time). Further from 1 (a voxel turning faster than about 24 rad/s at the
    seed's time step) the seed's exact square root and division, voxel by voxel */
 #define SOFTGYM_QUAT_NEWTON_TOL 6.103515625e-05
-/* the seed's exact renormalisation of voxel i's unnormalised quaternion in rows
-   q_out[k n + i], snapped to the identity at w >= 1 */
-static inline void softgym_quat_exact(Py_ssize_t i, Py_ssize_t n, double *q_out)
+/* the seed's exact renormalisation of (qw, qx, qy, qz) (its square root and division; a
+   zero quaternion left as it is) snapped to the identity at w >= 1, into nv[0..3]: selects,
+   so that the orientation loop vectorises with it */
+SOFTGYM_ALWAYS_INLINE void softgym_quat_seed_norm(double qw, double qx, double qy, double qz,
+                                                  double *nv)
 {
-    double qw = q_out[i], qx = q_out[n + i], qy = q_out[2 * n + i], qz = q_out[3 * n + i];
     double nq = sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
     double inv = 1.0 / nq;
     double nw = nq != 0.0 ? qw * inv : qw;
     double nx = nq != 0.0 ? qx * inv : qx;
     double ny = nq != 0.0 ? qy * inv : qy;
     double nz = nq != 0.0 ? qz * inv : qz;
-    if (nw >= 1.0) {
-        nw = 1.0;
-        nx = ny = nz = 0.0;
-    }
-    q_out[i] = nw;
-    q_out[n + i] = nx;
-    q_out[2 * n + i] = ny;
-    q_out[3 * n + i] = nz;
+    long long one = nw >= 1.0;
+    nv[0] = one ? 1.0 : nw;
+    nv[1] = one ? 0.0 : nx;
+    nv[2] = one ? 0.0 : ny;
+    nv[3] = one ? 0.0 : nz;
+}
+/* that renormalisation of voxel i's unnormalised quaternion in rows q_out[k n + i] */
+static inline void softgym_quat_exact(Py_ssize_t i, Py_ssize_t n, double *q_out)
+{
+    double nv[4];
+    softgym_quat_seed_norm(q_out[i], q_out[n + i], q_out[2 * n + i], q_out[3 * n + i], nv);
+    for (int k = 0; k < 4; k++)
+        q_out[k * n + i] = nv[k];
 }
 /* voxels lo..hi: q + (w dt / 2) x q, then (seed, a compile-time constant in each copy)
    the seed's renormalisation snapped to the identity at w >= 1: 1, its square root and
@@ -90,18 +96,12 @@ SOFTGYM_ALWAYS_INLINE void softgym_quats_impl(const int seed, Py_ssize_t lo, Py_
             ny = one ? 0.0 : ny;
             nz = one ? 0.0 : nz;
         } else if (seed == 1) {
-            double nq = sqrt(qw * qw + qx * qx + qy * qy + qz * qz);
-            double inv = 1.0 / nq;
-            long long one;
-            nw = nq != 0.0 ? qw * inv : qw;
-            nx = nq != 0.0 ? qx * inv : qx;
-            ny = nq != 0.0 ? qy * inv : qy;
-            nz = nq != 0.0 ? qz * inv : qz;
-            one = nw >= 1.0;
-            nw = one ? 1.0 : nw;
-            nx = one ? 0.0 : nx;
-            ny = one ? 0.0 : ny;
-            nz = one ? 0.0 : nz;
+            double nv[4];
+            softgym_quat_seed_norm(qw, qx, qy, qz, nv);
+            nw = nv[0];
+            nx = nv[1];
+            ny = nv[2];
+            nz = nv[3];
         } else {
             double nq = 1.5 - 0.5 * (qw * qw + qx * qx + qy * qy + qz * qz);
             nw = qw * nq;

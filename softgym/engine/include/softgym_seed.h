@@ -211,11 +211,12 @@ typedef struct {
 /* the loop of softgym_seed_modes without the strain check's stop: links lo..hi's modes and
    rows; whether any of them is strained (or NaN) */
 static inline long long softgym_seed_modes_loop(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
-                                                double max_ext, double sa_w, double sah_w,
-                                                double st_in, double ex_in, double st_out,
-                                                double ex_out, long long *link_sa,
-                                                const long long *homog, double *o)
+                                                const softgym_modes_args *m, double *o)
 {
+    const double max_ext = m->max_ext, sa_w = m->sa_w, sah_w = m->sah_w, st_in = m->st_in;
+    const double ex_in = m->ex_in, st_out = m->st_out, ex_out = m->ex_out;
+    long long *link_sa = m->link_sa;
+    const long long *homog = m->homog;
     Py_ssize_t li;
     long long bad = 0;
     SOFTGYM_IVDEP
@@ -264,12 +265,13 @@ static inline Py_ssize_t softgym_seed_modes_end(Py_ssize_t lo, Py_ssize_t hi, Py
    lanes that are strained (or NaN) */
 SOFTGYM_ALWAYS_INLINE __mmask8 softgym_seed_modes8v(Py_ssize_t li, Py_ssize_t n, __m512d p0,
                                                     __m512d qw, __m512d nom, __m512d len,
-                                                    __m512d st, double max_ext,
-                                                    double sa_w, double sah_w, double st_in,
-                                                    double ex_in, double st_out, double ex_out,
-                                                    long long *link_sa, const long long *homog,
+                                                    __m512d st, const softgym_modes_args *m,
                                                     double *o)
 {
+    const double max_ext = m->max_ext, sa_w = m->sa_w, sah_w = m->sah_w, st_in = m->st_in;
+    const double ex_in = m->ex_in, st_out = m->st_out, ex_out = m->ex_out;
+    long long *link_sa = m->link_sa;
+    const long long *homog = m->homog;
     const __m512d ex = _mm512_div_pd(p0, nom);
     const __m512i zero = _mm512_setzero_si512();
     const __mmask8 sa = _mm512_cmpneq_epi64_mask(_mm512_loadu_si512((const void *)(link_sa + li)),
@@ -350,9 +352,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
     Py_ssize_t li = lo;
 #define SOFTGYM_GEOM_MODES(a, b) do { \
         if (m) \
-            *bad |= softgym_seed_modes_loop((a), (b), n, m->max_ext, m->sa_w, m->sah_w, \
-                                            m->st_in, m->ex_in, m->st_out, m->ex_out, \
-                                            m->link_sa, m->homog, o); \
+            *bad |= softgym_seed_modes_loop((a), (b), n, m, o); \
     } while (0)
 #if defined(SOFTGYM_VLANES)
     SOFTGYM_SEED_GEOM_AXIS(ax);
@@ -395,9 +395,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
             if (m) \
                 *bad |= softgym_seed_modes8v(li, n, (__m512d)geo_p0, (__m512d)geo_qw, \
                                              (__m512d)geo_nom, (__m512d)geo_len, \
-                                             (__m512d)geo_st, m->max_ext, m->sa_w, m->sah_w, \
-                                             m->st_in, m->ex_in, m->st_out, m->ex_out, \
-                                             m->link_sa, m->homog, o); \
+                                             (__m512d)geo_st, m, o); \
         } while (0)
 #else  /* (m is passed only where SOFTGYM_MODES8: softgym_seed_geom_modes) */
 #define SOFTGYM_GEOM_AFTER (void)0
@@ -1129,8 +1127,9 @@ static Py_ssize_t softgym_seed_modes(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
                                      const long long *homog, double *o)
 {
 #if defined(__AVX__)
-    long long bad = softgym_seed_modes_loop(lo, hi, n, max_ext, sa_w, sah_w, st_in, ex_in,
-                                            st_out, ex_out, link_sa, homog, o);
+    const softgym_modes_args m = {max_ext, sa_w, sah_w, st_in, ex_in, st_out, ex_out,
+                                  link_sa, homog, 0};
+    long long bad = softgym_seed_modes_loop(lo, hi, n, &m, o);
     return softgym_seed_modes_end(lo, hi, n, max_ext, bad, link_sa, o);
 #else
     /* 2 lanes and no 64-bit compare (SSE2): the branchy scalar loop is
