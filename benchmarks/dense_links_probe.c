@@ -263,7 +263,7 @@ int main(int argc, char **argv)
         t0 = __rdtsc();
         for (int ax = 0; ax < 3; ax++)
             softgym_seed_geom(ax, start[ax], start[ax + 1], ne, v1, v2, nv, pos, quat, vr, vn,
-                              scale, o, (double *)0);
+                              scale, o, (double *)0, (float *)0);
         t = __rdtsc() - t0;
         best[0] = t < best[0] ? t : best[0];
         memset(fa, 0, SOFTGYM_FM_STRIDE * nv * 8);
@@ -275,8 +275,8 @@ int main(int argc, char **argv)
                 Py_ssize_t a0 = start[ax] > c0 ? start[ax] : c0;
                 Py_ssize_t a1 = start[ax + 1] < c1 ? start[ax + 1] : c1;
                 if (a0 < a1)
-                    softgym_seed_scatter(ax, a0, a1, v1, v2, rot, chunk, (const float *)0,
-                                         bo + 23 * ne, fa, fa + 4);
+                    softgym_seed_scatter(ax, a0, a1, v1, v2, rot, chunk, bo + 23 * ne, fa,
+                                         fa + 4);
             }
         }
         t = __rdtsc() - t0;

@@ -65,8 +65,8 @@ SEED_PASSES = {
                        "softgym_seed_forces32_small", "softgym_seed_forces32_mixed",
                        "softgym_seed_forces32_neg2", "softgym_seed_forces32_small_neg2",
                        "softgym_seed_forces32_block16"),
-    "scatter": ("softgym_seed_scatter_ax", "softgym_seed_scatter8", "softgym_turn8",
-                "softgym_v8_rows4"),
+    "scatter": ("softgym_seed_push32_ax", "softgym_seed_push32_16", "softgym_push16",
+                "softgym_seed_push32_links"),
     "voxel update": ("softgym_seed_voxels8", "softgym_v8_finish"),
 }
 COROT_PASSES = {
@@ -82,14 +82,15 @@ MODELS = {
     "seed": (SEED_PASSES, "_seed", "integrate_integrate_seed"),
     "corotational": (COROT_PASSES, "_corotational", "integrate_integrate_corotational"),
 }
-# what one iteration of a pass's main loop handles: links, except the voxel update (both
-# models' scatters take blocks of 8 links with AVX-512; the corotational links 8 a vector
-# from its voxels' rows; the float frames' main loop in the x86-64-v4 build is its pairs of
-# 16-lane blocks, softgym_seed_frames32_x2)
+# what one iteration of a pass's main loop handles: links, except the voxel update (the
+# seed preset's float push takes blocks of 16 links, both their sides, the corotational
+# scatter blocks of 8 with AVX-512; the corotational links 8 a vector from its voxels'
+# rows; the float frames' main loop in the x86-64-v4 build is its pairs of 16-lane blocks,
+# softgym_seed_frames32_x2)
 PER_ITERATION = {"geometry": 8, "  rows path": 8, "  gather path": 8, "modes": 8,
-                 "frames (float)": 32, "forces (float)": 16, "scatter": 8, "voxel update": 8,
+                 "frames (float)": 32, "forces (float)": 16, "scatter": 16, "voxel update": 8,
                  "links": 8}
-PER_ITERATION_OF = {"seed": PER_ITERATION, "corotational": PER_ITERATION}
+PER_ITERATION_OF = {"seed": PER_ITERATION, "corotational": {**PER_ITERATION, "scatter": 8}}
 
 
 def build_copy(dest: Path) -> Path:
@@ -249,10 +250,15 @@ def _geometry_paths(rows, best) -> None:
     best["  rows path"] = (loop_body(rows, s, e), rows[s][0])
     arithmetic = [t for _a, _sym, fn, t in rows[s:e + 1]
                   if not t.startswith(SKIP) and fn not in _ROWS_ONLY]
-    s, e = min(outer, key=lambda r: r[1] - r[0])
-    gathers = [t for _a, _sym, fn, t in rows[s:e + 1] if not t.startswith(SKIP)
-               and (fn in _GATHER_ONLY or fn.startswith(("_mm256_", "_mm_")))]
-    best["  gather path"] = (arithmetic + gathers, rows[s][0])
+    def gathers_of(r):
+        return [t for _a, _sym, fn, t in rows[r[0]:r[1] + 1] if not t.startswith(SKIP)
+                and (fn in _GATHER_ONLY or fn.startswith(("_mm256_", "_mm_")))]
+
+    # the smallest loop among those with the most gather instructions (GCC may also copy
+    # a few of the gathers' loads into smaller loops of the nest, without their gathers)
+    s, e = min(outer, key=lambda r: (-sum(t.startswith("vgather") for t in gathers_of(r)),
+                                     r[1] - r[0]))
+    best["  gather path"] = (arithmetic + gathers_of((s, e)), rows[s][0])
 
 
 CLOCK_C = r"""

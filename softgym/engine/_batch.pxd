@@ -70,6 +70,13 @@ cdef struct Batch:
                              #   rows) and are never read; voxel i's force at
                              #   force[SOFTGYM_FM_STRIDE * i]
     float64_t* moment        # force + 4: voxel i's moment at moment[SOFTGYM_FM_STRIDE * i]
+    float* link_f            # NULL, or (model 0 with link_f32, during advance) the thread's
+                             #   float rows of the link forces in place of force and
+                             #   moment: 6 rows (force x, y, z, moment x, y, z), row k of
+                             #   voxel i at link_f[k * link_fs + i], i among the robot's
+                             #   voxels (the links' push and the contacts add into them,
+                             #   the voxel update widens them to doubles and zeroes them)
+    intp_t link_fs           # their row stride
     float64_t* vox_out       # the voxel update's scratch, SOFTGYM_VOXEL_ROWS rows: row k of
                              #   voxel i at vox_out[k * vox_stride + i], i among the robot's
                              #   voxels (include/softgym_simd.h)
@@ -116,7 +123,8 @@ cdef struct Batch:
                              #   first (_seed.links_seed; per thread)
     float* chunk_f32         # scratch of the seed model's single-precision frames and forces:
                              #   SOFTGYM_CHUNK_FROWS float rows, SOFTGYM_CHUNK_FSTRIDE apart, for one
-                             #   chunk of links (the forces' from row SOFTGYM_CHUNK_FOUT)
+                             #   chunk of links (the forces' from row SOFTGYM_CHUNK_FOUT, voxel
+                             #   1's rotation rounded from row SOFTGYM_CHUNK_FR)
     intp_t* v1               # (n_links,) voxel on the negative side
     intp_t* v2               # (n_links,) voxel on the positive side
     int32* axis              # (n_links,) 0, 1, 2 for x, y, z

@@ -589,12 +589,65 @@ cdef int _obstacle_pairs(Batch* b, intp_t r, Contacts* c, float64_t horizon) noe
     return STATUS_OK
 
 
+cdef void _contacts32(Batch* b, Contacts* c, int obstacles) noexcept nogil:
+    # collide (obstacles 0) or collide_obstacles (1) with single-precision links: the same
+    # contact forces, rounded to float and added to the voxels' float rows of link forces
+    # (b.link_f, which the voxel update reads instead of b.force; loops of their own, so
+    # that the double loops' products and sums fuse as they did)
+    cdef:
+        intp_t k, i, j, m, s = b.link_fs
+        float64_t dx, dy, dz, d2, env, dist, kk, fmag
+        float fx, fy, fz
+        float* lf = b.link_f
+    for k in range(0 if obstacles else c.n_pairs):
+        i = c.pairs[2 * k]
+        j = c.pairs[2 * k + 1]
+        dx = voxel_pos(b, j, 0) - voxel_pos(b, i, 0)
+        dy = voxel_pos(b, j, 1) - voxel_pos(b, i, 1)
+        dz = voxel_pos(b, j, 2) - voxel_pos(b, i, 2)
+        d2 = dx * dx + dy * dy + dz * dz
+        env = 0.75 * (b.scale[i] + b.scale[j])
+        if d2 >= env * env or d2 == 0.0:
+            continue
+        dist = sqrt(d2)
+        kk = b.k_floor[i] * b.k_floor[j] / (b.k_floor[i] + b.k_floor[j])
+        fmag = kk * (env - dist) / dist
+        fx = <float> (fmag * dx)
+        fy = <float> (fmag * dy)
+        fz = <float> (fmag * dz)
+        lf[j] += fx
+        lf[s + j] += fy
+        lf[2 * s + j] += fz
+        lf[i] -= fx
+        lf[s + i] -= fy
+        lf[2 * s + i] -= fz
+    for k in range(c.n_opairs if obstacles else 0):
+        i = c.opairs[2 * k]
+        m = c.opairs[2 * k + 1]
+        dx = voxel_pos(b, i, 0) - b.obs[4 * m]
+        dy = voxel_pos(b, i, 1) - b.obs[4 * m + 1]
+        dz = voxel_pos(b, i, 2) - b.obs[4 * m + 2]
+        d2 = dx * dx + dy * dy + dz * dz
+        env = 0.75 * (b.scale[i] + b.L)
+        if d2 >= env * env or d2 == 0.0:
+            continue
+        dist = sqrt(d2)
+        kk = b.k_floor[i] * b.obs[4 * m + 3] / (b.k_floor[i] + b.obs[4 * m + 3])
+        fmag = kk * (env - dist) / dist
+        lf[i] += <float> (fmag * dx)
+        lf[s + i] += <float> (fmag * dy)
+        lf[2 * s + i] += <float> (fmag * dz)
+
+
 cdef void collide_obstacles(Batch* b, Contacts* c) noexcept nogil:
     # OUT (accumulated): force on the voxels touching an obstacle voxel (the
     # seed's contact law; the obstacle is fixed and takes no force)
     cdef:
         intp_t k, i, m
         float64_t dx, dy, dz, d2, env, dist, kk, fmag
+    if b.link_f != NULL:
+        _contacts32(b, c, 1)
+        return
     for k in range(c.n_opairs):
         i = c.opairs[2 * k]
         m = c.opairs[2 * k + 1]
@@ -618,6 +671,9 @@ cdef void collide(Batch* b, Contacts* c) noexcept nogil:
     cdef:
         intp_t k, i, j
         float64_t dx, dy, dz, d2, env, dist, kk, fmag
+    if b.link_f != NULL:
+        _contacts32(b, c, 0)
+        return
     for k in range(c.n_pairs):
         i = c.pairs[2 * k]
         j = c.pairs[2 * k + 1]

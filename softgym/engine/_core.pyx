@@ -18,6 +18,7 @@
 from cython.parallel cimport prange, parallel, threadid
 from libc.math cimport sin, cos, sqrt, fabs, M_PI
 from libc.stdlib cimport calloc, realloc, free
+from libc.string cimport memset
 from libc.stdint cimport uintptr_t
 
 cimport numpy as cnp
@@ -146,6 +147,8 @@ cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
     # everything else reads positions and quaternions through voxel_pos / voxel_quat,
     # _batch.pxd); else the rows are filled from the records once a step
     voxel_state_enter(b, r)
+    if b.link_f != NULL:  # the thread's float rows of the link forces start at zero
+        memset(b.link_f + b.vox_start[r], 0, (6 * b.link_fs + 64) * sizeof(float))
     while b.steps[r] < target:
         t0 = softgym_prof_tsc()
         voxel_link_rows(b, r, 1)  # (where the records are the state: the geometry's rows)
@@ -366,6 +369,8 @@ cdef int _bind(Batch* b, dict a, dict s) except -1:
     b.chunk_link = NULL
     b.vox_stride = 0
     b.moment = b.force + 4  # its columns 4-6 (_batch.pxd)
+    b.link_f = NULL  # per thread, set by advance (single-precision links)
+    b.link_fs = 0
     b.ext_force = _f(a, "ext_force")
     b.mass = _f(a, "mass")
     b.inv_mass = _f(a, "inv_mass")
@@ -520,6 +525,7 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
         Batch bt
         intp_t r, n, t
         intp_t stride = 0, vstride = 0, block, fblock, i, m, vox_at, chunk_at, f32_at, link_at
+        intp_t lf_at, lfblock
         float64_t* scratch
     _bind(&b, arrays, settings)
     n = b.n_robots
@@ -545,7 +551,13 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
     chunk_at = vox_at + SOFTGYM_VOXEL_ROWS * vstride
     f32_at = chunk_at + SOFTGYM_CHUNK_ROWS * SOFTGYM_CHUNK_STRIDE
     link_at = f32_at + fblock
-    block = link_at + N_LINK_OUT * SOFTGYM_CHUNK_STRIDE
+    # the link forces' 6 float rows (single-precision links of model 0), a multiple of 16
+    # floats apart (each row starts on a line), and 64 floats of slack (the push's windows
+    # of 16 voxels may reach 47 past a robot's last voxel), in doubles
+    lf_at = link_at + N_LINK_OUT * SOFTGYM_CHUNK_STRIDE
+    b.link_fs = (vstride + 15) // 16 * 16
+    lfblock = (6 * b.link_fs + 64) // 2 if b.link_f32 and b.model == 0 else 0
+    block = lf_at + lfblock
     scratch = cache.scratch(max(n_threads * block, 1))
     # robots in the order 0, 8, 16, ..., then 1, 9, 17, ...: the robots that the
     # threads step at one time are ROBOT_SPREAD apart, so no two of them write
@@ -571,6 +583,8 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
                 bt.chunk_out = scratch + t * block + chunk_at
                 bt.chunk_f32 = <float*> (scratch + t * block + f32_at)
                 bt.chunk_link = scratch + t * block + link_at
+                if lfblock > 0:
+                    bt.link_f = <float*> (scratch + t * block + lf_at) - b.vox_start[r]
                 advance_robot(&bt, r, targets[r], &cache.items[r])
 
 

@@ -59,14 +59,37 @@ cdef inline void _fluid_drag(Batch* b, intp_t i, float64_t* f) noexcept nogil:
 
 
 cdef inline void _clear(Batch* b, intp_t i) noexcept nogil:
-    # voxel i's force and moment row (padding included)
-    memset(b.force + SOFTGYM_FM_STRIDE * i, 0, SOFTGYM_FM_STRIDE * sizeof(float64_t))
+    # voxel i's force and moment row (padding included), or its float link forces
+    cdef int k
+    if b.link_f != NULL:
+        for k in range(6):
+            b.link_f[k * b.link_fs + i] = 0.0
+    else:
+        memset(b.force + SOFTGYM_FM_STRIDE * i, 0, SOFTGYM_FM_STRIDE * sizeof(float64_t))
+
+
+cdef inline void _forces_of(const Batch* b, intp_t i, float64_t* fm) noexcept nogil:
+    # voxel i's accumulated force (fm[0..2]) and moment (fm[4..6]): its row of b.force, or
+    # its float link forces widened (exactly)
+    cdef int k
+    cdef const float64_t* row
+    if b.link_f != NULL:
+        for k in range(3):
+            fm[k] = b.link_f[k * b.link_fs + i]
+            fm[4 + k] = b.link_f[(3 + k) * b.link_fs + i]
+    else:
+        row = b.force + SOFTGYM_FM_STRIDE * i
+        for k in range(3):
+            fm[k] = row[k]
+            fm[4 + k] = row[4 + k]
 
 
 cdef void clear_robot(Batch* b, intp_t r) noexcept nogil:
     # zero the robot's force/moment scratch (after an early exit)
     cdef intp_t vs = b.vox_start[r], ve = b.vox_start[r + 1]
     memset(b.force + SOFTGYM_FM_STRIDE * vs, 0, SOFTGYM_FM_STRIDE * (ve - vs) * sizeof(float64_t))
+    if b.link_f != NULL:
+        memset(b.link_f + vs, 0, 6 * b.link_fs * sizeof(float))
 
 
 cdef inline float64_t _drift2(const float64_t* pos, const float64_t* ref, intp_t i, intp_t vs,
@@ -132,7 +155,8 @@ cdef extern from "softgym_voxels.h":
         const float64_t* scale, const float64_t* k_floor, const float64_t* c_floor,
         const float64_t* mu_s, const float64_t* mu_k, const flag_t* fixed,
         const float64_t* ref, float64_t* c, int track_speed, float64_t runaway,
-        float64_t* dmax, float64_t* vmax2, float64_t* rows, intp_t rn) noexcept nogil
+        float64_t* dmax, float64_t* vmax2, float64_t* rows, intp_t rn, float* lf,
+        intp_t lfs) noexcept nogil
 
 
 cdef inline intp_t _scalar_run(Batch* b, intp_t r, intp_t* lo, int seed, const float64_t* ref,
@@ -153,7 +177,7 @@ cdef inline intp_t _scalar_run(Batch* b, intp_t r, intp_t* lo, int seed, const f
                      b.c_global, b.mass, b.inv_mass, b.inv_inertia,
                      b.rot_damp, b.scale, b.k_floor, b.c_floor, b.mu_s, b.mu_k, b.fixed, ref,
                      c, b.self_collision and seed, RUNAWAY, dmax, vmax2, b.vox_out,
-                     b.vox_stride):
+                     b.vox_stride, b.link_f, b.link_fs):
             return lo[0] + 8
         lo[0] += 8
     return ve
@@ -192,7 +216,7 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
         intp_t i, k
         float64_t dt = b.dt[r]
         float64_t m, pen, cg, mx, my, mz
-        const float64_t* fm
+        float64_t fm[8]
         float64_t c[3]
         float64_t f[3]
         float64_t* pos = b.pos
@@ -227,7 +251,7 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
                 continue
             m = b.mass[i]
             cg = b.c_global[i]
-            fm = b.force + SOFTGYM_FM_STRIDE * i  # the voxel's force, then moment (+ 4)
+            _forces_of(b, i, fm)  # the voxel's force, then moment (+ 4)
             f[0] = fm[0] + b.ext_force[3 * i] - cg * vel[3 * i]
             f[1] = fm[1] + b.ext_force[3 * i + 1] - cg * vel[3 * i + 1]
             f[2] = fm[2] + b.ext_force[3 * i + 2] - cg * vel[3 * i + 2] + m * g
@@ -368,7 +392,7 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
         intp_t i, k
         float64_t dt = b.dt[r]
         float64_t cg, mx, my, mz
-        const float64_t* fm
+        float64_t fm[8]
         float64_t c[3]
         float64_t f[3]
         float64_t* pos = b.pos
@@ -400,7 +424,7 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
                 _clear(b, i)
                 continue
             cg = b.c_global[i]
-            fm = b.force + SOFTGYM_FM_STRIDE * i  # the voxel's force, then moment (+ 4)
+            _forces_of(b, i, fm)  # the voxel's force, then moment (+ 4)
             f[0] = -cg * vel[3 * i] + fm[0] + b.ext_force[3 * i]
             f[1] = -cg * vel[3 * i + 1] + fm[1] + b.ext_force[3 * i + 1]
             f[2] = (-cg * vel[3 * i + 2] + fm[2] + b.mass[i] * b.gravity

@@ -100,14 +100,24 @@ cdef extern from "softgym_seed.h":
                                    const intp_t* v2, intp_t vend, const float64_t* pos,
                                    const float64_t* quat, const float64_t* vr, intp_t vn,
                                    const float64_t* scale, float64_t* o, float64_t* rr,
-                                   const softgym_modes_args* m) noexcept nogil
+                                   float* rf, const softgym_modes_args* m) noexcept nogil
     void softgym_seed_scatter(int ax, intp_t lo, intp_t hi, const intp_t* v1, const intp_t* v2,
-                              const float64_t* rot, const float64_t* o, const float* of,
+                              const float64_t* rot, const float64_t* o,
                               const float64_t* neg2_row, float64_t* force,
                               float64_t* moment) noexcept nogil
+    # single-precision links: their forces turned in float and added to the voxels' float
+    # rows lf (row stride lfs), voxel 1's then voxel 2's (rf: the geometry's float rotation
+    # rows where SOFTGYM_SEED_R_USED, else NULL: rot)
+    void softgym_seed_push32(int ax, intp_t lo, intp_t hi, const intp_t* v1, const intp_t* v2,
+                             const float64_t* rot, const float* rf, const float* of,
+                             const float64_t* neg2_row, float* lf, intp_t lfs) noexcept nogil
     # the rows of the chunk's scratch that hold voxel 1's rotation (the geometry writes
     # them, the scatter reads them, where the build's SOFTGYM_SEED_R_USED is 1: AVX-512)
     enum: SOFTGYM_SEED_R_ROWS
+    # the float rows of the chunk's scratch that hold it rounded (single-precision links),
+    # and whether the geometry writes those rows (the AVX-512 builds)
+    enum: SOFTGYM_CHUNK_FR
+    enum: SOFTGYM_SEED_R_USED
     int softgym_seed_frames32(intp_t lo, intp_t hi, intp_t n, float sa_rad, float w_acos,
                               const float64_t* o, float* f) noexcept nogil
     void softgym_seed_forces32(intp_t lo, intp_t hi, intp_t n, float L, float bz, float bzh,
@@ -218,7 +228,7 @@ cdef inline void _seed_frames_forces32(Batch* b, intp_t lo, intp_t end, float64_
     # links_seed's frames and forces passes in single precision
     # (SimConfig.link_precision = "single"; include/softgym_seed.h): the chunk's float
     # rows in b.chunk_f32 from the frames, and from the forces its rows SOFTGYM_CHUNK_FOUT
-    # on, which the scatter widens to doubles (links lo..end: one chunk)
+    # on, which softgym_seed_push32 turns to the world (links lo..end: one chunk)
     cdef:
         intp_t li
         int fix
@@ -276,7 +286,7 @@ cdef inline void _seed_frames_forces(Batch* b, intp_t lo, intp_t end, float64_t*
 
 
 cdef inline intp_t _seed_geom_modes(Batch* b, int ax, intp_t lo, intp_t hi, intp_t n,
-                                   float64_t* o, intp_t vend, float64_t* rr,
+                                   float64_t* o, intp_t vend, float64_t* rr, float* rf,
                                    const softgym_modes_args* m) noexcept nogil:
     # the geometry and the modes of links lo..hi along axis ax (m: _modes_args), the
     # modes while the geometry's rows are in the cache: hi, or the first strained link
@@ -289,7 +299,7 @@ cdef inline intp_t _seed_geom_modes(Batch* b, int ax, intp_t lo, intp_t hi, intp
     # voxel_state_enter). The modes are decided in the geometry's loop in AVX-512 builds
     # (softgym_seed_geom_modes), so the probes charge them to the geometry's slot there
     end = softgym_seed_geom_modes(ax, lo, hi, n, b.v1, b.v2, vend, b.pos, b.quat, b.vox_out,
-                                  b.vox_stride, b.scale, o, rr, m)
+                                  b.vox_stride, b.scale, o, rr, rf, m)
     softgym_prof_add(0, t0)
     return end
 
@@ -305,7 +315,9 @@ cdef inline void _modes_args(Batch* b, softgym_modes_args* m) noexcept nogil:
     m.ex_out = HYSTERESIS * SA_BOND_EXT_PERC
     m.link_sa = <long long*> b.link_sa
     m.homog = <const long long*> b.homog
-    m.keep_len = not b.link_f32  # the double-precision frames pass reads rows 7 and 8
+    # the double-precision frames pass reads rows 7 and 8, the single-precision one row 8
+    # (the geometry stores row 8 in either case where it decides the modes: AVX-512)
+    m.keep_len = not b.link_f32
 
 
 cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
@@ -324,9 +336,9 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     #                        constant)
     #   softgym_seed_modes   (both by softgym_seed_geom_modes, which in AVX-512
     #                        builds decides the modes of each vector block of the
-    #                        geometry from its values in registers, the chord
-    #                        length and the transverse ratio stored only where the
-    #                        double-precision frames read row 8)
+    #                        geometry from its values in registers, the
+    #                        nominal length and the transverse ratio stored only
+    #                        where the double-precision frames read row 7)
     #                        the mode (link_sa; row 9 becomes 1.0 small / 0.0
     #                        large angle), row 10 the axial displacement P0 in
     #                        that mode (the single-precision frames read it),
@@ -344,12 +356,17 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     #                        all in small-angle mode; voxel 2's own force left out
     #                        where they all give it -F1) into the 12 rows of
     #                        b.chunk_out (in single precision: 12 float rows of
-    #                        b.chunk_f32 from SOFTGYM_CHUNK_FOUT, which the
-    #                        scatter widens to doubles as it loads them)
+    #                        b.chunk_f32 from SOFTGYM_CHUNK_FOUT)
     #   softgym_seed_scatter back to the world, scattered in link order (once
     #                        per axis; with AVX-512, 8 links at a time turned in
     #                        the lanes with voxel 1's rotation, which the geometry
-    #                        leaves in rows 12-20 of b.chunk_out: rr)
+    #                        leaves in rows 12-20 of b.chunk_out: rr); in single
+    #                        precision softgym_seed_push32 instead: the turn in
+    #                        float (voxel 1's rotation rounded: the geometry's
+    #                        float rows SOFTGYM_CHUNK_FR of b.chunk_f32, rf), the
+    #                        sums in the thread's float rows b.link_f, blocks of
+    #                        16 links in the lanes, voxel 1's side then voxel 2's
+    #                        (include/softgym_seed.h)
     # The passes run over one chunk of SOFTGYM_CHUNK_LINKS links at a time (64; 128
     # before the scatter took voxel 1's rotation from 9 more rows of the chunk),
     # all of them before the next chunk: a chunk's scratch rows stay in the L1
@@ -363,7 +380,9 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
     # result is the one of running each pass over all the links, bit for bit (a
     # strained link stops the step after the links before it, as the seed's scalar
     # loop does; 3.0 % on an Intel Xeon, benchmarks/RESULTS.md). With link_precision "single" the
-    # frames and forces run in float (_seed_frames_forces32).
+    # frames and forces run in float (_seed_frames_forces32), and the push's float sums
+    # take each voxel's forces in the order its chunks and blocks of 16 fix (the same in
+    # every build, alone or in a batch: a robot's chunks start at its first link).
     # The bond frame is voxel 1's frame turned by the proper rotation P that
     # takes the link axis onto +x (the seed's ToXDirBond): (x, y, z) ->
     # (x, y, z), (y, -x, z), (z, y, -x) for ax 0, 1, 2.
@@ -383,11 +402,16 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
         # the scatter's forces and moments: the float forces pass's rows of the chunk's
         # float scratch, indexed by link (NULL: the double pass's rows 0-11 of chunk_out)
         const float* of = NULL
+        # the geometry's float rotation rows of the chunk (single-precision links in the
+        # builds that write them; NULL: the push reads rot)
+        float* rf = NULL
         softgym_modes_args m
         unsigned long long t0
     if hi <= lo:
         return STATUS_OK
     _modes_args(b, &m)
+    if b.link_f32 and SOFTGYM_SEED_R_USED:
+        rf = b.chunk_f32 + SOFTGYM_CHUNK_FR * SOFTGYM_CHUNK_FSTRIDE
     run[0] = lo
     for ax in range(3):
         run[ax + 1] = run[ax] + b.link_axis_count[3 * r + ax] if ax < 2 else hi
@@ -400,7 +424,8 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
             a0 = max(c0, run[ax])
             a1 = min(c1, run[ax + 1])
             if a0 < a1:
-                end = _seed_geom_modes(b, ax, a0, a1, n, o, b.vox_start[r + 1], rr - c0, &m)
+                end = _seed_geom_modes(b, ax, a0, a1, n, o, b.vox_start[r + 1], rr - c0,
+                                       rf - c0 if rf != NULL else NULL, &m)
                 if end < a1:
                     break  # a strained link: the links after it stay as they were
                 end = c1
@@ -413,8 +438,12 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
         for ax in range(3):
             a0 = max(c0, run[ax])
             a1 = min(end, run[ax + 1])
-            if a0 < a1:
-                softgym_seed_scatter(ax, a0, a1, b.v1, b.v2, b.rot, b.chunk_out - c0, of,
+            if a0 < a1 and b.link_f32:
+                softgym_seed_push32(ax, a0, a1, b.v1, b.v2, b.rot,
+                                    rf - c0 if rf != NULL else NULL, of, o + 23 * n,
+                                    b.link_f, b.link_fs)
+            elif a0 < a1:
+                softgym_seed_scatter(ax, a0, a1, b.v1, b.v2, b.rot, b.chunk_out - c0,
                                      o + 23 * n, b.force, b.moment)
         softgym_prof_add(5, t0)
         if end < c1:

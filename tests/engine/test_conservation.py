@@ -9,11 +9,14 @@ from softgym.engine import SimConfig, Simulation
 
 @pytest.mark.parametrize("precision", ["double", "single"])
 def test_linear_momentum_constant_while_muscles_actuate(precision):
-    # No gravity, floor or global damping: internal forces cancel pairwise, so
-    # the total momentum keeps its initial value to 1e-9 relative (in either
-    # link precision: the two muscles differ only in CTE, so voxel 2 of a
-    # link between them takes exactly -F1 as in the seed's own arithmetic;
-    # float links fused the two forms differently and drifted by 1e-8).
+    # No gravity, floor or global damping: internal forces cancel pairwise (the two
+    # muscles differ only in CTE, so voxel 2 of a link between them takes exactly -F1 as
+    # in the seed's own arithmetic), so the total momentum keeps its initial value: to
+    # 1e-9 relative with double links, whose forces are summed in double; with float
+    # links each voxel's sum of its links' forces is a float sum (their turn to the world
+    # and sums in float, issue 29), whose rounding does not cancel between voxels: 2e-8
+    # to 8e-8 relative after 1 s for 3^3 to 6^3 bodies (the AVX-512 and portable builds),
+    # held to 3e-7 (a force that did not cancel would be off by its whole size).
     cfg = SimConfig(gravity=0.0, floor=False, global_damping=0.0, init_time=0.0,
                     actuation="symmetric", link_precision=precision)
     sim = Simulation(reference_robot(4), cfg)
@@ -26,7 +29,8 @@ def test_linear_momentum_constant_while_muscles_actuate(precision):
         sim.advance(0.1)
         # the muscles really move the body
         assert np.abs(sim.velocities(0) - sim.velocities(0).mean(axis=0)).max() > 1e-4
-        np.testing.assert_allclose(sim.momentum()[0], p0, rtol=0, atol=1e-9 * scale)
+        tol = 1e-9 if precision == "double" else 3e-7
+        np.testing.assert_allclose(sim.momentum()[0], p0, rtol=0, atol=tol * scale)
 
 
 @pytest.mark.parametrize("model", ["seed", "corotational"])

@@ -1,8 +1,9 @@
 """The seed model's single-precision link math (``SimConfig.link_precision="single"``,
 the seed model's default since issue 29; ``"double"`` keeps the seed's own operations).
 
-The frames and forces passes run in float; positions, geometry, modes, the
-world-frame sums and the voxel update stay double. Checked here: the float
+The frames and forces passes run in float, and the forces' turn to the world and
+the voxels' sums of them (the push); positions, geometry, modes and the voxel
+update stay double. Checked here: the float
 frames follow the seed's scalar code in double to float accuracy (including
 the near-identity rotations where the seed's own formula cancels), the
 closed-form cases hold, and results stay deterministic (threads, batches,

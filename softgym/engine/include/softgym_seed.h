@@ -34,8 +34,12 @@
    float is exactly a double, and the forces pass, which had widened its 16 lanes a row
    into two stores of 8 doubles, now stores them as they are) */
 #define SOFTGYM_CHUNK_FSTRIDE (SOFTGYM_CHUNK_LINKS + 16)
-#define SOFTGYM_CHUNK_FROWS 24
+#define SOFTGYM_CHUNK_FROWS 33
 #define SOFTGYM_CHUNK_FOUT 12
+/* rows 24-32 of the float rows: voxel 1's rotation matrix, row-major, rounded to float by
+   the geometry (AVX-512 builds with single-precision links: softgym_seed_push32's blocks
+   turn the forces with it) */
+#define SOFTGYM_CHUNK_FR 24
 
 /* The first pass of links_seed (_seed.pyx): links lo..hi (all along axis ax, a
    compile-time constant in each copy) measured in the bond frame, without
@@ -63,13 +67,21 @@
     double *__restrict__ o_n1 = (o) + 4 * (n), *__restrict__ o_n2 = (o) + 5 * (n); \
     double *__restrict__ o_n3 = (o) + 6 * (n), *__restrict__ o_nom = (o) + 7 * (n); \
     double *__restrict__ o_len = (o) + 8 * (n), *__restrict__ o_st = (o) + 9 * (n)
+/* v (a double, or a vector of them) rounded to float and stored at row[li] (the geometry's
+   float rows of voxel 1's rotation) */
+#define SOFTGYM_PUTF1(row, li, v) ((row)[li] = (float)(v))
+#if defined(SOFTGYM_VLANES) && SOFTGYM_VLANES == 8
+#define SOFTGYM_VPUTF(row, li, v) _mm256_storeu_ps((row) + (li), _mm512_cvtpd_ps((__m512d)(v)))
+#elif defined(SOFTGYM_VLANES)
+#define SOFTGYM_VPUTF(row, li, v) _mm_storeu_ps((row) + (li), _mm256_cvtpd_ps((__m256d)(v)))
+#endif
 /* one link's geometry into column li of those rows, from voxel 2's position relative
    to voxel 1's (dx, dy, dz), their orientations (w, x, y, z), (wj, xj, yj, zj) and
    sizes si, sj (the axis constants and output rows in scope); the engine's pass
    below and benchmarks/dense_links_probe.c share it */
 #define SOFTGYM_SEED_GEOM_LINK(li, dx, dy, dz, w, x, y, z, wj, xj, yj, zj, si, sj) \
-    SOFTGYM_SEED_GEOM_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, li, dx, dy, dz, w, x, y, z, \
-                             wj, xj, yj, zj, si, sj, (double *)0, 7, (void)0)
+    SOFTGYM_SEED_GEOM_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, SOFTGYM_PUTF1, li, dx, dy, dz, w, \
+                             x, y, z, wj, xj, yj, zj, si, sj, (double *)0, (float *)0, 7, (void)0)
 /* the same for any arithmetic type T (double, or a vector of doubles: then links li ..
    li + lanes - 1 at once, SQRT and FABS T's square root and absolute value, PUT(row,
    li, v) storing v at row + li); in builds whose scatter reads them (SOFTGYM_SEED_R_USED)
@@ -80,11 +92,14 @@
    frames pass (rows 7 and 8) read; AFTER: a statement run with the link's values in scope
    (geo_p0, geo_qw, geo_nom, geo_len, geo_st), where the geometry's vector loop decides
    their modes (softgym_seed_modes8v) */
-#define SOFTGYM_SEED_GEOM_LINK_T(T, SQRT, FABS, PUT, li, dx, dy, dz, w, x, y, z, wj, xj, yj, \
-                                 zj, si, sj, rr, KEEPLS, AFTER) do { \
+#define SOFTGYM_SEED_GEOM_LINK_T(T, SQRT, FABS, PUT, PUTF, li, dx, dy, dz, w, x, y, z, wj, xj, \
+                                 yj, zj, si, sj, rr, rf, KEEPLS, AFTER) do { \
         T geo_R[9]; \
         SOFTGYM_QUAT_MATRIX(w, x, y, z, geo_R); \
-        if (SOFTGYM_SEED_R_USED && (rr) != 0) { \
+        if (SOFTGYM_SEED_R_USED && (rf) != 0) { \
+            for (int geo_k = 0; geo_k < 9; geo_k++) \
+                PUTF((rf) + geo_k * SOFTGYM_CHUNK_FSTRIDE, li, geo_R[geo_k]); \
+        } else if (SOFTGYM_SEED_R_USED && (rr) != 0) { \
             for (int geo_k = 0; geo_k < 9; geo_k++) \
                 PUT((rr) + geo_k * SOFTGYM_CHUNK_STRIDE, li, geo_R[geo_k]); \
         } \
@@ -314,7 +329,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_scalar(const int ax, Py_ssize_t lo,
                                                     const Py_ssize_t *v2, const double *pos,
                                                     const double *quat, const double *vr,
                                                     Py_ssize_t vn, const double *scale,
-                                                    double *o, double *rr)
+                                                    double *o, double *rr, float *rf)
 {
     SOFTGYM_SEED_GEOM_AXIS(ax);
     SOFTGYM_SEED_GEOM_OUT(o, n);
@@ -333,8 +348,9 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_scalar(const int ax, Py_ssize_t lo,
         double y = SOFTGYM_GEOM_QUAT(i, 2), z = SOFTGYM_GEOM_QUAT(i, 3);
         double wj = SOFTGYM_GEOM_QUAT(j, 0), xj = SOFTGYM_GEOM_QUAT(j, 1);
         double yj = SOFTGYM_GEOM_QUAT(j, 2), zj = SOFTGYM_GEOM_QUAT(j, 3);
-        SOFTGYM_SEED_GEOM_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, li, dx, dy, dz, w, x, y, z,
-                                 wj, xj, yj, zj, scale[i], scale[j], rr, 7, (void)0);
+        SOFTGYM_SEED_GEOM_LINK_T(double, sqrt, fabs, SOFTGYM_PUT1, SOFTGYM_PUTF1, li, dx, dy, dz,
+                                 w, x, y, z, wj, xj, yj, zj, scale[i], scale[j], rr, rf, 7,
+                                 (void)0);
     }
 }
 /* m not NULL (a compile-time constant where inlined; only in SOFTGYM_MODES8 builds, from
@@ -347,7 +363,8 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
                                                 const double *pos, const double *quat,
                                                 const double *vr, Py_ssize_t vn,
                                                 const double *scale, double *o, double *rr,
-                                                const softgym_modes_args *m, long long *bad)
+                                                float *rf, const softgym_modes_args *m,
+                                                long long *bad)
 {
     Py_ssize_t li = lo;
 #define SOFTGYM_GEOM_MODES(a, b) do { \
@@ -366,7 +383,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
     while (al < hi && ((uintptr_t)(o + al) & 63) != 0)
         al++;
     if (al + SOFTGYM_VLANES <= hi) {
-        softgym_seed_geom_scalar(ax, lo, al, n, v1, v2, pos, quat, vr, vn, scale, o, rr);
+        softgym_seed_geom_scalar(ax, lo, al, n, v1, v2, pos, quat, vr, vn, scale, o, rr, rf);
         SOFTGYM_GEOM_MODES(lo, al);
         li = al;
     }
@@ -400,16 +417,16 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
 #else  /* (m is passed only where SOFTGYM_MODES8: softgym_seed_geom_modes) */
 #define SOFTGYM_GEOM_AFTER (void)0
 #endif
-        SOFTGYM_SEED_GEOM_LINK_T(softgym_vd, SOFTGYM_VSQRT, softgym_vabs, SOFTGYM_VPUT, li, dx,
-                                 dy, dz, gi[3], gi[4], gi[5], gi[6], gj[3], gj[4], gj[5], gj[6],
-                                 gi[7], gj[7], rr,
-                                 SOFTGYM_MODES8 && m ? (m->keep_len ? 5 : 0) : 7,
+        SOFTGYM_SEED_GEOM_LINK_T(softgym_vd, SOFTGYM_VSQRT, softgym_vabs, SOFTGYM_VPUT,
+                                 SOFTGYM_VPUTF, li, dx, dy, dz, gi[3], gi[4], gi[5], gi[6],
+                                 gj[3], gj[4], gj[5], gj[6], gi[7], gj[7], rr, rf,
+                                 SOFTGYM_MODES8 && m ? (m->keep_len ? 5 : 1) : 7,
                                  SOFTGYM_GEOM_AFTER);
 #undef SOFTGYM_GEOM_AFTER
     }
 #endif
     /* the rest (and every link without AVX): the compiler's vectoriser */
-    softgym_seed_geom_scalar(ax, li, hi, n, v1, v2, pos, quat, vr, vn, scale, o, rr);
+    softgym_seed_geom_scalar(ax, li, hi, n, v1, v2, pos, quat, vr, vn, scale, o, rr, rf);
     SOFTGYM_GEOM_MODES(li, hi);
 #undef SOFTGYM_GEOM_MODES
 }
@@ -421,10 +438,11 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_geom_ax(const int ax, Py_ssize_t lo, Py_
 static void softgym_seed_geom(int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n,
                               const Py_ssize_t *v1, const Py_ssize_t *v2, Py_ssize_t vend,
                               const double *pos, const double *quat, const double *vr,
-                              Py_ssize_t vn, const double *scale, double *o, double *rr)
+                              Py_ssize_t vn, const double *scale, double *o, double *rr,
+                              float *rf)
 {
     SOFTGYM_BY_AXIS(ax, softgym_seed_geom_ax, lo, hi, n, v1, v2, vend, pos, quat, vr, vn, scale,
-                    o, rr, (const softgym_modes_args *)0, (long long *)0);
+                    o, rr, rf, (const softgym_modes_args *)0, (long long *)0);
 }
 
 /* The frames pass of links_seed, in C for one pragma: the bond-frame
@@ -462,14 +480,14 @@ static inline long long softgym_rotvec_needs_acos(double w, double thr)
    (1 + nx, 0, nz, -ny) / sqrt(2 (1 + nx)), i.e. (|p| + p0, 0, p2, -p1) / s
    with s = sqrt(2 |p| (|p| + p0)): two square roots and one division (the
    seed's cos(th / 2), sin(th / 2) and 1 / |n_yz| took four and four). */
-#define SOFTGYM_CHORD_FRAME(T, M, SQRT, p0, p1, p2, sa_rad) \
+#define SOFTGYM_CHORD_FRAME(T, M, SQRT, p0, p1, p2, sa_rad, LN) \
     M zero = (p0 == (T)0.0) & (p1 == (T)0.0) & (p2 == (T)0.0); \
     T inv_p0_ = (T)1.0 / p0; \
     T yx_ = p1 * inv_p0_, zx_ = p2 * inv_p0_; \
     M small = (yx_ < sa_rad) & (yx_ > -sa_rad) & (zx_ < sa_rad) & (zx_ > -sa_rad); \
     T ry_s_ = (T)0.5 * zx_, rz_s_ = (T)-0.5 * yx_; \
     T rw_s_ = (T)1.0 + (T)0.5 * (-ry_s_ * ry_s_ - rz_s_ * rz_s_); \
-    T ln_ = SQRT(p0 * p0 + p1 * p1 + p2 * p2); \
+    T ln_ = (LN); \
     T lp_ = ln_ + p0; \
     T inv_s_ = (T)1.0 / SQRT((T)2.0 * ln_ * lp_); \
     T ch_ = lp_ * inv_s_; \
@@ -531,7 +549,8 @@ SOFTGYM_ALWAYS_INLINE long long softgym_seed_frames_impl(
         double n1 = n1_[li], n2 = n2_[li], n3 = n3_[li], nom = nom_[li], cl = len_[li];
         long long is_sa = all_small ? 1 : sa_[li] != 0.0;
         long long fix = 0;
-        SOFTGYM_CHORD_FRAME(double, long long, sqrt, p0, p1, p2, sa_rad);
+        SOFTGYM_CHORD_FRAME(double, long long, sqrt, p0, p1, p2, sa_rad,
+                            sqrt(p0 * p0 + p1 * p1 + p2 * p2));
         fix |= (1 - is_sa) & (1 - zero) & back;
         double k1 = softgym_rotvec_k_sqrt(rw);
         fix |= (1 - is_sa) & (1 - zero) & softgym_rotvec_needs_acos(rw, thr);
@@ -578,10 +597,13 @@ static int softgym_seed_frames(
    the divider's float rate, on quantities relative to voxel 1 (positions
    stay double; the geometry and mode passes stay double). The frames' float rows
    are a chunk's float scratch (SOFTGYM_CHUNK_FROWS rows); the forces pass
-   leaves floats (rows SOFTGYM_CHUNK_FOUT on), which the scatter widens.
+   leaves floats (rows SOFTGYM_CHUNK_FOUT on), which softgym_seed_push32 turns to
+   the world and adds to the voxels' float rows.
    Reformulated where float would cancel:
    - the displacements p0 - nom and |p| - nom are taken in double (the modes pass
-     leaves the link's mode's one in row 10), then rounded;
+     leaves the link's mode's one in row 10), then rounded; the chord length |p|
+     of the large-angle frame is the geometry's (row 8, double), rounded (one
+     square root fewer on the pass's longest chain of operations);
    - the rotation vector of a unit quaternion (w, v) is k v with the seed's
      k = 2 sqrt((2 - 2w) / (1 - w^2)), which is 2 sqrt(2 / (1 + w)) exactly:
      that form, with no cancellation near w = 1 (the seed's own form loses
@@ -590,19 +612,20 @@ static int softgym_seed_frames(
      lanes for w >= 0.5 (softgym_rotvec_k32_acos).
    Links turned past 120 degrees (w < 0.5) or with a backward chord are redone
    in double by _seed_frame_one, as in double precision. */
-/* k = 2 sqrt(2 / (1 + w)) = 2 sqrt(2) / sqrt(x), x = 1 + w, without the division unit (which
-   bound the pass: each 512-bit float division or square root holds it about 10-12
-   cycles): for w >= 0.5 (the links the pass keeps: x in [1.5, 2]) the minimax cubic's
-   estimate of 1 / sqrt(x) (relative error 1.5e-5) and one Newton step, r + r (1/2 -
-   (x / 2) r^2), its multiply-adds fused where the build has FMA instructions (written out,
-   so that the compiler's loop and the AVX-512 blocks round alike): within 1.2 float
-   roundings of 1 / sqrt(x), k within 2.4 (the square root and division: 1.5). The lanes
-   with w < 0.5 are redone in double (the fix-up) */
-#define SOFTGYM_RSQ_C3 (-0.04495887491657028f)
-#define SOFTGYM_RSQ_C2 0.3299957526995059f
-#define SOFTGYM_RSQ_C1 (-0.9578919498396243f)
-#define SOFTGYM_RSQ_C0 1.6625683559094815f
-#define SOFTGYM_RSQ_K 2.8284271247461903f
+/* k = 2 sqrt(2 / (1 + w)) without the division unit (which bound the pass: each 512-bit
+   float division or square root holds it about 10-12 cycles): for w >= 0.5 (the links the
+   pass keeps) the minimax cubic in w of k itself (relative error 1.5e-5; SOFTGYM_RSQ_D0..D3,
+   fitted by benchmarks/rotvec_fit.py) and one Newton step for 1 / sqrt, e + e (1/2 -
+   ((1 + w) / 16) e^2) (k^2 (1 + w) = 8), the cubic in Estrin's form: the chain from w to k is
+   4 multiply-adds and a product deep (the frames' longest chain runs through it), the
+   multiply-adds fused where the build has FMA instructions (written out, so that the
+   compiler's loop and the AVX-512 blocks round alike): k within 1.7 float roundings (the
+   square root and division: 1.5). The lanes with w < 0.5 are redone in double (the
+   fix-up) */
+#define SOFTGYM_RSQ_D3 (-0.12716345489025116f)
+#define SOFTGYM_RSQ_D2 0.5518827438354492f
+#define SOFTGYM_RSQ_D1 (-1.2240811586380005f)
+#define SOFTGYM_RSQ_D0 2.799332857131958f
 #if defined(__FMA__)
 #define SOFTGYM_FMAF(a, b, c) fmaf((a), (b), (c))
 #else
@@ -610,31 +633,38 @@ static int softgym_seed_frames(
 #endif
 static inline float softgym_rotvec_k32(float w)
 {
-    float x = 1.0f + w, h = 0.5f * x;
-    float e = SOFTGYM_FMAF(SOFTGYM_FMAF(SOFTGYM_FMAF(SOFTGYM_RSQ_C3, x, SOFTGYM_RSQ_C2), x,
-                                        SOFTGYM_RSQ_C1), x, SOFTGYM_RSQ_C0);
-    float y = SOFTGYM_FMAF(e, SOFTGYM_FMAF(-h, e * e, 0.5f), e);
-    return SOFTGYM_RSQ_K * y;
+    float w2 = w * w, x16 = SOFTGYM_FMAF(w, 0.0625f, 0.0625f);
+    float e = SOFTGYM_FMAF(SOFTGYM_FMAF(SOFTGYM_RSQ_D3, w, SOFTGYM_RSQ_D2), w2,
+                           SOFTGYM_FMAF(SOFTGYM_RSQ_D1, w, SOFTGYM_RSQ_D0));
+    float u = SOFTGYM_FMAF(-x16, e * e, 0.5f);
+    return SOFTGYM_FMAF(e, u, e);
 }
 /* k(w) in float for every w >= 0.5: past the seed's acos cut (w <= w_acos)
    its k = 2 acos(w) / sqrt(1 - w^2) is, with z = (1 - w) / 2 and u = sqrt(z),
    (2 / sqrt(1 - z)) (asin(u) / u): the square-root branch's k times asin(u) / u,
    which for z <= 1/4 (w >= 0.5) is single-precision asin's polynomial 1 + z
-   P(z) (Cephes' asinf, good to float rounding). 1 - w is exact there. Below
+   P(z) (Cephes' asinf, good to float rounding; P in Estrin's form, its chain two
+   multiply-adds shorter than Horner's). z = 0.5 - 0.5 w is exact there. Below
    w = 0.5 (rotations past 120 degrees) the link is redone in double. */
+#define SOFTGYM_ASIN_P4 4.2163199048e-2f
+#define SOFTGYM_ASIN_P3 2.4181311049e-2f
+#define SOFTGYM_ASIN_P2 4.5470025998e-2f
+#define SOFTGYM_ASIN_P1 7.4953002686e-2f
+#define SOFTGYM_ASIN_P0 1.6666752422e-1f
 static inline float softgym_rotvec_k32_acos(float w, float w_acos)
 {
-    float z = 0.5f * (1.0f - w);
-    float p = (((4.2163199048e-2f * z + 2.4181311049e-2f) * z + 4.5470025998e-2f) * z
-               + 7.4953002686e-2f) * z + 1.6666752422e-1f;
-    float r = w <= w_acos ? 1.0f + z * p : 1.0f;
+    float z = SOFTGYM_FMAF(-0.5f, w, 0.5f), z2 = z * z;
+    float p = SOFTGYM_FMAF(SOFTGYM_FMAF(SOFTGYM_ASIN_P4, z2, SOFTGYM_FMAF(SOFTGYM_ASIN_P3, z,
+                                                                        SOFTGYM_ASIN_P2)),
+                           z2, SOFTGYM_FMAF(SOFTGYM_ASIN_P1, z, SOFTGYM_ASIN_P0));
+    float r = w <= w_acos ? SOFTGYM_FMAF(z, p, 1.0f) : 1.0f;
     return softgym_rotvec_k32(w) * r;
 }
 SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_impl(
     const int all_small, Py_ssize_t lo, Py_ssize_t hi, float sa_rad, float w_acos,
     const double *p0_, const double *p1_, const double *p2_, const double *qw_,
     const double *n1_, const double *n2_, const double *n3_, const double *P0_,
-    const double *sa_, float *o_P0, float *o_P1, float *o_P2,
+    const double *len_, const double *sa_, float *o_P0, float *o_P1, float *o_P2,
     float *o_a1y, float *o_a1z, float *o_a2x, float *o_a2y, float *o_a2z, float *o_rw,
     float *o_ry, float *o_rz, float *o_fix)
 {
@@ -647,7 +677,7 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_impl(
         float n3 = (float)n3_[li];
         int is_sa = all_small ? 1 : sa_[li] != 0.0;
         int fix = 0;
-        SOFTGYM_CHORD_FRAME(float, int, sqrtf, p0, p1, p2, sa_rad);
+        SOFTGYM_CHORD_FRAME(float, int, sqrtf, p0, p1, p2, sa_rad, (float)len_[li]);
         fix |= (1 - is_sa) & (1 - zero) & back;
         float k1 = softgym_rotvec_k32_acos(rw, w_acos);
         fix |= (1 - is_sa) & (1 - zero) & (rw < 0.5f);
@@ -714,26 +744,28 @@ typedef float softgym_v16f __attribute__((vector_size(64)));
     ((softgym_v16f)_mm512_fnmadd_ps((__m512)(a), (__m512)(b), (__m512)(c)))
 /* softgym_rotvec_k32_acos(w, w_acos) of 16 lanes (softgym_rotvec_k32's operations lane by lane) */
 #define SOFTGYM_F16_ROTVEC_K(w, w_acos, k) do { \
-        softgym_v16f z_ = 0.5f * (1.0f - (w)); \
-        softgym_v16f p_ = (((4.2163199048e-2f * z_ + 2.4181311049e-2f) * z_ \
-                            + 4.5470025998e-2f) * z_ + 7.4953002686e-2f) * z_ \
-                          + 1.6666752422e-1f; \
+        softgym_v16f w2_ = (w) * (w); \
+        softgym_v16f x16_ = SOFTGYM_F16_FMA((w), SOFTGYM_F16_SET(0.0625f), SOFTGYM_F16_SET(0.0625f)); \
+        softgym_v16f e_ = SOFTGYM_F16_FMA( \
+            SOFTGYM_F16_FMA(SOFTGYM_F16_SET(SOFTGYM_RSQ_D3), (w), SOFTGYM_F16_SET(SOFTGYM_RSQ_D2)), \
+            w2_, SOFTGYM_F16_FMA(SOFTGYM_F16_SET(SOFTGYM_RSQ_D1), (w), SOFTGYM_F16_SET(SOFTGYM_RSQ_D0))); \
+        softgym_v16f u_ = SOFTGYM_F16_FNMA(x16_, e_ * e_, SOFTGYM_F16_SET(0.5f)); \
+        softgym_v16f z_ = SOFTGYM_F16_FNMA(SOFTGYM_F16_SET(0.5f), (w), SOFTGYM_F16_SET(0.5f)); \
+        softgym_v16f z2_ = z_ * z_; \
+        softgym_v16f p_ = SOFTGYM_F16_FMA( \
+            SOFTGYM_F16_FMA(SOFTGYM_F16_SET(SOFTGYM_ASIN_P4), z2_, SOFTGYM_F16_FMA( \
+                SOFTGYM_F16_SET(SOFTGYM_ASIN_P3), z_, SOFTGYM_F16_SET(SOFTGYM_ASIN_P2))), \
+            z2_, SOFTGYM_F16_FMA(SOFTGYM_F16_SET(SOFTGYM_ASIN_P1), z_, SOFTGYM_F16_SET(SOFTGYM_ASIN_P0))); \
         softgym_v16f r_ = SOFTGYM_F16_PICK( \
-            SOFTGYM_F16_CMP((w), SOFTGYM_F16_SET(w_acos), _CMP_LE_OQ), 1.0f + z_ * p_, \
-            SOFTGYM_F16_SET(1.0f)); \
-        softgym_v16f x_ = 1.0f + (w), h_ = 0.5f * x_; \
-        softgym_v16f e_ = SOFTGYM_F16_FMA(SOFTGYM_F16_FMA(SOFTGYM_F16_FMA( \
-            SOFTGYM_F16_SET(SOFTGYM_RSQ_C3), x_, SOFTGYM_F16_SET(SOFTGYM_RSQ_C2)), x_, \
-            SOFTGYM_F16_SET(SOFTGYM_RSQ_C1)), x_, SOFTGYM_F16_SET(SOFTGYM_RSQ_C0)); \
-        softgym_v16f y_ = SOFTGYM_F16_FMA(e_, SOFTGYM_F16_FNMA(h_, e_ * e_, SOFTGYM_F16_SET(0.5f)), \
-                                          e_); \
-        k = (SOFTGYM_RSQ_K * y_) * r_; \
+            SOFTGYM_F16_CMP((w), SOFTGYM_F16_SET(w_acos), _CMP_LE_OQ), \
+            SOFTGYM_F16_FMA(z_, p_, SOFTGYM_F16_SET(1.0f)), SOFTGYM_F16_SET(1.0f)); \
+        k = SOFTGYM_F16_FMA(e_, u_, e_) * r_; \
     } while (0)
 SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_x2(
     Py_ssize_t li, float sa_rad, float w_acos, const double *p0_, const double *p1_,
     const double *p2_, const double *qw_, const double *n1_, const double *n2_,
-    const double *n3_, const double *P0_, const double *sa_, float *o_P0, float *o_P1,
-    float *o_P2, float *o_a1y, float *o_a1z, float *o_a2x, float *o_a2y, float *o_a2z,
+    const double *n3_, const double *P0_, const double *len_, const double *sa_, float *o_P0,
+    float *o_P1, float *o_P2, float *o_a1y, float *o_a1z, float *o_a2x, float *o_a2y, float *o_a2z,
     float *o_rw, float *o_ry, float *o_rz, float *o_fix)
 {
     softgym_v16f p0[2], p1[2], p2[2], qw[2], n1[2], n2[2], n3[2];
@@ -752,8 +784,7 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_x2(
                           & SOFTGYM_F16_CMP(p1[k_], nil, _CMP_EQ_OQ)
                           & SOFTGYM_F16_CMP(p2[k_], nil, _CMP_EQ_OQ));
     SOFTGYM_X2(inv_p0[k_] = 1.0f / p0[k_]);
-    SOFTGYM_X2(ln[k_] = (softgym_v16f)_mm512_sqrt_ps((__m512)SOFTGYM_F16_FMA(
-                   p2[k_], p2[k_], SOFTGYM_F16_FMA(p0[k_], p0[k_], p1[k_] * p1[k_]))));
+    SOFTGYM_X2(ln[k_] = SOFTGYM_F16_LOAD(len_ + SOFTGYM_L));
     SOFTGYM_X2(yx[k_] = p1[k_] * inv_p0[k_]);
     SOFTGYM_X2(zx[k_] = p2[k_] * inv_p0[k_]);
     SOFTGYM_X2(lp[k_] = ln[k_] + p0[k_]);
@@ -822,8 +853,8 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_x2(
 #define SOFTGYM_F16_LANES 0
 #endif
 /* the frames pass in float: rows in as softgym_seed_frames, but the axial displacement P0
-   from row 10 (softgym_seed_modes leaves it) instead of rows 7 and 8, float rows out (row k
-   at f + k SOFTGYM_CHUNK_FSTRIDE, indexed by link); returns whether any link got fix = 1 */
+   from row 10 (softgym_seed_modes leaves it) instead of row 7, float rows out (row k at f +
+   k SOFTGYM_CHUNK_FSTRIDE, indexed by link); returns whether any link got fix = 1 */
 static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, float sa_rad,
                                  float w_acos, const double *o, float *f)
 {
@@ -832,7 +863,7 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
     const int all_small = softgym_all_nonzero(sa_, lo, hi);
 #define SOFTGYM_FRAMES32(s) softgym_seed_frames32_impl( \
             s, lo, hi, sa_rad, w_acos, o, o + n, o + 2 * n, o + 3 * n, o + 4 * n, o + 5 * n, \
-            o + 6 * n, o + 10 * n, sa_, f, f + fs, f + 2 * fs, f + 3 * fs, \
+            o + 6 * n, o + 10 * n, o + 8 * n, sa_, f, f + fs, f + 2 * fs, f + 3 * fs, \
             f + 4 * fs, f + 5 * fs, f + 6 * fs, f + 7 * fs, f + 8 * fs, f + 9 * fs, \
             f + 10 * fs, f + 11 * fs)
     int any_fix = 0;
@@ -845,7 +876,7 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
         for (; lo + 32 <= hi; lo += 32)
             any_fix |= softgym_seed_frames32_x2(
                 lo, sa_rad, w_acos, o, o + n, o + 2 * n, o + 3 * n, o + 4 * n, o + 5 * n,
-                o + 6 * n, o + 10 * n, sa_, f, f + fs, f + 2 * fs, f + 3 * fs, f + 4 * fs,
+                o + 6 * n, o + 10 * n, o + 8 * n, sa_, f, f + fs, f + 2 * fs, f + 3 * fs, f + 4 * fs,
                 f + 5 * fs, f + 6 * fs, f + 7 * fs, f + 8 * fs, f + 9 * fs, f + 10 * fs,
                 f + 11 * fs);
 #endif
@@ -1077,7 +1108,6 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
 #undef SOFTGYM_F16_DAMP
 #undef SOFTGYM_F16_FNMS
 #undef SOFTGYM_F16_FMS
-#undef SOFTGYM_F16_NONZERO
 #undef SOFTGYM_F16_ROW
 #endif
 #define SOFTGYM_FT float
@@ -1169,15 +1199,15 @@ static Py_ssize_t softgym_seed_geom_modes(int ax, Py_ssize_t lo, Py_ssize_t hi, 
                                           Py_ssize_t vend, const double *pos,
                                           const double *quat, const double *vr, Py_ssize_t vn,
                                           const double *scale, double *o, double *rr,
-                                          const softgym_modes_args *m)
+                                          float *rf, const softgym_modes_args *m)
 {
 #if SOFTGYM_MODES8
     long long bad = 0;
     SOFTGYM_BY_AXIS(ax, softgym_seed_geom_ax, lo, hi, n, v1, v2, vend, pos, quat, vr, vn, scale,
-                    o, rr, m, &bad);
+                    o, rr, rf, m, &bad);
     return softgym_seed_modes_end(lo, hi, n, m->max_ext, bad, m->link_sa, o);
 #else
-    softgym_seed_geom(ax, lo, hi, n, v1, v2, vend, pos, quat, vr, vn, scale, o, rr);
+    softgym_seed_geom(ax, lo, hi, n, v1, v2, vend, pos, quat, vr, vn, scale, o, rr, rf);
     return softgym_seed_modes(lo, hi, n, m->max_ext, m->sa_w, m->sah_w, m->st_in, m->ex_in,
                               m->st_out, m->ex_out, m->link_sa, m->homog, o);
 #endif
@@ -1233,8 +1263,8 @@ typedef long long softgym_v4i __attribute__((vector_size(32)));
     } while (0)
 #endif
 /* row k of the link's forces and moments: the forces pass's doubles (o, SOFTGYM_CHUNK_STRIDE
-   apart), or (f32) its floats (of, SOFTGYM_CHUNK_FSTRIDE apart) widened: the same value */
-#define SOFTGYM_SQ(k) (f32 ? (double)qf[(k) * SOFTGYM_CHUNK_FSTRIDE] : q[(k) * n])
+   apart) */
+#define SOFTGYM_SQ(k) (q[(k) * n])
 #define SOFTGYM_SCATTER_TURN(acc, x, y, z) do { \
         SOFTGYM_SCATTER_W(x, y, z); \
         SOFTGYM_SCATTER_ACC(acc, +=); \
@@ -1250,15 +1280,14 @@ typedef long long softgym_v4i __attribute__((vector_size(32)));
             SOFTGYM_SCATTER_TURN(fj, x, y, z); \
         } \
     } while (0)
-SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_links(const int ax, const int f32, Py_ssize_t lo,
+SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_links(const int ax, Py_ssize_t lo,
                                                       Py_ssize_t hi, const Py_ssize_t *v1,
                                                       const Py_ssize_t *v2, const double *rot,
-                                                      const double *o, const float *of,
+                                                      const double *o,
                                                       const double *neg2_row, double *force,
                                                       double *moment)
 {
     const Py_ssize_t n = SOFTGYM_CHUNK_STRIDE;
-    (void)of;
     Py_ssize_t li;
 #if defined(SOFTGYM_SCATTER_V4)
     /* voxel 2's rows after the last link, kept in registers: where a link's
@@ -1303,7 +1332,6 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_links(const int ax, const int f3
         double w[3];
 #endif
         const double *q = o + li;
-        const float *qf = f32 ? of + li : 0;
         /* neg2_row (row 23 of the scratch) holds exactly 1.0 or 0.0 (the modes pass): its
            bits, one integer test (a double's != 0.0 is two branches, for NaN) */
         unsigned long long neg2_bits;
@@ -1395,19 +1423,15 @@ SOFTGYM_ALWAYS_INLINE void softgym_turn8(const int ax, const softgym_v8 *R, cons
    moment, force being the rows' start), link after link: each voxel's sum in the same
    order. Where voxel 2 takes -F1 (neg2_row), its force is the turn of -F1: exactly minus
    F1's, and adding it is subtracting F1's */
-SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter8(const int ax, const int f32, Py_ssize_t li,
+SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter8(const int ax, Py_ssize_t li,
                                                  const Py_ssize_t *v1, const Py_ssize_t *v2,
-                                                 const double *o, const float *of,
-                                                 const double *neg2_row, double *force)
+                                                 const double *o, const double *neg2_row,
+                                                 double *force)
 {
     const Py_ssize_t n = SOFTGYM_CHUNK_STRIDE;
     const double *q = o + li;
-    const float *qf = f32 ? of + li : 0;
-    (void)qf;
-    /* row k of the 8 links' forces and moments (softgym_seed_scatter_links's SOFTGYM_SQ):
-       the floats widened by the load (vcvtps2pd from memory: no shuffle of their own) */
-#define SOFTGYM_SQ8(k) (f32 ? (softgym_v8)_mm512_cvtps_pd(_mm256_loadu_ps(qf + (k) * SOFTGYM_CHUNK_FSTRIDE)) \
-                            : softgym_v8_load(q + (k) * n))
+    /* row k of the 8 links' forces and moments (softgym_seed_scatter_links's SOFTGYM_SQ) */
+#define SOFTGYM_SQ8(k) (softgym_v8_load(q + (k) * n))
     softgym_v8 R[9], a[3], b[3];
     for (int k = 0; k < 9; k++)
         R[k] = softgym_v8_load(q + (SOFTGYM_SEED_R_ROWS + k) * n);
@@ -1449,10 +1473,9 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter8(const int ax, const int f32, Py
 #endif
 /* links lo..hi along ax: blocks of 8 whose rows start on a cache line through
    softgym_seed_scatter8 (with AVX-512), the others link by link */
-SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, const int f32, Py_ssize_t lo,
-                                                   Py_ssize_t hi, const Py_ssize_t *v1,
-                                                   const Py_ssize_t *v2, const double *rot,
-                                                   const double *o, const float *of,
+SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
+                                                   const Py_ssize_t *v1, const Py_ssize_t *v2,
+                                                   const double *rot, const double *o,
                                                    const double *neg2_row, double *force,
                                                    double *moment)
 {
@@ -1461,29 +1484,238 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_scatter_ax(const int ax, const int f32, 
     while (al < hi && ((uintptr_t)(o + al) & 63) != 0)
         al++;
     if (al + 8 <= hi) {
-        softgym_seed_scatter_links(ax, f32, lo, al, v1, v2, rot, o, of, neg2_row, force,
-                                   moment);
+        softgym_seed_scatter_links(ax, lo, al, v1, v2, rot, o, neg2_row, force, moment);
         for (lo = al; lo + 8 <= hi; lo += 8)
-            softgym_seed_scatter8(ax, f32, lo, v1, v2, o, of, neg2_row, force);
+            softgym_seed_scatter8(ax, lo, v1, v2, o, neg2_row, force);
     }
 #endif
-    softgym_seed_scatter_links(ax, f32, lo, hi, v1, v2, rot, o, of, neg2_row, force, moment);
+    softgym_seed_scatter_links(ax, lo, hi, v1, v2, rot, o, neg2_row, force, moment);
 }
 
-/* of: NULL, the forces and moments in the double rows 0-11 of o (link_precision "double"),
-   else the single-precision forces pass's float rows (indexed by link, SOFTGYM_CHUNK_FSTRIDE
-   apart) */
+/* the double-precision links' forces and moments (the double rows 0-11 of o, indexed by
+   link) back to the world and into the voxels' rows of force and moment (the
+   single-precision links' go through softgym_seed_push32) */
 static void softgym_seed_scatter(int ax, Py_ssize_t lo, Py_ssize_t hi, const Py_ssize_t *v1,
                                  const Py_ssize_t *v2, const double *rot, const double *o,
-                                 const float *of, const double *neg2_row, double *force,
-                                 double *moment)
+                                 const double *neg2_row, double *force, double *moment)
 {
-    if (of)
-        SOFTGYM_BY_AXIS(ax, softgym_seed_scatter_ax, 1, lo, hi, v1, v2, rot, o, of, neg2_row,
-                        force, moment);
-    else
-        SOFTGYM_BY_AXIS(ax, softgym_seed_scatter_ax, 0, lo, hi, v1, v2, rot, o, of, neg2_row,
-                        force, moment);
+    SOFTGYM_BY_AXIS(ax, softgym_seed_scatter_ax, lo, hi, v1, v2, rot, o, neg2_row, force, moment);
 }
+
+/* The single-precision links' last pass (link_precision "single"): the forces pass's float
+   forces and moments turned to the world in float and added to the voxels' float rows
+   (Batch.link_f: row k at lf + k lfs, k = 0-5 the force's x, y, z and the moment's, indexed
+   by voxel), which the voxel update widens to doubles. The links of a chunk's axis run go
+   in blocks of 16 from its start, and in each block every link's voxel 1 takes its f1 and
+   m1, then every link's voxel 2 its f2 (or -f1 where neg2_row) and m2: within one block's
+   side a voxel takes at most one link (a link joins a voxel to its neighbour along the
+   axis), so the order of the links inside it does not matter and any grouping of them into
+   vector lanes gives the same sums, bit for bit; the blocks, the sides' order and the
+   chunks (SOFTGYM_CHUNK_LINKS from the robot's first link) fix the order of each voxel's
+   additions in every build. The turn R1 P^T v (P^T and the first column's sign as in
+   softgym_seed_scatter_links) with its multiply-adds written out (component c is
+   fma(R[3c+2], z, fma(R[3c+1], y, R[3c] x))), so the scalar loop and the AVX-512 blocks
+   round alike; R1 is voxel 1's rotation matrix rounded to float: the geometry's float rows
+   (rf, SOFTGYM_CHUNK_FR, indexed by link) or the voxels' matrices (rot). Where the double
+   scatter transposed each link's turned vectors into its voxels' rows of 8 (a third of its
+   operations shuffles) and widened the forces to doubles, a block here turns 16 links in
+   the lanes and adds them to the voxels' rows in windows of 16 voxels (softgym_push16). */
+#define SOFTGYM_TURN32(R, x, y, z, c) \
+    SOFTGYM_FMAF((R)[3 * (c) + 2], (z), SOFTGYM_FMAF((R)[3 * (c) + 1], (y), (R)[3 * (c)] * (x)))
+/* one side (1: voxel 1's f1 and m1; 2: voxel 2's f2 or -f1, and m2) of links lo..hi, link
+   by link */
+SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_links(const int ax, const int side, Py_ssize_t lo,
+                                                     Py_ssize_t hi, const Py_ssize_t *v1,
+                                                     const Py_ssize_t *v2, const double *rot,
+                                                     const float *rf, const float *of,
+                                                     const double *neg2_row, float *lf,
+                                                     Py_ssize_t lfs)
+{
+    for (Py_ssize_t li = lo; li < hi; li++) {
+        Py_ssize_t i = v1[li], j = side == 1 ? i : v2[li];
+        float R[9];
+        if (rf) {
+            for (int k = 0; k < 9; k++)
+                R[k] = rf[k * SOFTGYM_CHUNK_FSTRIDE + li];
+        } else {
+            for (int k = 0; k < 9; k++)
+                R[k] = (float)rot[9 * i + k];
+        }
+        if (ax != 0) {
+            R[0] = -R[0];
+            R[3] = -R[3];
+            R[6] = -R[6];
+        }
+        /* row k of the link's float forces and moments (SOFTGYM_CHUNK_FSTRIDE apart) */
+        const float *q = of + li;
+        float a[3], m[3];
+        for (int c = 0; c < 3; c++) {
+            if (side == 1)
+                a[c] = q[c * SOFTGYM_CHUNK_FSTRIDE];
+            else
+                a[c] = neg2_row[li] != 0.0 ? -q[c * SOFTGYM_CHUNK_FSTRIDE]
+                                           : q[(3 + c) * SOFTGYM_CHUNK_FSTRIDE];
+            m[c] = q[((side == 1 ? 6 : 9) + c) * SOFTGYM_CHUNK_FSTRIDE];
+        }
+        float x = a[ax], y = ax == 1 ? a[0] : a[1], z = ax == 2 ? a[0] : a[2];
+        float mx = m[ax], my = ax == 1 ? m[0] : m[1], mz = ax == 2 ? m[0] : m[2];
+        for (int c = 0; c < 3; c++) {
+            lf[c * lfs + j] += SOFTGYM_TURN32(R, x, y, z, c);
+            lf[(3 + c) * lfs + j] += SOFTGYM_TURN32(R, mx, my, mz, c);
+        }
+    }
+}
+#if defined(__AVX512F__) && SOFTGYM_SEED_R_USED && (defined(__GNUC__) || defined(__clang__))
+#define SOFTGYM_PUSH16 1
+/* w[0..5] (the turned force and moment components of the links in the lanes `lanes`, the
+   first n = popcount(lanes) of 16) added to the float rows of their voxels idx[0..n-1]
+   (distinct, ascending): 16 consecutive voxels in one read-add-write a row; else in
+   windows of 16 voxels that start on a row's cache line (lf's rows start on lines, lfs a
+   multiple of 16): a window's lanes are the links' lanes permuted to their voxels (the
+   inverse of the links' places, by an expand of their lane numbers), zero where no link of
+   the block has its voxel, and the window's row takes one aligned read-add-write (a sum of
+   floats that starts at +0.0 is never -0.0, so adding +0.0 leaves it as it is). A window's
+   read meets the stores before it whole or not at all (a read that overlaps part of a
+   store in flight waits for it to reach the cache: adding each run of voxels through
+   masked unaligned stores took twice as long). Returns 0 (nothing added) where the voxels
+   span more than 3 windows or are not strictly ascending (the layout's links along an
+   axis are, by voxel; a guard, never taken by a lattice's links) */
+SOFTGYM_ALWAYS_INLINE int softgym_push16(const softgym_v16f *w, const Py_ssize_t *idx,
+                                         __mmask16 lanes, float *lf, Py_ssize_t lfs)
+{
+    const int n = __builtin_popcount((unsigned int)lanes);
+    if (n == 16 && idx[15] - idx[0] == 15) {
+        float *p = lf + idx[0];
+        for (int k = 0; k < 6; k++)
+            _mm512_storeu_ps(p + k * lfs,
+                             _mm512_add_ps(_mm512_loadu_ps(p + k * lfs), (__m512)w[k]));
+        return 1;
+    }
+    Py_ssize_t base = idx[0] - (Py_ssize_t)(((uintptr_t)(lf + idx[0]) & 63) / sizeof(float));
+    if (idx[n - 1] - base >= 48)
+        return 0;
+    const __m512i vb = _mm512_set1_epi64((long long)base), one = _mm512_set1_epi64(1);
+    const __mmask8 la = (__mmask8)lanes, lb = (__mmask8)(lanes >> 8);
+    __m512i a = _mm512_sub_epi64(_mm512_maskz_loadu_epi64(la, (const void *)idx), vb);
+    __m512i b = _mm512_sub_epi64(_mm512_maskz_loadu_epi64(lb, (const void *)(idx + 8)), vb);
+    /* each lane above its left neighbour (lane 0 against itself: left out) */
+    unsigned int up = ((unsigned int)_mm512_cmpgt_epi64_mask(b, _mm512_alignr_epi64(b, a, 7)) << 8)
+                      | (unsigned int)_mm512_cmpgt_epi64_mask(a, _mm512_alignr_epi64(a, a, 7));
+    if (((up | 1u) & (unsigned int)lanes) != (unsigned int)lanes)
+        return 0;
+    unsigned long long mask = (unsigned long long)_mm512_reduce_or_epi64(_mm512_or_si512(
+        _mm512_maskz_sllv_epi64(la, one, a), _mm512_maskz_sllv_epi64(lb, one, b)));
+    const __m512i iota = _mm512_set_epi32(15, 14, 13, 12, 11, 10, 9, 8, 7, 6, 5, 4, 3, 2, 1, 0);
+    int before = 0;
+    for (int win = 0; win < 3; win++) {
+        __mmask16 m = (__mmask16)(mask >> (16 * win));
+        if (m == 0)
+            break;
+        __m512i inv = _mm512_maskz_expand_epi32(
+            m, _mm512_add_epi32(iota, _mm512_set1_epi32(before)));
+        before += __builtin_popcount((unsigned int)m);
+        float *p = lf + base + 16 * win;
+        for (int k = 0; k < 6; k++)
+            _mm512_store_ps(p + k * lfs,
+                            _mm512_add_ps(_mm512_load_ps(p + k * lfs),
+                                          _mm512_maskz_permutexvar_ps(m, inv, (__m512)w[k])));
+    }
+    return 1;
+}
+/* (x, y, z) of the bond frame turned to the world: w[c] for c = 0..2 (softgym_turn8's
+   order, in float) */
+#define SOFTGYM_TURN16(R, x, y, z, w) do { \
+        for (int c_ = 0; c_ < 3; c_++) \
+            (w)[c_] = SOFTGYM_F16_FMA((R)[3 * c_ + 2], (z), \
+                                      SOFTGYM_F16_FMA((R)[3 * c_ + 1], (y), (R)[3 * c_] * (x))); \
+    } while (0)
+/* the block of links li..li + 15 in the lanes `lanes` (all 16, or the first few: a run's
+   last block: full 0, the other lanes' loads masked off), both sides, in the lanes of
+   AVX-512 (rf: the geometry's float rows); a side whose voxels softgym_push16 leaves goes
+   link by link */
+SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_16(const int ax, const int full, Py_ssize_t li,
+                                                  __mmask16 lanes,
+                                                  const Py_ssize_t *v1, const Py_ssize_t *v2,
+                                                  const double *rot, const float *rf,
+                                                  const float *of, const double *neg2_row,
+                                                  float *lf, Py_ssize_t lfs)
+{
+    const float *q = of + li;
+    softgym_v16f R[9], a[3], m[3], w[6];
+#define SOFTGYM_LOAD16(p) \
+    ((softgym_v16f)(full ? _mm512_loadu_ps(p) : _mm512_maskz_loadu_ps(lanes, (p))))
+    for (int k = 0; k < 9; k++)
+        R[k] = SOFTGYM_LOAD16(rf + k * SOFTGYM_CHUNK_FSTRIDE + li);
+    if (ax != 0) {
+        R[0] = -R[0];
+        R[3] = -R[3];
+        R[6] = -R[6];
+    }
+    const Py_ssize_t hi = li + __builtin_popcount((unsigned int)lanes);
+    for (int c = 0; c < 3; c++) {
+        a[c] = SOFTGYM_LOAD16(q + c * SOFTGYM_CHUNK_FSTRIDE);
+        m[c] = SOFTGYM_LOAD16(q + (6 + c) * SOFTGYM_CHUNK_FSTRIDE);
+    }
+    SOFTGYM_TURN16(R, a[ax], ax == 1 ? a[0] : a[1], ax == 2 ? a[0] : a[2], w);
+    SOFTGYM_TURN16(R, m[ax], ax == 1 ? m[0] : m[1], ax == 2 ? m[0] : m[2], w + 3);
+    if (!softgym_push16(w, v1 + li, lanes, lf, lfs))
+        softgym_seed_push32_links(ax, 1, li, hi, v1, v2, rot, rf, of, neg2_row, lf, lfs);
+    /* voxel 2: -F1 in the lanes whose row 23 is not 0.0 (1.0: it takes -F1) */
+    __mmask16 neg2 = _mm512_kunpackb(
+        _mm512_cmp_pd_mask(full ? _mm512_loadu_pd(neg2_row + li + 8)
+                                : _mm512_maskz_loadu_pd((__mmask8)(lanes >> 8), neg2_row + li + 8),
+                           _mm512_setzero_pd(), _CMP_NEQ_UQ),
+        _mm512_cmp_pd_mask(full ? _mm512_loadu_pd(neg2_row + li)
+                                : _mm512_maskz_loadu_pd((__mmask8)lanes, neg2_row + li),
+                           _mm512_setzero_pd(), _CMP_NEQ_UQ));
+    for (int c = 0; c < 3; c++) {
+        a[c] = SOFTGYM_F16_PICK(neg2, -a[c], SOFTGYM_LOAD16(q + (3 + c) * SOFTGYM_CHUNK_FSTRIDE));
+        m[c] = SOFTGYM_LOAD16(q + (9 + c) * SOFTGYM_CHUNK_FSTRIDE);
+    }
+#undef SOFTGYM_LOAD16
+    SOFTGYM_TURN16(R, a[ax], ax == 1 ? a[0] : a[1], ax == 2 ? a[0] : a[2], w);
+    SOFTGYM_TURN16(R, m[ax], ax == 1 ? m[0] : m[1], ax == 2 ? m[0] : m[2], w + 3);
+    if (!softgym_push16(w, v2 + li, lanes, lf, lfs))
+        softgym_seed_push32_links(ax, 2, li, hi, v1, v2, rot, rf, of, neg2_row, lf, lfs);
+}
+#undef SOFTGYM_TURN16
+#endif
+SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
+                                                  const Py_ssize_t *v1, const Py_ssize_t *v2,
+                                                  const double *rot, const float *rf,
+                                                  const float *of, const double *neg2_row,
+                                                  float *lf, Py_ssize_t lfs)
+{
+    for (Py_ssize_t li = lo; li < hi; li += 16) {
+        Py_ssize_t e = hi - li < 16 ? hi : li + 16;
+#if defined(SOFTGYM_PUSH16)
+        if (rf) {
+            if (e - li == 16)
+                softgym_seed_push32_16(ax, 1, li, (__mmask16)0xFFFF, v1, v2, rot, rf, of,
+                                       neg2_row, lf, lfs);
+            else
+                softgym_seed_push32_16(ax, 0, li, (__mmask16)((1u << (e - li)) - 1u), v1, v2,
+                                       rot, rf, of, neg2_row, lf, lfs);
+            continue;
+        }
+#endif
+        softgym_seed_push32_links(ax, 1, li, e, v1, v2, rot, rf, of, neg2_row, lf, lfs);
+        softgym_seed_push32_links(ax, 2, li, e, v1, v2, rot, rf, of, neg2_row, lf, lfs);
+    }
+}
+/* links lo..hi along ax (one chunk's run): of, the float forces pass's rows (indexed by
+   link); rf, the geometry's float rotation rows (indexed by link) or NULL (then rot, the
+   voxels' matrices, rounded) */
+static void softgym_seed_push32(int ax, Py_ssize_t lo, Py_ssize_t hi, const Py_ssize_t *v1,
+                                const Py_ssize_t *v2, const double *rot, const float *rf,
+                                const float *of, const double *neg2_row, float *lf,
+                                Py_ssize_t lfs)
+{
+    SOFTGYM_BY_AXIS(ax, softgym_seed_push32_ax, lo, hi, v1, v2, rot, rf, of, neg2_row, lf, lfs);
+}
+#undef SOFTGYM_TURN32
+#if defined(SOFTGYM_F16_NONZERO)
+#undef SOFTGYM_F16_NONZERO
+#endif
 
 #endif  /* SOFTGYM_SEED_H */

@@ -31,11 +31,12 @@
     const double *inv_inertia, const double *rot_damp, const double *scale, \
     const double *k_floor, const double *c_floor, const double *mu_s, const double *mu_k, \
     const signed char *fixed, const double *ref, double *c, int track_speed, \
-    double runaway, double *dmax, double *vmax2, double *rows, Py_ssize_t rn
+    double runaway, double *dmax, double *vmax2, double *rows, Py_ssize_t rn, float *lf, \
+    Py_ssize_t lfs
 
 #define SOFTGYM_VOXELS8_ARGS i, vs, dt, g, has_floor, force, moment, c_global, mass, \
     inv_mass, inv_inertia, rot_damp, scale, k_floor, c_floor, mu_s, mu_k, fixed, ref, c, \
-    track_speed, runaway, dmax, vmax2, rows, rn
+    track_speed, runaway, dmax, vmax2, rows, rn, lf, lfs
 
 #if defined(__AVX512F__) && (defined(__GNUC__) || defined(__clang__))
 #define SOFTGYM_VOXELS8 1
@@ -47,6 +48,21 @@
 #define SOFTGYM_V8_EQ(a, b) _mm512_cmp_pd_mask((__m512d)(a), (__m512d)(b), _CMP_EQ_OQ)
 
 
+/* the force (a = force + SOFTGYM_FM_STRIDE i) or moment columns of voxels i..i+7 as rows
+   x, y, z (softgym_v8_load4_fm), or with lf (single-precision links: Batch.link_f, its
+   force's or moment's three rows lfs apart) those rows' floats widened (exactly) */
+SOFTGYM_ALWAYS_INLINE void softgym_v8_forces(const double *a, const float *lf, Py_ssize_t lfs,
+                                             Py_ssize_t i, softgym_v8 *x, softgym_v8 *y,
+                                             softgym_v8 *z)
+{
+    if (lf) {
+        *x = (softgym_v8)_mm512_cvtps_pd(_mm256_loadu_ps(lf + i));
+        *y = (softgym_v8)_mm512_cvtps_pd(_mm256_loadu_ps(lf + lfs + i));
+        *z = (softgym_v8)_mm512_cvtps_pd(_mm256_loadu_ps(lf + 2 * lfs + i));
+    } else {
+        softgym_v8_load4_fm(a, x, y, z);
+    }
+}
 /* rows k, k + 1, k + 2 of the voxel rows (rn apart) at voxel i, as three vectors */
 #define SOFTGYM_V8_ROWS3(k, a, b, c) do { \
         a = softgym_v8_load(rows + (k) * rn + i); \
@@ -69,7 +85,7 @@
     SOFTGYM_V8_ROWS3(SOFTGYM_ROW_VEL, v0, v1, v2); \
     SOFTGYM_V8_ROWS3(SOFTGYM_ROW_EXT, E0, E1, E2); \
     SOFTGYM_V8_ROWS3(SOFTGYM_ROW_POS, p0, p1, p2); \
-    softgym_v8_load4_fm(force + SOFTGYM_FM_STRIDE * i, &F0, &F1, &F2); \
+    softgym_v8_forces(force + SOFTGYM_FM_STRIDE * i, lf, lfs, i, &F0, &F1, &F2); \
     softgym_v8 cg = softgym_v8_load(c_global + i), m = softgym_v8_load(mass + i)
 
 /* the largest lane of v above *best, as the scalar loop's "if v > best": the lanes'
@@ -93,7 +109,8 @@ SOFTGYM_ALWAYS_INLINE int softgym_v8_finish(SOFTGYM_VOXELS8_PARAMS,
                                     softgym_v8 f0, softgym_v8 f1, softgym_v8 f2)
 {
     softgym_v8 M0, M1, M2;
-    softgym_v8_load4_fm(moment + SOFTGYM_FM_STRIDE * i, &M0, &M1, &M2);
+    softgym_v8_forces(moment + SOFTGYM_FM_STRIDE * i, lf ? lf + 3 * lfs : lf, lfs, i, &M0, &M1,
+                      &M2);
     softgym_v8 h = dt * softgym_v8_load(inv_mass + i);
     softgym_v8 vx = v0 + (f0 * h), vy = v1 + (f1 * h), vz = v2 + (f2 * h);
     softgym_v8 px = p0 + (vx * dt), py = p1 + (vy * dt), pz = p2 + (vz * dt);
@@ -106,8 +123,13 @@ SOFTGYM_ALWAYS_INLINE int softgym_v8_finish(SOFTGYM_VOXELS8_PARAMS,
     /* the 8 voxels' force and moment rows, padding included: one aligned 64-byte store a
        row (a memset of the 512 bytes compiled to `rep stos`, whose start-up took a sixth
        of the voxel update on an Intel Xeon) */
-    for (int k = 0; k < 8; k++)
-        _mm512_store_pd(force + SOFTGYM_FM_STRIDE * (i + k), _mm512_setzero_pd());
+    if (lf) {
+        for (int k = 0; k < 6; k++)
+            _mm256_storeu_ps(lf + k * lfs + i, _mm256_setzero_ps());
+    } else {
+        for (int k = 0; k < 8; k++)
+            _mm512_store_pd(force + SOFTGYM_FM_STRIDE * (i + k), _mm512_setzero_pd());
+    }
     if (ref != NULL) {
         softgym_v8 r0, r1, r2;
         softgym_v8_load3(ref + 3 * (i - vs), &r0, &r1, &r2);
