@@ -589,108 +589,108 @@ cdef int _obstacle_pairs(Batch* b, intp_t r, Contacts* c, float64_t horizon) noe
     return STATUS_OK
 
 
+cdef inline float64_t _pair_law(Batch* b, intp_t i, intp_t j, float64_t* d) noexcept nogil:
+    # the contact law of voxels i and j (d: p_j - p_i): the force on j is fmag d, on i
+    # -fmag d; fmag 0 where their envelopes do not overlap (or they coincide)
+    cdef float64_t d2, env, dist, kk
+    d[0] = voxel_pos(b, j, 0) - voxel_pos(b, i, 0)
+    d[1] = voxel_pos(b, j, 1) - voxel_pos(b, i, 1)
+    d[2] = voxel_pos(b, j, 2) - voxel_pos(b, i, 2)
+    d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+    env = 0.75 * (b.scale[i] + b.scale[j])
+    if d2 >= env * env or d2 == 0.0:
+        return 0.0
+    dist = sqrt(d2)
+    # E_h L = harmonic mean of the voxels' E L = k1 k2 / (k1 + k2), k = 2 E L
+    kk = b.k_floor[i] * b.k_floor[j] / (b.k_floor[i] + b.k_floor[j])
+    return kk * (env - dist) / dist
+
+
+cdef inline float64_t _obstacle_law(Batch* b, intp_t i, intp_t m, float64_t* d) noexcept nogil:
+    # the contact law of voxel i and obstacle voxel m (d: p_i - p_m): the force on i is
+    # fmag d (the obstacle is fixed and takes none); fmag 0 where they do not touch
+    cdef float64_t d2, env, dist, kk
+    d[0] = voxel_pos(b, i, 0) - b.obs[4 * m]
+    d[1] = voxel_pos(b, i, 1) - b.obs[4 * m + 1]
+    d[2] = voxel_pos(b, i, 2) - b.obs[4 * m + 2]
+    d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+    env = 0.75 * (b.scale[i] + b.L)
+    if d2 >= env * env or d2 == 0.0:
+        return 0.0
+    dist = sqrt(d2)
+    kk = b.k_floor[i] * b.obs[4 * m + 3] / (b.k_floor[i] + b.obs[4 * m + 3])
+    return kk * (env - dist) / dist
+
+
 cdef void _contacts32(Batch* b, Contacts* c, int obstacles) noexcept nogil:
     # collide (obstacles 0) or collide_obstacles (1) with single-precision links: the same
     # contact forces, rounded to float and added to the voxels' float rows of link forces
     # (b.link_f, which the voxel update reads instead of b.force; loops of their own, so
     # that the double loops' products and sums fuse as they did)
     cdef:
-        intp_t k, i, j, m, s = b.link_fs
-        float64_t dx, dy, dz, d2, env, dist, kk, fmag
-        float fx, fy, fz
+        intp_t k, i, j, s = b.link_fs
+        float64_t fmag
+        float64_t d[3]
+        float f[3]
         float* lf = b.link_f
+        int a
     for k in range(0 if obstacles else c.n_pairs):
         i = c.pairs[2 * k]
         j = c.pairs[2 * k + 1]
-        dx = voxel_pos(b, j, 0) - voxel_pos(b, i, 0)
-        dy = voxel_pos(b, j, 1) - voxel_pos(b, i, 1)
-        dz = voxel_pos(b, j, 2) - voxel_pos(b, i, 2)
-        d2 = dx * dx + dy * dy + dz * dz
-        env = 0.75 * (b.scale[i] + b.scale[j])
-        if d2 >= env * env or d2 == 0.0:
+        fmag = _pair_law(b, i, j, d)
+        if fmag == 0.0:
             continue
-        dist = sqrt(d2)
-        kk = b.k_floor[i] * b.k_floor[j] / (b.k_floor[i] + b.k_floor[j])
-        fmag = kk * (env - dist) / dist
-        fx = <float> (fmag * dx)
-        fy = <float> (fmag * dy)
-        fz = <float> (fmag * dz)
-        lf[j] += fx
-        lf[s + j] += fy
-        lf[2 * s + j] += fz
-        lf[i] -= fx
-        lf[s + i] -= fy
-        lf[2 * s + i] -= fz
+        for a in range(3):
+            f[a] = <float> (fmag * d[a])
+            lf[a * s + j] += f[a]
+            lf[a * s + i] -= f[a]
     for k in range(c.n_opairs if obstacles else 0):
         i = c.opairs[2 * k]
-        m = c.opairs[2 * k + 1]
-        dx = voxel_pos(b, i, 0) - b.obs[4 * m]
-        dy = voxel_pos(b, i, 1) - b.obs[4 * m + 1]
-        dz = voxel_pos(b, i, 2) - b.obs[4 * m + 2]
-        d2 = dx * dx + dy * dy + dz * dz
-        env = 0.75 * (b.scale[i] + b.L)
-        if d2 >= env * env or d2 == 0.0:
+        fmag = _obstacle_law(b, i, c.opairs[2 * k + 1], d)
+        if fmag == 0.0:
             continue
-        dist = sqrt(d2)
-        kk = b.k_floor[i] * b.obs[4 * m + 3] / (b.k_floor[i] + b.obs[4 * m + 3])
-        fmag = kk * (env - dist) / dist
-        lf[i] += <float> (fmag * dx)
-        lf[s + i] += <float> (fmag * dy)
-        lf[2 * s + i] += <float> (fmag * dz)
+        for a in range(3):
+            lf[a * s + i] += <float> (fmag * d[a])
 
 
 cdef void collide_obstacles(Batch* b, Contacts* c) noexcept nogil:
     # OUT (accumulated): force on the voxels touching an obstacle voxel (the
     # seed's contact law; the obstacle is fixed and takes no force)
     cdef:
-        intp_t k, i, m
-        float64_t dx, dy, dz, d2, env, dist, kk, fmag
+        intp_t k, i
+        float64_t fmag
+        float64_t d[3]
     if b.link_f != NULL:
         _contacts32(b, c, 1)
         return
     for k in range(c.n_opairs):
         i = c.opairs[2 * k]
-        m = c.opairs[2 * k + 1]
-        dx = voxel_pos(b, i, 0) - b.obs[4 * m]
-        dy = voxel_pos(b, i, 1) - b.obs[4 * m + 1]
-        dz = voxel_pos(b, i, 2) - b.obs[4 * m + 2]
-        d2 = dx * dx + dy * dy + dz * dz
-        env = 0.75 * (b.scale[i] + b.L)
-        if d2 >= env * env or d2 == 0.0:
+        fmag = _obstacle_law(b, i, c.opairs[2 * k + 1], d)
+        if fmag == 0.0:
             continue
-        dist = sqrt(d2)
-        kk = b.k_floor[i] * b.obs[4 * m + 3] / (b.k_floor[i] + b.obs[4 * m + 3])
-        fmag = kk * (env - dist) / dist
-        b.force[SOFTGYM_FM_STRIDE * i] += fmag * dx
-        b.force[SOFTGYM_FM_STRIDE * i + 1] += fmag * dy
-        b.force[SOFTGYM_FM_STRIDE * i + 2] += fmag * dz
+        b.force[SOFTGYM_FM_STRIDE * i] += fmag * d[0]
+        b.force[SOFTGYM_FM_STRIDE * i + 1] += fmag * d[1]
+        b.force[SOFTGYM_FM_STRIDE * i + 2] += fmag * d[2]
 
 
 cdef void collide(Batch* b, Contacts* c) noexcept nogil:
     # OUT (accumulated): force of the touching candidate pairs.
     cdef:
         intp_t k, i, j
-        float64_t dx, dy, dz, d2, env, dist, kk, fmag
+        float64_t fmag
+        float64_t d[3]
     if b.link_f != NULL:
         _contacts32(b, c, 0)
         return
     for k in range(c.n_pairs):
         i = c.pairs[2 * k]
         j = c.pairs[2 * k + 1]
-        dx = voxel_pos(b, j, 0) - voxel_pos(b, i, 0)
-        dy = voxel_pos(b, j, 1) - voxel_pos(b, i, 1)
-        dz = voxel_pos(b, j, 2) - voxel_pos(b, i, 2)
-        d2 = dx * dx + dy * dy + dz * dz
-        env = 0.75 * (b.scale[i] + b.scale[j])
-        if d2 >= env * env or d2 == 0.0:
+        fmag = _pair_law(b, i, j, d)
+        if fmag == 0.0:
             continue
-        dist = sqrt(d2)
-        # E_h L = harmonic mean of the voxels' E L = k1 k2 / (k1 + k2), k = 2 E L
-        kk = b.k_floor[i] * b.k_floor[j] / (b.k_floor[i] + b.k_floor[j])
-        fmag = kk * (env - dist) / dist
-        b.force[SOFTGYM_FM_STRIDE * j] += fmag * dx
-        b.force[SOFTGYM_FM_STRIDE * j + 1] += fmag * dy
-        b.force[SOFTGYM_FM_STRIDE * j + 2] += fmag * dz
-        b.force[SOFTGYM_FM_STRIDE * i] -= fmag * dx
-        b.force[SOFTGYM_FM_STRIDE * i + 1] -= fmag * dy
-        b.force[SOFTGYM_FM_STRIDE * i + 2] -= fmag * dz
+        b.force[SOFTGYM_FM_STRIDE * j] += fmag * d[0]
+        b.force[SOFTGYM_FM_STRIDE * j + 1] += fmag * d[1]
+        b.force[SOFTGYM_FM_STRIDE * j + 2] += fmag * d[2]
+        b.force[SOFTGYM_FM_STRIDE * i] -= fmag * d[0]
+        b.force[SOFTGYM_FM_STRIDE * i + 1] -= fmag * d[1]
+        b.force[SOFTGYM_FM_STRIDE * i + 2] -= fmag * d[2]
