@@ -68,20 +68,16 @@ cdef inline void _clear(Batch* b, intp_t i) noexcept nogil:
         memset(b.force + SOFTGYM_FM_STRIDE * i, 0, SOFTGYM_FM_STRIDE * sizeof(float64_t))
 
 
-cdef inline void _forces_of(const Batch* b, intp_t i, float64_t* fm) noexcept nogil:
-    # voxel i's accumulated force (fm[0..2]) and moment (fm[4..6]): its row of b.force, or
-    # its float link forces widened (exactly)
+cdef inline const float64_t* _forces_of(const Batch* b, intp_t i, float64_t* buf) noexcept nogil:
+    # voxel i's accumulated force (columns 0-2) and moment (4-6): its row of b.force, or
+    # its float link forces widened (exactly) into buf
     cdef int k
-    cdef const float64_t* row
-    if b.link_f != NULL:
-        for k in range(3):
-            fm[k] = b.link_f[k * b.link_fs + i]
-            fm[4 + k] = b.link_f[(3 + k) * b.link_fs + i]
-    else:
-        row = b.force + SOFTGYM_FM_STRIDE * i
-        for k in range(3):
-            fm[k] = row[k]
-            fm[4 + k] = row[4 + k]
+    if b.link_f == NULL:
+        return b.force + SOFTGYM_FM_STRIDE * i
+    for k in range(3):
+        buf[k] = b.link_f[k * b.link_fs + i]
+        buf[4 + k] = b.link_f[(3 + k) * b.link_fs + i]
+    return buf
 
 
 cdef void clear_robot(Batch* b, intp_t r) noexcept nogil:
@@ -216,7 +212,8 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
         intp_t i, k
         float64_t dt = b.dt[r]
         float64_t m, pen, cg, mx, my, mz
-        float64_t fm[8]
+        const float64_t* fm
+        float64_t fbuf[8]
         float64_t c[3]
         float64_t f[3]
         float64_t* pos = b.pos
@@ -251,7 +248,7 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
                 continue
             m = b.mass[i]
             cg = b.c_global[i]
-            _forces_of(b, i, fm)  # the voxel's force, then moment (+ 4)
+            fm = _forces_of(b, i, fbuf)  # the voxel's force, then moment (+ 4)
             f[0] = fm[0] + b.ext_force[3 * i] - cg * vel[3 * i]
             f[1] = fm[1] + b.ext_force[3 * i + 1] - cg * vel[3 * i + 1]
             f[2] = fm[2] + b.ext_force[3 * i + 2] - cg * vel[3 * i + 2] + m * g
@@ -392,7 +389,8 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
         intp_t i, k
         float64_t dt = b.dt[r]
         float64_t cg, mx, my, mz
-        float64_t fm[8]
+        const float64_t* fm
+        float64_t fbuf[8]
         float64_t c[3]
         float64_t f[3]
         float64_t* pos = b.pos
@@ -424,7 +422,7 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
                 _clear(b, i)
                 continue
             cg = b.c_global[i]
-            _forces_of(b, i, fm)  # the voxel's force, then moment (+ 4)
+            fm = _forces_of(b, i, fbuf)  # the voxel's force, then moment (+ 4)
             f[0] = -cg * vel[3 * i] + fm[0] + b.ext_force[3 * i]
             f[1] = -cg * vel[3 * i + 1] + fm[1] + b.ext_force[3 * i + 1]
             f[2] = (-cg * vel[3 * i + 2] + fm[2] + b.mass[i] * b.gravity

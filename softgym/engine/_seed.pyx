@@ -106,18 +106,17 @@ cdef extern from "softgym_seed.h":
                               const float64_t* neg2_row, float64_t* force,
                               float64_t* moment) noexcept nogil
     # single-precision links: their forces turned in float and added to the voxels' float
-    # rows lf (row stride lfs), voxel 1's then voxel 2's (rf: the geometry's float rotation
-    # rows where SOFTGYM_SEED_R_USED, else NULL: rot)
+    # rows lf (row stride lfs), voxel 1's then voxel 2's (rf: the geometry's float rows of
+    # voxel 1's rotation)
     void softgym_seed_push32(int ax, intp_t lo, intp_t hi, const intp_t* v1, const intp_t* v2,
-                             const float64_t* rot, const float* rf, const float* of,
-                             const float64_t* neg2_row, float* lf, intp_t lfs) noexcept nogil
+                             const float* rf, const float* of, const float64_t* neg2_row,
+                             float* lf, intp_t lfs) noexcept nogil
     # the rows of the chunk's scratch that hold voxel 1's rotation (the geometry writes
     # them, the scatter reads them, where the build's SOFTGYM_SEED_R_USED is 1: AVX-512)
     enum: SOFTGYM_SEED_R_ROWS
-    # the float rows of the chunk's scratch that hold it rounded (single-precision links),
-    # and whether the geometry writes those rows (the AVX-512 builds)
+    # the float rows of the chunk's scratch that hold it rounded (single-precision links:
+    # the geometry writes them in every build)
     enum: SOFTGYM_CHUNK_FR
-    enum: SOFTGYM_SEED_R_USED
     int softgym_seed_frames32(intp_t lo, intp_t hi, intp_t n, float sa_rad, float w_acos,
                               const float64_t* o, float* f) noexcept nogil
     void softgym_seed_forces32(intp_t lo, intp_t hi, intp_t n, float L, float bz, float bzh,
@@ -402,15 +401,15 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
         # the scatter's forces and moments: the float forces pass's rows of the chunk's
         # float scratch, indexed by link (NULL: the double pass's rows 0-11 of chunk_out)
         const float* of = NULL
-        # the geometry's float rotation rows of the chunk (single-precision links in the
-        # builds that write them; NULL: the push reads rot)
+        # the geometry's float rows of voxel 1's rotation (single-precision links; NULL with
+        # double links)
         float* rf = NULL
         softgym_modes_args m
         unsigned long long t0
     if hi <= lo:
         return STATUS_OK
     _modes_args(b, &m)
-    if b.link_f32 and SOFTGYM_SEED_R_USED:
+    if b.link_f32:
         rf = b.chunk_f32 + SOFTGYM_CHUNK_FR * SOFTGYM_CHUNK_FSTRIDE
     run[0] = lo
     for ax in range(3):
@@ -439,8 +438,7 @@ cdef int links_seed(Batch* b, intp_t r) noexcept nogil:
             a0 = max(c0, run[ax])
             a1 = min(end, run[ax + 1])
             if a0 < a1 and b.link_f32:
-                softgym_seed_push32(ax, a0, a1, b.v1, b.v2, b.rot,
-                                    rf - c0 if rf != NULL else NULL, of, o + 23 * n,
+                softgym_seed_push32(ax, a0, a1, b.v1, b.v2, rf - c0, of, o + 23 * n,
                                     b.link_f, b.link_fs)
             elif a0 < a1:
                 softgym_seed_scatter(ax, a0, a1, b.v1, b.v2, b.rot, b.chunk_out - c0,

@@ -176,8 +176,8 @@ HARNESS = _c_harness("softgym_seed.h", r"""
    three ways of loading the voxels: runs, windows of 16, gathers; and its remainder)
    against SOFTGYM_SEED_GEOM_LINK, one link at a time; and, run a chunk at a time as the
    engine does, the rotation rows it leaves for the scatter (AVX-512) against voxel 1's
-   matrix, and (single-precision links) the float rows of it rounded that it leaves for
-   the push instead. The runs and windows load the voxel rows vr (quaternions in rows
+   matrix, and (single-precision links, every build) the float rows of it rounded that it
+   leaves for the push instead. The runs and windows load the voxel rows vr (quaternions in rows
    SOFTGYM_ROW_QUAT.., positions in SOFTGYM_ROW_POS.., VN apart); in the builds whose seed step keeps its state there
    (SOFTGYM_STATE_ROWS) every path does, and the records it is given are NaN (stale during
    that step); elsewhere they are the records' copy */
@@ -203,7 +203,7 @@ SOFTGYM_ALWAYS_INLINE long check_ax(const int ax, Py_ssize_t n, const Py_ssize_t
         }
         softgym_seed_geom(ax, c0, c1, n, v1, v2, nv, pos_rec, quat_rec, vr, VN, sc, o, (double *)0,
                           rf - c0);
-        for (Py_ssize_t li = c0; li < c1 && SOFTGYM_SEED_R_USED; li++) {
+        for (Py_ssize_t li = c0; li < c1; li++) {  /* (every build writes these) */
             double m[9];
             softgym_quat_matrix(quat + 4 * v1[li], m);
             for (int k = 0; k < 9; k++) {
@@ -415,11 +415,10 @@ int main(void)
 
 
 PUSH_HARNESS = _c_harness("softgym_seed.h", r"""
-/* the single-precision links' push (softgym_seed_push32): with the geometry's float rotation
-   rows (rf; with AVX-512 blocks of 16 links turned in float lanes and added to the voxels'
-   float rows in windows of 16 voxels) against rf NULL (every link one by one, voxel 1's
-   matrix from rot rounded), and against the turn and the sums written out in double from
-   the same floats (each voxel's contributions in the push's order: per block of 16 links
+/* the single-precision links' push (softgym_seed_push32: with AVX-512 blocks of 16 links
+   turned in float lanes and added to the voxels' float rows in windows of 16 voxels)
+   against softgym_seed_push32_links (each block's side turned in a loop, then added link by
+   link), and against the turn and the sums written out in double from the same floats (each voxel's contributions in the push's order: per block of 16 links
    from the run's start, voxel 1's then voxel 2's; a float turn within 1e-5 of it). Links
    of a lattice's x runs (5 of 6 voxels), y runs (30, then a gap), runs of 16 and more,
    random ascending voxels (sparse bodies: gaps past the windows' reach), starting anywhere
@@ -466,8 +465,12 @@ static long check(int ax, Py_ssize_t lo, Py_ssize_t hi)
     for (int k = 0; k < 6 * NV; k++)
         ref[k] = 0.0;
     const float *of = rows + SOFTGYM_CHUNK_FOUT * FS, *rf = rows + SOFTGYM_CHUNK_FR * FS;
-    softgym_seed_push32(ax, lo, hi, v1, v2, rot, rf, of, neg2, lf_a, LFS);
-    softgym_seed_push32(ax, lo, hi, v1, v2, rot, (const float *)0, of, neg2, lf_b, LFS);
+    softgym_seed_push32(ax, lo, hi, v1, v2, rf, of, neg2, lf_a, LFS);
+    for (Py_ssize_t b0 = lo; b0 < hi; b0 += 16) {
+        Py_ssize_t e = hi - b0 < 16 ? hi : b0 + 16;
+        SOFTGYM_BY_AXIS(ax, softgym_seed_push32_links, 1, b0, e, v1, v2, rf, of, neg2, lf_b, LFS);
+        SOFTGYM_BY_AXIS(ax, softgym_seed_push32_links, 2, b0, e, v1, v2, rf, of, neg2, lf_b, LFS);
+    }
     long bad = 0;
     for (int k = 0; k < 6 * LFS + 64; k++)
         bad += memcmp(&lf_a[k], &lf_b[k], sizeof(float)) != 0;

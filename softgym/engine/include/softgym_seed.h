@@ -37,8 +37,7 @@
 #define SOFTGYM_CHUNK_FROWS 33
 #define SOFTGYM_CHUNK_FOUT 12
 /* rows 24-32 of the float rows: voxel 1's rotation matrix, row-major, rounded to float by
-   the geometry (AVX-512 builds with single-precision links: softgym_seed_push32's blocks
-   turn the forces with it) */
+   the geometry (single-precision links: softgym_seed_push32 turns the forces with it) */
 #define SOFTGYM_CHUNK_FR 24
 
 /* The first pass of links_seed (_seed.pyx): links lo..hi (all along axis ax, a
@@ -96,7 +95,7 @@
                                  yj, zj, si, sj, rr, rf, KEEPLS, AFTER) do { \
         T geo_R[9]; \
         SOFTGYM_QUAT_MATRIX(w, x, y, z, geo_R); \
-        if (SOFTGYM_SEED_R_USED && (rf) != 0) { \
+        if ((rf) != 0) { \
             for (int geo_k = 0; geo_k < 9; geo_k++) \
                 PUTF((rf) + geo_k * SOFTGYM_CHUNK_FSTRIDE, li, geo_R[geo_k]); \
         } else if (SOFTGYM_SEED_R_USED && (rr) != 0) { \
@@ -1516,31 +1515,30 @@ static void softgym_seed_scatter(int ax, Py_ssize_t lo, Py_ssize_t hi, const Py_
    softgym_seed_scatter_links) with its multiply-adds written out (component c is
    fma(R[3c+2], z, fma(R[3c+1], y, R[3c] x))), so the scalar loop and the AVX-512 blocks
    round alike; R1 is voxel 1's rotation matrix rounded to float: the geometry's float rows
-   (rf, SOFTGYM_CHUNK_FR, indexed by link) or the voxels' matrices (rot). Where the double
+   (rf, SOFTGYM_CHUNK_FR, indexed by link). Where the double
    scatter transposed each link's turned vectors into its voxels' rows of 8 (a third of its
    operations shuffles) and widened the forces to doubles, a block here turns 16 links in
    the lanes and adds them to the voxels' rows in windows of 16 voxels (softgym_push16). */
 #define SOFTGYM_TURN32(R, x, y, z, c) \
     SOFTGYM_FMAF((R)[3 * (c) + 2], (z), SOFTGYM_FMAF((R)[3 * (c) + 1], (y), (R)[3 * (c)] * (x)))
-/* one side (1: voxel 1's f1 and m1; 2: voxel 2's f2 or -f1, and m2) of links lo..hi, link
-   by link */
+/* one side (1: voxel 1's f1 and m1; 2: voxel 2's f2 or -f1, and m2) of links lo..hi (at
+   most 16, one block; distinct voxels): the turn of every link into w (row k of link li at
+   w[k][li - lo], a loop the compiler vectorises: the rows are contiguous by link), then
+   each link's six components added to its voxel's float rows, in one vector loop a row
+   where the voxels are consecutive */
 SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_links(const int ax, const int side, Py_ssize_t lo,
                                                      Py_ssize_t hi, const Py_ssize_t *v1,
-                                                     const Py_ssize_t *v2, const double *rot,
-                                                     const float *rf, const float *of,
-                                                     const double *neg2_row, float *lf,
-                                                     Py_ssize_t lfs)
+                                                     const Py_ssize_t *v2, const float *rf,
+                                                     const float *of, const double *neg2_row,
+                                                     float *lf, Py_ssize_t lfs)
 {
+    float w[6][16];
+    const Py_ssize_t fs = SOFTGYM_CHUNK_FSTRIDE;
+    SOFTGYM_IVDEP
     for (Py_ssize_t li = lo; li < hi; li++) {
-        Py_ssize_t i = v1[li], j = side == 1 ? i : v2[li];
         float R[9];
-        if (rf) {
-            for (int k = 0; k < 9; k++)
-                R[k] = rf[k * SOFTGYM_CHUNK_FSTRIDE + li];
-        } else {
-            for (int k = 0; k < 9; k++)
-                R[k] = (float)rot[9 * i + k];
-        }
+        for (int k = 0; k < 9; k++)
+            R[k] = rf[k * fs + li];
         if (ax != 0) {
             R[0] = -R[0];
             R[3] = -R[3];
@@ -1551,18 +1549,37 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_links(const int ax, const int sid
         float a[3], m[3];
         for (int c = 0; c < 3; c++) {
             if (side == 1)
-                a[c] = q[c * SOFTGYM_CHUNK_FSTRIDE];
+                a[c] = q[c * fs];
             else
-                a[c] = neg2_row[li] != 0.0 ? -q[c * SOFTGYM_CHUNK_FSTRIDE]
-                                           : q[(3 + c) * SOFTGYM_CHUNK_FSTRIDE];
-            m[c] = q[((side == 1 ? 6 : 9) + c) * SOFTGYM_CHUNK_FSTRIDE];
+                a[c] = neg2_row[li] != 0.0 ? -q[c * fs] : q[(3 + c) * fs];
+            m[c] = q[((side == 1 ? 6 : 9) + c) * fs];
         }
         float x = a[ax], y = ax == 1 ? a[0] : a[1], z = ax == 2 ? a[0] : a[2];
         float mx = m[ax], my = ax == 1 ? m[0] : m[1], mz = ax == 2 ? m[0] : m[2];
         for (int c = 0; c < 3; c++) {
-            lf[c * lfs + j] += SOFTGYM_TURN32(R, x, y, z, c);
-            lf[(3 + c) * lfs + j] += SOFTGYM_TURN32(R, mx, my, mz, c);
+            w[c][li - lo] = SOFTGYM_TURN32(R, x, y, z, c);
+            w[3 + c][li - lo] = SOFTGYM_TURN32(R, mx, my, mz, c);
         }
+    }
+    const Py_ssize_t *v = side == 1 ? v1 : v2;
+    int run = 1;
+    for (Py_ssize_t li = lo + 1; li < hi; li++)
+        run &= v[li] == v[lo] + (li - lo);
+    if (run) {
+        /* consecutive voxels (a lattice's links along its slower axes): a loop the compiler
+           vectorises, the same additions */
+        for (int k = 0; k < 6; k++) {
+            float *row = lf + k * lfs + v[lo];
+            SOFTGYM_IVDEP
+            for (Py_ssize_t t = 0; t < hi - lo; t++)
+                row[t] += w[k][t];
+        }
+        return;
+    }
+    for (Py_ssize_t li = lo; li < hi; li++) {
+        Py_ssize_t j = v[li];
+        for (int k = 0; k < 6; k++)
+            lf[k * lfs + j] += w[k][li - lo];
     }
 }
 #if defined(__AVX512F__) && SOFTGYM_SEED_R_USED && (defined(__GNUC__) || defined(__clang__))
@@ -1636,9 +1653,9 @@ SOFTGYM_ALWAYS_INLINE int softgym_push16(const softgym_v16f *w, const Py_ssize_t
 SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_16(const int ax, const int full, Py_ssize_t li,
                                                   __mmask16 lanes,
                                                   const Py_ssize_t *v1, const Py_ssize_t *v2,
-                                                  const double *rot, const float *rf,
-                                                  const float *of, const double *neg2_row,
-                                                  float *lf, Py_ssize_t lfs)
+                                                  const float *rf, const float *of,
+                                                  const double *neg2_row, float *lf,
+                                                  Py_ssize_t lfs)
 {
     const float *q = of + li;
     softgym_v16f R[9], a[3], m[3], w[6];
@@ -1659,7 +1676,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_16(const int ax, const int full, 
     SOFTGYM_TURN16(R, a[ax], ax == 1 ? a[0] : a[1], ax == 2 ? a[0] : a[2], w);
     SOFTGYM_TURN16(R, m[ax], ax == 1 ? m[0] : m[1], ax == 2 ? m[0] : m[2], w + 3);
     if (!softgym_push16(w, v1 + li, lanes, lf, lfs))
-        softgym_seed_push32_links(ax, 1, li, hi, v1, v2, rot, rf, of, neg2_row, lf, lfs);
+        softgym_seed_push32_links(ax, 1, li, hi, v1, v2, rf, of, neg2_row, lf, lfs);
     /* voxel 2: -F1 in the lanes whose row 23 is not 0.0 (1.0: it takes -F1) */
     __mmask16 neg2 = _mm512_kunpackb(
         _mm512_cmp_pd_mask(full ? _mm512_loadu_pd(neg2_row + li + 8)
@@ -1676,42 +1693,38 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_16(const int ax, const int full, 
     SOFTGYM_TURN16(R, a[ax], ax == 1 ? a[0] : a[1], ax == 2 ? a[0] : a[2], w);
     SOFTGYM_TURN16(R, m[ax], ax == 1 ? m[0] : m[1], ax == 2 ? m[0] : m[2], w + 3);
     if (!softgym_push16(w, v2 + li, lanes, lf, lfs))
-        softgym_seed_push32_links(ax, 2, li, hi, v1, v2, rot, rf, of, neg2_row, lf, lfs);
+        softgym_seed_push32_links(ax, 2, li, hi, v1, v2, rf, of, neg2_row, lf, lfs);
 }
 #undef SOFTGYM_TURN16
 #endif
 SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
                                                   const Py_ssize_t *v1, const Py_ssize_t *v2,
-                                                  const double *rot, const float *rf,
-                                                  const float *of, const double *neg2_row,
-                                                  float *lf, Py_ssize_t lfs)
+                                                  const float *rf, const float *of,
+                                                  const double *neg2_row, float *lf,
+                                                  Py_ssize_t lfs)
 {
     for (Py_ssize_t li = lo; li < hi; li += 16) {
         Py_ssize_t e = hi - li < 16 ? hi : li + 16;
 #if defined(SOFTGYM_PUSH16)
-        if (rf) {
-            if (e - li == 16)
-                softgym_seed_push32_16(ax, 1, li, (__mmask16)0xFFFF, v1, v2, rot, rf, of,
-                                       neg2_row, lf, lfs);
-            else
-                softgym_seed_push32_16(ax, 0, li, (__mmask16)((1u << (e - li)) - 1u), v1, v2,
-                                       rot, rf, of, neg2_row, lf, lfs);
-            continue;
-        }
+        if (e - li == 16)
+            softgym_seed_push32_16(ax, 1, li, (__mmask16)0xFFFF, v1, v2, rf, of, neg2_row, lf,
+                                   lfs);
+        else
+            softgym_seed_push32_16(ax, 0, li, (__mmask16)((1u << (e - li)) - 1u), v1, v2, rf,
+                                   of, neg2_row, lf, lfs);
+#else
+        softgym_seed_push32_links(ax, 1, li, e, v1, v2, rf, of, neg2_row, lf, lfs);
+        softgym_seed_push32_links(ax, 2, li, e, v1, v2, rf, of, neg2_row, lf, lfs);
 #endif
-        softgym_seed_push32_links(ax, 1, li, e, v1, v2, rot, rf, of, neg2_row, lf, lfs);
-        softgym_seed_push32_links(ax, 2, li, e, v1, v2, rot, rf, of, neg2_row, lf, lfs);
     }
 }
-/* links lo..hi along ax (one chunk's run): of, the float forces pass's rows (indexed by
-   link); rf, the geometry's float rotation rows (indexed by link) or NULL (then rot, the
-   voxels' matrices, rounded) */
+/* links lo..hi along ax (one chunk's run): of, the float forces pass's rows, and rf, the
+   geometry's float rows of voxel 1's rotation (both indexed by link) */
 static void softgym_seed_push32(int ax, Py_ssize_t lo, Py_ssize_t hi, const Py_ssize_t *v1,
-                                const Py_ssize_t *v2, const double *rot, const float *rf,
-                                const float *of, const double *neg2_row, float *lf,
-                                Py_ssize_t lfs)
+                                const Py_ssize_t *v2, const float *rf, const float *of,
+                                const double *neg2_row, float *lf, Py_ssize_t lfs)
 {
-    SOFTGYM_BY_AXIS(ax, softgym_seed_push32_ax, lo, hi, v1, v2, rot, rf, of, neg2_row, lf, lfs);
+    SOFTGYM_BY_AXIS(ax, softgym_seed_push32_ax, lo, hi, v1, v2, rf, of, neg2_row, lf, lfs);
 }
 #undef SOFTGYM_TURN32
 #if defined(SOFTGYM_F16_NONZERO)
