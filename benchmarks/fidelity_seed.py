@@ -58,7 +58,15 @@ sys.path.insert(0, str(HERE))
 import fidelity_cases as fc  # noqa: E402
 
 from softgym.engine import SimConfig, Simulation  # noqa: E402
-from softgym.fidelity import METRIC, SOFTGYM_METRIC, fence_terrain, micro_trace  # noqa: E402
+from softgym.fidelity import (  # noqa: E402
+    METRIC,
+    SOFTGYM_METRIC,
+    fence_terrain,
+    mean_figures,
+    micro_trace,
+    sample_draws,
+    targets_met,
+)
 from softgym.metrics import dilute, walk_metrics  # noqa: E402
 
 DATA = HERE / "data" / "seed_engine"
@@ -170,36 +178,19 @@ def _one_sample(cases, oracle, ours, draws, terrain, halves, regime):
             [{"case": n, "softgym": float(x), "oracle": float(y)} for _, n, x, y in worst])
 
 
-def _mean_figures(figs: list[dict[str, float]]) -> dict[str, float]:
-    """The samples' figures averaged (n: the cases of the first; moved/still: summed)."""
-    out = {"n": figs[0]["n"]}
-    for key in ("spearman", "median_abs_log10", "within_2x", "within_3x"):
-        out[key] = float(np.mean([f[key] for f in figs]))
-    out["moved_vs_still"] = int(sum(f["moved_vs_still"] for f in figs))
-    return out
-
-
-def compare(cases, oracle, ours, draws, terrain: str = "flat", halves=ORACLE_HALVES,
-            per_sample: int | None = None) -> dict[str, Any]:
-    """Per regime: softgym vs the oracle's first half, and the oracle's halves vs each other.
-
-    `per_sample` (default: all of `draws`) splits softgym's draws into consecutive samples
-    of that many (3: the oracle halves' size): each sample's figures, and their mean, on
-    which the targets are judged (a moved/still mismatch in any sample misses its target)."""
-    per = per_sample or len(draws)
-    groups = [draws[k:k + per] for k in range(0, len(draws) - per + 1, per)]
+def compare(cases, oracle, ours, groups, terrain: str = "flat",
+            halves=ORACLE_HALVES) -> dict[str, Any]:
+    """Per regime: softgym vs the oracle's first half, and the oracle's halves vs each other,
+    for each sample of softgym's draws (`groups`: softgym.fidelity.sample_draws), and their
+    mean, on which the targets are judged (softgym.fidelity.mean_figures, targets_met)."""
     report = {}
     for regime in fc.REGIMES:
         found = [_one_sample(cases, oracle, ours, g, terrain, halves, regime) for g in groups]
         if any(f is None for f in found):
             continue
-        soft = _mean_figures([f[0] for f in found])
-        self_ = _mean_figures([f[1] for f in found])
-        targets = {
-            "spearman": soft["spearman"] >= 0.9 * self_["spearman"],
-            "within_2x": soft["within_2x"] >= 0.9 * self_["within_2x"],
-            "moved_vs_still": soft["moved_vs_still"] == 0,
-        }
+        soft = mean_figures([f[0] for f in found])
+        self_ = mean_figures([f[1] for f in found])
+        targets = targets_met(soft, self_)
         report[regime] = {"softgym_vs_oracle": soft, "oracle_vs_oracle": self_, "targets": targets,
                           "samples": [{"draws": g, **f[0]} for g, f in zip(groups, found)],
                           "worst": found[0][2]}
@@ -242,15 +233,16 @@ def main() -> int:
         for c in cases:
             by_set.setdefault(c.set, []).append(c)
         cases = [c for cs in by_set.values() for c in cs[:12]]
-    draws = list(range(a.first_draw, a.first_draw + a.draws * a.samples))
+    groups = sample_draws(a.first_draw, a.draws, a.samples)
+    draws = [d for g in groups for d in g]
     halves = tuple(tuple(int(x) for x in h.split(",")) for h in a.halves.split("/"))
     ours = run_softgym(cases, draws, a.model, a.threads, a.link_precision)
     prec = SimConfig(model=a.model, link_precision=a.link_precision).effective_link_precision
     report = {"model": a.model, "link_precision": prec, "sets": sets, "draws": draws, "n_cases": len(cases),
               "halves": halves,
               "samples": a.samples,
-              "regimes": compare(cases, oracle, ours, draws, "flat", halves, a.draws),
-              "fence_regimes": compare(cases, oracle, ours, draws, "fence", halves, a.draws),
+              "regimes": compare(cases, oracle, ours, groups, "flat", halves),
+              "fence_regimes": compare(cases, oracle, ours, groups, "fence", halves),
               "micro": micro_errors(a.model, a.link_precision)}
     report["wall_s"] = time.perf_counter() - t0
     print(f"softgym model {a.model!r} (link precision {prec}) against the seed's engine: {len(cases)} cases "
