@@ -1522,10 +1522,11 @@ static void softgym_seed_scatter(int ax, Py_ssize_t lo, Py_ssize_t hi, const Py_
 #define SOFTGYM_TURN32(R, x, y, z, c) \
     SOFTGYM_FMAF((R)[3 * (c) + 2], (z), SOFTGYM_FMAF((R)[3 * (c) + 1], (y), (R)[3 * (c)] * (x)))
 /* one side (1: voxel 1's f1 and m1; 2: voxel 2's f2 or -f1, and m2) of links lo..hi (at
-   most 16, one block; distinct voxels): the turn of every link into w (row k of link li at
-   w[k][li - lo], a loop the compiler vectorises: the rows are contiguous by link), then
-   each link's six components added to its voxel's float rows, in one vector loop a row
-   where the voxels are consecutive */
+   most 16, one block): the turn of every link into w (row k of link li at w[k][li - lo], a
+   loop the compiler vectorises: the rows are contiguous by link), then each link's six
+   components added to its voxel's float rows in link order, in one vector loop a row
+   where the voxels are consecutive (the portable builds' path, and the AVX-512 blocks'
+   fall-back) */
 SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_links(const int ax, const int side, Py_ssize_t lo,
                                                      Py_ssize_t hi, const Py_ssize_t *v1,
                                                      const Py_ssize_t *v2, const float *rf,
