@@ -622,11 +622,11 @@ cdef inline float64_t _obstacle_law(Batch* b, intp_t i, intp_t m, float64_t* d) 
     return kk * (env - dist) / dist
 
 
-cdef void _contacts32(Batch* b, Contacts* c, int obstacles) noexcept nogil:
-    # collide (obstacles 0) or collide_obstacles (1) with single-precision links: the same
-    # contact forces, rounded to float and added to the voxels' float rows of link forces
-    # (b.link_f, which the voxel update reads instead of b.force; loops of their own, so
-    # that the double loops' products and sums fuse as they did)
+# collide and collide_obstacles with single-precision links: the same contact forces,
+# rounded to float and added to the voxels' float rows of link forces (b.link_f, which the
+# voxel update reads instead of b.force; loops of their own, so that the double loops'
+# products and sums fuse as they did)
+cdef void _collide32(Batch* b, Contacts* c) noexcept nogil:
     cdef:
         intp_t k, i, j, s = b.link_fs
         float64_t fmag
@@ -634,7 +634,7 @@ cdef void _contacts32(Batch* b, Contacts* c, int obstacles) noexcept nogil:
         float f[3]
         float* lf = b.link_f
         int a
-    for k in range(0 if obstacles else c.n_pairs):
+    for k in range(c.n_pairs):
         i = c.pairs[2 * k]
         j = c.pairs[2 * k + 1]
         fmag = _pair_law(b, i, j, d)
@@ -644,7 +644,16 @@ cdef void _contacts32(Batch* b, Contacts* c, int obstacles) noexcept nogil:
             f[a] = <float> (fmag * d[a])
             lf[a * s + j] += f[a]
             lf[a * s + i] -= f[a]
-    for k in range(c.n_opairs if obstacles else 0):
+
+
+cdef void _collide_obstacles32(Batch* b, Contacts* c) noexcept nogil:
+    cdef:
+        intp_t k, i, s = b.link_fs
+        float64_t fmag
+        float64_t d[3]
+        float* lf = b.link_f
+        int a
+    for k in range(c.n_opairs):
         i = c.opairs[2 * k]
         fmag = _obstacle_law(b, i, c.opairs[2 * k + 1], d)
         if fmag == 0.0:
@@ -661,7 +670,7 @@ cdef void collide_obstacles(Batch* b, Contacts* c) noexcept nogil:
         float64_t fmag
         float64_t d[3]
     if b.link_f != NULL:
-        _contacts32(b, c, 1)
+        _collide_obstacles32(b, c)
         return
     for k in range(c.n_opairs):
         i = c.opairs[2 * k]
@@ -680,7 +689,7 @@ cdef void collide(Batch* b, Contacts* c) noexcept nogil:
         float64_t fmag
         float64_t d[3]
     if b.link_f != NULL:
-        _contacts32(b, c, 0)
+        _collide32(b, c)
         return
     for k in range(c.n_pairs):
         i = c.pairs[2 * k]

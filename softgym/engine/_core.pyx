@@ -18,7 +18,6 @@
 from cython.parallel cimport prange, parallel, threadid
 from libc.math cimport sin, cos, sqrt, fabs, M_PI
 from libc.stdlib cimport calloc, realloc, free
-from libc.string cimport memset
 from libc.stdint cimport uintptr_t
 
 cimport numpy as cnp
@@ -147,8 +146,7 @@ cdef int _advance_seed(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
     # everything else reads positions and quaternions through voxel_pos / voxel_quat,
     # _batch.pxd); else the rows are filled from the records once a step
     voxel_state_enter(b, r)
-    if b.link_f != NULL:  # the thread's float rows of the link forces start at zero
-        memset(b.link_f + b.vox_start[r], 0, (6 * b.link_fs + 64) * sizeof(float))
+    clear_robot(b, r)  # (the thread's float rows of the link forces: another robot's)
     while b.steps[r] < target:
         t0 = softgym_prof_tsc()
         voxel_link_rows(b, r, 1)  # (where the records are the state: the geometry's rows)

@@ -35,4 +35,4 @@ cdef void refresh_robot_rotations(Batch* b, intp_t r) noexcept nogil
     # robot r's rot from its quat where the voxel updates leave it
     # (SOFTGYM_ROT_DEFERRED; else nothing)
 cdef void clear_robot(Batch* b, intp_t r) noexcept nogil
-    # zero robot r's force and moment scratch (after an early exit)
+    # zero robot r's force and moment scratch (before its steps, after an early exit)

@@ -81,11 +81,12 @@ cdef inline const float64_t* _forces_of(const Batch* b, intp_t i, float64_t* buf
 
 
 cdef void clear_robot(Batch* b, intp_t r) noexcept nogil:
-    # zero the robot's force/moment scratch (after an early exit)
+    # zero the robot's force/moment scratch (before its steps, after an early exit): its
+    # rows of b.force, and the thread's float rows of link forces with their slack
     cdef intp_t vs = b.vox_start[r], ve = b.vox_start[r + 1]
     memset(b.force + SOFTGYM_FM_STRIDE * vs, 0, SOFTGYM_FM_STRIDE * (ve - vs) * sizeof(float64_t))
     if b.link_f != NULL:
-        memset(b.link_f + vs, 0, 6 * b.link_fs * sizeof(float))
+        memset(b.link_f + vs, 0, (6 * b.link_fs + 64) * sizeof(float))
 
 
 cdef inline float64_t _drift2(const float64_t* pos, const float64_t* ref, intp_t i, intp_t vs,
