@@ -230,6 +230,8 @@ extensions = [
       for m in ENGINE_MODULES),
     Extension("softgym.engine._openmp", ["softgym/engine/_openmp.pyx"], **ext_kwargs),
     Extension("softgym.engine._cpu", ["softgym/engine/_cpu.pyx"], **ext_kwargs),
+    # the robots' contact sensor (read after an engine call; never part of a step)
+    Extension("softgym.engine._sense", ["softgym/engine/_sense.pyx"], **ext_kwargs),
 ]
 directives = {
     "language_level": 3,

@@ -105,7 +105,9 @@ def caller_shows_progress() -> Iterator[None]:
     finally:
         with _caller_lock:
             _caller_bars -= 1
-_VOXEL_STEPS_PER_S = 5e6  # per thread, for that estimate (the seed preset's order of magnitude)
+_VOXEL_STEPS_PER_S = 5e6
+# a closed-loop episode samples the centre of mass itself: the engine's trace stays off
+_NO_TRACE = 1.0e9  # per thread, for that estimate (the seed preset's order of magnitude)
 
 
 def evaluate(
@@ -200,10 +202,43 @@ def evaluate(
         out["traces"] = [None] * n
     if n == 0:
         return out
-    from softgym.engine import Simulation, voxel_steps_per_second
     from softgym.metrics import composition_counts
 
     cfg = task.config(config, settings=config is None)  # a full config replaces the task's
+    for i, d in enumerate(designs):
+        c = composition_counts(d)
+        for k in _COUNTS:
+            out[k][i] = getattr(c, k)
+    # designs with a brain run as closed-loop control episodes (softgym.tasks.brains); the
+    # others on the seed's open-loop path below, bit for bit as without them
+    closed = [i for i, d in enumerate(designs) if d.brain is not None]
+    if closed:
+        from softgym.tasks.brains import run_brains
+
+        metrics, closed_traces = run_brains(
+            [designs[i] for i in closed], task, cfg.replace(trace_interval=_NO_TRACE),
+            n_threads=task.n_threads,
+        )  # fmt: skip
+        for k, v in metrics.items():
+            if k not in out:
+                out[k] = np.zeros(n, dtype=v.dtype)
+            out[k][closed] = v
+        if traces:
+            for j, i in enumerate(closed):
+                out["traces"][i] = None if metrics["diverged"][j] else closed_traces[j]
+    idx = [i for i, d in enumerate(designs) if d.brain is None]
+    if not idx:
+        return out
+    _open_loop(out, [designs[i] for i in idx], np.asarray(idx), task, cfg, traces, progress)
+    return out
+
+
+def _open_loop(out: dict[str, Any], designs: list, where: np.ndarray, task: Task, cfg: Any,
+               traces: bool, progress: bool | None) -> None:  # fmt: skip
+    # the seed's path: one Simulation of the designs, its rollout scored by the task
+    from softgym.engine import Simulation, voxel_steps_per_second
+
+    n = len(designs)
     # longest first: the kernel's dynamic schedule then balances the threads (results do not
     # depend on a robot's place in the batch, so the order is free)
     order = sorted(range(n), key=lambda i: -estimated_cost(designs[i], cfg.voxel_size))
@@ -224,17 +259,15 @@ def evaluate(
         sim.advance_to(task.seconds)
     back = np.argsort(order)
     rollout = _reorder(sim.rollout(), back)
-    out.update(task.metrics(rollout, [terrains[i] for i in back]))
-    for i, d in enumerate(designs):
-        c = composition_counts(d)
-        for k in _COUNTS:
-            out[k][i] = getattr(c, k)
+    for k, v in task.metrics(rollout, [terrains[i] for i in back]).items():
+        if k not in out:
+            out[k] = np.zeros(len(out["diverged"]), dtype=v.dtype)
+        out[k][where] = v
     if traces:
-        out["traces"] = [
-            None if rollout.diverged[i] else rollout.trace(i, since=rollout.init_time)
-            for i in range(n)
-        ]
-    return out
+        for i in range(n):
+            out["traces"][where[i]] = (
+                None if rollout.diverged[i] else rollout.trace(i, since=rollout.init_time)
+            )
 
 
 def _reorder(rollout: Any, perm: np.ndarray) -> Any:

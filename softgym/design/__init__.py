@@ -7,6 +7,16 @@ seed study's (1-4 evosoro's, 5 obstacle, 6-9 evolvable), see
 :mod:`softgym.design.material`.
 """
 
+from softgym.design.brain import (
+    BRAIN_KINDS,
+    CONTROL_DT_RANGE,
+    MAX_BRAIN_PARAMS,
+    MAX_HIDDEN,
+    MAX_SIGNALS,
+    WEIGHT_BOUND,
+    Brain,
+    BrainSpec,
+)
 from softgym.design.controller import CONTROLLER_BOUNDS, Controller
 from softgym.design.cppn import (
     ACTIVATIONS,
@@ -58,6 +68,14 @@ from softgym.design.vxa import (
 )
 
 __all__ = [
+    "BRAIN_KINDS",
+    "CONTROL_DT_RANGE",
+    "MAX_BRAIN_PARAMS",
+    "MAX_HIDDEN",
+    "MAX_SIGNALS",
+    "WEIGHT_BOUND",
+    "Brain",
+    "BrainSpec",
     "ACTIVATIONS",
     "BONE_IDS",
     "CONTROLLER_BOUNDS",

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from softgym.design.brain import Brain
 from softgym.design.controller import Controller
 from softgym.design.material import (
     BONE_IDS,
@@ -553,6 +554,11 @@ class RobotDesign:
     controller : Controller, optional
         The sinusoidal drive (default: the seed's). Its ``muscle_cte`` is
         written into palette entries 3 and 4 (``+`` and ``-``) on construction.
+    brain : Brain, optional
+        A closed-loop network controller (:mod:`softgym.design.brain`): when
+        set, it drives the muscles from the robot's senses instead of the
+        sinusoid (whose amplitude, muscle CTE and period still scale its
+        outputs and set its clock). None (the default): the seed's open loop.
 
     Raises
     ------
@@ -564,6 +570,7 @@ class RobotDesign:
     grid: np.ndarray
     palette: Palette = field(default_factory=default_palette)
     controller: Controller = field(default_factory=Controller)
+    brain: Brain | None = None
 
     def __post_init__(self) -> None:
         try:
@@ -589,6 +596,8 @@ class RobotDesign:
             raise InvalidDesignError(
                 f"controller must be a Controller, got {type(self.controller).__name__}"
             )
+        if self.brain is not None and not isinstance(self.brain, Brain):
+            raise InvalidDesignError(f"brain must be a Brain or None, got {type(self.brain).__name__}")
         grid = np.array(raw, dtype=np.int8, order="C", copy=True)
         used = [int(v) for v in np.unique(grid) if v != 0]
         missing = [v for v in used if v not in self.palette]
@@ -610,6 +619,7 @@ class RobotDesign:
             and bool(np.array_equal(self.grid, other.grid))
             and self.palette == other.palette
             and self.controller == other.controller
+            and self.brain == other.brain
         )
 
     __hash__ = None  # type: ignore[assignment]
@@ -617,7 +627,9 @@ class RobotDesign:
     def __repr__(self) -> str:
         return (
             f"RobotDesign(shape={self.shape}, n_voxels={self.n_voxels}, "
-            f"materials={self.material_counts()}, controller={self.controller})"
+            f"materials={self.material_counts()}, controller={self.controller}"
+            + ("" if self.brain is None else f", brain={self.brain!r}")
+            + ")"
         )
 
     @property
@@ -641,8 +653,9 @@ class RobotDesign:
         return {int(v): int(c) for v, c in zip(values, counts)}
 
     def replace(self, **changes: Any) -> RobotDesign:
-        """Return a copy with ``grid``, ``palette`` and/or ``controller`` replaced."""
-        kw = {"grid": self.grid, "palette": self.palette, "controller": self.controller}
+        """Return a copy with ``grid``, ``palette``, ``controller`` and/or ``brain`` replaced."""
+        kw = {"grid": self.grid, "palette": self.palette, "controller": self.controller,
+              "brain": self.brain}  # fmt: skip
         unknown = set(changes) - set(kw)
         if unknown:
             raise InvalidDesignError(f"unknown RobotDesign field(s) {sorted(unknown)}")
@@ -763,6 +776,7 @@ class RobotDesign:
             "grid": _grid_to_json(self.grid),
             "palette": self.palette.to_list(),
             "controller": self.controller.to_dict(),
+            **({} if self.brain is None else {"brain": self.brain.to_dict()}),
         }
 
     @classmethod
@@ -799,7 +813,8 @@ class RobotDesign:
         grid = _grid_from_json(data["grid"])
         palette = Palette.from_list(data["palette"])
         controller = Controller.from_dict(data["controller"])
-        return cls(grid=grid, palette=palette, controller=controller)
+        brain = None if data.get("brain") is None else Brain.from_dict(data["brain"])
+        return cls(grid=grid, palette=palette, controller=controller, brain=brain)
 
     def to_json(self, indent: int | None = 1) -> str:
         """Serialise to a JSON string (floats written exactly, no pickle)."""

@@ -52,6 +52,7 @@ import numpy as np
 
 from softgym.engine import _core
 from softgym.engine._openmp import openmp_enabled
+from softgym.engine._sense import contact_gaps as _contact_gaps
 from softgym.engine.body import Body
 from softgym.engine.config import SimConfig
 from softgym.engine.layout import (  # noqa: F401 (re-exported: the public API is unchanged)
@@ -545,6 +546,58 @@ class Simulation:
     def all_velocities(self) -> np.ndarray:
         """Voxel velocities (m/s) of the whole batch, shape (n_voxels, 3) (a copy; robots' voxels only)."""
         return self._a["vel"].copy() if self._own is None else self._a["vel"][self._own]
+
+    @property
+    def all_scales(self) -> np.ndarray:
+        """Actuated voxel edge lengths (m) of the whole batch, shape (n_voxels,) (robots' voxels only)."""
+        return self._a["scale"].copy() if self._own is None else self._a["scale"][self._own]
+
+    def object_velocity(self) -> np.ndarray:
+        """Ndarray of shape (n_robots, 3): velocity (m/s) of each robot's objects' centre of mass (0 if none)."""
+        a = self._a
+        if self._own is None:
+            return np.zeros((self.n_robots, 3))
+        total = np.add.reduceat(a["mass"], a["vox_start"][:-1])
+        m_obj = total - a["mass_total"]
+        p_obj = self.momentum(objects=True) - self.momentum()
+        with np.errstate(invalid="ignore", divide="ignore"):
+            v = p_obj / m_obj[:, None]
+        v[m_obj <= 0.0] = 0.0
+        return v
+
+    #: Lattice steps (Manhattan) within which a robot's own voxels never count as touching
+    #: each other in :meth:`contact_gaps` (at rest they are neighbours, not contacts).
+    SELF_TOUCH_HOPS: int = 3
+    #: Robots of more voxels skip the own-voxel part of :meth:`contact_gaps` (it is quadratic).
+    SELF_TOUCH_MAX_VOXELS: int = 4096
+
+    def contact_gaps(self, n_threads: int | None = None) -> np.ndarray:
+        """Each robot voxel's smallest surface gap (m) to anything it can touch, now.
+
+        The floor (its bottom face's height), the terrain's boxes and obstacle
+        voxels, the robot's movable objects and its own voxels more than
+        :attr:`SELF_TOUCH_HOPS` lattice steps away (robots of up to
+        :attr:`SELF_TOUCH_MAX_VOXELS` voxels), each voxel a cube of its actuated
+        edge (obstacle voxels of edge L). Negative values are penetration, +inf
+        where nothing can be touched (no floor and no obstacle). Computed in
+        compiled code, robots in parallel (``softgym.engine._sense``); it reads
+        the state and never changes a result.
+
+        Returns
+        -------
+        ndarray of shape (n_voxels,), float64
+            In the order of :attr:`all_positions`.
+        """
+        a = self._a
+        out = np.empty(self.n_voxels)
+        threads = self.n_threads if n_threads is None else int(n_threads)
+        _contact_gaps(
+            a["pos"], a["scale"], a["vox_start"], a["body_end"], self._grid_index, a["floor"],
+            a["box_start"], a["boxes"], a["obs_start"], np.ascontiguousarray(a["obs"]),
+            float(self.config.voxel_size), self.SELF_TOUCH_HOPS, self.SELF_TOUCH_MAX_VOXELS,
+            self._own_offsets.astype(np.intp), out, threads,
+        )  # fmt: skip
+        return out
 
     def set_external_force(self, robot: int, force: Any) -> None:
         """Apply a constant external force (N) to each voxel of one robot.

@@ -33,6 +33,7 @@ from softgym.validate import positive, show
 __all__ = [
     "DRIVES",
     "MAX_CONTROL_DT",
+    "OBSERVATIONS",
     "MAX_STEPS_PER_EPISODE",
     "OBS_POSITION_BOUND",
     "OBS_VELOCITY_BOUND",
@@ -44,8 +45,13 @@ __all__ = [
 OBS_POSITION_BOUND = 50.0
 #: Observed velocities are clipped to +-this (voxel lengths per second).
 OBS_VELOCITY_BOUND = 500.0
-#: What drives the muscles: the actions, or the design's own controller (actions ignored).
-DRIVES: tuple[str, ...] = ("action", "controller")
+#: What drives the muscles: the actions, the design's own sinusoid, or the design's brain
+#: (:class:`softgym.tasks.brains.BrainDrive`; actions ignored by the last two).
+DRIVES: tuple[str, ...] = ("action", "controller", "brain")
+#: What a robot observes: ``"blind"``, its voxels and a clock (:func:`observation_size`), or
+#: ``"sensing"``, every sensor of :mod:`softgym.tasks.sensing` (touch, strain, orientation, the
+#: task's senses).
+OBSERVATIONS: tuple[str, ...] = ("blind", "sensing")
 #: RGB colour of movable objects (push, carry) in rendered frames.
 OBJECT_COLOR = (0.55, 0.55, 0.6)
 #: Most control steps an episode may have: its centre-of-mass samples are allocated up front
@@ -118,7 +124,13 @@ class EpisodeBatch:
         as in :func:`softgym.evaluate` and the seed (actions are checked and
         ignored): the open-loop baseline, whose episode reports exactly
         :func:`softgym.evaluate`'s metrics when ``control_dt`` is the task's
-        ``trace_interval``.
+        ``trace_interval``. ``"brain"``: each design's
+        :class:`~softgym.design.Brain` sets them from its senses before each
+        control step (:attr:`brains`; actions are checked and ignored).
+    observe : {"blind", "sensing"}
+        What :meth:`observations` returns: the voxels and a clock
+        (:func:`observation_size`), or every sensor
+        (:func:`softgym.tasks.sensing.sensing_layout`).
     """
 
     def __init__(
@@ -133,11 +145,15 @@ class EpisodeBatch:
         terrains: list[Terrain] | None = None,
         n_threads: int | None = None,
         drive: str = "action",
+        observe: str = "blind",
     ) -> None:
         if not isinstance(task, Task):
             raise InvalidParameterError(f"task must be a Task, got {type(task).__name__}")
         if not isinstance(drive, str) or drive not in DRIVES:
             raise InvalidParameterError(f"drive must be one of {DRIVES}, got {show(drive)}")
+        if not isinstance(observe, str) or observe not in OBSERVATIONS:
+            raise InvalidParameterError(f"observe must be one of {OBSERVATIONS}, got {show(observe)}")
+        self.observe = observe
         self.task = task
         self.drive = drive
         self.metric = task.reward
@@ -206,7 +222,14 @@ class EpisodeBatch:
         )
         self.period = np.array([d.controller.period for d in self.designs], dtype=np.float64)
         self.robot_mass = np.array([self.sim.masses(r).sum() for r in range(n)])
-        self.obs_size = observation_size(self.grid_shape)
+        if observe == "blind":
+            self.obs_size = observation_size(self.grid_shape)
+        else:
+            from softgym.tasks.sensing import sensing_layout
+
+            self.obs_size = sensing_layout(task, self.grid_shape).size
+        self._sensing: Any = None
+        self._brains: Any = None
         self._settled: dict[str, np.ndarray] | None = None
         self._settled_time = np.zeros(n)
         self.cm0 = np.zeros((n, 3))
@@ -232,12 +255,32 @@ class EpisodeBatch:
         ).astype(np.intp)
         self._feat_bound = np.array([OBS_POSITION_BOUND] * 3 + [OBS_VELOCITY_BOUND] * 3)
         self._cell_buf = np.zeros((n * self.n_cells, 6))
+        if drive == "brain":
+            self._brains = self.brains  # the brains are checked against the task and grid now
+
+    @property
+    def sensing(self) -> Any:
+        """The batch's sensors (:class:`softgym.tasks.sensing.Sensing`), made on first use."""
+        if self._sensing is None:
+            from softgym.tasks.sensing import Sensing
+
+            self._sensing = Sensing(self)
+        return self._sensing
+
+    @property
+    def brains(self) -> Any:
+        """The designs' brains as one control step (:class:`softgym.tasks.brains.BrainDrive`)."""
+        if self._brains is None:
+            from softgym.tasks.brains import BrainDrive
+
+            self._brains = BrainDrive(self)
+        return self._brains
 
     # ---------------------------------------------------------------- reset
     def _settle(self) -> None:
         sim = self.sim
         sim.reset()
-        if self.drive == "action":
+        if self.drive != "controller":
             for r in range(self.n_robots):
                 sim.set_temperature(r, np.zeros(len(self.cells[r])))
         # (the design's controller holds the nominal sizes while settling, as idle muscles do)
@@ -283,6 +326,8 @@ class EpisodeBatch:
         self.done_diverged[:] = self._settled["diverged"] != 0
         self._time_offset[:] = 0.0
         self._start_trace(slice(None))
+        if self._brains is not None:
+            self._brains.reset()
 
     def reset_robots(self, ids: np.ndarray) -> None:
         """Put the robots ``ids`` back to their settled start; the others go on untouched."""
@@ -301,6 +346,8 @@ class EpisodeBatch:
         self.done_diverged[ids] = init["diverged"][ids] != 0
         self._time_offset[ids] = self.sim.time[ids] - self._settled_time[ids]
         self._start_trace(ids)
+        if self._brains is not None:
+            self._brains.reset(ids)
 
     # ----------------------------------------------------------------- step
     def validate_actions(self, actions: Any, single: bool = False) -> np.ndarray:
@@ -349,12 +396,13 @@ class EpisodeBatch:
             )
         return np.clip(a, -1.0, 1.0)
 
-    def apply(self, actions: np.ndarray, active: np.ndarray | None = None) -> None:
+    def apply(self, actions: np.ndarray, active: np.ndarray | None = None, force: bool = False) -> None:
         """Set every active robot's muscle temperatures ``action * dT`` (degC).
 
-        With ``drive="controller"`` the design's controller keeps the muscles.
+        With ``drive="controller"`` the design's controller keeps the muscles,
+        with ``drive="brain"`` its brain (which calls this with ``force=True``).
         """
-        if self.drive == "controller":
+        if self.drive != "action" and not force:
             return
         # every voxel of the batch at once: its cell's action times its robot's dT
         temps = actions.reshape(-1)[self._flat_cells] * self.amplitude[self._voxel_robot]
@@ -417,8 +465,15 @@ class EpisodeBatch:
         """Each robot's time since it was placed (s): settling plus its episode's steps."""
         return self.settle_seconds + self.steps * self.control_dt
 
+    def trace(self, r: int) -> np.ndarray:
+        """Robot ``r``'s centre-of-mass samples of its episode so far: rows (x, y, z, t), m and s."""
+        k = int(min(self.steps[r], self.max_steps)) + 1
+        return np.column_stack([self._trace_cm[r, :k], self._trace_t[r, :k]])
+
     def observations(self) -> np.ndarray:
         """Observation of every robot, ndarray of shape (n_robots, obs_size), float32."""
+        if self.observe == "sensing":
+            return self.sensing.observation(self.clock(), self.period).astype(np.float32)
         sim = self.sim
         n, nc = self.n_robots, self.n_cells
         obs = np.empty((n, self.obs_size), dtype=np.float32)

@@ -23,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from softgym.exceptions import InvalidParameterError
+from softgym.tasks.sensing import SENSES, TaskSense
 from softgym.terrain import Block, Box, Terrain
 
 __all__ = ["KINDS", "Option", "TaskKind", "flat_layout", "stairs_layout", "wall_layout"]
@@ -86,6 +87,10 @@ class TaskKind:
         Its difficulty arguments.
     sim : callable
         ``sim(options) -> dict`` of :class:`~softgym.engine.SimConfig` fields it sets.
+    senses : tuple of TaskSense
+        What a robot senses of the task beyond its own body
+        (:data:`softgym.tasks.sensing.SENSES`: the object, the target, terrain
+        heights ahead...): the task part of the sensing observation.
     """
 
     name: str
@@ -94,6 +99,7 @@ class TaskKind:
     reward: str
     options: Mapping[str, Option] = field(default_factory=dict)
     sim: Callable[[Mapping[str, Any]], dict[str, Any]] = lambda o: {}
+    senses: tuple[TaskSense, ...] = ()
 
     def resolve(self, options: Mapping[str, Any] | None) -> dict[str, Any]:
         """Every argument, the given ones checked, the others at their defaults."""
@@ -289,6 +295,9 @@ def stairs_layout(shape: Sequence[int]) -> Terrain:
 
 # ----------------------------------------------------------------------- suite
 _SEED = Option(0, 0, 2**31 - 1, "seed of the random heights", integer=True)
+# the task senses (softgym.tasks.sensing): what each kind lets a robot perceive
+_TERRAIN = (SENSES["terrain"],)
+_OBJECT = (SENSES["object"],)
 
 #: Every kind of task by name, the one registry: the seed's three (``flat``, ``wall``,
 #: ``stairs``: no arguments) and the suite's.
@@ -297,15 +306,16 @@ KINDS: dict[str, TaskKind] = {
     for k in (
         TaskKind("flat", "walk on flat ground (the seed's)", flat_layout, "norm_final_dist"),
         TaskKind("wall", "get past a fence around the start (the seed's obstacle)", wall_layout,
-                 "max_xy_dist"),  # fmt: skip
+                 "max_xy_dist", senses=_TERRAIN),  # fmt: skip
         TaskKind("stairs", "climb three rings of steps around the start", stairs_layout,
-                 "max_xy_dist"),  # fmt: skip
+                 "max_xy_dist", senses=_TERRAIN),  # fmt: skip
         TaskKind(
             "stairs_down", "walk down a stepped pyramid from its top", stairs_down_layout,
             "max_xy_dist",
             {"step_height": Option(1.0, 0.25, 3.0, "height of each step, voxel lengths"),
              "n_steps": Option(3, 1, 10, "steps down to the ground", integer=True),
              "step_width": Option(2.0, 1.0, 10.0, "width of each step, voxel lengths")},
+            senses=_TERRAIN,
         ),
         TaskKind(
             "rough", "walk over a seeded random height field of boxes", rough_layout,
@@ -314,22 +324,25 @@ KINDS: dict[str, TaskKind] = {
              "tile": Option(3.0, 1.0, 10.0, "side of a tile, voxel lengths"),
              "extent": Option(12.0, 4.0, 30.0, "half side of the rough area, voxel lengths"),
              "seed": _SEED},
+            senses=_TERRAIN,
         ),
         TaskKind(
             "gap", "reach across a pit from the start platform to the ground around it", gap_layout,
             "gap_crossed",
             {"width": Option(2.0, 0.5, 10.0, "width of the pit, voxel lengths"),
              "depth": Option(4.0, 1.0, 20.0, "depth of the pit, voxel lengths")},
+            senses=_TERRAIN,
         ),
         TaskKind(
             "tunnel", "crawl out under a low roof", tunnel_layout, "max_xy_dist",
             {"clearance": Option(0.75, 0.0, 4.0, "how far the roof is below the grid's top, voxel lengths"),
              "length": Option(6.0, 1.0, 20.0, "length of the roofed ring, voxel lengths")},
+            senses=_TERRAIN,
         ),
         TaskKind(
             "incline", "walk uphill (+x) on a slope made by tilting gravity", _flat("incline"),
             "x_progress", {"angle": Option(5.0, 0.0, 30.0, "slope, degrees")},
-            sim=lambda o: {"incline": float(o["angle"])},
+            sim=lambda o: {"incline": float(o["angle"])}, senses=(SENSES["gravity"],),
         ),
         TaskKind(
             "ice", "walk on slippery ground", _flat("ice"), "norm_final_dist",
@@ -345,17 +358,20 @@ KINDS: dict[str, TaskKind] = {
             "jump", "raise the centre of mass as high as possible (muscles expand and contract)",
             _flat("jump"), "peak_height", sim=lambda o: {"actuation": "symmetric"},
         ),
-        TaskKind("turn", "turn in place about the vertical axis", _flat("turn"), "yaw"),
+        TaskKind("turn", "turn in place about the vertical axis", _flat("turn"), "yaw",
+                 senses=(SENSES["heading"],)),  # fmt: skip
         TaskKind(
             "push", "push a box to a target (-x of the robot)", push_layout, "push_progress",
             {"size": Option(3, 1, 6, "side of the box, voxels", integer=True),
              "distance": Option(10.0, 1.0, 50.0, "target distance from the box, voxel lengths"),
              "density": Option(5e5, 1e4, 1e7, "the box's density, kg/m^3 (the robot's: 1e6)")},
+            senses=(SENSES["object"], SENSES["target"]),
         ),
         TaskKind(
             "carry", "walk with a cap on top without dropping it", carry_layout, "carried_dist",
             {"rim": Option(2, 0, 4, "depth of the cap's rim round the robot's top, voxels", integer=True),
              "density": Option(1e5, 1e4, 1e7, "the cap's density, kg/m^3 (the robot's: 1e6)")},
+            senses=_OBJECT,
         ),
         TaskKind(
             "swim", "swim in a fluid (no floor, no weight, drag on exposed faces; muscles expand and contract)", _swim,

@@ -186,6 +186,22 @@ class Task:
         return self.terrain + ":" + ",".join(f"{k}={v!r}" for k, v in sorted(changed.items()))
 
     @property
+    def senses(self) -> tuple:
+        """The task's senses (:class:`softgym.tasks.sensing.TaskSense`): its kind's, or for a custom
+        terrain the terrain heights ahead where it has boxes and the object where it has objects.
+        """
+        from softgym.tasks.sensing import SENSES
+
+        if isinstance(self.terrain, str):
+            return KINDS[self.terrain].senses
+        out = []
+        if self.terrain.boxes or not self.terrain.floor:
+            out.append(SENSES["terrain"])
+        if self.terrain.objects:
+            out.append(SENSES["object"])
+        return tuple(out)
+
+    @property
     def metric_names(self) -> tuple[str, ...]:
         """The fitness measures the task reports: :data:`softgym.metrics.WALK_METRICS` and its score."""
         extra = (self.reward,) if self.reward not in WALK_METRICS else ()
