@@ -266,7 +266,7 @@ class Brain:
         return cls(BrainSpec.from_dict(rest), data["weights"])
 
 
-def forward(spec: BrainSpec, weights: np.ndarray, x: np.ndarray) -> np.ndarray:
+def forward(spec: BrainSpec, weights: np.ndarray, x: np.ndarray | list[np.ndarray]) -> np.ndarray:
     """The networks of many robots at once: ``tanh`` hidden layer, ``tanh`` outputs in [-1, 1].
 
     Parameters
@@ -274,19 +274,32 @@ def forward(spec: BrainSpec, weights: np.ndarray, x: np.ndarray) -> np.ndarray:
     spec : BrainSpec
         Every robot's network has these sizes.
     weights : ndarray of shape (n_robots, spec.n_params)
-    x : ndarray of shape (n_robots, ..., spec.n_inputs)
-        The inputs (any number of middle axes: a distributed brain's cells).
+    x : ndarray of shape (n_robots, m, spec.n_inputs), or a list of parts
+        The inputs of ``m`` networks per robot (a distributed brain's cells;
+        1 for a central brain). As a list, the parts' last axes are the
+        inputs in order, each part of shape (n_robots, m, k) or (n_robots, 1,
+        k): a part shared by a robot's networks (its clock, its task senses)
+        is multiplied once per robot, not once per cell.
 
     Returns
     -------
-    ndarray of shape (n_robots, ..., spec.n_outputs), float64
+    ndarray of shape (n_robots, m, spec.n_outputs), float64
     """
+    parts = [x] if isinstance(x, np.ndarray) else list(x)
     n = weights.shape[0]
-    mid = x.shape[1:-1]
-    h = x.reshape(n, -1, x.shape[-1])
     start = 0
-    for rows, cols in spec.layer_shapes():
+    h = None
+    for layer, (rows, cols) in enumerate(spec.layer_shapes()):
         w = weights[:, start:start + rows * cols].reshape(n, rows, cols)
         start += rows * cols
-        h = np.tanh(np.einsum("rci,roi->rco", h, w[:, :, :-1], optimize=True) + w[:, None, :, -1])
-    return h.reshape(n, *mid, spec.n_outputs)
+        if layer == 0:
+            at = 0
+            for part in parts:
+                k = part.shape[-1]
+                term = np.matmul(part, w[:, :, at:at + k].transpose(0, 2, 1))
+                h = term if h is None else h + term
+                at += k
+        else:
+            h = np.matmul(h, w[:, :, :-1].transpose(0, 2, 1))
+        h = np.tanh(h + w[:, None, :, -1])
+    return h

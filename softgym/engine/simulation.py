@@ -571,17 +571,18 @@ class Simulation:
     #: Robots of more voxels skip the own-voxel part of :meth:`contact_gaps` (it is quadratic).
     SELF_TOUCH_MAX_VOXELS: int = 4096
 
-    def contact_gaps(self, n_threads: int | None = None) -> np.ndarray:
-        """Each robot voxel's smallest surface gap (m) to anything it can touch, now.
+    def contact_gaps(self, cap: float = math.inf, n_threads: int | None = None) -> np.ndarray:
+        """Each robot voxel's smallest surface gap (m) to anything it can touch, now, at most ``cap``.
 
         The floor (its bottom face's height), the terrain's boxes and obstacle
         voxels, the robot's movable objects and its own voxels more than
         :attr:`SELF_TOUCH_HOPS` lattice steps away (robots of up to
         :attr:`SELF_TOUCH_MAX_VOXELS` voxels), each voxel a cube of its actuated
-        edge (obstacle voxels of edge L). Negative values are penetration, +inf
-        where nothing can be touched (no floor and no obstacle). Computed in
-        compiled code, robots in parallel (``softgym.engine._sense``); it reads
-        the state and never changes a result.
+        edge (obstacle voxels of edge L). Negative values are penetration;
+        ``cap`` (m) where nothing is nearer, and for voxels with all six bonds
+        (they touch only their neighbours). Computed in compiled code, robots
+        in parallel (``softgym.engine._sense``); it reads the state and never
+        changes a result.
 
         Returns
         -------
@@ -592,10 +593,10 @@ class Simulation:
         out = np.empty(self.n_voxels)
         threads = self.n_threads if n_threads is None else int(n_threads)
         _contact_gaps(
-            a["pos"], a["scale"], a["vox_start"], a["body_end"], self._grid_index, a["floor"],
-            a["box_start"], a["boxes"], a["obs_start"], np.ascontiguousarray(a["obs"]),
+            a["pos"], a["scale"], a["surface"], a["vox_start"], a["body_end"], self._grid_index,
+            a["floor"], a["box_start"], a["boxes"], a["obs_start"], np.ascontiguousarray(a["obs"]),
             float(self.config.voxel_size), self.SELF_TOUCH_HOPS, self.SELF_TOUCH_MAX_VOXELS,
-            self._own_offsets.astype(np.intp), out, threads,
+            float(cap), self._own_offsets.astype(np.intp), out, threads,
         )  # fmt: skip
         return out
 

@@ -31,34 +31,47 @@ from softgym.envs.vector import SoftWalkerVectorEnv
 from softgym.envs.walker import SoftWalkerEnv
 from softgym.tasks import TASKS
 
-__all__ = ["ENV_IDS", "TASKS", "SoftWalkerEnv", "SoftWalkerVectorEnv", "env_id", "register_envs"]
+__all__ = ["ENV_IDS", "SENSING_ENV_IDS", "TASKS", "SoftWalkerEnv", "SoftWalkerVectorEnv", "env_id", "register_envs"]
 
 #: Registered ids -> task name (filled by :func:`register_envs`).
 ENV_IDS: dict[str, str] = {}
 
 
 
-def env_id(task_name: str) -> str:
-    """The Gym id of a task name: ``"wall"`` -> ``"SoftWalker-Wall-v0"``."""
-    return f"SoftWalker-{task_name.replace('_', ' ').title().replace(' ', '')}-v0"
+#: Registered sensing ids (``observe="sensing"``: ``SoftWalker-<Name>-Sensing-v0``) -> task name.
+SENSING_ENV_IDS: dict[str, str] = {}
+
+
+def env_id(task_name: str, sensing: bool = False) -> str:
+    """The Gym id of a task name: ``"wall"`` -> ``"SoftWalker-Wall-v0"`` (``sensing=True``:
+    ``"SoftWalker-Wall-Sensing-v0"``).
+
+    The plain ids observe the robot's voxels and a clock (the blind
+    observation); the sensing ids every sensor and the task's senses
+    (:mod:`softgym.tasks.sensing`), the same as ``observe="sensing"``.
+    """
+    name = task_name.replace("_", " ").title().replace(" ", "")
+    return f"SoftWalker-{name}{'-Sensing' if sensing else ''}-v0"
 
 
 def register_envs() -> None:
     """Register an id for every task of :data:`softgym.tasks.TASKS` (idempotent)."""
     for task in TASKS:
         ENV_IDS.setdefault(env_id(task), task)
-    for eid, task in ENV_IDS.items():
-        if eid in gym.registry:
-            continue
-        gym.register(
-            id=eid,
-            entry_point="softgym.envs.walker:SoftWalkerEnv",
-            vector_entry_point="softgym.envs.vector:SoftWalkerVectorEnv",
-            # no step limit: an episode lasts its task's seconds whatever control_dt
-            # (the env truncates itself; gym.make(..., max_episode_steps=k) still adds one)
-            max_episode_steps=None,
-            kwargs={"task": task},
-        )
+        SENSING_ENV_IDS.setdefault(env_id(task, sensing=True), task)
+    for ids, extra in ((ENV_IDS, {}), (SENSING_ENV_IDS, {"observe": "sensing"})):
+        for eid, task in ids.items():
+            if eid in gym.registry:
+                continue
+            gym.register(
+                id=eid,
+                entry_point="softgym.envs.walker:SoftWalkerEnv",
+                vector_entry_point="softgym.envs.vector:SoftWalkerVectorEnv",
+                # no step limit: an episode lasts its task's seconds whatever control_dt
+                # (the env truncates itself; gym.make(..., max_episode_steps=k) still adds one)
+                max_episode_steps=None,
+                kwargs={"task": task, **extra},
+            )
 
 
 register_envs()

@@ -119,6 +119,7 @@ class SoftWalkerVectorEnv(VectorEnv):
         max_episode_steps: int | None = None,
         autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
         drive: str = "action",
+        observe: str = "blind",
         action_mode: str | None = None,
     ) -> None:
         try:
@@ -165,7 +166,7 @@ class SoftWalkerVectorEnv(VectorEnv):
             robots, task, terrain=terrain, episode_seconds=episode_seconds,
             control_dt=control_dt, actuation=actuation, self_collision=self_collision,
             grid_shape=grid_shape, sim_config=sim_config, n_threads=n_threads,
-            max_episode_steps=max_episode_steps, drive=drive,
+            max_episode_steps=max_episode_steps, drive=drive, observe=observe,
         )  # fmt: skip
         b = self._batch
         self._action_map = ActionMap(b, action_mode)
@@ -187,7 +188,8 @@ class SoftWalkerVectorEnv(VectorEnv):
         self._renderer: Any = None
         self.single_action_space = action_space(b.grid_shape)
         self.action_space = batch_space(self.single_action_space, num_envs)
-        self.single_observation_space = observation_space(b.grid_shape)
+        self.observe = b.observe
+        self.single_observation_space = observation_space(b.grid_shape, b.task, b.observe)
         self.observation_space = batch_space(self.single_observation_space, num_envs)
         self._prev_done = np.zeros(num_envs, dtype=bool)
         self._needs_reset = True

@@ -180,6 +180,7 @@ def make_batch(
     n_threads: int | None,
     max_episode_steps: int | None,
     drive: str,
+    observe: str = "blind",
 ) -> EpisodeBatch:
     """The :class:`~softgym.tasks.EpisodeBatch` behind a SoftWalker env (the single and vector envs' shared set-up).
 
@@ -207,7 +208,7 @@ def make_batch(
             )
     batch = EpisodeBatch(
         designs, t, grid_shape, control_dt, episode_seconds, max_episode_steps, config,
-        n_threads=n_threads, drive=drive,
+        n_threads=n_threads, drive=drive, observe=observe,
     )  # fmt: skip
     if max_episode_steps is not None:
         warn_if_cut_short(max_episode_steps, batch.control_dt, batch.episode_seconds)
@@ -449,6 +450,7 @@ class SoftWalkerEnv(gym.Env):
         max_episode_steps: int | None = None,
         drive: str = "action",
         action_mode: str | None = None,
+        observe: str = "blind",
     ) -> None:
         super().__init__()
         size = check_render_options(render_mode, width, height)
@@ -457,9 +459,10 @@ class SoftWalkerEnv(gym.Env):
             [self.design], task, terrain=terrain, episode_seconds=episode_seconds,
             control_dt=control_dt, actuation=actuation, self_collision=self_collision,
             grid_shape=grid_shape, sim_config=sim_config, n_threads=n_threads,
-            max_episode_steps=max_episode_steps, drive=drive,
+            max_episode_steps=max_episode_steps, drive=drive, observe=observe,
         )  # fmt: skip
         b = self._batch
+        self.observe = b.observe
         self._action_map = ActionMap(b, action_mode)
         self.action_mode = self._action_map.mode
         self.task = b.task
@@ -472,7 +475,7 @@ class SoftWalkerEnv(gym.Env):
         self.width, self.height = size
         self._renderer: Any = None
         self.action_space = action_space(b.grid_shape)
-        self.observation_space = observation_space(b.grid_shape)
+        self.observation_space = observation_space(b.grid_shape, b.task, b.observe)
         self._needs_reset = True
 
     # ------------------------------------------------------------ properties
@@ -611,8 +614,14 @@ def action_space(grid_shape: Sequence[int]) -> spaces.Box:
     return spaces.Box(-1.0, 1.0, (int(np.prod(grid_shape)),), dtype=np.float32)
 
 
-def observation_space(grid_shape: Sequence[int]) -> spaces.Box:
-    """The observation space of a grid (see :class:`SoftWalkerEnv`)."""
+def observation_space(grid_shape: Sequence[int], task: Task | None = None,
+                      observe: str = "blind") -> spaces.Box:  # fmt: skip
+    """The observation space of a grid (see :class:`SoftWalkerEnv`): blind, or a task's sensing one."""
+    if observe == "sensing":
+        from softgym.tasks.sensing import sensing_layout
+
+        high = sensing_layout(Task() if task is None else task, grid_shape).bounds().astype(np.float32)
+        return spaces.Box(-high, high, dtype=np.float32)
     n = int(np.prod(grid_shape))
     high = np.empty(observation_size(grid_shape), dtype=np.float32)
     cell = high[: 6 * n].reshape(n, 6)

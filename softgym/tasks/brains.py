@@ -19,15 +19,17 @@ from typing import Any
 import numpy as np
 
 from softgym.design import RobotDesign
-from softgym.design.brain import BrainSpec, forward
+from softgym.design.brain import WEIGHT_BOUND, Brain, BrainSpec, forward
 from softgym.exceptions import InvalidDesignError, InvalidParameterError
-from softgym.tasks.sensing import sensing_layout
+from softgym.tasks.sensing import CELL_SENSORS, ROBOT_SENSORS, sensing_layout
 from softgym.tasks.task import Task
 from softgym.validate import show
 
-__all__ = ["BrainDrive", "brain_spec", "run_brains"]
+__all__ = ["BrainDrive", "brain_spec", "run_brains", "sinusoid_brain"]
 
 #: One step along each lattice axis, both ways: the distributed brains' six neighbours.
+#: Index of ``clock_sin`` among the robot sensors.
+_CLOCK_SIN = [name for name, _, _ in ROBOT_SENSORS].index("clock_sin")
 _NEIGHBOURS: tuple[tuple[int, int], ...] = ((0, 1), (0, -1), (1, 1), (1, -1), (2, 1), (2, -1))
 
 
@@ -68,6 +70,41 @@ def brain_spec(
         return BrainSpec("distributed", layout.local_size + 6 * int(s), 1 + int(s), hidden, int(s),
                          control_dt)  # fmt: skip
     raise InvalidParameterError(f"brain kind must be 'central' or 'distributed', got {show(kind)}")
+
+
+def sinusoid_brain(spec: BrainSpec, gain: float = 2.0) -> Brain:
+    """The brain that drives every muscle with the clock alone: the seed's gait as a network.
+
+    Every weight is 0 but the path from the clock's ``sin`` input to the
+    actuation output (through hidden unit 0 when there is a hidden layer),
+    each ``gain``: the output is ``tanh(gain tanh(gain sin(2 pi t / period)))``
+    on every muscle, which the contraction map turns into the two muscle
+    kinds' counter-phase (the sinusoid's gait, squarer). A start for an
+    optimiser that then adds what the senses tell.
+    """
+    # the inputs: a central brain's cells (8 each) or a voxel's own cell, then the robot's
+    cells = len(CELL_SENSORS) * (spec.n_outputs if spec.kind == "central" else 1)
+    clock = cells + _CLOCK_SIN
+    g = float(min(max(gain, -WEIGHT_BOUND), WEIGHT_BOUND))
+    w = np.zeros(spec.n_params)
+    shapes = spec.layer_shapes()
+    if spec.hidden == 0:
+        rows, cols = shapes[0]
+        m = w[: rows * cols].reshape(rows, cols)
+        if spec.kind == "central":
+            m[:, clock] = g
+        else:
+            m[0, clock] = g
+        return spec.brain(w)
+    (r1, c1), (r2, c2) = shapes
+    m1 = w[: r1 * c1].reshape(r1, c1)
+    m1[0, clock] = g
+    m2 = w[r1 * c1:].reshape(r2, c2)
+    if spec.kind == "central":
+        m2[:, 0] = g
+    else:
+        m2[0, 0] = g
+    return spec.brain(w)
 
 
 class BrainDrive:
@@ -160,20 +197,17 @@ class BrainDrive:
         cells, robot, task = b.sensing.read(b.clock(), b.period)
         n, nc = b.n_robots, b.n_cells
         out = np.zeros((n, nc))
+        nc_cell = cells.shape[2]
+        shared = np.concatenate([robot, task], axis=1) / self.local_scales[nc_cell:]
         for k, (spec, ids, w) in enumerate(self.groups):
             if spec.kind == "central":
                 x = np.concatenate([cells[ids].reshape(len(ids), -1), robot[ids], task[ids]], axis=1)
-                out[ids] = forward(spec, w, x / self.scales)
+                out[ids] = forward(spec, w, (x / self.scales)[:, None, :])[:, 0, :]
                 continue
-            shared = np.concatenate([robot[ids], task[ids]], axis=1)
-            local = np.concatenate(
-                [cells[ids], np.broadcast_to(shared[:, None, :], (len(ids), nc, shared.shape[1]))],
-                axis=2,
-            ) / self.local_scales
-            parts = [local]
+            parts = [cells[ids] / self.local_scales[:nc_cell], shared[ids][:, None, :]]
             if spec.signals:
                 parts.append(self._neighbour_signals(self.signals[k]))
-            y = forward(spec, w, np.concatenate(parts, axis=2))
+            y = forward(spec, w, parts)
             out[ids] = y[..., 0]
             if spec.signals:
                 self.signals[k] = y[..., 1:] * self.mask[ids][:, :, None]

@@ -388,7 +388,7 @@ class Sensing:
         rel = (pos - cm[vr]) / L
         feats[b._flat_cells, 0:3] = rel
         feats[b._flat_cells, 3:6] = (sim.all_velocities - cm_vel[vr]) / L
-        gaps = sim.contact_gaps() / L
+        gaps = sim.contact_gaps(cap=TOUCH_REACH * L) / L
         feats[b._flat_cells, 6] = np.clip(1.0 - np.maximum(gaps, 0.0) / TOUCH_REACH, 0.0, 1.0)
         cells = feats.reshape(n, nc, 8)
         # strain: the mean stretch of each cell's bonds (lattice positions in voxel lengths)

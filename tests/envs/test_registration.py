@@ -124,3 +124,22 @@ def test_make_vec_uses_the_batched_vector_env():
     assert venv.action_space.shape == (2, 216)
     assert venv.observation_space.shape == (2, 1301)
     venv.close()
+
+
+def test_sensing_ids_are_check_env_clean_and_see_their_task():
+    from gymnasium.utils.env_checker import check_env
+
+    from softgym.envs import SENSING_ENV_IDS, env_id
+    from softgym.tasks import get_task
+    from softgym.tasks.sensing import sensing_layout
+
+    assert env_id("push", sensing=True) == "SoftWalker-Push-Sensing-v0" in SENSING_ENV_IDS
+    for name in ("push", "gap", "turn"):
+        env = gym.make(env_id(name, sensing=True))
+        check_env(env.unwrapped, skip_render_check=True)
+        size = sensing_layout(get_task(name), (6, 6, 6)).size
+        assert env.observation_space.shape == (size,)
+        assert gym.make(env_id(name)).observation_space.shape == (6 * 216 + 5,)  # v0 stays blind
+    vec = gym.make_vec("SoftWalker-Push-Sensing-v0", num_envs=2, vectorization_mode="vector_entry_point")
+    obs, _ = vec.reset(seed=0)
+    assert obs.shape == (2, sensing_layout(get_task("push"), (6, 6, 6)).size)
