@@ -3,7 +3,8 @@
 At ``builder-inited`` it writes ``docs/tasks/index.md`` and ``docs/tasks/<name>.md``
 (generated, git-ignored) from each task's registry entry: its summary, Gym id, score,
 arguments with their defaults and ranges, the engine settings it sets, the world it
-builds around the default 6x6x6 grid and the docstring of its layout function. Run it
+builds around the default 6x6x6 grid, the docstring of its layout function and its
+sensing observation's layout (``softgym.tasks.sensing``). Run it
 alone with ``python docs/_ext/softgym_tasks.py OUT_DIR``.
 """
 
@@ -13,6 +14,7 @@ from pathlib import Path
 
 from softgym.envs import env_id
 from softgym.tasks import ALIASES, KINDS, get_task
+from softgym.tasks.sensing import CELL_SENSORS, ROBOT_SENSORS, sensing_layout
 
 SHAPE = (6, 6, 6)
 
@@ -35,7 +37,7 @@ def task_page(name: str) -> str:
         "",
         "| | |",
         "|---|---|",
-        f"| Gym id | `{env_id(name)}` |",
+        f"| Gym id | `{env_id(name)}` (blind), `{env_id(name, sensing=True)}` (sensing) |",
         f"| score (`reward`) | `{kind.reward}` |",
         f"| `softgym evolve` | `--task {name}` |",
         f"| `softgym.evaluate` | `task=\"{name}\"` |",
@@ -74,6 +76,21 @@ def task_page(name: str) -> str:
     doc = inspect.getdoc(kind.layout)
     if doc:
         lines += ["", "The layout function's docstring:", "", "```text", doc, "```"]
+    lay = sensing_layout(task, SHAPE)
+    lines += [
+        "", "## Observation (sensing)", "",
+        f"`{env_id(name, sensing=True)}` (or `observe=\"sensing\"`) observes "
+        f"{lay.size} values on the {'x'.join(map(str, SHAPE))} grid ({len(CELL_SENSORS)} per "
+        f"cell, {len(ROBOT_SENSORS)} of the robot, {lay.n_task} of the task), each clipped "
+        "to its bound; `c` is a cell's C-order index, `n` the number of cells. A brain reads "
+        "the same values (`softgym.tasks.brains.brain_spec`): a central one all of them, a "
+        f"distributed one its cell's, the robot's and the task's ({lay.local_size}) plus its "
+        "neighbours' signals.",
+        "", "| index | value | bound |", "|---|---|---|",
+    ]
+    lines += [f"| `{i}` | {what} | {b} |" for i, what, b in lay.table()]
+    if not lay.task_senses:
+        lines += ["", "The task adds no senses of its own: the robot feels the world through touch."]
     return "\n".join(lines) + "\n"
 
 

@@ -128,3 +128,89 @@ def contact_gaps(
         _robot_gaps(r, &pos[0, 0], &scale[0], &surface[0], &vox_start[0], &body_end[0],
                     &grid[0, 0], &floor[0], &box_start[0], bx, &obs_start[0], ob, 0.5 * obs_edge,
                     self_hops, self_max, cap, &out[0], own_offsets[r])
+
+
+cdef void _robot_cells(
+    intp_t r, const float64_t* pos, const float64_t* vel, const float64_t* gaps,
+    const float64_t* cm, const float64_t* cm_vel, const intp_t* own_offsets, const intp_t* cell_of,
+    const intp_t* voxel_of, intp_t nx, intp_t ny, intp_t nz, double inv_l, double reach,
+    double pos_bound, double vel_bound, const float64_t* rest, float64_t* out, float64_t* cov,
+) noexcept nogil:
+    cdef intp_t nc = nx * ny * nz
+    cdef intp_t v, c, i, j, k, a, w, m, cnt
+    cdef intp_t step[3]
+    cdef intp_t coord[3]
+    cdef intp_t size[3]
+    cdef double rel[3]
+    cdef double d, dx, dy, dz, s, t
+    cdef float64_t* o
+    cdef const float64_t* q
+    step[0] = ny * nz
+    step[1] = nz
+    step[2] = 1
+    size[0] = nx
+    size[1] = ny
+    size[2] = nz
+    for a in range(9):
+        cov[9 * r + a] = 0.0
+    for v in range(own_offsets[r], own_offsets[r + 1]):
+        c = cell_of[v]
+        o = &out[(r * nc + c) * 8]
+        for a in range(3):
+            rel[a] = (pos[3 * v + a] - cm[3 * r + a]) * inv_l
+            o[a] = min(max(rel[a], -pos_bound), pos_bound)
+            o[3 + a] = min(max((vel[3 * v + a] - cm_vel[3 * r + a]) * inv_l, -vel_bound), vel_bound)
+        t = gaps[v] * inv_l
+        t = 1.0 - (t if t > 0.0 else 0.0) / reach
+        o[6] = t if t > 0.0 else 0.0
+        # strain: the mean stretch of the voxel's bonds to its lattice neighbours
+        coord[0] = c // step[0]
+        coord[1] = (c // step[1]) % ny
+        coord[2] = c % nz
+        s = 0.0
+        cnt = 0
+        for a in range(3):
+            for k in range(2):
+                m = coord[a] + (1 if k == 0 else -1)
+                if m < 0 or m >= size[a]:
+                    continue
+                w = voxel_of[r * nc + c + (step[a] if k == 0 else -step[a])]
+                if w < 0:
+                    continue
+                q = &pos[3 * w]
+                dx = pos[3 * v] - q[0]
+                dy = pos[3 * v + 1] - q[1]
+                dz = pos[3 * v + 2] - q[2]
+                s += sqrt(dx * dx + dy * dy + dz * dz) * inv_l - 1.0
+                cnt += 1
+        o[7] = min(max(s / cnt if cnt else 0.0, -1.0), 1.0)
+        # the cross-covariance of the lattice positions and the current ones (the body's rotation)
+        for i in range(3):
+            for j in range(3):
+                cov[9 * r + 3 * i + j] += rest[(r * nc + c) * 3 + i] * rel[j]
+
+
+def cell_sensors(
+    const float64_t[:, ::1] pos, const float64_t[:, ::1] vel, const float64_t[::1] gaps,
+    const float64_t[:, ::1] cm, const float64_t[:, ::1] cm_vel, const intp_t[::1] own_offsets,
+    const intp_t[::1] cell_of, const intp_t[:, ::1] voxel_of, intp_t nx, intp_t ny, intp_t nz,
+    double voxel_size, double reach, double pos_bound, double vel_bound,
+    const float64_t[:, :, ::1] rest, float64_t[:, :, ::1] out, float64_t[:, :, ::1] cov,
+    int n_threads,
+):
+    """Each robot voxel's eight cell sensors into ``out`` (n_robots, n_cells, 8), rows of its
+    cell (position and velocity relative to the centre of mass in voxel lengths, clipped to
+    the bounds; touch from ``gaps`` (m), 1 at contact, 0 from ``reach`` voxel lengths; the mean
+    bond stretch to its lattice neighbours, clipped to +-1), and each robot's cross-covariance
+    of its centred lattice positions ``rest`` with the relative positions into ``cov``
+    (n_robots, 3, 3). Rows of empty cells are left as they are. Robots in parallel."""
+    cdef intp_t n = cm.shape[0]
+    cdef intp_t r
+    if out.shape[0] != n or out.shape[1] != nx * ny * nz or out.shape[2] != 8:
+        raise ValueError("out must have shape (n_robots, n_cells, 8)")
+    if n_threads < 1:
+        n_threads = 1
+    for r in prange(n, nogil=True, schedule="static", num_threads=n_threads):
+        _robot_cells(r, &pos[0, 0], &vel[0, 0], &gaps[0], &cm[0, 0], &cm_vel[0, 0],
+                     &own_offsets[0], &cell_of[0], &voxel_of[0, 0], nx, ny, nz, 1.0 / voxel_size,
+                     reach, pos_bound, vel_bound, &rest[0, 0, 0], &out[0, 0, 0], &cov[0, 0, 0])

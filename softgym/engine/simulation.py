@@ -52,6 +52,7 @@ import numpy as np
 
 from softgym.engine import _core
 from softgym.engine._openmp import openmp_enabled
+from softgym.engine._sense import cell_sensors as _cell_sensors
 from softgym.engine._sense import contact_gaps as _contact_gaps
 from softgym.engine.body import Body
 from softgym.engine.config import SimConfig
@@ -599,6 +600,59 @@ class Simulation:
             float(cap), self._own_offsets.astype(np.intp), out, threads,
         )  # fmt: skip
         return out
+
+    def cell_sensors(
+        self,
+        grid_shape: Sequence[int],
+        cell_of: np.ndarray,
+        voxel_of: np.ndarray,
+        rest: np.ndarray,
+        out: np.ndarray,
+        cov: np.ndarray,
+        reach: float,
+        bounds: tuple[float, float],
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Every robot voxel's sensors on its grid cell, in one compiled pass (robots in parallel).
+
+        Parameters
+        ----------
+        grid_shape : 3 ints
+            The grid every robot's voxels are placed on.
+        cell_of : ndarray (n_voxels,), intp
+            Each voxel's C-order cell in its robot's grid.
+        voxel_of : ndarray (n_robots, n_cells), intp
+            Each cell's voxel (an index of :attr:`all_positions`), -1 where empty.
+        rest : ndarray (n_robots, n_cells, 3)
+            Each cell's lattice position minus its robot's mean (voxel lengths; 0 where empty).
+        out : ndarray (n_robots, n_cells, 8)
+            Filled, row of each voxel's cell: position and velocity relative to the
+            centre of mass (voxel lengths, clipped to ``bounds``), touch (1 in contact,
+            falling to 0 at a gap of ``reach`` voxel lengths: :meth:`contact_gaps`),
+            the mean stretch of its bonds to its lattice neighbours (clipped to +-1).
+            Empty cells' rows are left as they are.
+        cov : ndarray (n_robots, 3, 3)
+            Filled with each robot's ``sum rest (position - cm)^T`` (the body's rotation).
+        reach : float
+        bounds : (float, float)
+            Bounds of the relative positions and velocities.
+
+        Returns
+        -------
+        cm, cm_vel : ndarray (n_robots, 3)
+            Centre of mass (m) and its velocity (m/s).
+        """
+        L = float(self.config.voxel_size)
+        cm = self.center_of_mass()
+        mass = self._a["mass_total"]
+        cm_vel = self.momentum() / mass[:, None]
+        gaps = self.contact_gaps(cap=reach * L)
+        nx, ny, nz = (int(v) for v in grid_shape)
+        _cell_sensors(
+            self.all_positions, self.all_velocities, gaps, cm, cm_vel,
+            self._own_offsets.astype(np.intp), cell_of, voxel_of, nx, ny, nz, L, float(reach),
+            float(bounds[0]), float(bounds[1]), rest, out, cov, self.n_threads,
+        )  # fmt: skip
+        return cm, cm_vel
 
     def set_external_force(self, robot: int, force: Any) -> None:
         """Apply a constant external force (N) to each voxel of one robot.

@@ -321,33 +321,22 @@ class Sensing:
 
     def __init__(self, batch: EpisodeBatch) -> None:
         self.batch = batch
-        sim = batch.sim
         self.layout = sensing_layout(batch.task, batch.grid_shape)
         n, nc = batch.n_robots, batch.n_cells
         self.L = float(batch.L)
-        nx, ny, nz = batch.grid_shape
-        self.shape5 = (n, nx, ny, nz)
         # the lattice positions of every cell (voxel lengths) and each robot's filled cells
         idx = np.stack(np.unravel_index(np.arange(nc), batch.grid_shape), axis=1).astype(np.float64)
-        self.mask = batch.filled_mask.reshape(n, nc)
-        w = self.mask.astype(np.float64)
-        self.count = np.maximum(w.sum(axis=1), 1.0)
+        w = batch.filled_mask.reshape(n, nc).astype(np.float64)
+        count = np.maximum(w.sum(axis=1), 1.0)
         rest = np.broadcast_to(idx, (n, nc, 3))
-        rest_c = rest - (w[:, :, None] * rest).sum(axis=1, keepdims=True) / self.count[:, None, None]
-        self.rest_w = rest_c * w[:, :, None]  # centred, empty cells zero
-        filled = self.mask.reshape(self.shape5)
-        # bonds along each axis: both cells filled
-        self.bonds = [filled[:, 1:] & filled[:, :-1], filled[:, :, 1:] & filled[:, :, :-1],
-                      filled[:, :, :, 1:] & filled[:, :, :, :-1]]  # fmt: skip
-        deg = np.zeros(self.shape5)
-        for a, bnd in enumerate(self.bonds):
-            lo = [slice(None)] * 4
-            hi = [slice(None)] * 4
-            lo[a + 1] = slice(1, None)
-            hi[a + 1] = slice(None, -1)
-            deg[tuple(lo)] += bnd
-            deg[tuple(hi)] += bnd
-        self.degree = np.maximum(deg, 1.0)
+        rest_c = rest - (w[:, :, None] * rest).sum(axis=1, keepdims=True) / count[:, None, None]
+        self.rest_w = np.ascontiguousarray(rest_c * w[:, :, None])  # centred, empty cells zero
+        # the compiled pass's maps: each voxel's cell, each cell's voxel (-1: empty)
+        self.cell_of = (batch._flat_cells % nc).astype(np.intp)
+        self.voxel_of = np.full((n, nc), -1, dtype=np.intp)
+        self.voxel_of.reshape(-1)[batch._flat_cells] = np.arange(batch._flat_cells.size)
+        self.cells = np.zeros((n, nc, 8))
+        self.cov = np.zeros((n, 3, 3))
         terrains = batch.terrains
         floors = np.array([bool(t.floor) and bool(batch.config.floor) for t in terrains])
         self.heights = _Heights(terrains, floors)
@@ -356,7 +345,6 @@ class Sensing:
         self._cell_bound = np.array([b for _, b, _ in CELL_SENSORS])
         self._robot_bound = np.array([b for _, b, _ in ROBOT_SENSORS])
         self.rot = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
-        del sim
 
     # ------------------------------------------------------------------ read
     def read(self, clock: np.ndarray, period: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -378,38 +366,15 @@ class Sensing:
         """
         b = self.batch
         sim = b.sim
-        n, nc = b.n_robots, b.n_cells
+        n = b.n_robots
         L = self.L
-        cm = sim.center_of_mass()
-        cm_vel = sim.momentum() / b.robot_mass[:, None]
-        vr = b._voxel_robot
-        feats = np.zeros((n * nc, 8))
-        pos = sim.all_positions
-        rel = (pos - cm[vr]) / L
-        feats[b._flat_cells, 0:3] = rel
-        feats[b._flat_cells, 3:6] = (sim.all_velocities - cm_vel[vr]) / L
-        gaps = sim.contact_gaps(cap=TOUCH_REACH * L) / L
-        feats[b._flat_cells, 6] = np.clip(1.0 - np.maximum(gaps, 0.0) / TOUCH_REACH, 0.0, 1.0)
-        cells = feats.reshape(n, nc, 8)
-        # strain: the mean stretch of each cell's bonds (lattice positions in voxel lengths)
-        p = np.zeros((n * nc, 3))
-        p[b._flat_cells] = pos / L
-        p5 = p.reshape(*self.shape5, 3)
-        acc = np.zeros(self.shape5)
-        for a, bnd in enumerate(self.bonds):
-            lo = [slice(None)] * 4
-            hi = [slice(None)] * 4
-            lo[a + 1] = slice(1, None)
-            hi[a + 1] = slice(None, -1)
-            s = (np.linalg.norm(p5[tuple(lo)] - p5[tuple(hi)], axis=-1) - 1.0) * bnd
-            acc[tuple(lo)] += s
-            acc[tuple(hi)] += s
-        cells[:, :, 7] = (acc / self.degree).reshape(n, nc)
-        cells *= self.mask[:, :, None]
-        np.clip(cells, -self._cell_bound, self._cell_bound, out=cells)
+        cells = self.cells  # empty cells' rows stay zero
+        cm, cm_vel = sim.cell_sensors(
+            b.grid_shape, self.cell_of, self.voxel_of, self.rest_w, cells, self.cov, TOUCH_REACH,
+            (self._cell_bound[0], self._cell_bound[3]),
+        )  # fmt: skip
         # the body's rotation: the best fit of its centred voxel centres to their lattice ones
-        h = np.einsum("rci,rcj->rij", self.rest_w, cells[:, :, 0:3])
-        u, _, vt = np.linalg.svd(h)
+        u, _, vt = np.linalg.svd(self.cov)
         d = np.sign(np.linalg.det(np.einsum("rij,rjk->rik", u, vt)))
         d[d == 0] = 1.0
         vt[:, 2, :] *= d[:, None]
