@@ -35,6 +35,8 @@ stable-baselines3). Runs with one torch thread.
     python benchmarks/rl_ppo.py --task flat --seed 0 --timesteps 500000 \\
         --run-dir benchmarks/data/rl/ppo/flat-s0
     python benchmarks/rl_ppo.py --timesteps 600000 --action-mode temperature --json  # the seed's signal
+    python benchmarks/rl_ppo.py --task push --observe sensing --seed 0 --timesteps 500000 \\
+        --run-dir benchmarks/data/rl/ppo/push-sensing-s0      # sees the box and the target
 """
 
 from __future__ import annotations
@@ -75,6 +77,9 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--episode-seconds", type=float, default=None, help="(env default: 4 s)")
     ap.add_argument("--actuation", choices=["seed", "symmetric"], default=None)
     ap.add_argument("--action-mode", choices=["contraction", "temperature"], default=None)
+    ap.add_argument("--observe", choices=["blind", "sensing"], default="blind",
+                    help="the observation: the voxels and a clock (the -v0 ids), or every sensor "
+                         "and the task's senses (the -Sensing-v0 ids)")  # fmt: skip
     ap.add_argument(
         "--n-steps", type=int, default=None,
         help="rollout length per env (default: one episode, so checkpoints fall between episodes)",
@@ -239,7 +244,7 @@ def main(argv: list[str] | None = None) -> int:
         print("rl_ppo.py needs the rl extra: pip install -e '.[rl]'", file=sys.stderr)
         return 2
     torch.set_num_threads(1)
-    eid = env_id(args.task)
+    eid = env_id(args.task, sensing=args.observe == "sensing")
     kw = env_kwargs(args)
     probe = gym.make(eid, **kw).unwrapped
     episode_steps, action_mode, preset = probe.max_steps, probe.action_mode, probe.sim.config.model
@@ -250,6 +255,8 @@ def main(argv: list[str] | None = None) -> int:
     if args.batch_size is None:
         args.batch_size = max(1, args.n_steps * args.n_envs // 4)
     settings = {k: getattr(args, k) for k in RUN_ARGS}
+    if args.observe != "blind":  # (the blind runs' records predate the option)
+        settings["observe"] = args.observe
     rollout = args.n_steps * args.n_envs
     run_dir = Path(args.run_dir) if args.run_dir else None
     ckpt = find_checkpoint(run_dir) if run_dir else None

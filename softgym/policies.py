@@ -73,8 +73,12 @@ class Sinusoid:
         control_dt: float = 0.05,
         amplitude: float = 1.0,
         phase: float = 0.0,
+        clock: int | None = None,
     ) -> None:
         self.n_cells = int(n_cells)
+        # where the observation holds sin(2 pi t / period) (cos follows): the last two entries
+        # of the blind observation, after the cells and the robot's first values when sensing
+        self.clock = None if clock is None else int(clock)
         if self.n_cells < 1:
             raise InvalidParameterError(f"n_cells must be >= 1, got {n_cells}")
         self.period = np.asarray(period, dtype=np.float64)
@@ -95,12 +99,19 @@ class Sinusoid:
         """The policy matching a SoftWalker env or vector env (its period, control step, grid)."""
         base = env.unwrapped
         space = getattr(base, "single_action_space", None) or base.action_space
+        n = int(np.prod(space.shape))
+        clock = None
+        if getattr(base, "observe", "blind") == "sensing":
+            from softgym.tasks.sensing import CELL_SENSORS, ROBOT_SENSORS
+
+            clock = len(CELL_SENSORS) * n + [r[0] for r in ROBOT_SENSORS].index("clock_sin")
         return cls(
-            n_cells=int(np.prod(space.shape)),
+            n_cells=n,
             period=base.period,
             control_dt=base.control_dt,
             amplitude=amplitude,
             phase=phase,
+            clock=clock,
         )
 
     def _values(self, theta: np.ndarray) -> np.ndarray:
@@ -118,7 +129,10 @@ class Sinusoid:
         ndarray of shape (n_cells,) or (n_envs, n_cells), float32
         """
         obs = np.asarray(observation, dtype=np.float64)
-        theta = np.arctan2(obs[..., -2], obs[..., -1])
+        if self.clock is None:
+            theta = np.arctan2(obs[..., -2], obs[..., -1])
+        else:
+            theta = np.arctan2(obs[..., self.clock], obs[..., self.clock + 1])
         value = self._values(theta)
         out = np.broadcast_to(np.asarray(value)[..., None], (*theta.shape, self.n_cells))
         return np.ascontiguousarray(out, dtype=np.float32)
