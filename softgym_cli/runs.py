@@ -21,17 +21,20 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from evolvers.evaluation.experiments import Experiment, get_experiment
+from evolvers.evaluation.experiments import CONTROLLERS, Experiment, get_experiment
 from evolvers.recording.recorder import RunInterrupted, read_run_config
-from softgym.exceptions import CheckpointError
+from softgym.exceptions import CheckpointError, InvalidParameterError, SoftGymError
 from softgym_cli.flags import subcommands
 
 __all__ = [
+    "add_controller_flags",
     "add_evolve_parser",
     "add_poet_parser",
     "add_qd_parser",
     "add_run_flags",
     "build_run",
+    "controller_overrides",
+    "load_body",
     "quiet_dask",
     "run_command",
 ]
@@ -56,6 +59,89 @@ def add_run_flags(p: argparse.ArgumentParser, out: str, gif: bool = True) -> Non
     p.add_argument("--no-figures", action="store_true", help="write no figures at the end")
     if gif:
         p.add_argument("--no-gif", action="store_true", help="no GIF of the best robot")
+
+
+def add_controller_flags(p: argparse.ArgumentParser) -> None:
+    """``--controller``, ``--hidden``, ``--signals``, ``--control-dt``, ``--body`` (evolve and qd)."""
+    p.add_argument("--controller", metavar="{" + ",".join(CONTROLLERS) + "}",
+                   help="the robots' controller: the open-loop sinusoid, or a network "
+                   "(central: one per robot; distributed: one per voxel, any body) whose "
+                   "weights evolve with the body (default: sinusoid)")  # fmt: skip
+    p.add_argument("--hidden", type=int, help="hidden units of the network (default: 8)")
+    p.add_argument("--signals", type=int,
+                   help="values a distributed network's voxel sends each neighbour (default: 1)")  # fmt: skip
+    p.add_argument("--control-dt", type=float, metavar="S",
+                   help="seconds between the network's control steps (default: 0.05)")  # fmt: skip
+    p.add_argument("--body", metavar="FILE.json|walker",
+                   help="a fixed body (a design file, or walker: softgym's hand-made 6x6x6 "
+                   "walker): only the controller / network evolves; --shape defaults to its grid")  # fmt: skip
+
+
+def load_body(spec: str) -> tuple[dict[str, Any], tuple[int, int, int]]:
+    """A ``--body`` as a design dict and its grid's shape: ``walker`` or a design file
+    (JSON, .vxa), its brain dropped.
+
+    Raises
+    ------
+    InvalidParameterError
+        Naming the file, when it does not load as a robot design.
+    """
+    from softgym.design import default_walker
+
+    if spec == "walker":
+        design = default_walker()
+    else:
+        from softgym_cli.commands import _load_design
+
+        try:
+            design = _load_design(Path(spec))
+        except (SoftGymError, OSError, KeyError, TypeError, ValueError) as exc:
+            message = " ".join(str(exc).split()) or type(exc).__name__
+            raise InvalidParameterError(
+                f"--body {spec}: not a robot design file ({message})"
+            ) from None
+    return design.replace(brain=None).to_dict(), tuple(int(n) for n in design.grid.shape)
+
+
+def controller_overrides(args: argparse.Namespace, exp: Experiment | None) -> dict[str, Any]:
+    """The typed controller flags as :class:`Experiment` overrides (checked before any file is written).
+
+    ``exp``: the experiment they change (its controller counts when ``--controller``
+    is not typed). A fixed body sets the grid too unless ``--shape`` is typed.
+
+    Raises
+    ------
+    InvalidParameterError
+        An unknown controller, ``--signals`` without a distributed network, ``--hidden``
+        or ``--control-dt`` without a network, a body file that does not load.
+    """
+    out: dict[str, Any] = {}
+    if args.controller is not None:
+        if args.controller not in CONTROLLERS:
+            raise InvalidParameterError(
+                f"--controller must be one of {', '.join(CONTROLLERS)}, got {args.controller!r}"
+            )
+        out["controller"] = args.controller
+    controller = out.get("controller", exp.controller if exp is not None else "sinusoid")
+    if args.signals is not None:
+        if controller != "distributed":
+            raise InvalidParameterError(
+                f"--signals is for --controller distributed (a {controller} controller sends "
+                "no signals)"
+            )
+        out["signals"] = args.signals
+    for dest, flag in (("hidden", "--hidden"), ("control_dt", "--control-dt")):
+        if getattr(args, dest) is not None:
+            if controller == "sinusoid":
+                raise InvalidParameterError(
+                    f"{flag} sizes a network controller: add --controller central or distributed"
+                )
+            out[dest] = getattr(args, dest)
+    if args.body is not None:
+        out["body"], grid_shape = load_body(args.body)
+        if args.shape is None:
+            out["shape"] = grid_shape
+    return out
 
 
 def quiet_dask(verbose: int) -> None:
@@ -157,7 +243,8 @@ def run_command(args: argparse.Namespace, unit: str, make: Maker,
 _RUN_FLAGS = {
     "experiment": "--experiment", "pop": "--pop", "seed": "--seed", "backend": "--backend",
     "algorithm": "--algorithm", "task": "--task", "seconds": "--seconds", "shape": "--shape",
-    "selection": "--selection",
+    "selection": "--selection", "controller": "--controller", "hidden": "--hidden",
+    "signals": "--signals", "control_dt": "--control-dt", "body": "--body",
 }  # fmt: skip
 
 
@@ -178,17 +265,24 @@ def _resumed_settings(args: argparse.Namespace, cfg: dict) -> dict:
         "experiment": exp.name, "pop": exp.pop_size, "seed": cfg.get("seed"),
         "backend": cfg.get("backend"), "algorithm": cfg.get("algorithm"),
         "seconds": exp.seconds, "shape": list(exp.shape), "selection": exp.selection,
+        "controller": exp.controller, "hidden": exp.hidden, "signals": exp.signals,
+        "control_dt": exp.control_dt,
     }  # fmt: skip
     for dest in sorted(getattr(args, "explicit", set()) & set(_RUN_FLAGS)):
         given = getattr(args, dest)
         if dest == "task":
             same = exp.replace(task=given).to_dict()["task"] == exp.to_dict()["task"]
             shown = "its own task"
+        elif dest == "body":
+            same = exp.body is not None and load_body(given)[0] == exp.body
+            shown = "its own body" if exp.body is not None else "no fixed body"
         elif dest == "algorithm" and recorded["backend"] != "pymoo":
             continue  # --algorithm only matters to pymoo
         else:
             want = list(given) if dest == "shape" else given
-            same = want == recorded[dest] or (dest == "seconds" and float(want) == recorded[dest])
+            same = want == recorded[dest] or (
+                dest in ("seconds", "control_dt") and float(want) == recorded[dest]
+            )
             rec = recorded[dest]
             shown = " ".join(map(str, rec)) if dest == "shape" else rec
         if not same:
@@ -211,6 +305,7 @@ def _evolve_run(args: argparse.Namespace, cfg: dict | None) -> tuple[type, Exper
         overrides = {"pop_size": args.pop, "seconds": args.seconds, "selection": args.selection,
                      "task": args.task, "shape": None if args.shape is None else tuple(args.shape)}  # fmt: skip
         overrides = {k: v for k, v in overrides.items() if v is not None}
+        overrides.update(controller_overrides(args, get_experiment(args.experiment)))
         st = {"experiment": get_experiment(args.experiment, **overrides), "seed": args.seed,
               "backend": args.backend, "algorithm": args.algorithm,
               "generations": args.generations}  # fmt: skip
@@ -231,6 +326,8 @@ def _evolve_summary(run: Any, _: Any) -> dict[str, Any]:
     return {
         "experiment": run.experiment.name,
         "backend": run.backend,
+        "controller": run.experiment.controller,
+        "fixed_body": run.experiment.body is not None,
         "generations": run.generation,
         "evaluations": run.evaluations_total,
         "best": None if best is None else best["objectives"].get(run.experiment.fitness.name),
@@ -254,8 +351,10 @@ def add_evolve_parser(sub: Any) -> argparse.ArgumentParser:
     add_run_flags(p, "runs/evolve")
     p.add_argument("--backend", choices=["native", "deap", "pymoo"], default="native",
                    help="the search loop: softgym's own, a DEAP toolbox, or a pymoo algorithm")  # fmt: skip
-    p.add_argument("--algorithm", choices=["nsga2", "nsga3", "sms-emoa", "ga"], default="nsga2",
-                   help="pymoo algorithm (--backend pymoo; ga optimises the first objective alone)")  # fmt: skip
+    p.add_argument("--algorithm", choices=["nsga2", "nsga3", "sms-emoa", "ga", "cmaes"],
+                   default="nsga2",
+                   help="pymoo algorithm (--backend pymoo; ga optimises the first objective alone; "
+                   "cmaes: pymoo's CMA-ES over the network's weights on a fixed --body)")  # fmt: skip
     p.add_argument("--task", metavar="TASK[:ARG=V,...]|FILE.json",
                    help="the world (default: the experiment's): a task name or a terrain JSON file")  # fmt: skip
     p.add_argument("--seconds", type=float,
@@ -266,6 +365,7 @@ def add_evolve_parser(sub: Any) -> argparse.ArgumentParser:
                    choices=["pareto", "tournament", "novelty", "novelty-archive", "nsga2"],
                    help="override the experiment's selection (native and DEAP backends; "
                    "default: the experiment's)")  # fmt: skip
+    add_controller_flags(p)
     p.set_defaults(func=cmd_evolve)
     return p
 
@@ -302,6 +402,9 @@ def _qd_run(args: argparse.Namespace, cfg: dict | None) -> tuple[type, Experimen
     else:
         exp = get_experiment(args.experiment or "basic", pop_size=16)
     exp = _sized(exp, args, pop_size=args.batch, task=args.task)
+    control = controller_overrides(args, exp)
+    if control:
+        exp = exp.replace(**control)
     qd = QDConfig.from_dict(cfg["qd"]) if cfg is not None and "qd" in cfg else QDConfig()
     typed = _typed(args, ("descriptors", "cells", "archive", "objective"))
     if typed:
@@ -316,6 +419,7 @@ def _qd_run(args: argparse.Namespace, cfg: dict | None) -> tuple[type, Experimen
 def _qd_summary(run: Any, _: Any) -> dict[str, Any]:
     return {
         "experiment": run.experiment.name,
+        "controller": run.experiment.controller,
         "archive": run.config.to_dict(),
         "generations": run.generation,
         "evaluations": run.evaluations_total,
@@ -369,6 +473,7 @@ def add_qd_parser(sub: Any) -> None:
     p.add_argument("--seconds", type=float, help="simulated seconds per evaluation (default: 5)")
     p.add_argument("--shape", type=int, nargs=3, metavar=("NX", "NY", "NZ"),
                    help="robot grid (default: 6 6 6)")  # fmt: skip
+    add_controller_flags(p)
     ss = subcommands(p, "qd_command", default="run")
     r = ss.add_parser("export", help="write a QD run's elites as design files (.json, .vxa)")
     r.add_argument("run", help="a softgym qd run folder")

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import random
 from collections.abc import Callable, Iterable
+from dataclasses import fields
 from functools import partial
 from typing import Any
 
@@ -33,9 +34,15 @@ from evolvers.evaluation.evaluator import BatchFn, EvalStats, Evaluator
 from evolvers.evaluation.experiments import Experiment
 from evolvers.operators.genome import Individual
 from evolvers.operators.selection import sel_fitness_tournament, sel_novelty, sel_pareto
-from evolvers.operators.variation import cx_arithmetic, mut_controller, mut_cppn, mut_materials
+from evolvers.operators.variation import (
+    cx_arithmetic,
+    mut_brain,
+    mut_controller,
+    mut_cppn,
+    mut_materials,
+)
 
-__all__ = ["BatchedMap", "DeapRun", "make_toolbox", "softbot_classes"]
+__all__ = ["BatchedMap", "DeapRun", "as_softbot", "make_toolbox", "softbot_classes"]
 
 
 def softbot_classes(experiment: Experiment) -> tuple[type, type]:
@@ -54,6 +61,17 @@ def softbot_classes(experiment: Experiment) -> tuple[type, type]:
     if not hasattr(creator, ind_name):
         creator.create(ind_name, Individual, fitness=getattr(creator, fit_name))
     return getattr(creator, fit_name), getattr(creator, ind_name)
+
+
+#: The genome's fields a Softbot copies (the grid cache is rebuilt).
+_GENOME_FIELDS = tuple(f.name for f in fields(Individual) if not f.name.startswith("_"))
+
+
+def as_softbot(Softbot: type, ind: Individual) -> Individual:
+    """``ind`` as a ``Softbot`` of :func:`softbot_classes` (the same genome, results and brain)."""
+    if isinstance(ind, Softbot):
+        return ind
+    return Softbot(**{name: getattr(ind, name) for name in _GENOME_FIELDS})
 
 
 class _BatchEvaluate:
@@ -107,8 +125,9 @@ def make_toolbox(
 
     Registered: ``individual``, ``population`` (``tools.initRepeat``),
     ``evaluate`` (batched through ``map``), ``map`` (:class:`BatchedMap`),
-    ``clone``, ``mutate`` (CPPN mutation with validity retries, then the
-    controller / material Gaussian mutation the experiment evolves),
+    ``clone``, ``mutate`` (CPPN mutation with validity retries; none on a
+    fixed body), ``mutate_genes`` (the controller / material / brain-weight
+    Gaussian mutation the experiment evolves),
     ``mate`` (the seed's arithmetic crossover over a list of children and
     the parents), ``selPareto``, ``selFitnessTournament``, ``selNovelty``,
     ``selNSGA2`` (``tools.selNSGA2``), ``selTournament``
@@ -144,18 +163,14 @@ def make_toolbox(
     evaluator = evaluator or Evaluator(exp, batch_fn=batch_fn, n_threads=n_threads)
 
     def individual() -> Individual:
-        g = Individual.random(rng, next_id(), exp.shape, exp.cppn_outputs, exp.rules)
-        return Softbot(cppn=g.cppn, id=g.id)
+        return as_softbot(Softbot, exp.random_individual(rng, next_id()))
 
     def clone(ind: Individual) -> Individual:
-        child = ind.child(next_id())
-        return Softbot(
-            cppn=child.cppn, materials=child.materials, controller=child.controller,
-            id=child.id, parent_id=child.parent_id, age=child.age,
-        )  # fmt: skip
+        return as_softbot(Softbot, ind.child(next_id()))
 
     def mutate(ind: Individual) -> tuple[Individual]:
-        mut_cppn(ind, rng, shape=exp.shape, rules=exp.rules)
+        if exp.evolve_body:
+            mut_cppn(ind, rng, shape=exp.shape, rules=exp.rules)
         return (ind,)
 
     def mutate_genes(ind: Individual) -> tuple[Individual]:
@@ -163,6 +178,8 @@ def make_toolbox(
             mut_controller(ind, rng)
         if exp.evolve_materials:
             mut_materials(ind, rng)
+        if exp.evolve_brain:
+            mut_brain(ind, rng)
         return (ind,)
 
     toolbox = base.Toolbox()
@@ -175,7 +192,7 @@ def make_toolbox(
     toolbox.register("mutate_genes", mutate_genes)
     toolbox.register(
         "mate", cx_arithmetic, rng=rng, rate=exp.crossover_rate,
-        controller=exp.evolve_controller, materials=exp.evolve_materials,
+        controller=exp.evolve_controller, materials=exp.evolve_materials, brain=exp.evolve_brain,
     )  # fmt: skip
     toolbox.register("selPareto", sel_pareto, objectives=exp.objectives, rng=rng)
     toolbox.register(
@@ -243,13 +260,7 @@ class DeapRun(EvolutionRun):
         return self.toolbox.individual()
 
     def _as_softbot(self, ind: Individual) -> Individual:
-        if isinstance(ind, self.Softbot):
-            return ind
-        return self.Softbot(
-            cppn=ind.cppn, materials=ind.materials, controller=ind.controller, id=ind.id,
-            parent_id=ind.parent_id, age=ind.age, objectives=ind.objectives, trace=ind.trace,
-            novelty=ind.novelty,
-        )  # fmt: skip
+        return as_softbot(self.Softbot, ind)
 
     def _from_dict(self, data: dict[str, Any]) -> Individual:
         ind = self._as_softbot(Individual.from_dict(data))
@@ -274,7 +285,8 @@ class DeapRun(EvolutionRun):
             child = self.toolbox.clone(parents[int(i)])
             (child,) = self.toolbox.mutate(child)
             children.append(child)
-        if self.experiment.evolve_controller or self.experiment.evolve_materials:
+        exp = self.experiment
+        if exp.evolve_controller or exp.evolve_materials or exp.evolve_brain:
             self.toolbox.mate(children, parents)
             for child in children:
                 self.toolbox.mutate_genes(child)

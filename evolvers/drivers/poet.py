@@ -499,6 +499,11 @@ class PoetRun(Driver):
         figures: bool = True,
         progress: bool = True,
     ) -> None:
+        if experiment is not None and (experiment.evolve_brain or not experiment.evolve_body):
+            raise InvalidParameterError(
+                "POET evolves CPPN bodies with the sinusoid controller: network controllers "
+                "(controller != 'sinusoid') and fixed bodies are for evolve and qd runs"
+            )
         self.config = PoetConfig() if config is None else config
         self.metric = "max_xy_dist"
         self._jobs_fn = jobs_fn or getattr(batch_fn, "jobs", None)

@@ -10,8 +10,15 @@
   material genes, probability 0.4), :class:`SoftbotMutation` (CPPN mutation
   with validity retries + bounded Gaussian gene mutation) and
   :class:`SoftbotDuplicateElimination` (same phenotype hash).
+* :class:`BrainProblem` and ``algorithm="cmaes"``: pymoo's own CMA-ES
+  (:class:`pymoo.algorithms.soo.nonconvex.cmaes.CMAES`, which wraps the
+  ``cma`` package) over a brain's weight vector (bounds ``+-WEIGHT_BOUND``) on
+  the experiment's fixed body: each ``x`` is evaluated as the body with
+  ``spec.clipped(x)``; generation 0 is ``pop_size`` random brains
+  (``BrainSpec.random``), the best of which is CMA-ES's ``x0``. Only for an
+  experiment with a fixed ``body`` and a network ``controller``.
 * :class:`PymooRun`: a pymoo algorithm (``algorithm=``: NSGA-II by default,
-  ``"nsga3"``, ``"sms-emoa"``, ``"ga"``, or any pymoo algorithm class)
+  ``"nsga3"``, ``"sms-emoa"``, ``"ga"``, ``"cmaes"``, or any pymoo algorithm class)
   driven through pymoo's public ask-and-tell interface
   (``algorithm.setup``, ``ask``, ``evaluator.eval``, ``tell``), with the same
   run folder as every driver (:class:`~evolvers.recording.recorder.RunRecorder`).
@@ -29,8 +36,9 @@ past behaviours.
 
 from __future__ import annotations
 
+import contextlib
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -47,15 +55,24 @@ from evolvers.evaluation.evaluator import EvalStats, Evaluator, PhenotypeCache, 
 from evolvers.evaluation.experiments import Experiment
 from evolvers.operators.genome import Individual
 from evolvers.operators.selection import Objective, minimised_matrix
-from evolvers.operators.variation import mut_controller, mut_cppn, mut_materials, set_counterphase
+from evolvers.operators.variation import (
+    mut_brain,
+    mut_controller,
+    mut_cppn,
+    mut_materials,
+    set_counterphase,
+)
 from evolvers.recording.rows import population_summary
 from softgym.design import CompositionRules, Controller
+from softgym.design.brain import WEIGHT_BOUND
 from softgym.exceptions import CheckpointError, InvalidParameterError
 from softgym.io import rng_state
 from softgym.metrics import NoveltyArchive
 
 __all__ = [
     "ALGORITHMS",
+    "BrainProblem",
+    "BrainSampling",
     "PymooRun",
     "SoftbotCrossover",
     "SoftbotDuplicateElimination",
@@ -169,17 +186,16 @@ class SoftbotSampling(Sampling):
         exp = self.experiment
         X = np.empty((n_samples, 1), dtype=object)
         for i in range(n_samples):
-            X[i, 0] = Individual.random(
-                random_state, self.next_id(), exp.shape, exp.cppn_outputs, exp.rules
-            )
+            X[i, 0] = exp.random_individual(random_state, self.next_id())
         return X
 
 
 class SoftbotCrossover(Crossover):
     """The seed's arithmetic crossover: a child of parent A with the mean genes of A and B.
 
-    Controller genes (and material genes 6-8, 9 as the counter-phase of 8)
-    are averaged; the CPPN is A's. Applied with probability ``prob`` (0.4).
+    Controller genes (and material genes 6-8, 9 as the counter-phase of 8,
+    and brain weights) are averaged; the CPPN is A's. Applied with probability
+    ``prob`` (0.4).
     """
 
     def __init__(self, experiment: Experiment, next_id: Any, prob: float | None = None) -> None:
@@ -203,12 +219,15 @@ class SoftbotCrossover(Crossover):
             if self.experiment.evolve_materials:
                 child.materials[:3] = (a.materials[:3] + b.materials[:3]) / 2.0
                 set_counterphase(child.materials)
+            if self.experiment.evolve_brain and a.brain is not None and b.brain is not None:
+                child.brain = np.clip((a.brain + b.brain) / 2.0, -WEIGHT_BOUND, WEIGHT_BOUND)
             Q[0, k, 0] = child
         return Q
 
 
 class SoftbotMutation(Mutation):
-    """CPPN mutation with validity retries, then bounded Gaussian controller / material mutation.
+    """CPPN mutation with validity retries (none on a fixed body), then bounded Gaussian
+    controller / material / brain-weight mutation.
 
     Evaluated individuals (parents copied through by the crossover) are
     cloned first, so parents are never modified.
@@ -226,11 +245,14 @@ class SoftbotMutation(Mutation):
             ind = X[i, 0]
             child = ind.child(self.next_id()) if ind.objectives else ind
             child.age = ind.age + 1
-            mut_cppn(child, random_state, shape=exp.shape, rules=exp.rules)
+            if exp.evolve_body:
+                mut_cppn(child, random_state, shape=exp.shape, rules=exp.rules)
             if exp.evolve_controller:
                 mut_controller(child, random_state)
             if exp.evolve_materials:
                 mut_materials(child, random_state)
+            if exp.evolve_brain:
+                mut_brain(child, random_state)
             Y[i, 0] = child
         return Y
 
@@ -245,6 +267,97 @@ class SoftbotDuplicateElimination(ElementwiseDuplicateElimination):
     def is_equal(self, a, b) -> bool:
         """Whether two pymoo individuals hold the same phenotype."""
         return a.X[0].phenotype_key(self.shape) == b.X[0].phenotype_key(self.shape)
+
+
+class BrainProblem(Problem):
+    """A brain's weights on an experiment's fixed body, as a real-valued pymoo Problem.
+
+    ``n_var`` is the brain's ``n_params``, every variable in ``[-WEIGHT_BOUND,
+    WEIGHT_BOUND]``; ``x`` is evaluated as the fixed body carrying
+    ``spec.clipped(x)`` (one batched Simulation per call, phenotype-cached);
+    ``F`` is the experiment's fitness, minimised (a maximised one negated).
+    :meth:`individuals` gives the :class:`~evolvers.operators.genome.Individual`
+    each evaluated ``x`` became.
+
+    Parameters
+    ----------
+    experiment : Experiment
+        With a fixed ``body`` and a network ``controller``.
+    evaluator : Evaluator
+    next_id : callable
+        Ids of the individuals made.
+    """
+
+    def __init__(self, experiment: Experiment, evaluator: Evaluator, next_id: Any) -> None:
+        spec, body = experiment.brain_spec(), experiment.fixed_body()
+        if spec is None or body is None:
+            raise InvalidParameterError(
+                "CMA-ES searches a brain's weights on a fixed body: the experiment needs "
+                "controller='central' or 'distributed' and a body"
+            )
+        self.experiment = experiment
+        self.evaluator = evaluator
+        self.next_id = next_id
+        self.spec, self.body = spec, body
+        self.objectives = experiment.objectives[:1]
+        self.last_stats = EvalStats()
+        self._made: dict[bytes, Individual] = {}
+        n = spec.n_params
+        super().__init__(n_var=n, n_obj=1, xl=np.full(n, -WEIGHT_BOUND),
+                         xu=np.full(n, WEIGHT_BOUND), vtype=float)  # fmt: skip
+
+    def _evaluate(self, X, out, *args, **kwargs):
+        inds = []
+        for x in np.atleast_2d(np.asarray(X, dtype=np.float64)):
+            ind = Individual(
+                cppn=None, controller=self.body.controller, id=self.next_id(), body=self.body,
+                brain=self.spec.clipped(x).weights, brain_spec=self.spec,
+            )  # fmt: skip
+            inds.append(ind)
+        self.last_stats = self.evaluator.evaluate(inds)
+        self._made = {np.asarray(x, dtype=np.float64).tobytes(): ind for x, ind in zip(X, inds)}
+        out["F"] = minimised_matrix(inds, self.objectives)
+
+    def individuals(self, X: np.ndarray) -> list[Individual]:
+        """The individuals the rows of ``X`` (the last evaluated batch's) became."""
+        try:
+            return [self._made[np.asarray(x, dtype=np.float64).tobytes()] for x in X]
+        except KeyError:
+            raise CheckpointError("a CMA-ES solution was not evaluated in the last batch") from None
+
+
+class BrainSampling(Sampling):
+    """Random brains (:meth:`BrainSpec.random`) as real vectors: CMA-ES's first population."""
+
+    def __init__(self, experiment: Experiment) -> None:
+        super().__init__()
+        self.spec = experiment.brain_spec()
+
+    def _do(self, problem, n_samples, *args, random_state=None, **kwargs):
+        return np.stack([self.spec.random(random_state).weights for _ in range(n_samples)])
+
+
+def make_cmaes(experiment: Experiment, sigma: float = 0.1, **kwargs: Any) -> Algorithm:
+    """Pymoo's CMA-ES over a brain's weights (:class:`BrainProblem`).
+
+    ``experiment.pop_size`` random brains (:class:`BrainSampling`) are the
+    first generation; the best is ``x0``; CMA-ES then asks ``pop_size``
+    solutions a generation. ``sigma`` is the initial step in the [0, 1]-normalised
+    box (0.1: 0.6 weight units). cma's stopping tests are off (the run ends at
+    its generations); ``kwargs`` go to :class:`~pymoo.algorithms.soo.nonconvex.cmaes.CMAES`.
+    """
+    from pymoo.algorithms.soo.nonconvex.cmaes import CMAES
+    from pymoo.core.initialization import Initialization
+
+    opts: dict[str, Any] = {
+        "tolfun": 0, "tolx": 0, "tolflatfitness": 10**9, "tolstagnation": 10**9,
+        "tolfunhist": 0, "tolupsigma": 1e300, "tolconditioncov": 1e300,
+    }  # fmt: skip
+    opts.update(kwargs)
+    algorithm = CMAES(sigma=sigma, pop_size=experiment.pop_size, **opts)
+    algorithm.initialization = Initialization(BrainSampling(experiment))
+    algorithm.n_sample_points = experiment.pop_size
+    return algorithm
 
 
 def _nsga3(pop_size: int, n_obj: int, **operators: Any) -> Algorithm:
@@ -275,8 +388,9 @@ def _named(name: str) -> Callable[..., Algorithm]:
     raise InvalidParameterError(f"unknown algorithm {name!r}; expected one of {ALGORITHMS}")
 
 
-#: Algorithms known by name (``"ga"`` is single-objective: it optimises the experiment's fitness).
-ALGORITHMS: tuple[str, ...] = ("nsga2", "nsga3", "sms-emoa", "ga")
+#: Algorithms known by name (``"ga"`` and ``"cmaes"`` are single-objective: they optimise the
+#: experiment's fitness; ``"cmaes"`` only a brain on a fixed body, :func:`make_cmaes`).
+ALGORITHMS: tuple[str, ...] = ("nsga2", "nsga3", "sms-emoa", "ga", "cmaes")
 
 
 def make_algorithm(
@@ -318,6 +432,8 @@ def make_algorithm(
     }
     if algorithm == "nsga3" and "ref_dirs" not in kwargs:
         return _nsga3(exp.pop_size, n_obj, **operators)
+    if algorithm == "cmaes":
+        return make_cmaes(exp, **kwargs)
     factory = _named(algorithm) if isinstance(algorithm, str) else algorithm
     if not callable(factory):
         raise InvalidParameterError(
@@ -347,9 +463,11 @@ class PymooRun(Driver):
         :class:`~evolvers.recording.recorder.RunInterrupted` the same way).
     algorithm : str or callable
         ``"nsga2"`` (default), ``"nsga3"``, ``"sms-emoa"``, ``"ga"``
-        (single-objective, on the experiment's fitness), or a pymoo algorithm
-        class or factory (:func:`make_algorithm`); a fresh algorithm is built
-        for every :meth:`run`.
+        (single-objective, on the experiment's fitness), ``"cmaes"`` (pymoo's
+        CMA-ES over the brain's weights, on the fitness; needs an experiment
+        with a fixed ``body`` and a network ``controller``: the controller genes
+        stay the body's), or a pymoo algorithm class or factory
+        (:func:`make_algorithm`); a fresh algorithm is built for every :meth:`run`.
     algorithm_kwargs : dict, optional
         More keywords for the algorithm (e.g. NSGA-III's ``ref_dirs``).
     single_objective : bool, optional
@@ -367,10 +485,17 @@ class PymooRun(Driver):
             raise InvalidParameterError(
                 f"unknown algorithm {algorithm!r}; expected one of {ALGORITHMS}"
             )
+        self.cmaes = algorithm == "cmaes"
+        if self.cmaes and (experiment.body is None or not experiment.evolve_brain):
+            raise InvalidParameterError(
+                "algorithm 'cmaes' searches a brain's weights on a fixed body: it needs a network "
+                "controller ('central' or 'distributed') and a fixed body (--body); with a "
+                "CPPN body use nsga2, nsga3, sms-emoa or ga"
+            )
         self.algorithm_spec = algorithm
         self.algorithm_kwargs = dict(algorithm_kwargs or {})
         self.single_objective = (
-            (algorithm == "ga") if single_objective is None else single_objective
+            (algorithm in ("ga", "cmaes")) if single_objective is None else single_objective
         )
         super().__init__(experiment, out, seed, generations,
                          extra_config={"algorithm": _algorithm_label(algorithm)}, **driver)  # fmt: skip
@@ -384,30 +509,69 @@ class PymooRun(Driver):
             NoveltyArchive(k=exp.pop_size, n_add=2, variant="normalized") if novelty else None
         )
         objectives = exp.objectives[:1] if self.single_objective else exp.objectives
-        self.problem = SoftbotProblem(exp, self.evaluator, self.archive, objectives)
+        self.problem: Problem = (
+            BrainProblem(exp, self.evaluator, self.ids) if self.cmaes
+            else SoftbotProblem(exp, self.evaluator, self.archive, objectives)
+        )  # fmt: skip
         self.algorithm: Algorithm = make_algorithm(
             self.algorithm_spec, exp, self.ids, self.problem.n_obj, **self.algorithm_kwargs
         )
+        # CMA-ES draws depend on its maxiter (pymoo passes n_gen): one fixed value, so that a
+        # run resumed with more generations replays the same draws; the run counts its own
+        n_gen = 10**6 if self.cmaes else self.generations + 1
         self.algorithm.setup(
-            self.problem, termination=("n_gen", self.generations + 1), seed=self.seed,
-            verbose=False,
+            self.problem, termination=("n_gen", n_gen), seed=self.seed, verbose=False,
         )  # fmt: skip
+        #: numpy's global generator as cma left it (cma draws from numpy.random; see _cma_random)
+        self._cma_state: Any = None
+        if self.cmaes:  # cma reads seed 0 as "from the clock": a fixed non-zero seed of the run's
+            self.algorithm.options["seed"] = self.seed % (2**31 - 1) + 1
 
     @property
     def label(self) -> str:
         """The progress bar's description."""
         return f"{self.experiment.name} [pymoo {_algorithm_label(self.algorithm_spec)}]"
 
-    def _generation(self, problem: SoftbotProblem, algorithm: Algorithm) -> list[Individual]:
-        """One ask / evaluate / tell round; returns the evaluated infills."""
-        infills = algorithm.ask()
-        algorithm.evaluator.eval(problem, infills)
-        algorithm.tell(infills=infills)
-        self.generation += 1
-        self.population = [x[0] for x in algorithm.pop.get("X")]
-        return [x[0] for x in infills.get("X")]
+    def _individuals(self, problem: Problem, pop: Any) -> list[Individual]:
+        """The individuals of a pymoo population (object variables, or CMA-ES's vectors)."""
+        if isinstance(problem, BrainProblem):
+            return problem.individuals(pop.get("X"))
+        return [x[0] for x in pop.get("X")]
 
-    def _replay(self, problem: SoftbotProblem, algorithm: Algorithm, state: dict[str, Any]) -> None:
+    @contextlib.contextmanager
+    def _cma_random(self) -> Iterator[None]:
+        """Cma samples from ``numpy.random``'s global generator (seeded once by it): give it
+        its own state, kept apart from any other user of the global generator, so a run
+        replayed without simulating draws exactly what the uninterrupted run drew.
+        """
+        if not self.cmaes:
+            yield
+            return
+        outer = np.random.get_state()  # noqa: NPY002 - cma's own generator
+        if self._cma_state is not None:
+            np.random.set_state(self._cma_state)  # noqa: NPY002 - cma's own generator
+        try:
+            yield
+        finally:
+            self._cma_state = np.random.get_state()  # noqa: NPY002 - cma's own generator
+            np.random.set_state(outer)  # noqa: NPY002 - cma's own generator
+
+    def _generation(self, problem: Problem, algorithm: Algorithm) -> list[Individual]:
+        """One ask / evaluate / tell round; returns the evaluated infills."""
+        with self._cma_random():
+            infills = algorithm.ask()
+        if infills is None or len(infills) == 0:
+            raise RuntimeError(
+                f"{self.label}: the algorithm stopped asking at generation {self.generation}"
+            )
+        algorithm.evaluator.eval(problem, infills)
+        with self._cma_random():
+            algorithm.tell(infills=infills)
+        self.generation += 1
+        self.population = self._individuals(problem, algorithm.pop)
+        return self._individuals(problem, infills)
+
+    def _replay(self, problem: Problem, algorithm: Algorithm, state: dict[str, Any]) -> None:
         """Re-run the checkpointed generations from the seed; every result comes from the cache."""
         target = int(state["generation"])
         counter = self.evaluator.n_evaluations

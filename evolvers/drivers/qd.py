@@ -12,8 +12,9 @@ The pieces are pyribs' own (``pip install "softgym[qd]"``, pyribs 0.12):
   parents uniformly from the elites and varies them with softgym's operators
   (:func:`~evolvers.operators.variation.make_children`: CPPN mutation with validity
   retries, arithmetic crossover and bounded Gaussian mutation of the
-  controller / material genes when the experiment evolves them); while the
-  archive is empty it asks for random valid robots;
+  controller / material genes and the brain's weights when the experiment
+  evolves them; on a fixed body only those vary); while the archive is empty
+  it asks for random valid robots (with random brains);
 * a :class:`ribs.schedulers.Scheduler` ask/tell loop, each ask evaluated by
   softgym's :class:`~evolvers.evaluation.evaluator.Evaluator` (one batched Simulation,
   phenotype-cached, or Dask through ``batch_fn``).
@@ -319,17 +320,14 @@ class SoftbotEmitter(EmitterBase):
         exp = self.experiment
         if self.archive.empty:
             children = [
-                Individual.random(self.rng, self.next_id(), exp.shape, exp.cppn_outputs, exp.rules)
-                for _ in range(self.batch_size)
+                exp.random_individual(self.rng, self.next_id()) for _ in range(self.batch_size)
             ]
         else:
             pool = _elite_data(self.archive)["solution"]
             picks = self.rng.integers(len(pool), size=self.batch_size)
             children = make_children(
-                [pool[int(i)] for i in picks], self.rng, self.next_id,
-                shape=exp.shape, rules=exp.rules, evolve_controller=exp.evolve_controller,
-                evolve_materials=exp.evolve_materials, crossover_rate=exp.crossover_rate,
-            )  # fmt: skip
+                [pool[int(i)] for i in picks], self.rng, self.next_id, **exp.variation()
+            )
         return _object_array(children)
 
     def tell(

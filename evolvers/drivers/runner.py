@@ -2,7 +2,7 @@
 
 Generation 0: ``pop_size`` random valid individuals, evaluated. Every later
 generation: every age += 1; each parent makes one mutated child (plus the
-controller/material GA); ``n_random`` random newcomers join; the whole
+controller/material/brain GA; no CPPN mutation on a fixed body); ``n_random`` random newcomers join; the whole
 population (31 for the seed) is evaluated in one batched Simulation, cached
 phenotypes not re-run; selection brings it back to ``pop_size``.
 
@@ -77,21 +77,10 @@ class EvolutionRun(Driver):
         return self.ids()
 
     def _random_individual(self) -> Individual:
-        exp = self.experiment
-        return Individual.random(self.rng, self.next_id(), exp.shape, exp.cppn_outputs, exp.rules)
+        return self.experiment.random_individual(self.rng, self.next_id())
 
     def _vary(self, parents: list[Individual]) -> list[Individual]:
-        exp = self.experiment
-        return make_children(
-            parents,
-            self.rng,
-            self.next_id,
-            shape=exp.shape,
-            rules=exp.rules,
-            evolve_controller=exp.evolve_controller,
-            evolve_materials=exp.evolve_materials,
-            crossover_rate=exp.crossover_rate,
-        )
+        return make_children(parents, self.rng, self.next_id, **self.experiment.variation())
 
     def _evaluate(self, individuals: list[Individual]) -> EvalStats:
         return self.evaluator.evaluate(individuals)

@@ -22,6 +22,12 @@ the seed's composition constraints (>= 10 % tissue, >= 1 bone, >= 10 % muscle).
 Any experiment runs on another task with ``get_experiment(name, task="stairs")``
 (or a Terrain, or a terrain JSON file: ``softgym evolve --task FILE.json``). Every experiment: 6x6x6 CPPN robots,
 population 15, 15 children and 1 random newcomer per generation, 5 s simulated.
+
+Any experiment evolves bodies and brains with ``controller="central"`` or
+``"distributed"`` (a network controller, :mod:`softgym.design.brain`, whose
+weights are genes next to the CPPN; ``hidden``, ``signals``, ``control_dt``
+size it), or a brain alone on a fixed ``body`` (a RobotDesign's ``to_dict()``):
+``get_experiment("basic", controller="distributed", body=default_walker().to_dict())``.
 """
 
 from __future__ import annotations
@@ -32,15 +38,19 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
+from evolvers.operators.genome import Individual
 from evolvers.operators.selection import SELECTORS, Objective
 from softgym.design import MATERIAL_TREE_4, MATERIAL_TREE_8, CompositionRules
-from softgym.exceptions import InvalidParameterError
+from softgym.design.brain import CONTROL_DT_RANGE, MAX_HIDDEN, MAX_SIGNALS, BrainSpec
+from softgym.design.robot import RobotDesign
+from softgym.exceptions import InvalidParameterError, SoftGymError
 from softgym.metrics import WALK_METRICS
 from softgym.tasks import Task, get_task
 from softgym.terrain import Terrain
-from softgym.validate import is_int, show
+from softgym.validate import is_int, is_real, show
 
 __all__ = [
+    "CONTROLLERS",
     "EXPERIMENTS",
     "MAX_POP_SIZE",
     "SELECTIONS",
@@ -55,6 +65,10 @@ MAX_POP_SIZE = 100_000
 
 #: Selection schemes an experiment may name.
 SELECTIONS: tuple[str, ...] = tuple(SELECTORS)
+
+#: Controllers an experiment may name: the seed's open-loop sinusoid, or a network
+#: (:mod:`softgym.design.brain`) whose weights evolve.
+CONTROLLERS: tuple[str, ...] = ("sinusoid", "central", "distributed")
 
 
 @dataclass(frozen=True)
@@ -106,6 +120,22 @@ class Experiment:
         seed's obstacle runs selected on. Off by default (the robot's own
         voxels); the study's obstacle scenarios turn it on. Traces, and so a
         crossing of the wall, stay the robot's own.
+    controller : {"sinusoid", "central", "distributed"}
+        The seed's open-loop sinusoid alone, or a network controller (a
+        brain, :func:`softgym.tasks.brains.brain_spec`) whose weights evolve
+        (random at first, arithmetic crossover, bounded Gaussian mutation).
+    hidden : int
+        Hidden units of the network, in [0, MAX_HIDDEN].
+    signals : int
+        Values a distributed brain's voxel sends each neighbour, in [0,
+        MAX_SIGNALS] (unused by a central brain).
+    control_dt : float
+        Seconds between two control steps of the network.
+    body : dict, optional
+        A fixed body (a :class:`~softgym.design.RobotDesign`'s ``to_dict()``;
+        its own brain is dropped): no CPPN evolves, every robot has this grid
+        and palette, and only the brain (and controller genes) vary. Its grid
+        must be ``shape`` and pass ``rules``.
     """
 
     name: str
@@ -127,8 +157,14 @@ class Experiment:
     shape: tuple[int, int, int] = (6, 6, 6)
     sim: dict[str, Any] = field(default_factory=dict)
     seed_centre_of_mass: bool = False
+    controller: str = "sinusoid"
+    hidden: int = 8
+    signals: int = 1
+    control_dt: float = 0.05
+    body: dict[str, Any] | None = None
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "_cache", {})
         if self.selection not in SELECTIONS:
             raise InvalidParameterError(
                 f"unknown selection {self.selection!r}; expected one of {SELECTIONS}"
@@ -154,6 +190,107 @@ class Experiment:
                     objectives.append(o)
                     seen.add(o.name)
             object.__setattr__(self, "objectives", tuple(objectives))
+        self._check_controller()
+
+    def _check_controller(self) -> None:
+        """Validate the controller fields and the fixed body (typed errors naming the field)."""
+        if not isinstance(self.controller, str) or self.controller not in CONTROLLERS:
+            raise InvalidParameterError(
+                f"controller must be one of {list(CONTROLLERS)}, got {show(self.controller)}"
+            )
+        if not is_int(self.hidden) or not 0 <= self.hidden <= MAX_HIDDEN:
+            raise InvalidParameterError(
+                f"hidden must be an integer in [0, {MAX_HIDDEN}], got {show(self.hidden)}"
+            )
+        if not is_int(self.signals) or not 0 <= self.signals <= MAX_SIGNALS:
+            raise InvalidParameterError(
+                f"signals must be an integer in [0, {MAX_SIGNALS}], got {show(self.signals)}"
+            )
+        lo, hi = CONTROL_DT_RANGE
+        if not is_real(self.control_dt) or not lo <= float(self.control_dt) <= hi:
+            raise InvalidParameterError(
+                f"control_dt must be a number in [{lo}, {hi}] s, got {show(self.control_dt)}"
+            )
+        object.__setattr__(self, "hidden", int(self.hidden))
+        object.__setattr__(self, "signals", int(self.signals))
+        object.__setattr__(self, "control_dt", float(self.control_dt))
+        if self.body is not None:
+            if not isinstance(self.body, Mapping):
+                raise InvalidParameterError(
+                    f"body must be a robot design's to_dict() or None, got {type(self.body).__name__}"
+                )
+            try:
+                design = RobotDesign.from_dict(self.body).replace(brain=None)
+            except (SoftGymError, KeyError, TypeError, ValueError) as exc:
+                raise InvalidParameterError(f"body is not a robot design: {exc}") from None
+            if tuple(design.grid.shape) != self.shape:
+                raise InvalidParameterError(
+                    f"body grid {tuple(design.grid.shape)} does not fit the experiment's shape "
+                    f"{self.shape} (use shape={tuple(design.grid.shape)})"
+                )
+            if not design.is_valid(self.rules):
+                raise InvalidParameterError(
+                    f"body breaks experiment {self.name!r}'s composition rules"
+                )
+            if self.evolve_materials:
+                raise InvalidParameterError(
+                    f"body: a fixed body keeps its own materials; experiment {self.name!r} "
+                    "evolves material genes (choose an experiment without materials evolution)"
+                )
+            if self.controller == "sinusoid" and not self.evolve_controller:
+                raise InvalidParameterError(
+                    f"body: on a fixed body with the sinusoid controller nothing of experiment "
+                    f"{self.name!r} evolves; use controller='central' or 'distributed'"
+                )
+            object.__setattr__(self, "body", design.to_dict())
+            self._cache["body"] = design
+        try:
+            self.brain_spec()
+        except SoftGymError as exc:
+            raise InvalidParameterError(f"controller {self.controller!r}: {exc}") from None
+
+    @property
+    def evolve_brain(self) -> bool:
+        """Whether robots carry an evolving network controller (``controller`` is not sinusoid)."""
+        return self.controller != "sinusoid"
+
+    @property
+    def evolve_body(self) -> bool:
+        """Whether the CPPN body evolves (no fixed ``body``)."""
+        return self.body is None
+
+    def fixed_body(self) -> RobotDesign | None:
+        """The fixed body as a :class:`~softgym.design.RobotDesign` (None: bodies evolve)."""
+        return self._cache.get("body")
+
+    def brain_spec(self) -> BrainSpec | None:
+        """The :class:`~softgym.design.brain.BrainSpec` of the robots' brains (None for sinusoid)."""
+        if self.controller == "sinusoid":
+            return None
+        if "brain_spec" not in self._cache:
+            from softgym.tasks.brains import brain_spec
+
+            signals = self.signals if self.controller == "distributed" else None
+            self._cache["brain_spec"] = brain_spec(
+                self.controller, self.make_task(), self.shape, self.hidden, signals,
+                self.control_dt,
+            )  # fmt: skip
+        return self._cache["brain_spec"]
+
+    def random_individual(self, rng: Any, id: int) -> Individual:
+        """A random individual of this experiment (CPPN or fixed body; a random brain if any)."""
+        return Individual.random(
+            rng, id, self.shape, self.cppn_outputs, self.rules,
+            brain_spec=self.brain_spec(), body=self.fixed_body(),
+        )  # fmt: skip
+
+    def variation(self) -> dict[str, Any]:
+        """The keywords of :func:`~evolvers.operators.variation.make_children` for this experiment."""
+        return {
+            "shape": self.shape, "rules": self.rules, "evolve_controller": self.evolve_controller,
+            "evolve_materials": self.evolve_materials, "crossover_rate": self.crossover_rate,
+            "evolve_brain": self.evolve_brain, "evolve_body": self.evolve_body,
+        }  # fmt: skip
 
     @property
     def fitness(self) -> Objective:
@@ -356,6 +493,7 @@ def smoke_sizes(experiment: Experiment, generations: int) -> tuple[Experiment, i
     small = experiment.replace(
         pop_size=min(experiment.pop_size, 4),
         seconds=min(experiment.seconds, 1.5),
-        shape=tuple(min(n, 4) for n in experiment.shape),
+        # a fixed body keeps its own grid
+        shape=experiment.shape if experiment.body else tuple(min(n, 4) for n in experiment.shape),
     )
     return small, min(int(generations), 1)

@@ -7,6 +7,11 @@ The genome of the seed study (docs/PHYSICS.md):
   the evolvable materials 6-9 (material 9 is the counter-phase copy of 8);
 * controller genes: a :class:`~softgym.design.Controller` (temperature
   amplitude, period, muscle CTE);
+* optionally a network controller: ``brain``, the flat weight vector of a
+  :class:`~softgym.design.brain.BrainSpec` (``brain_spec``), run in closed loop;
+* optionally a fixed ``body`` (a :class:`~softgym.design.RobotDesign` whose
+  grid and palette every robot of the run shares; ``cppn`` is then None and
+  only the controller / brain genes vary: "brain only on a fixed body");
 * bookkeeping: ``age`` (generations survived, the age objective), ``id``
   (unique in a run, increasing) and ``parent_id``.
 
@@ -24,7 +29,9 @@ from typing import Any
 import numpy as np
 
 from softgym.design import CPPN, MATERIAL_TREE_4, CompositionRules, Controller, default_palette
+from softgym.design.brain import BrainSpec
 from softgym.design.robot import RobotDesign
+from softgym.exceptions import InvalidParameterError
 
 __all__ = [
     "INITIAL_MATERIAL_GENES",
@@ -52,8 +59,8 @@ class Individual:
 
     Parameters
     ----------
-    cppn : CPPN
-        Body and material-choice genome.
+    cppn : CPPN or None
+        Body and material-choice genome (None with a fixed ``body``).
     materials : ndarray of shape (4, 3), float64
         Genes of materials 6, 7, 8, 9: columns Young's modulus (Pa),
         density (kg/m^3), CTE (1/°C).
@@ -72,9 +79,16 @@ class Individual:
         Centre-of-mass trace (x, y, z, t) in m and s, for novelty.
     novelty : float, optional
         Last novelty score (lower = more novel).
+    brain : ndarray of shape (brain_spec.n_params,), float64, optional
+        Weights of a network controller (None: the open-loop sinusoid alone).
+    brain_spec : BrainSpec, optional
+        What ``brain`` is read as (required with ``brain``).
+    body : RobotDesign, optional
+        A fixed body: its grid and palette replace the CPPN's and the material
+        genes (its own brain, if any, is ignored).
     """
 
-    cppn: CPPN
+    cppn: CPPN | None
     materials: np.ndarray = field(default_factory=lambda: INITIAL_MATERIAL_GENES.copy())
     controller: Controller = field(default_factory=Controller)
     id: int = 0
@@ -83,11 +97,20 @@ class Individual:
     objectives: dict[str, float] = field(default_factory=dict)
     trace: np.ndarray | None = None
     novelty: float | None = None
+    brain: np.ndarray | None = None
+    brain_spec: BrainSpec | None = None
+    body: RobotDesign | None = None
     _grid: np.ndarray | None = field(default=None, repr=False)
     _grid_shape: tuple[int, ...] | None = field(default=None, repr=False)
 
     def __post_init__(self) -> None:
         self.materials = np.array(self.materials, dtype=np.float64).reshape(4, 3)
+        if self.brain is not None:
+            if self.brain_spec is None:
+                raise InvalidParameterError("an individual with a brain needs its brain_spec")
+            self.brain = np.array(self.brain, dtype=np.float64).reshape(self.brain_spec.n_params)
+        if self.cppn is None and self.body is None:
+            raise InvalidParameterError("an individual needs a cppn or a fixed body")
 
     # ------------------------------------------------------------------ phenotype
     @classmethod
@@ -98,6 +121,9 @@ class Individual:
         shape: Sequence[int] = (6, 6, 6),
         outputs: Sequence[str] = MATERIAL_TREE_4,
         rules: CompositionRules | None = None,
+        *,
+        brain_spec: BrainSpec | None = None,
+        body: RobotDesign | None = None,
     ) -> Individual:
         """A random valid individual (the seed's new and gen-0 individuals).
 
@@ -111,21 +137,38 @@ class Individual:
             CPPN outputs (:data:`~softgym.design.MATERIAL_TREE_4` or ``_8``).
         rules : CompositionRules, optional
             Validity (default :meth:`CompositionRules.seed`).
+        brain_spec : BrainSpec, optional
+            Draw a brain too (``brain_spec.random(rng)``, after the CPPN).
+        body : RobotDesign, optional
+            A fixed body: no CPPN is drawn; the controller starts as the body's.
+
+        Without ``brain_spec`` and ``body`` the draws are the seed's (bit-identical).
         """
-        rules = CompositionRules.seed() if rules is None else rules
-        g = CPPN.random_valid(outputs, rng=rng, shape=tuple(shape), is_valid=rules)
-        return cls(cppn=g, id=int(id))
+        if body is None:
+            rules = CompositionRules.seed() if rules is None else rules
+            g = CPPN.random_valid(outputs, rng=rng, shape=tuple(shape), is_valid=rules)
+            ind = cls(cppn=g, id=int(id))
+        else:
+            ind = cls(cppn=None, controller=body.controller, id=int(id), body=body)
+        if brain_spec is not None:
+            ind.brain = np.array(brain_spec.random(rng).weights)
+            ind.brain_spec = brain_spec
+        return ind
 
     def grid(self, shape: Sequence[int] = (6, 6, 6)) -> np.ndarray:
         """The material grid, ndarray of shape ``shape``, int8 (cached)."""
         shape = tuple(int(s) for s in shape)
+        if self.body is not None:
+            return self.body.grid
         if self._grid is None or self._grid_shape != shape:
             self._grid = self.cppn.to_grid(shape)
             self._grid_shape = shape
         return self._grid
 
     def palette(self):
-        """The default palette with materials 6-9 set from the material genes."""
+        """The default palette with materials 6-9 set from the material genes (a fixed body's own)."""
+        if self.body is not None:
+            return self.body.palette
         pal = default_palette()
         for row, mid in zip(self.materials, MATERIAL_GENE_IDS):
             pal = pal.with_changes(
@@ -134,11 +177,14 @@ class Individual:
         return pal
 
     def design(self, shape: Sequence[int] = (6, 6, 6)) -> RobotDesign:
-        """The :class:`~softgym.design.RobotDesign` of this genome (not validated)."""
-        return RobotDesign(self.grid(shape), palette=self.palette(), controller=self.controller)
+        """The :class:`~softgym.design.RobotDesign` of this genome (not validated; with its brain)."""
+        brain = None if self.brain is None else self.brain_spec.clipped(self.brain)
+        return RobotDesign(
+            self.grid(shape), palette=self.palette(), controller=self.controller, brain=brain
+        )
 
     def phenotype_key(self, shape: Sequence[int] = (6, 6, 6)) -> str:
-        """Hash of what the simulator sees: grid, used materials' properties, controller.
+        """Hash of what the simulator sees: grid, used materials' properties, controller, brain.
 
         Two individuals with the same key behave identically, so the second
         is not simulated again (the seed's md5 phenotype cache, §2.3).
@@ -158,19 +204,29 @@ class Individual:
                 ).encode()
             )
         h.update(repr((c.temp_amplitude, c.period, c.muscle_cte)).encode())
+        if self.brain is not None:  # (sinusoid keys are unchanged: old caches stay valid)
+            h.update(repr(sorted(self.brain_spec.to_dict().items())).encode())
+            h.update(np.ascontiguousarray(self.brain, dtype=np.float64).tobytes())
         return h.hexdigest()
 
     # ------------------------------------------------------------------ copies
     def child(self, id: int) -> Individual:
         """A copy with a new ``id``, this individual as parent, no evaluation results."""
-        return Individual(
-            cppn=self.cppn.copy(),
-            materials=self.materials.copy(),
-            controller=self.controller,
-            id=int(id),
-            parent_id=self.id,
-            age=self.age,
-        )
+        return Individual(**self._child_fields(id))
+
+    def _child_fields(self, id: int) -> dict[str, Any]:
+        """The constructor keywords of :meth:`child` (for subclasses: DEAP's ``Softbot``)."""
+        return {
+            "cppn": None if self.cppn is None else self.cppn.copy(),
+            "materials": self.materials.copy(),
+            "controller": self.controller,
+            "id": int(id),
+            "parent_id": self.id,
+            "age": self.age,
+            "brain": None if self.brain is None else self.brain.copy(),
+            "brain_spec": self.brain_spec,
+            "body": self.body,
+        }
 
     def value(self, name: str) -> float:
         """An objective's value (``"age"`` reads the age)."""
@@ -202,22 +258,33 @@ class Individual:
     # ------------------------------------------------------------------ JSON
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready dict (the trace is stored separately, in checkpoint arrays)."""
-        return {
+        out = {
             "id": self.id,
             "parent_id": self.parent_id,
             "age": self.age,
-            "cppn": self.cppn.to_dict(),
+            "cppn": None if self.cppn is None else self.cppn.to_dict(),
             "materials": self.materials.tolist(),
             "controller": self.controller.to_dict(),
             "objectives": dict(self.objectives),
             "novelty": self.novelty,
         }
+        # only when present: a sinusoid individual's dict is what it has always been
+        if self.brain is not None:
+            out["brain"] = {**self.brain_spec.to_dict(), "weights": [float(v) for v in self.brain]}
+        if self.body is not None:
+            out["body"] = self.body.replace(brain=None).to_dict()
+        return out
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Individual:
-        """Inverse of :meth:`to_dict`."""
+        """Inverse of :meth:`to_dict` (dicts without ``brain`` / ``body`` load with None)."""
+        brain = data.get("brain")
+        spec = None
+        if brain is not None:
+            spec = BrainSpec.from_dict({k: v for k, v in brain.items() if k != "weights"})
+        body = data.get("body")
         return cls(
-            cppn=CPPN.from_dict(data["cppn"]),
+            cppn=None if data.get("cppn") is None else CPPN.from_dict(data["cppn"]),
             materials=np.asarray(data["materials"], dtype=np.float64),
             controller=Controller.from_dict(data["controller"]),
             id=int(data["id"]),
@@ -225,4 +292,7 @@ class Individual:
             age=int(data["age"]),
             objectives={k: float(v) for k, v in data.get("objectives", {}).items()},
             novelty=None if data.get("novelty") is None else float(data["novelty"]),
+            brain=None if brain is None else np.asarray(brain["weights"], dtype=np.float64),
+            brain_spec=spec,
+            body=None if body is None else RobotDesign.from_dict(body),
         )

@@ -7,6 +7,9 @@
   distinct random parents' controller and/or material genes.
 * :func:`mut_controller`, :func:`mut_materials`: bounded Gaussian mutation
   with the seed's sigmas and bounds.
+* :func:`mut_brain`: bounded Gaussian mutation of a network controller's
+  weights (clipped to ``+-WEIGHT_BOUND``); :func:`cx_arithmetic` averages
+  two parents' weights when brains evolve.
 * :func:`make_children`: the whole variation step of one generation.
 
 Every function takes an explicit ``numpy.random.Generator``.
@@ -21,12 +24,15 @@ import numpy as np
 
 from evolvers.operators.genome import Individual
 from softgym.design import CONTROLLER_BOUNDS, CompositionRules, Controller
+from softgym.design.brain import WEIGHT_BOUND
 
 __all__ = [
+    "BRAIN_SIGMA",
     "CONTROLLER_SIGMAS",
     "MATERIAL_MUTATION",
     "cx_arithmetic",
     "make_children",
+    "mut_brain",
     "mut_controller",
     "mut_cppn",
     "mut_materials",
@@ -35,6 +41,9 @@ __all__ = [
 
 #: Gaussian sigma per controller gene (§3.2); bounds are :data:`softgym.design.CONTROLLER_BOUNDS`.
 CONTROLLER_SIGMAS: dict[str, float] = {"temp_amplitude": 1.0, "period": 0.1, "muscle_cte": 0.01}
+
+#: Gaussian sigma of a brain weight's mutation (weights lie in [-WEIGHT_BOUND, WEIGHT_BOUND] = [-3, 3]).
+BRAIN_SIGMA = 0.1
 
 #: Material-gene mutation (§3.1): (row of id, column, sigma, low, high); applied in this order.
 #: Rows: 0 = id 6 (soft tissue), 1 = id 7 (hard tissue), 2 = id 8 (muscle); columns E, density, CTE.
@@ -106,6 +115,23 @@ def mut_controller(
     return ind
 
 
+def mut_brain(
+    ind: Individual, rng: np.random.Generator | int | None, sigma: float = BRAIN_SIGMA
+) -> Individual:
+    """Bounded Gaussian mutation of the brain's weights (in place; returns ``ind``).
+
+    Every weight gets ``N(0, sigma)`` added (one draw of the whole vector),
+    then is clipped into ``[-WEIGHT_BOUND, WEIGHT_BOUND]``. An individual
+    without a brain is left as it is (no draw).
+    """
+    if ind.brain is None:
+        return ind
+    rng = _rng(rng)
+    w = ind.brain + rng.normal(0.0, float(sigma), size=ind.brain.shape)
+    ind.brain = np.clip(w, -WEIGHT_BOUND, WEIGHT_BOUND)
+    return ind
+
+
 def mut_materials(ind: Individual, rng: np.random.Generator | int | None) -> Individual:
     """Bounded Gaussian mutation of the material genes (in place; returns ``ind``).
 
@@ -129,13 +155,16 @@ def cx_arithmetic(
     rate: float = 0.4,
     controller: bool = True,
     materials: bool = False,
+    brain: bool = False,
 ) -> list[Individual]:
     """Arithmetic crossover of the real-valued genes (§3.1, §3.2), in place.
 
     ``children`` is shuffled; the first ``floor(rate * len(parents))`` of
     them take, for the controller, each gene's mean over two distinct random
     parents, and for each evolvable material (6, 7, 8; 9 follows 8), its
-    properties' mean over another two distinct random parents.
+    properties' mean over another two distinct random parents; with
+    ``brain``, the mean of the brain weights of another two (parents of one
+    run share one :class:`~softgym.design.brain.BrainSpec`).
 
     Returns
     -------
@@ -164,6 +193,11 @@ def cx_arithmetic(
                     parents[int(a)].materials[row] + parents[int(b)].materials[row]
                 ) / 2.0
             set_counterphase(child.materials)
+        if brain:
+            a, b = rng.choice(len(parents), size=2, replace=False)
+            wa, wb = parents[int(a)].brain, parents[int(b)].brain
+            if wa is not None and wb is not None:
+                child.brain = np.clip((wa + wb) / 2.0, -WEIGHT_BOUND, WEIGHT_BOUND)
     return children
 
 
@@ -178,14 +212,17 @@ def make_children(
     evolve_materials: bool = False,
     crossover_rate: float = 0.4,
     max_attempts: int = 1500,
+    evolve_brain: bool = False,
+    evolve_body: bool = True,
 ) -> list[Individual]:
     """One generation's variation (§2.5, §3.1, §3.2).
 
     Parents are shuffled; each makes one child (a copy with a new id and the
-    parent's age) whose CPPN is mutated with validity retries. Then, if the
-    controller or materials evolve, arithmetic crossover on
+    parent's age) whose CPPN is mutated with validity retries (unless
+    ``evolve_body`` is False: a fixed body). Then, if the controller,
+    materials or brain evolve, arithmetic crossover on
     ``floor(crossover_rate * len(parents))`` children and bounded Gaussian
-    mutation of every child.
+    mutation of every child (controller, materials, then brain weights).
 
     Parameters
     ----------
@@ -205,9 +242,10 @@ def make_children(
     children = []
     for i in order:
         child = parents[int(i)].child(next_id())
-        mut_cppn(child, rng, shape=shape, rules=rules, max_attempts=max_attempts)
+        if evolve_body:
+            mut_cppn(child, rng, shape=shape, rules=rules, max_attempts=max_attempts)
         children.append(child)
-    if evolve_controller or evolve_materials:
+    if evolve_controller or evolve_materials or evolve_brain:
         cx_arithmetic(
             children,
             parents,
@@ -215,10 +253,13 @@ def make_children(
             rate=crossover_rate,
             controller=evolve_controller,
             materials=evolve_materials,
+            brain=evolve_brain,
         )
         for child in children:
             if evolve_controller:
                 mut_controller(child, rng)
             if evolve_materials:
                 mut_materials(child, rng)
+            if evolve_brain:
+                mut_brain(child, rng)
     return children
