@@ -259,6 +259,16 @@ class EpisodeBatch:
             self._brains = self.brains  # the brains are checked against the task and grid now
 
     @property
+    def flat_cells(self) -> np.ndarray:
+        """Each voxel's cell in the batch (robot ``r``'s cell ``c`` is ``r * n_cells + c``), in voxel order."""
+        return self._flat_cells
+
+    @property
+    def measure_params(self) -> dict[str, np.ndarray]:
+        """The task measure's per-robot parameters (:func:`softgym.tasks.task.measure_params`)."""
+        return self._params
+
+    @property
     def sensing(self) -> Any:
         """The batch's sensors (:class:`softgym.tasks.sensing.Sensing`), made on first use."""
         if self._sensing is None:

@@ -332,9 +332,9 @@ class Sensing:
         rest_c = rest - (w[:, :, None] * rest).sum(axis=1, keepdims=True) / count[:, None, None]
         self.rest_w = np.ascontiguousarray(rest_c * w[:, :, None])  # centred, empty cells zero
         # the compiled pass's maps: each voxel's cell, each cell's voxel (-1: empty)
-        self.cell_of = (batch._flat_cells % nc).astype(np.intp)
+        self.cell_of = (batch.flat_cells % nc).astype(np.intp)
         self.voxel_of = np.full((n, nc), -1, dtype=np.intp)
-        self.voxel_of.reshape(-1)[batch._flat_cells] = np.arange(batch._flat_cells.size)
+        self.voxel_of.reshape(-1)[batch.flat_cells] = np.arange(batch.flat_cells.size)
         self.cells = np.zeros((n, nc, 8))
         self.cov = np.zeros((n, 3, 3))
         terrains = batch.terrains
@@ -389,7 +389,7 @@ class Sensing:
             return cells, robot, np.zeros((n, 0))
         ctx = SenseContext(
             cm=cm, cm_vel=cm_vel, rot=self.rot, object_cm=sim.object_center_of_mass(),
-            object_vel=sim.object_velocity(), aux=sim.aux(), aux0=b.aux0, params=b._params,
+            object_vel=sim.object_velocity(), aux=sim.aux(), aux0=b.aux0, params=b.measure_params,
             heights=self.heights, gravity=self.gravity, voxel_size=L,
         )  # fmt: skip
         task = np.concatenate(
