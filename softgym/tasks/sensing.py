@@ -282,8 +282,25 @@ class SenseLayout:
 
 
 def sensing_layout(task: Any, grid_shape: Sequence[int]) -> SenseLayout:
-    """The sensing observation's layout of ``task`` (a :class:`~softgym.tasks.Task`) on a grid."""
-    return SenseLayout(tuple(int(s) for s in grid_shape), tuple(task.senses))
+    """The sensing observation's layout of ``task`` (a :class:`~softgym.tasks.Task`) on a grid.
+
+    Raises
+    ------
+    InvalidParameterError
+        For a grid that is not 3 integers within the design caps
+        (:func:`softgym.design.check_grid_shape`) or a task that is not a Task.
+    """
+    from softgym.design import check_grid_shape
+    from softgym.exceptions import InvalidDesignError, InvalidParameterError
+    from softgym.tasks.task import Task
+
+    if not isinstance(task, Task):
+        raise InvalidParameterError(f"task must be a softgym Task, got {type(task).__name__}")
+    try:
+        shape = check_grid_shape(grid_shape, "grid_shape")
+    except InvalidDesignError as exc:
+        raise InvalidParameterError(str(exc)) from None
+    return SenseLayout(shape, tuple(task.senses))
 
 
 class _Heights:

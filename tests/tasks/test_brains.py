@@ -94,3 +94,18 @@ def test_a_brain_that_does_not_fit_is_a_typed_error():
         softgym.evaluate([default_walker().replace(brain=d.random(0))], task="flat", seconds=0.9)
     with pytest.raises(InvalidDesignError, match="control_dt"):
         BrainSpec("distributed", 25, 2, signals=1, control_dt=5.0)
+
+
+@pytest.mark.parametrize("grid", [(0, 6, 6), (6, 6), (6.5, 6, 6), "666", (10**9, 10**9, 10**9)])
+def test_a_grid_the_sensors_cannot_read_is_a_typed_error(grid):
+    with pytest.raises(softgym.exceptions.InvalidParameterError, match="grid_shape"):
+        brain_spec("central", get_task("flat"), grid)
+    with pytest.raises(softgym.exceptions.InvalidParameterError, match="grid_shape"):
+        sensing_layout(get_task("flat"), grid)
+
+
+def test_an_unknown_brain_kind_is_a_typed_error():
+    with pytest.raises(softgym.exceptions.InvalidParameterError, match="central"):
+        brain_spec("cortex", get_task("flat"), (6, 6, 6))
+    with pytest.raises(softgym.exceptions.InvalidParameterError, match="Task"):
+        sensing_layout("flat", (6, 6, 6))
