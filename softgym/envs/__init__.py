@@ -12,7 +12,10 @@ id                         world                                       reward (p
                            Carry, Swim, Grow)
 =========================  ==========================================  =====================
 
-Every task of :data:`softgym.tasks.TASKS` gets an id (a task added with
+Beside each, ``SoftWalker-<Name>-Sensing-v0`` observes every sensor and the task's own
+senses (:mod:`softgym.tasks.sensing`: touch, strain, orientation, the object of push, the
+terrain ahead of gap...) instead of the voxels and a clock. Every task of
+:data:`softgym.tasks.TASKS` gets an id (a task added with
 :func:`softgym.tasks.register_task` gets one at the next :func:`register_envs`).
 ``gym.make(id)`` gives a :class:`SoftWalkerEnv` (4 s episodes of 0.05 s control
 steps, actions setting the muscles' contractions; the episode length is

@@ -333,6 +333,16 @@ class SoftWalkerEnv(gym.Env):
     time since it was placed (settling included), ``period`` its controller's.
     Values beyond the bounds are clipped (only a diverging robot reaches them).
 
+    With ``observe="sensing"`` (the ``SoftWalker-<Task>-Sensing-v0`` ids) the
+    robot observes every sensor instead (:mod:`softgym.tasks.sensing`): 8
+    values per cell (position and velocity relative to the centre of mass,
+    touch, bond strain), 11 of the robot (centre-of-mass velocity, its up and
+    forward axes, the clock's sin and cos) and the task's own senses (the
+    object and the target of ``push``, terrain heights ahead on the obstacle
+    tasks, ...): ``Box(-bounds, bounds)`` of
+    :func:`~softgym.tasks.sensing.sensing_layout` ``(task, grid_shape).size``
+    values (1747 for push on 6x6x6); each task's page lists them.
+
     ## Rewards
 
     The per-step progress of the task metric, in voxel lengths: on Flat the
@@ -412,12 +422,17 @@ class SoftWalkerEnv(gym.Env):
       the env's own cap goes through ``SoftWalkerEnv(max_episode_steps=k)`` or ``make_vec``.
     * ``action_mode``: ``"contraction"``, ``"temperature"`` (see Action Space) or None: contraction
       under the seed's actuation law, temperature under ``"symmetric"``.
+    * ``observe``: ``"blind"`` (default: the table above) or ``"sensing"`` (every sensor and
+      the task's senses; the ``-Sensing-v0`` ids set it).
     * ``drive``: ``"action"`` (default) or ``"controller"``: the design's own sinusoidal
       controller drives the muscles as in :func:`softgym.evaluate` and the seed, and actions
       are ignored (the open-loop baseline; with ``control_dt`` equal to the task's
       ``trace_interval`` an episode reports exactly ``softgym.evaluate``'s metrics).
 
     ## Version History
+
+    * ``-Sensing-v0`` (new ids beside the ``-v0`` ones, which are unchanged): the
+      sensing observation (``observe="sensing"``).
 
     * v0: initial version. Since issue 33: ``action_mode`` (contractions by default
       under the seed's law; ``action_mode="temperature"`` is the former action), and the ids
