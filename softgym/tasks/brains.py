@@ -230,7 +230,9 @@ def run_brains(
     grid); a distributed batch runs on the largest body's grid. Each robot
     settles for ``config.init_time`` with idle muscles, then its brain drives
     it for the rest of ``task.seconds``, one control step at a time, and the
-    task's metrics come from the centre of mass sampled at each control step
+    task's metrics come from the centre of mass sampled every
+    ``task.trace_interval`` (the open loop's sampling) where that is a whole
+    number of control steps, else at every control step
     (:meth:`softgym.tasks.EpisodeBatch.metrics`).
 
     Returns
@@ -271,7 +273,9 @@ def run_brains(
             batch.brains.step()
             batch.advance()
             batch.update(every)
-        m = batch.metrics()
+        ratio = float(task.trace_interval) / dt
+        stride = int(round(ratio)) if round(ratio) >= 1 and abs(ratio - round(ratio)) < 1e-9 else 1
+        m = batch.metrics(stride)
         for key, v in m.items():
             if key not in out:
                 out[key] = np.zeros(len(designs), dtype=v.dtype)

@@ -315,12 +315,18 @@ class EpisodeBatch:
             self._trace_aux[ids] = 0.0
             self._trace_aux[ids, 0] = self.aux0[ids]
 
-    def _task_measure(self, k: np.ndarray) -> np.ndarray:
+    @staticmethod
+    def _valid(k: np.ndarray, stride: int = 1) -> np.ndarray:
+        # samples 0..k of each robot, every stride-th one and the last
+        idx = np.arange(int(k.max()) + 1)[None, :]
+        return (idx <= k[:, None]) & ((idx % stride == 0) | (idx == k[:, None]))
+
+    def _task_measure(self, k: np.ndarray, stride: int = 1) -> np.ndarray:
         # the suite task's measure of every robot over its samples 0..k
         kmax = int(k.max()) + 1
         return task_measure_from_arrays(
             self.metric, self.cm0, self.aux0, self._trace_cm[:, :kmax], self._trace_aux[:, :kmax],
-            np.arange(kmax)[None, :] <= k[:, None], self.L, self._params,
+            self._valid(k, stride), self.L, self._params,
         )  # fmt: skip
 
     def reset_all(self) -> None:
@@ -509,12 +515,19 @@ class EpisodeBatch:
         obs[:, -1] = np.cos(theta)
         return obs
 
-    def metrics(self) -> dict[str, np.ndarray]:
+    def metrics(self, stride: int = 1) -> dict[str, np.ndarray]:
         """The task's metrics of every robot's episode so far (:func:`softgym.metrics.walk_metrics_from_arrays`).
 
         The samples are the centre of mass at the episode start and after each
         control step, timed from the robot's placement (settling included, as
         in the seed); the end is the latest step.
+
+        Parameters
+        ----------
+        stride : int
+            Use every ``stride``-th sample (and the last): with ``stride *
+            control_dt`` the task's ``trace_interval``, the samples
+            :func:`softgym.evaluate` scores an open-loop run on.
 
         Returns
         -------
@@ -535,10 +548,10 @@ class EpisodeBatch:
             self.L,
             np.maximum(end, self.control_dt),
             diverged=self.done_diverged,
-            valid=np.arange(kmax)[None, :] <= k[:, None],
+            valid=self._valid(k, stride),
         )
         if self._measure:
-            value = self._task_measure(k)
+            value = self._task_measure(k, stride)
             value[self.done_diverged] = out["norm_final_dist"][self.done_diverged]  # the worst
             out[self.metric] = value
         out["score"] = out[self.metric].copy()
