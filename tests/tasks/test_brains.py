@@ -109,3 +109,20 @@ def test_an_unknown_brain_kind_is_a_typed_error():
         brain_spec("cortex", get_task("flat"), (6, 6, 6))
     with pytest.raises(softgym.exceptions.InvalidParameterError, match="Task"):
         sensing_layout("flat", (6, 6, 6))
+
+
+@pytest.mark.parametrize("task", ["stairs", "rough", "turn"])
+def test_a_finer_control_step_scored_every_trace_interval_reports_evaluates_metrics(task):
+    # the design's own sinusoid run as episodes of 0.05 s steps, scored on every second
+    # sample (0.1 s: the task's trace_interval): exactly softgym.evaluate's open-loop metrics
+    t = get_task(task)
+    b = EpisodeBatch([default_walker()], t, (6, 6, 6), 0.05, t.seconds - 1.0, None,
+                     t.config(trace_interval=1e9), n_threads=1, drive="controller")  # fmt: skip
+    b.reset_all()
+    for _ in range(b.max_steps):
+        b.advance()
+        b.update(np.ones(1, dtype=bool))
+    got = b.metrics(stride=2)
+    want = softgym.evaluate([default_walker()], task=t)
+    for k in ("norm_final_dist", "max_xy_dist", "l_coefficient", "score"):
+        assert got[k][0] == pytest.approx(want[k][0], rel=1e-9, abs=1e-12), k
