@@ -12,6 +12,7 @@ from softgym.design import RobotDesign, default_walker
 from softgym.envs import ENV_IDS, SoftWalkerEnv, SoftWalkerVectorEnv
 
 IDS = sorted(ENV_IDS)
+SENSING_IDS = sorted(softgym.envs.SENSING_ENV_IDS)
 
 
 def small_design() -> RobotDesign:
@@ -24,14 +25,15 @@ def small_design() -> RobotDesign:
 
 def test_import_softgym_registers_every_id():
     assert "envs" in softgym.__all__
-    for env_id in IDS:
+    assert len(SENSING_IDS) == len(IDS)
+    for env_id in IDS + SENSING_IDS:
         spec = gym.spec(env_id)
         assert isinstance(spec.entry_point, str) and spec.entry_point.startswith("softgym.envs")
         assert spec.vector_entry_point == "softgym.envs.vector:SoftWalkerVectorEnv"
         assert spec.max_episode_steps is None  # the episode is set in seconds, not steps
 
 
-@pytest.mark.parametrize("env_id", IDS)
+@pytest.mark.parametrize("env_id", IDS + SENSING_IDS)
 def test_check_env_passes_without_warnings(env_id):
     env = gym.make(env_id)
     with warnings.catch_warnings():
@@ -143,3 +145,14 @@ def test_sensing_ids_are_check_env_clean_and_see_their_task():
     vec = gym.make_vec("SoftWalker-Push-Sensing-v0", num_envs=2, vectorization_mode="vector_entry_point")
     obs, _ = vec.reset(seed=0)
     assert obs.shape == (2, sensing_layout(get_task("push"), (6, 6, 6)).size)
+
+
+@pytest.mark.parametrize("bad", ["eyes", "", None, 1, True])
+def test_an_unknown_observation_is_a_typed_error(bad):
+    from softgym.exceptions import InvalidParameterError
+
+    with pytest.raises(InvalidParameterError, match="observe"):
+        gym.make("SoftWalker-Flat-v0", observe=bad)
+    with pytest.raises(InvalidParameterError, match="observe"):
+        gym.make_vec("SoftWalker-Flat-v0", num_envs=2, vectorization_mode="vector_entry_point",
+                     observe=bad)  # fmt: skip
