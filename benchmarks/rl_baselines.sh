@@ -9,15 +9,21 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUDGET=${BUDGET:-500000}
-RUNS=${RUNS:-"flat:0 flat:1 flat:2 wall:0 rough:0 gap:0 incline:0 push:0 carry:0 swim:0"}
+# a run is task:seed, or task:seed:sensing for the sensing observation (the -Sensing-v0 ids)
+RUNS=${RUNS:-"flat:0 flat:1 flat:2 wall:0 rough:0 gap:0 incline:0 push:0 carry:0 swim:0 push:0:sensing carry:0:sensing gap:0:sensing"}
 for run in $RUNS; do
-  task=${run%%:*}
-  seed=${run##*:}
-  dir=benchmarks/data/rl/ppo/$task-s$seed
+  IFS=: read -r task seed observe <<< "$run"
+  observe=${observe:-blind}
+  if [ "$observe" = sensing ]; then
+    dir=benchmarks/data/rl/ppo/$task-sensing-s$seed
+  else
+    dir=benchmarks/data/rl/ppo/$task-s$seed
+  fi
   if [ -f "$dir/run.json" ] && grep -q '"finished": true' "$dir/run.json"; then
     echo "$dir: finished"
     continue
   fi
   echo "$(date -u +%FT%TZ) $dir: start/resume"
-  python benchmarks/rl_ppo.py --task "$task" --seed "$seed" --timesteps "$BUDGET" --run-dir "$dir"
+  python benchmarks/rl_ppo.py --task "$task" --seed "$seed" --timesteps "$BUDGET" --run-dir "$dir" \
+    --observe "$observe"
 done
