@@ -41,6 +41,17 @@ cdef inline double _box_gap(const float64_t* p, const float64_t* b, double half)
     return -inside - half
 
 
+cdef inline double _pair_gap(const float64_t* p, const float64_t* q, double reach, double cap,
+                             double best) noexcept nogil:
+    # the smaller of ``best`` and the gap between two cubes (centre distance minus the sum of
+    # their half edges, ``reach``), the square root only for a pair within reach + cap
+    cdef double dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2]
+    cdef double d2 = dx * dx + dy * dy + dz * dz
+    if d2 < (reach + cap) * (reach + cap):
+        return min(best, sqrt(d2) - reach)
+    return best
+
+
 cdef void _robot_gaps(
     intp_t r, const float64_t* pos, const float64_t* scale, const flag_t* surface,
     const intp_t* vox_start, const intp_t* body_end, const intp_t* grid, const flag_t* floor,
@@ -50,7 +61,7 @@ cdef void _robot_gaps(
 ) noexcept nogil:
     cdef intp_t a = vox_start[r], e = body_end[r], z = vox_start[r + 1]
     cdef intp_t i, j, k, hops, di, dj, dk
-    cdef double half, g, reach, dx, dy, dz, d2
+    cdef double half, g
     cdef bint own = (e - a) <= self_max
     for i in range(a, e):
         out[out0 + i - a] = cap
@@ -64,21 +75,9 @@ cdef void _robot_gaps(
         for k in range(box_start[r], box_start[r + 1]):
             g = min(g, _box_gap(&pos[3 * i], &boxes[6 * k], half))
         for k in range(obs_start[r], obs_start[r + 1]):
-            reach = half + obs_half
-            dx = pos[3 * i] - obs[4 * k]
-            dy = pos[3 * i + 1] - obs[4 * k + 1]
-            dz = pos[3 * i + 2] - obs[4 * k + 2]
-            d2 = dx * dx + dy * dy + dz * dz
-            if d2 < (reach + cap) * (reach + cap):
-                g = min(g, sqrt(d2) - reach)
+            g = _pair_gap(&pos[3 * i], &obs[4 * k], half + obs_half, cap, g)
         for j in range(e, z):  # the terrain's movable objects
-            reach = half + 0.5 * scale[j]
-            dx = pos[3 * i] - pos[3 * j]
-            dy = pos[3 * i + 1] - pos[3 * j + 1]
-            dz = pos[3 * i + 2] - pos[3 * j + 2]
-            d2 = dx * dx + dy * dy + dz * dz
-            if d2 < (reach + cap) * (reach + cap):
-                g = min(g, sqrt(d2) - reach)
+            g = _pair_gap(&pos[3 * i], &pos[3 * j], half + 0.5 * scale[j], cap, g)
         out[out0 + i - a] = min(out[out0 + i - a], g)
         if not own:
             continue
@@ -91,17 +90,11 @@ cdef void _robot_gaps(
             hops = (di if di >= 0 else -di) + (dj if dj >= 0 else -dj) + (dk if dk >= 0 else -dk)
             if hops <= self_hops:
                 continue
-            reach = half + 0.5 * scale[j]
-            dx = pos[3 * i] - pos[3 * j]
-            dy = pos[3 * i + 1] - pos[3 * j + 1]
-            dz = pos[3 * i + 2] - pos[3 * j + 2]
-            d2 = dx * dx + dy * dy + dz * dz
-            if d2 < (reach + cap) * (reach + cap):
-                g = sqrt(d2) - reach
-                if g < out[out0 + i - a]:
-                    out[out0 + i - a] = g
-                if g < out[out0 + j - a]:
-                    out[out0 + j - a] = g
+            g = _pair_gap(&pos[3 * i], &pos[3 * j], half + 0.5 * scale[j], cap, cap)
+            if g < out[out0 + i - a]:
+                out[out0 + i - a] = g
+            if g < out[out0 + j - a]:
+                out[out0 + j - a] = g
 
 
 def contact_gaps(
