@@ -57,15 +57,29 @@ cdef void _robot_gaps(
     const intp_t* vox_start, const intp_t* body_end, const intp_t* grid, const flag_t* floor,
     const intp_t* box_start, const float64_t* boxes, const intp_t* obs_start,
     const float64_t* obs, double obs_half, intp_t self_hops, intp_t self_max, double cap,
-    float64_t* out, intp_t out0,
+    float64_t* out, intp_t out0, intp_t* order,
 ) noexcept nogil:
     cdef intp_t a = vox_start[r], e = body_end[r], z = vox_start[r + 1]
-    cdef intp_t i, j, k, hops, di, dj, dk
-    cdef double half, g
-    cdef bint own = (e - a) <= self_max
+    cdef intp_t n = e - a
+    cdef intp_t i, j, k, t, u, key, hops, di, dj, dk
+    cdef double half, g, x, window, edge = 0.0
+    cdef bint own = n <= self_max
     for i in range(a, e):
         out[out0 + i - a] = cap
-    for i in range(a, e):
+        edge = max(edge, scale[i])
+    # the robot's voxels by x (insertion sort from the last call's order: nearly sorted), so
+    # that its own pairs are swept within a window of x: beyond it no pair is within cap
+    for t in range(1, n):
+        key = order[t]
+        x = pos[3 * (a + key)]
+        u = t - 1
+        while u >= 0 and pos[3 * (a + order[u])] > x:
+            order[u + 1] = order[u]
+            u -= 1
+        order[u + 1] = key
+    window = edge + cap
+    for t in range(n):
+        i = a + order[t]
         if not surface[i]:  # a voxel with all six bonds touches nothing but its neighbours
             continue
         half = 0.5 * scale[i]
@@ -81,7 +95,10 @@ cdef void _robot_gaps(
         out[out0 + i - a] = min(out[out0 + i - a], g)
         if not own:
             continue
-        for j in range(i + 1, e):  # each pair once, both voxels take the gap
+        for u in range(t + 1, n):  # each pair once, both voxels take the gap
+            j = a + order[u]
+            if pos[3 * j] - pos[3 * i] >= window:
+                break
             if not surface[j]:
                 continue
             di = grid[3 * i] - grid[3 * j]
@@ -102,25 +119,29 @@ def contact_gaps(
     const intp_t[::1] vox_start, const intp_t[::1] body_end, const intp_t[:, ::1] grid,
     const flag_t[::1] floor, const intp_t[::1] box_start, const float64_t[:, ::1] boxes,
     const intp_t[::1] obs_start, const float64_t[:, ::1] obs, double obs_edge, intp_t self_hops,
-    intp_t self_max, double cap, const intp_t[::1] own_offsets, float64_t[::1] out, int n_threads,
+    intp_t self_max, double cap, const intp_t[::1] own_offsets, float64_t[::1] out,
+    intp_t[::1] order, int n_threads,
 ):
     """Fill ``out`` (one value per robot voxel, in the order of ``own_offsets``) with its
     smallest surface gap (m) to the floor, boxes, obstacle voxels (edge ``obs_edge``),
     the entry's objects and its own voxels more than ``self_hops`` lattice steps away
     (robots of more than ``self_max`` voxels skip the last), at most ``cap``. Voxels with
-    all six bonds (not ``surface``) get ``cap``: they touch nothing."""
+    all six bonds (not ``surface``) get ``cap``: they touch nothing. ``order`` holds, per
+    robot (its segment of ``own_offsets``), a permutation of its voxels' local indices,
+    sorted by x here (kept between calls: the next sort is short); the result does not
+    depend on it."""
     cdef intp_t n = vox_start.shape[0] - 1
     cdef intp_t r
     cdef const float64_t* bx = &boxes[0, 0] if boxes.shape[0] else NULL
     cdef const float64_t* ob = &obs[0, 0] if obs.shape[0] else NULL
-    if out.shape[0] != own_offsets[n]:
-        raise ValueError("out must hold one value per robot voxel")
+    if out.shape[0] != own_offsets[n] or order.shape[0] != own_offsets[n]:
+        raise ValueError("out and order must hold one value per robot voxel")
     if n_threads < 1:
         n_threads = 1
     for r in prange(n, nogil=True, schedule="dynamic", num_threads=n_threads):
         _robot_gaps(r, &pos[0, 0], &scale[0], &surface[0], &vox_start[0], &body_end[0],
                     &grid[0, 0], &floor[0], &box_start[0], bx, &obs_start[0], ob, 0.5 * obs_edge,
-                    self_hops, self_max, cap, &out[0], own_offsets[r])
+                    self_hops, self_max, cap, &out[0], own_offsets[r], &order[own_offsets[r]])
 
 
 cdef void _robot_cells(

@@ -597,9 +597,20 @@ class Simulation:
             a["pos"], a["scale"], a["surface"], a["vox_start"], a["body_end"], self._grid_index,
             a["floor"], a["box_start"], a["boxes"], a["obs_start"], np.ascontiguousarray(a["obs"]),
             float(self.config.voxel_size), self.SELF_TOUCH_HOPS, self.SELF_TOUCH_MAX_VOXELS,
-            float(cap), self._own_offsets.astype(np.intp), out, threads,
+            float(cap), self._own_offsets.astype(np.intp), out, self._sense_order(), threads,
         )  # fmt: skip
         return out
+
+    def _sense_order(self) -> np.ndarray:
+        # each robot's voxels sorted by x at the last contact_gaps call (local indices), kept
+        # so that the next call's sort is short; any permutation gives the same gaps
+        order = getattr(self, "_order", None)
+        if order is None:
+            off = self._own_offsets
+            counts = np.diff(off)
+            order = (np.arange(int(off[-1])) - np.repeat(off[:-1], counts)).astype(np.intp)
+            self._order = order
+        return order
 
     def cell_sensors(
         self,

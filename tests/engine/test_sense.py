@@ -82,3 +82,20 @@ def test_own_voxels_count_beyond_three_lattice_steps():
     L = sim.config.voxel_size
     gaps = sim.contact_gaps(cap=10 * L)
     np.testing.assert_allclose(gaps / L, [3, 3, 10, 10, 3, 3], rtol=0, atol=1e-9)
+
+
+def test_the_sweep_order_kept_between_calls_never_changes_the_gaps():
+    from softgym.tasks import get_task
+
+    task = get_task("push")
+    sim = Simulation([default_walker()] * 3, config=task.config(),
+                     terrain=task.terrain_for((6, 6, 6)), n_threads=2)  # fmt: skip
+    sim.advance(1.5)
+    L = sim.config.voxel_size
+    first = sim.contact_gaps(cap=0.3 * L)  # sorts from the lattice order
+    again = sim.contact_gaps(cap=0.3 * L)  # from the sorted one
+    fresh = Simulation([default_walker()] * 3, config=task.config(),
+                       terrain=task.terrain_for((6, 6, 6)), n_threads=1)  # fmt: skip
+    fresh.advance(1.5)
+    np.testing.assert_array_equal(first, again)
+    np.testing.assert_array_equal(first, fresh.contact_gaps(cap=0.3 * L))
