@@ -23,7 +23,8 @@ bootstrap 95 % confidence intervals and writes the figure.
 
     python benchmarks/closed_loop.py --tasks push carry turn gap rough stairs --seeds 5 \\
         --evals 320 --out benchmarks/data/closed_loop          # runs, resumable
-    python benchmarks/closed_loop.py --out benchmarks/data/closed_loop --report
+    python benchmarks/closed_loop.py --out benchmarks/data/closed_loop --report \\
+        --figure docs/figures/closed_loop.png
 """
 
 from __future__ import annotations
@@ -146,7 +147,7 @@ def rescore(runs: list[dict]) -> None:
             r["search_score"], r["best_score"] = r["best_score"], float(s)
 
 
-def report(out: Path, again: bool = True) -> str:
+def report(out: Path, again: bool = True, figure: Path | None = None) -> str:
     """The table of medians with bootstrap 95 % intervals, and the figure ``closed_loop.png``."""
     runs = [json.loads(p.read_text()) for p in sorted((out / "runs").glob("*.json"))]
     if again:
@@ -188,7 +189,7 @@ def report(out: Path, again: bool = True) -> str:
     ax.set_title("open-loop sinusoid vs distributed sensing brain, same CMA-ES budget")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(out / "closed_loop.png", dpi=110)
+    fig.savefig(out / "closed_loop.png" if figure is None else figure, dpi=110)
     plt.close(fig)
     return "\n".join(lines)
 
@@ -203,11 +204,13 @@ def main(argv=None) -> None:
     ap.add_argument("--conditions", nargs="+", default=list(CONDITIONS), choices=CONDITIONS)
     ap.add_argument("--out", type=Path, default=Path("benchmarks/data/closed_loop"))
     ap.add_argument("--report", action="store_true", help="print the table and write the figure")
+    ap.add_argument("--figure", type=Path, default=None,
+                    help="where --report writes the figure (default OUT/closed_loop.png)")
     ap.add_argument("--no-rescore", action="store_true",
                     help="report the searches' own best scores (default: score each best design again)")
     args = ap.parse_args(argv)
     if args.report:
-        print(report(args.out, again=not args.no_rescore))
+        print(report(args.out, again=not args.no_rescore, figure=args.figure))
         return
     (args.out / "runs").mkdir(parents=True, exist_ok=True)
     # seeds outermost: an interrupted study has every task at its first seeds
