@@ -32,6 +32,7 @@ gives one writer at a time a run folder.
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import io
 import json
@@ -70,11 +71,13 @@ __all__ = [
     "loads_json",
     "read_capped",
     "read_json",
+    "remove_stale_temp_files",
     "rng_from_state",
     "rng_state",
     "python_random_state",
     "set_python_random_state",
     "save_checkpoint",
+    "temp_file_target",
 ]
 
 #: ``"schema"`` field of a checkpoint's JSON half.
@@ -102,6 +105,73 @@ MAX_JSON_BYTES = 64 * 2**20
 MAX_CHECKPOINT_BYTES = 2 * 2**30
 
 logger = logging.getLogger(__name__)
+
+#: How :func:`atomic_write_bytes` names its temporary file: ``.NAME.tmpPID`` beside the target.
+_TEMP_PREFIX, _TEMP_INFIX = ".", ".tmp"
+_TEMP_NAME = re.compile(r"^\.(.+)\.tmp(\d+)$")
+
+
+def _pid_alive(pid: int) -> bool:
+    """Whether a process ``pid`` runs on this host (True when that cannot be told)."""
+    if pid == os.getpid():
+        return False  # ours: this process writes no file while it cleans
+    if sys.platform == "win32":  # pragma: no cover - no signal 0 there
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, OSError):
+        return True
+    return True
+
+
+def temp_file_target(name: str) -> str | None:
+    """The file name a temporary file of :func:`atomic_write_bytes` named ``name`` was
+    being written to (``.NAME.tmpPID`` gives ``NAME``), or None if ``name`` is not one.
+    """
+    m = _TEMP_NAME.match(name)
+    return m.group(1) if m else None
+
+
+def remove_stale_temp_files(directory: str | os.PathLike[str], recursive: bool = True) -> list[Path]:
+    """Remove the temporary files of :func:`atomic_write_bytes` left in ``directory`` by a
+    process that was killed mid-write (``.NAME.tmpPID`` whose process no longer runs).
+
+    Called by a run that holds its folder's :class:`RunLock` (no other writer), on
+    resume: a file of a process that still runs is kept. Links and anything
+    that is not a regular file are left alone.
+
+    Returns
+    -------
+    list of Path
+        The files removed.
+    """
+    root = Path(directory)
+    removed: list[Path] = []
+    if not root.is_dir():
+        return removed
+    folders = [root]
+    while folders:
+        folder = folders.pop()
+        try:
+            entries = list(os.scandir(folder))
+        except OSError:
+            continue
+        for entry in entries:
+            if entry.is_dir(follow_symlinks=False):
+                if recursive:
+                    folders.append(Path(entry.path))
+                continue
+            m = _TEMP_NAME.match(entry.name)
+            if not m or not entry.is_file(follow_symlinks=False) or _pid_alive(int(m.group(2))):
+                continue
+            try:
+                os.unlink(entry.path)
+            except OSError:
+                continue
+            removed.append(Path(entry.path))
+    return removed
 
 
 def read_capped(
@@ -198,26 +268,49 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
     """Write ``data`` to ``path`` through a temporary file, fsync and rename.
 
     A reader sees either the old file or the complete new one, never a part;
-    on failure the temporary file is removed. A folder at ``path`` raises
-    :class:`CheckpointError` naming it.
+    on failure the temporary file is removed. A folder at ``path``, or
+    anything else there that is not a regular file (a device, a FIFO, a
+    socket: the rename would replace it), raises :class:`CheckpointError`
+    naming it, as does a write that fails (naming ``path``, not the
+    temporary file).
     """
     path = Path(path)
     if path.is_dir():
         raise CheckpointError(f"{path} is a folder: cannot write a file there")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
     try:
-        with open(tmp, "wb") as fh:
+        st = os.stat(path)
+    except (FileNotFoundError, NotADirectoryError):
+        st = None  # nothing there yet (or a dangling link, which the rename replaces)
+    except OSError as exc:
+        raise CheckpointError(f"cannot write {path}: {exc.strerror or exc}") from None
+    if st is not None and not stat.S_ISREG(st.st_mode):
+        raise CheckpointError(
+            f"{path} exists and is not a regular file (a device, FIFO or socket): "
+            f"it is never replaced; write to another path"
+        )
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f"{_TEMP_PREFIX}{path.name}{_TEMP_INFIX}{os.getpid()}")
+    try:
+        try:
+            tmp.unlink()  # a temporary file left by a killed process of the same pid
+        except FileNotFoundError:
+            pass
+        # a new file, never through a link someone left at the temporary name
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_NOFOLLOW", 0)
+                     | getattr(os, "O_BINARY", 0), 0o644)  # fmt: skip
+        with open(fd, "wb") as fh:
             fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
         # never leave the temporary file behind (a full disk, a folder in the way...)
         try:
             tmp.unlink()
         except OSError:
             pass
+        if isinstance(exc, OSError) and not isinstance(exc, CheckpointError):
+            raise CheckpointError(f"cannot write {path}: {exc.strerror or exc}") from None
         raise
     try:  # make the rename durable (best effort: not every filesystem allows it)
         fd = os.open(path.parent, os.O_RDONLY)
@@ -586,11 +679,17 @@ class RunLock:
     ------
     RunFolderLockedError
         On entry, if another process holds the folder; the message names it.
+    CheckpointError
+        On entry, if ``.lock`` is a symbolic link or not a regular file (it is
+        never followed nor written through), naming it.
     """
+
+    #: The lock file's name in the run folder.
+    FILE_NAME = ".lock"
 
     def __init__(self, directory: str | os.PathLike[str]) -> None:
         self.directory = Path(directory)
-        self.path = self.directory / ".lock"
+        self.path = self.directory / self.FILE_NAME
         self._fd: int | None = None
 
     def __enter__(self) -> RunLock:
@@ -603,7 +702,35 @@ class RunLock:
     def acquire(self) -> None:
         """Take the lock or raise :class:`RunFolderLockedError` naming the holder."""
         self.directory.mkdir(parents=True, exist_ok=True)
-        fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+        # never through a symbolic link (it could truncate a file outside the run folder),
+        # never a FIFO or device (opened without blocking, then refused)
+        flags = os.O_RDWR | os.O_CREAT | getattr(os, "O_NOFOLLOW", 0) | getattr(os, "O_NONBLOCK", 0)
+        try:
+            fd = os.open(self.path, flags, 0o644)
+        except OSError as exc:
+            if os.path.islink(self.path) or exc.errno == errno.ELOOP:
+                raise CheckpointError(
+                    f"lock file {str(self.path)!r} is a symbolic link, not a regular file; "
+                    f"remove it (the run folder's lock is never followed elsewhere)"
+                ) from None
+            raise
+        try:
+            st = os.fstat(fd)
+            if not stat.S_ISREG(st.st_mode):
+                raise CheckpointError(
+                    f"lock file {str(self.path)!r} is not a regular file (a FIFO, device or "
+                    f"socket); remove it"
+                )
+            if st.st_nlink > 1:  # a hard link to a file elsewhere: writing the holder would change it
+                raise CheckpointError(
+                    f"lock file {str(self.path)!r} has {st.st_nlink} hard links (another file "
+                    f"shares it); remove it"
+                )
+            if hasattr(os, "set_blocking"):
+                os.set_blocking(fd, True)
+        except BaseException:
+            os.close(fd)
+            raise
         try:
             _lock_fd(fd)
         except OSError:

@@ -47,9 +47,11 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
 def _cmd_replay(args: argparse.Namespace) -> int:
     from evolvers.evaluation.experiments import Experiment
+    from evolvers.recording.recorder import read_run_config
     from softgym.design import RobotDesign
     from softgym.evaluate import evaluate
-    from softgym.exceptions import SoftGymError
+    from softgym.exceptions import InvalidParameterError, SoftGymError
+    from softgym.io import read_json
     from softgym.render.figures import (
         plot_robot,
         plot_trajectory,
@@ -58,17 +60,26 @@ def _cmd_replay(args: argparse.Namespace) -> int:
     )
 
     run_dir = Path(args.run_dir)
-    try:
-        cfg = json.loads((run_dir / "config.json").read_text())
+    try:  # every file through the capped reader: a FIFO is refused, never waited on
+        cfg = read_run_config(run_dir)
         design = RobotDesign.load(run_dir / "best_design.json")
-        best = json.loads((run_dir / "best_designs.json").read_text())["best"][0]
+        best = read_json(run_dir / "best_designs.json")["best"][0]
         experiment = Experiment.from_dict(cfg["experiment"])
-    except (OSError, ValueError, KeyError, TypeError, SoftGymError) as exc:
+        if not isinstance(best, dict):
+            raise TypeError("best_designs.json: 'best' holds no design entry")
+    except (OSError, ValueError, KeyError, TypeError, IndexError, SoftGymError) as exc:
         print(f"softgym replay: {run_dir} is not a finished run folder ({exc})", file=sys.stderr)
         return 2
     exp = cfg["experiment"]
-    seconds = float(exp["seconds"] if args.seconds is None else args.seconds)
+    seconds = float(experiment.seconds if args.seconds is None else args.seconds)
     task = experiment.make_task().replace(seconds=seconds)
+    settle = float(task.config().init_time)
+    if not seconds > settle:  # the trajectory is sampled after the settling time: none at all
+        given = "--seconds" if args.seconds is not None else f"the run's seconds ({run_dir})"
+        raise InvalidParameterError(
+            f"{given} must be more than the {settle:g} s settling time (the trajectory starts "
+            f"after it), got {seconds:g}; give --seconds above {settle:g}"
+        )
     m = evaluate([design], task=task, traces=True)
     out = Path(args.out) if args.out else run_dir / "replay"
     terrain = task.terrain_for(design.shape)

@@ -4,11 +4,23 @@ import os
 import sys
 
 import pytest
+from fuzzing import refused_in_child  # tests/fuzzing.py
 
 from softgym.exceptions import CheckpointError, InvalidDesignError, SoftGymError
 from softgym_cli import main
 
 TINY = ["--pop", "4", "--seconds", "0.5", "--shape", "4", "4", "4", "--quiet", "--no-figures"]
+#: One short generation of a few small robots per run command (what a refused input would
+#: have started, had it been taken: never a long run, even on a softgym without the check).
+SMALL = {
+    "evolve": ["--generations", "0", "--no-gif", *TINY],
+    "qd": ["--generations", "0", "--batch", "4", "--seconds", "0.5", "--shape", "4", "4", "4",
+           "--quiet", "--no-figures", "--no-gif"],
+    "poet": ["--iterations", "0", "--pop", "4", "--seconds", "0.5", "--shape", "4", "4", "4",
+             "--quiet", "--no-figures"],
+    "study": ["--generations", "0", "--pop", "4", "--seconds", "0.5", "--shape", "4", "4", "4",
+              "--quiet"],
+}  # fmt: skip
 
 
 def _one_line_error(capsys, argv, command):
@@ -147,3 +159,104 @@ def test_compare_into_a_format_matplotlib_cannot_write_is_one_line(tmp_path, cap
     line = _one_line_error(capsys, ["compare", str(tmp_path), "--out", str(tmp_path / "c.xyz")],
                            "compare")  # fmt: skip
     assert "c.xyz" in line and "not a format matplotlib writes" in line
+
+
+def _one_line_error_in_child(argv, command, timeout=60, cwd=None):
+    """``softgym ARGV`` in a child process (a hang fails the test by ``timeout``): one line, exit 2."""
+    import subprocess
+
+    res = subprocess.run([sys.executable, "-m", "softgym_cli", *argv], capture_output=True,
+                         text=True, timeout=timeout, cwd=cwd)  # fmt: skip
+    lines = res.stderr.splitlines()
+    assert res.returncode == 2 and len(lines) == 1, res.stderr[-2000:]
+    assert lines[0].startswith(f"softgym {command}: ") and "Traceback" not in res.stderr
+    return lines[0]
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        # issue 61, hang 3: these ran (or planned) for ever; capped like the population
+        (["evolve", "--generations", "999999999999999999999"],
+         "generations must be an integer in [0, 1000000]"),
+        (["poet", "--iterations", "99999999999"], "iterations must be an integer in [0, 1000000]"),
+        (["study", "--seeds", "1000000000", "--plan"], "seeds must be an integer in [1, 10000]"),
+        (["study", "--generations", "99999999999", "--plan"],
+         "generations must be an integer in [0, 1000000]"),
+        # issue 61, hang 1: NSGA-III's reference directions never ended on one objective
+        (["evolve", "--backend", "pymoo", "--algorithm", "nsga3"],
+         "'nsga3' needs at least 2 objectives"),
+    ],
+)  # fmt: skip
+def test_counts_and_algorithms_that_would_run_for_ever_are_refused_in_one_line(tmp_path, argv,
+                                                                                needle):  # fmt: skip
+    out = tmp_path / "run"
+    line = _one_line_error_in_child([*argv, "--out", str(out)], argv[0])
+    assert needle in line
+    assert not out.exists()  # nothing was written
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        # issue 61, item 11: each was a traceback
+        (["evolve", "--seed", "-1"], "seed must be an integer in [0, 4294967295], got -1"),
+        (["qd", "--seed", "-1"], "seed must be an integer in [0, 4294967295], got -1"),
+        (["poet", "--seed", "-1"], "seed must be an integer in [0, 4294967295], got -1"),
+        (["study", "--first-seed", "-1", "--plan"], "first_seed must be an integer in [0, "),
+        (["study", "--first-seed", "4294967295", "--seeds", "2", "--plan"], "at most 4294967295"),
+        (["evolve", "--dask", "garbage"], "--dask"),
+        (["evolve", "--backend", "pymoo", "--algorithm", "sms-emoa"],
+         "'sms-emoa' needs at least 2 objectives"),
+        (["evolve", "--backend", "pymoo", "--algorithm", "nsga3", "--experiment", "novelty"],
+         "'nsga3' needs at least 2 objectives"),
+    ],
+)  # fmt: skip
+def test_bad_seeds_addresses_and_algorithms_are_one_line_before_anything_is_written(
+    tmp_path, capsys, argv, needle
+):
+    out = tmp_path / "run"
+    line = _one_line_error(capsys, [*argv, *SMALL[argv[0]], "--out", str(out)], argv[0])
+    assert needle in line
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("command", ["evolve", "qd", "poet", "study"])
+def test_an_empty_out_is_refused_not_taken_as_the_current_folder(tmp_path, monkeypatch, capsys,
+                                                                 command):  # fmt: skip
+    monkeypatch.chdir(tmp_path)
+    extra = ["--plan", "--seeds", "1"] if command == "study" else []
+    line = _one_line_error(capsys, [command, *SMALL[command], "--out", "", *extra], command)
+    assert "--out" in line and "''" in line
+    assert list(tmp_path.iterdir()) == []  # nothing written into the current folder
+
+
+def test_a_folder_of_a_users_files_is_refused_not_overwritten(tmp_path, capsys):
+    # issue 61, item 7: a folder without config.json counted as fresh; its log.csv was replaced
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "log.csv").write_text("my data\n")
+    for command in ("evolve", "qd", "poet"):
+        line = _one_line_error(capsys, [command, *SMALL[command], "--out", str(out)], command)
+        assert str(out) in line and "log.csv" in line and "holds no run" in line
+        assert "another --out" in line
+    assert sorted(p.name for p in out.iterdir() if p.name != ".lock") == ["log.csv"]
+    assert (out / "log.csv").read_text() == "my data\n"
+
+
+def test_replay_shorter_than_the_settling_time_and_of_a_fifo_is_one_line(tmp_path, capsys):
+    # issue 61: replay --seconds 0.5 was an IndexError in plot_trajectory (no trace sample
+    # after the 1 s settling); a FIFO config.json blocked replay for ever (read_text)
+    run = tmp_path / "run"
+    assert main(["evolve", "--out", str(run), "--generations", "0", "--no-gif", *TINY]) == 0
+    capsys.readouterr()
+    line = _one_line_error(capsys, ["replay", str(run), "--seconds", "0.5", "--no-gif",
+                                    "--out", str(tmp_path / "replay")], "replay")  # fmt: skip
+    assert "--seconds must be more than the 1 s settling time" in line and "0.5" in line
+    assert not (tmp_path / "replay").exists()
+    if hasattr(os, "mkfifo"):
+        (run / "config.json").unlink()
+        os.mkfifo(run / "config.json")
+        code = ("from softgym_cli import main\n"
+                f"print('REFUSED' if main(['replay', {str(run)!r}, '--no-gif']) == 2 else 'RAN')\n")  # fmt: skip
+        refused_in_child(code, timeout=60)

@@ -77,3 +77,20 @@ def test_kill9_then_corrupt_latest_resumes_identically(tmp_path, backend, caplog
     assert [r["generation"] for r in resumed.rows] == [0, 1, 2, 3]
     logged = [json.loads(x) for x in (tmp_path / "b" / "log.jsonl").read_text().splitlines()]
     assert _comparable(logged) == _comparable(ref.rows)
+
+
+def test_resume_removes_the_temporary_files_of_a_killed_write(tmp_path):
+    # issue 61, item 9: a kill mid-write left .NAME.tmpPID files that no resume removed
+    exp = get_experiment("controller-tournament", **TINY)
+    out = tmp_path / "run"
+    EvolutionRun(exp, out, seed=0, generations=0, figures=False, progress=False).run()
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True).stdout.strip()  # fmt: skip
+    stale = [out / f".log.csv.tmp{dead}", out / "checkpoints" / f".ckpt-000001.npz.tmp{dead}"]
+    for p in stale:
+        p.write_bytes(b"half a file")
+    run = EvolutionRun(exp, out, seed=0, generations=1, figures=False, progress=False)
+    run.run(resume=True)
+    assert run.generation == 1
+    assert not any(p.exists() for p in stale)
+    assert not list(out.rglob("*.tmp*"))

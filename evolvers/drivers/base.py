@@ -31,7 +31,12 @@ from typing import Any
 import numpy as np
 
 from evolvers.evaluation.evaluator import BatchFn, EvalStats, Evaluator
-from evolvers.evaluation.experiments import Experiment, smoke_sizes
+from evolvers.evaluation.experiments import (
+    Experiment,
+    check_generations,
+    check_seed,
+    smoke_sizes,
+)
 from evolvers.operators.genome import Individual
 from evolvers.recording.recorder import RunRecorder
 from softgym.exceptions import CheckpointError, InvalidParameterError
@@ -118,14 +123,17 @@ class Driver:
         progress: bool = True,
         extra_config: dict[str, Any] | None = None,
     ) -> None:
-        experiment, gens = smoke_sizes(
-            experiment, experiment.generations if generations is None else int(generations)
-        )
-        if gens < 0:
-            raise InvalidParameterError(f"{self.unit}s must be >= 0, got {gens}")
+        if isinstance(out, str) and not out.strip():
+            # Path("") is the current folder: a run written there by accident
+            raise InvalidParameterError(
+                f"the run folder (--out) must name a folder, got {out!r}; give one, e.g. runs/evolve"
+            )
+        gens = experiment.generations if generations is None else generations
+        gens = check_generations(gens, f"{self.unit}s")
+        experiment, gens = smoke_sizes(experiment, gens)
         self.experiment = experiment
         self.out = Path(out)
-        self.seed = int(seed)
+        self.seed = check_seed(seed)
         self.generations = gens
         self.n_threads = n_threads
         self.on_generation = on_generation

@@ -73,6 +73,7 @@ __all__ = [
     "ALGORITHMS",
     "BrainProblem",
     "BrainSampling",
+    "MULTI_OBJECTIVE",
     "PymooRun",
     "SoftbotCrossover",
     "SoftbotDuplicateElimination",
@@ -82,6 +83,7 @@ __all__ = [
     "constraint_values",
     "make_algorithm",
     "n_constraints",
+    "problem_objectives",
 ]
 
 
@@ -364,6 +366,10 @@ def _nsga3(pop_size: int, n_obj: int, **operators: Any) -> Algorithm:
     from pymoo.algorithms.moo.nsga3 import NSGA3
     from pymoo.util.ref_dirs import get_reference_directions
 
+    if n_obj < 2:  # one objective has one reference direction whatever p: the loop would not end
+        raise InvalidParameterError(
+            f"algorithm 'nsga3' needs at least 2 objectives, got {n_obj}; use 'nsga2' or 'ga'"
+        )
     # about one reference direction per individual ("das-dennis" on the objective simplex)
     p = 1
     while math.comb(p + 1 + n_obj - 1, n_obj - 1) <= pop_size:
@@ -386,6 +392,20 @@ def _named(name: str) -> Callable[..., Algorithm]:
 
         return GA
     raise InvalidParameterError(f"unknown algorithm {name!r}; expected one of {ALGORITHMS}")
+
+
+#: Algorithms by name that need two objectives or more (NSGA-III's reference directions,
+#: SMS-EMOA's hypervolume contributions): refused on a single-objective problem.
+MULTI_OBJECTIVE: tuple[str, ...] = ("nsga3", "sms-emoa")
+
+
+def problem_objectives(experiment: Experiment, single_objective: bool = False) -> int:
+    """Objectives of the pymoo problem of ``experiment``: 1 for a novelty search (its
+    novelty alone) or a single-objective algorithm, else the experiment's objectives.
+    """
+    if single_objective or experiment.selection.startswith("novelty"):
+        return 1
+    return len(experiment.objectives)
 
 
 #: Algorithms known by name (``"ga"`` and ``"cmaes"`` are single-objective: they optimise the
@@ -497,6 +517,14 @@ class PymooRun(Driver):
         self.single_objective = (
             (algorithm in ("ga", "cmaes")) if single_objective is None else single_objective
         )
+        n_obj = problem_objectives(experiment, self.single_objective or self.cmaes)
+        if algorithm in MULTI_OBJECTIVE and n_obj < 2:
+            raise InvalidParameterError(
+                f"algorithm {algorithm!r} needs at least 2 objectives; experiment "
+                f"{experiment.name!r} optimises {n_obj} ({experiment.objectives[0].name}"
+                f"{', novelty' if experiment.selection.startswith('novelty') else ''}): "
+                f"use algorithm 'nsga2' or 'ga' (--algorithm), or a multi-objective experiment"
+            )
         super().__init__(experiment, out, seed, generations,
                          extra_config={"algorithm": _algorithm_label(algorithm)}, **driver)  # fmt: skip
 

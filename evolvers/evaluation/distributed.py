@@ -153,7 +153,8 @@ def dask_client(
         If Dask is not installed (``pip install ".[distributed]"``).
     InvalidParameterError
         If ``n_workers`` is not an integer >= 1 (a cluster without workers
-        would wait for one forever).
+        would wait for one forever), or ``address`` is not ``"local"`` nor a
+        scheduler address.
     """
     if address == "local" and (not is_int(n_workers) or n_workers < 1):
         raise InvalidParameterError(
@@ -174,7 +175,13 @@ def dask_client(
             client.close()
             cluster.close()
     else:
-        client = Client(address)
+        try:
+            client = Client(address)
+        except (ValueError, TypeError) as exc:  # not an address: no port, unknown protocol...
+            raise InvalidParameterError(
+                f"Dask scheduler address (--dask) must be 'local' or e.g. tcp://HOST:8786, "
+                f"got {show(address)} ({exc!s:.120})"
+            ) from None
         try:
             yield client
         finally:

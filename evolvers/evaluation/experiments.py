@@ -52,9 +52,13 @@ from softgym.validate import is_int, is_real, show
 __all__ = [
     "CONTROLLERS",
     "EXPERIMENTS",
+    "MAX_GENERATIONS",
     "MAX_POP_SIZE",
+    "MAX_SEED",
     "SELECTIONS",
     "Experiment",
+    "check_generations",
+    "check_seed",
     "get_experiment",
     "list_experiments",
 ]
@@ -62,6 +66,43 @@ __all__ = [
 #: Largest population an experiment accepts (each individual is simulated every
 #: generation: 100,000 6x6x6 robots are ~10 CPU-hours a generation).
 MAX_POP_SIZE = 100_000
+
+#: Most generations (POET: iterations) a run accepts: a million generations of the
+#: smallest population are weeks of CPU; a typo of more digits is refused at once.
+MAX_GENERATIONS = 1_000_000
+
+#: Largest seed of a run (the seeds every random generator of the drivers accepts).
+MAX_SEED = 2**32 - 1
+
+
+
+def check_generations(value: Any, name: str = "generations") -> int:
+    """``value`` as a number of generations (iterations), an integer in [0, MAX_GENERATIONS].
+
+    Raises
+    ------
+    InvalidParameterError
+        Naming ``name`` and the accepted range (bools and floats are not counts).
+    """
+    if not is_int(value) or not 0 <= value <= MAX_GENERATIONS:
+        raise InvalidParameterError(
+            f"{name} must be an integer in [0, {MAX_GENERATIONS}], got {show(value)}"
+        )
+    return int(value)
+
+
+def check_seed(value: Any, name: str = "seed") -> int:
+    """``value`` as a run's seed, an integer in [0, MAX_SEED].
+
+    Raises
+    ------
+    InvalidParameterError
+        Naming ``name`` and the accepted range.
+    """
+    if not is_int(value) or not 0 <= value <= MAX_SEED:
+        raise InvalidParameterError(f"{name} must be an integer in [0, {MAX_SEED}], got {show(value)}")
+    return int(value)
+
 
 #: Selection schemes an experiment may name.
 SELECTIONS: tuple[str, ...] = tuple(SELECTORS)
@@ -175,6 +216,7 @@ class Experiment:
             )
         if not self.objectives:
             raise InvalidParameterError("an experiment needs at least one objective")
+        object.__setattr__(self, "generations", check_generations(self.generations))
         object.__setattr__(self, "shape", tuple(int(s) for s in self.shape))
         task = get_task(self.task)  # a name, alias, Terrain, JSON file or Task; raises if unknown
         # the world alone (what config.json records, Task.spec): the experiment sets the rest

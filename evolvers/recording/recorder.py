@@ -53,12 +53,15 @@ from evolvers.recording.rows import log_row, population_summary
 from softgym.evaluate import caller_shows_progress
 from softgym.exceptions import CheckpointError, InvalidParameterError
 from softgym.io import (
+    RunLock,
     atomic_write_json,
     atomic_write_text,
     latest_checkpoint,
     load_latest_intact,
     read_json,
+    remove_stale_temp_files,
     save_checkpoint,
+    temp_file_target,
 )
 
 __all__ = [
@@ -253,15 +256,38 @@ class RunRecorder:
 
     # ------------------------------------------------------------------ opening
     def start(self, generations: int) -> None:
-        """Create the run folder (refusing one that holds another run's checkpoints)."""
+        """Create the run folder (refusing one that holds another run's checkpoints, or
+        other files and no run: they could be overwritten).
+        """
         self.out.mkdir(parents=True, exist_ok=True)
         if self._has_checkpoint():
             raise CheckpointError(
                 f"{self.out}: the folder already holds a run; use resume (--resume) or another --out"
             )
+        self._refuse_foreign_files()
+        remove_stale_temp_files(self.out)
         self.generations = generations
         self._new_identity()
         self._write_config()
+
+    def _refuse_foreign_files(self) -> None:
+        """A folder that holds no run (no config.json) must be empty but for what a run
+        writes before its config (its lock, its identity): a user's files in it would be
+        overwritten (log.csv, figures...).
+        """
+        if (self.out / "config.json").exists():
+            return
+        own = {RunLock.FILE_NAME, IDENTITY_FILE, "config.json"}
+        foreign = sorted(
+            p.name for p in self.out.iterdir()
+            if p.name not in own and temp_file_target(p.name) not in own
+        )  # fmt: skip
+        if foreign:
+            shown = ", ".join(foreign[:3]) + (f" and {len(foreign) - 3} more" if len(foreign) > 3 else "")
+            raise CheckpointError(
+                f"{self.out} is not empty ({shown}) and holds no run (no config.json): its files "
+                "could be overwritten; choose an empty or new folder (another --out)"
+            )
 
     def _new_identity(self) -> None:
         digest = hashlib.sha256(json.dumps(self.config, sort_keys=True).encode()).hexdigest()
@@ -330,6 +356,8 @@ class RunRecorder:
             self.identity = {"run_id": ident["run_id"], "config_sha256": ident["config_sha256"]}
         else:  # a folder written before runs had an identity: it gets one from now on
             self._new_identity()
+        # what a killed write left (.NAME.tmpPID): this run holds the folder's lock
+        remove_stale_temp_files(self.out)
         if not self._has_checkpoint():
             return None
         # a checkpoint that records another run's identity (copied in, whatever its

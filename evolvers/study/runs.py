@@ -60,11 +60,19 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from evolvers.evaluation.experiments import Experiment, get_experiment
+from evolvers.evaluation.experiments import (
+    MAX_SEED,
+    Experiment,
+    check_generations,
+    check_seed,
+    get_experiment,
+)
 from softgym.exceptions import InvalidParameterError, SoftGymError
 from softgym.io import atomic_write_json
+from softgym.validate import is_int, show
 
 __all__ = [
+    "MAX_SEEDS",
     "SEED_REPORT",
     "STUDIES",
     "STUDY_SCHEMA",
@@ -85,6 +93,10 @@ log = logging.getLogger("evolvers")
 
 #: ``"schema"`` of a study's study.json and scenario.json.
 STUDY_SCHEMA = "softgym.study"
+
+#: Most seeds per scenario a study plans (planning is linear in them: 10,000 seeds of
+#: every scenario plan in seconds; each is a whole run).
+MAX_SEEDS = 10_000
 
 
 @dataclass(frozen=True)
@@ -329,15 +341,25 @@ def plan(
     """
     st = get_study(study) if isinstance(study, str) else study
     chosen = [st[name] for name in scenarios] if scenarios else list(st.scenarios)
-    if seeds is not None and seeds < 1:
-        raise InvalidParameterError(f"seeds must be >= 1, got {seeds}")
-    if generations is not None and generations < 0:
-        raise InvalidParameterError(f"generations must be >= 0, got {generations}")
+    if seeds is not None and (not is_int(seeds) or not 1 <= seeds <= MAX_SEEDS):
+        raise InvalidParameterError(
+            f"seeds must be an integer in [1, {MAX_SEEDS}] (per scenario), got {show(seeds)}"
+        )
+    if generations is not None:
+        generations = check_generations(generations)
+    first_seed = check_seed(first_seed, "first_seed")
+    if isinstance(out, str) and not out.strip():
+        raise InvalidParameterError(f"the study's root folder (--out) must name a folder, got {out!r}")
     root = Path(out)
     specs = []
     for sc in chosen:
         exp = sc.make_experiment(**overrides)
         n = sc.seeds if seeds is None else int(seeds)
+        if first_seed + n - 1 > MAX_SEED:
+            raise InvalidParameterError(
+                f"first_seed + seeds - 1 must be at most {MAX_SEED} (the largest seed), "
+                f"got {first_seed + n - 1}"
+            )
         gens = sc.generations if generations is None else int(generations)
         for k in range(first_seed, first_seed + n):
             specs.append(

@@ -868,11 +868,18 @@ class RobotDesign:
         ------
         DesignFileError
             Naming the file, if it is missing, a folder, unreadable, larger than
-            :data:`MAX_DESIGN_JSON_BYTES` or not UTF-8 text (also an ``OSError``).
+            :data:`MAX_DESIGN_JSON_BYTES` or not UTF-8 text (also an ``OSError``),
+            or if ``path`` is not a path at all (an int...).
         InvalidDesignError
             Naming the file, if its content is not a valid design.
         """
+        if not isinstance(path, (str, bytes, os.PathLike)):
+            raise DesignFileError(
+                f"design file must be a path (str or os.PathLike), got {type(path).__name__}"
+            )
         path = os.fspath(path)
+        if not isinstance(path, str):  # a bytes path
+            path = os.fsdecode(path)
         data = read_capped(path, MAX_DESIGN_JSON_BYTES, "design", DesignFileError)
         try:
             text = data.decode("utf-8")

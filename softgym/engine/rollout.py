@@ -6,6 +6,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from softgym.exceptions import InvalidIndexError
+
 __all__ = ["Rollout"]
 
 
@@ -155,7 +157,18 @@ class Rollout:
         -------
         ndarray of shape (n_points, 4), float64
             Positions in metres, time in seconds (the layout of the seed's CMTrace).
+
+        Raises
+        ------
+        InvalidIndexError
+            If ``i`` is not an integer in ``[0, n_robots)`` (as
+            :class:`~softgym.engine.Simulation` indexes robots: no negative index).
         """
+        n = len(self.times)
+        if isinstance(i, (bool, np.bool_)) or not isinstance(i, (int, np.integer)):
+            raise InvalidIndexError(f"robot must be an integer index, got {i!r:.40}")
+        if not 0 <= i < n:
+            raise InvalidIndexError(f"robot = {i} is out of range: this rollout holds robots 0..{n - 1}")
         t = self.times[i]
         keep = np.ones(t.shape, dtype=bool) if since is None else t >= since
         return np.column_stack([self.cm[i][keep], t[keep]])

@@ -36,7 +36,7 @@ except ImportError as exc:  # the rl extra is optional
         'softgym.envs.sb3 needs stable-baselines3: pip install "softgym[rl]"'
     ) from exc
 
-from softgym.exceptions import InvalidParameterError
+from softgym.exceptions import InvalidActionError, InvalidParameterError
 
 __all__ = ["SB3VecEnv", "make_sb3_vec_env"]
 
@@ -91,6 +91,7 @@ class SB3VecEnv(VecEnv):
                 f"{getattr(mode, 'name', mode)}; pass autoreset_mode=AutoresetMode.SAME_STEP"
             )
         self.venv = venv
+        self._actions: np.ndarray | None = None
         super().__init__(venv.num_envs, venv.single_observation_space, venv.single_action_space)
 
     def reset(self) -> np.ndarray:
@@ -108,7 +109,17 @@ class SB3VecEnv(VecEnv):
         self._actions = actions
 
     def step_wait(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, list[dict[str, Any]]]:
-        """Step every env with the stored actions: observations, rewards, dones, infos."""
+        """Step every env with the stored actions: observations, rewards, dones, infos.
+
+        Raises
+        ------
+        InvalidActionError
+            If :meth:`step_async` has given no actions yet.
+        gymnasium.error.ResetNeeded
+            If the envs have not been reset (as the single env raises).
+        """
+        if self._actions is None:
+            raise InvalidActionError("step_wait() has no actions: call step_async(actions) first")
         obs, reward, terminated, truncated, info = self.venv.step(self._actions)
         done = np.logical_or(terminated, truncated)
         infos = _info_dicts(info, self.num_envs)

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 from gymnasium import logger
+from gymnasium.error import ResetNeeded
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
@@ -275,11 +276,16 @@ class SoftWalkerVectorEnv(VectorEnv):
         rewards : ndarray of shape (num_envs,), float64
         terminations, truncations : ndarray of shape (num_envs,), bool
         infos : dict of arrays of shape (num_envs,)
+
+        Raises
+        ------
+        gymnasium.error.ResetNeeded
+            Before the first :meth:`reset` (as the single env).
         """
         b = self._batch
         a = b.validate_actions(actions)
-        if self._needs_reset:
-            raise RuntimeError("call reset() before step()")
+        if self._needs_reset:  # the single env's error for the same misuse
+            raise ResetNeeded("call reset() before step(): the episodes have not started")
         restart = self._prev_done.copy()
         live = ~restart
         if live.any():

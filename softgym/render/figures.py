@@ -27,6 +27,8 @@ from typing import Any
 
 import numpy as np
 
+from softgym.exceptions import InvalidParameterError
+
 __all__ = [
     "METRIC_LABELS",
     "design_colors",
@@ -95,8 +97,6 @@ def figure_path(path: str | os.PathLike[str]) -> Path:
     InvalidParameterError
         Naming the file and the formats matplotlib writes.
     """
-    from softgym.exceptions import InvalidParameterError
-
     path = Path(path)
     plt = pyplot()
     fig = plt.figure()
@@ -394,10 +394,20 @@ def plot_trajectory(
         Settling time (s), marked on the height plot.
     terrain : Terrain, optional
         Boxes drawn (outlined) in the top view.
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``trace`` holds no (x, y, z, t) row (a run no longer than its settling time).
     """
-    plt = pyplot()
     L = float(voxel_size)
     tr = np.asarray(trace, dtype=np.float64)
+    if tr.ndim != 2 or tr.shape[0] == 0 or tr.shape[1] < 4:
+        raise InvalidParameterError(
+            f"trace must be an array of (x, y, z, t) rows with at least one row, got shape "
+            f"{tr.shape} (a run no longer than its {init_time:g} s settling time samples none)"
+        )
+    plt = pyplot()
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
     if terrain is not None:
         from matplotlib.patches import Rectangle

@@ -13,6 +13,7 @@ to an MP4 with imageio and imageio-ffmpeg (the ``video`` extra).
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 from collections.abc import Callable, Iterable, Sequence
@@ -606,25 +607,29 @@ def save_video(
     path = os.fspath(path)
     tmp = f"{path}.tmp{os.getpid()}.mp4"
     n = 0
-    # macro_block_size 1 keeps any frame size (H.264 wants even sizes: pad below)
-    with imageio.get_writer(tmp, fps=fps, codec="libx264", quality=quality,
-                            macro_block_size=1, pixelformat="yuv420p") as w:  # fmt: skip
-        for k, f in enumerate(frames):
-            arr = np.asarray(f)
-            if arr.ndim != 3 or arr.shape[2] != 3:
-                raise InvalidParameterError(
-                    f"frame {k} must have shape (height, width, 3), got {arr.shape}"
-                )
-            arr = np.clip(arr, 0, 255).astype(np.uint8)
-            h, w_ = arr.shape[:2]
-            if h % 2 or w_ % 2:
-                arr = np.pad(arr, ((0, h % 2), (0, w_ % 2), (0, 0)), mode="edge")
-            w.append_data(arr)
-            n += 1
-    if n == 0:
-        os.unlink(tmp)
-        raise InvalidParameterError("save_video needs at least one frame")
-    os.replace(tmp, path)
+    try:
+        # macro_block_size 1 keeps any frame size (H.264 wants even sizes: pad below)
+        with imageio.get_writer(tmp, fps=fps, codec="libx264", quality=quality,
+                                macro_block_size=1, pixelformat="yuv420p") as w:  # fmt: skip
+            for k, f in enumerate(frames):
+                arr = np.asarray(f)
+                if arr.ndim != 3 or arr.shape[2] != 3:
+                    raise InvalidParameterError(
+                        f"frame {k} must have shape (height, width, 3), got {arr.shape}"
+                    )
+                arr = np.clip(arr, 0, 255).astype(np.uint8)
+                h, w_ = arr.shape[:2]
+                if h % 2 or w_ % 2:
+                    arr = np.pad(arr, ((0, h % 2), (0, w_ % 2), (0, 0)), mode="edge")
+                w.append_data(arr)
+                n += 1
+        if n == 0:  # (the writer opens its file with the first frame: there may be none)
+            raise InvalidParameterError("save_video needs at least one frame, got none")
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)  # never leave the temporary file behind
+        raise
     return n
 
 

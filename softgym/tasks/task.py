@@ -155,6 +155,14 @@ class Task:
         else:
             object.__setattr__(self, "options", kind.resolve(self.options))
             object.__setattr__(self, "sim", dict(self.sim))
+        from softgym.engine.config import SimConfig  # (the engine loads compiled code: used late)
+
+        known = sorted(f.name for f in fields(SimConfig))
+        unknown = sorted(map(str, set(self.sim) - set(known)))
+        if unknown:
+            raise InvalidParameterError(
+                f"task {self.name!r}: sim has unknown SimConfig field(s) {unknown}; the fields are {known}"
+            )
         if self.n_threads is not None:
             object.__setattr__(self, "n_threads", int(self.n_threads))
         reward = self.reward
@@ -295,7 +303,12 @@ class Task:
 
     # ------------------------------------------------------------------ data
     def replace(self, **changes: Any) -> Task:
-        """A copy with some fields changed."""
+        """A copy with some fields changed (an unknown field is an InvalidParameterError naming it)."""
+        unknown = sorted(map(str, set(changes) - {f.name for f in fields(self)}))
+        if unknown:
+            raise InvalidParameterError(
+                f"Task has no field(s) {unknown}; its fields are {[f.name for f in fields(self)]}"
+            )
         return replace(self, **changes)
 
     def to_dict(self) -> dict[str, Any]:

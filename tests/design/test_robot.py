@@ -278,3 +278,12 @@ def test_saving_onto_a_folder_raises_and_leaves_no_temporary_file(tmp_path):
     with pytest.raises(DesignFileError, match="is a folder"):
         save_vxa(default_walker(), target)
     assert sorted(p.name for p in tmp_path.rglob("*")) == ["out"]
+
+
+def test_loading_something_that_is_not_a_path_is_a_design_file_error():
+    # issue 61: RobotDesign.load(5) was a TypeError from os.fspath
+    from softgym.exceptions import DesignFileError
+
+    for bad in (5, None, 1.5, ["a.json"]):
+        with pytest.raises(DesignFileError, match="must be a path"):
+            RobotDesign.load(bad)

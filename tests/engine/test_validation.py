@@ -269,3 +269,14 @@ def test_a_body_placed_below_the_floor_is_refused():
         Simulation([Body.uniform(np.ones((2, 2, 2)), origin=(0.0, 0.0, -5.0))])
     Simulation([Body.uniform(np.ones((2, 2, 2)), origin=(0.0, 0.0, -5.0))],
                SimConfig(floor=False))  # fmt: skip  (no floor: any height)
+
+
+def test_a_rollouts_trace_index_is_checked_like_the_simulations():
+    # issue 61: trace(7) was a bare IndexError while trace(-1) was taken as the last robot
+    rollout = Simulation(_body(), SimConfig(trace_interval=0.01)).run(0.02)
+    assert rollout.trace(0).shape[1] == 4
+    for bad in (7, 1, -1):
+        with pytest.raises(InvalidIndexError, match=f"robot = {bad} is out of range: .* 0..0"):
+            rollout.trace(bad)
+    with pytest.raises(InvalidIndexError, match="integer index"):
+        rollout.trace(0.0)

@@ -94,3 +94,18 @@ def test_ppo_trains_on_it_with_vecnormalize():
     assert model.num_timesteps == 16 and len(model.ep_info_buffer) == 4
     assert all(e["l"] == 4 for e in model.ep_info_buffer)
     assert all(np.isfinite(e["r"]) for e in model.ep_info_buffer)
+
+
+def test_misordered_calls_raise_typed_errors_not_attribute_errors():
+    # issue 61: step before reset and step_wait before step_async gave bare Python errors
+    from softgym.exceptions import InvalidActionError
+
+    env = make_sb3_vec_env("SoftWalker-Flat-v0", n_envs=2, seed=1, episode_seconds=0.2, n_threads=1)
+    with pytest.raises(InvalidActionError, match="step_async"):
+        env.step_wait()
+    with pytest.raises(gym.error.ResetNeeded):
+        env.step(np.zeros((2, 216), dtype=np.float32))
+    env.reset()
+    obs, _, _, _ = env.step(np.zeros((2, 216), dtype=np.float32))
+    assert obs.shape == (2, 1301)
+    env.close()

@@ -153,3 +153,18 @@ def test_same_step_resets_a_diverged_robot_alone():
     assert np.array_equal(obs[0], walker_start) and not info["diverged"][0]
     assert np.array_equal(obs[1], o1) and r[1] == r1
     venv.close()
+
+
+def test_stepping_before_reset_raises_resetneeded_as_the_single_env():
+    # issue 61: the vector env raised a plain RuntimeError, the single env ResetNeeded
+    import pytest
+
+    actions = np.zeros((2, 216), dtype=np.float32)
+    venv = gym.make_vec("SoftWalker-Flat-v0", num_envs=2, episode_seconds=0.2)
+    with pytest.raises(gym.error.ResetNeeded, match="reset"):
+        venv.step(actions)
+    env = gym.make("SoftWalker-Flat-v0", episode_seconds=0.2)
+    with pytest.raises(gym.error.ResetNeeded):
+        env.step(actions[0])
+    venv.reset(seed=0)
+    assert venv.step(actions)[0].shape[0] == 2  # after reset it steps

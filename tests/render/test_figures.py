@@ -63,3 +63,19 @@ def test_save_video_writes_an_mp4(tmp_path):
     assert save_video(frames, tmp_path / "v.mp4", fps=5) == 6
     back = iio.imread(tmp_path / "v.mp4")
     assert back.shape[0] == 6 and back.shape[1:3] == (42, 64)
+
+
+def test_save_video_of_no_frames_and_an_empty_trajectory_are_typed_errors(tmp_path):
+    # issue 61: no frames was a FileNotFoundError naming a temporary file; a trace with no
+    # sample (a run no longer than its settling time) an IndexError in plot_trajectory
+    from softgym.exceptions import InvalidParameterError
+    from softgym.render.figures import plot_trajectory
+
+    pytest.importorskip(
+        "imageio_ffmpeg", reason='needs the video extra: pip install "softgym[video]"'
+    )
+    with pytest.raises(InvalidParameterError, match="at least one frame"):
+        save_video([], tmp_path / "v.mp4")
+    with pytest.raises(InvalidParameterError, match="x, y, z, t"):
+        plot_trajectory(np.zeros((0, 4)), tmp_path / "t.png")
+    assert list(tmp_path.iterdir()) == []  # no file, no temporary file

@@ -194,3 +194,14 @@ def test_engine_settings_are_assembled_in_one_place(spec, monkeypatch):
         base.replace(trace_interval=0.25),  # a full config replaces the task's settings
         base.replace(**own).replace(trace_interval=1e9, actuation="seed", self_collision=True),
     ]
+
+
+def test_unknown_task_fields_and_sim_keys_are_typed_errors_naming_them(tmp_path):
+    with pytest.raises(InvalidParameterError, match="bogus"):
+        get_task("gap", bogus=1)
+    with pytest.raises(InvalidParameterError, match="gravty"):
+        Task("flat", sim={"gravty": 1.0})
+    path = tmp_path / "t.json"
+    path.write_text(json.dumps({**Task("flat").to_dict(), "sim": {"no_such_field": 1}}))
+    with pytest.raises(InvalidParameterError, match="no_such_field"):
+        get_task(str(path))

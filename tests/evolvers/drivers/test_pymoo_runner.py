@@ -3,6 +3,7 @@ import json
 import numpy as np
 import pytest
 from evolver_helpers import tiny
+from fuzzing import refused_in_child  # tests/fuzzing.py
 from pymoo.algorithms.moo.nsga2 import NSGA2
 from pymoo.core.problem import Problem
 
@@ -83,3 +84,26 @@ def test_ga_resumes_exactly_and_resume_refuses_another_algorithm(tmp_path):
     assert resumed.rows[-1]["evaluations"] > 0 and resumed.evaluations_total > 0
     with pytest.raises(CheckpointError, match="algorithm"):
         PymooRun(exp, tmp_path / "b", seed=2, generations=3, figures=False).run(resume=True)
+
+
+@pytest.mark.parametrize("algorithm", ["nsga3", "sms-emoa"])
+@pytest.mark.parametrize("experiment", ["controller-tournament", "novelty"])
+def test_a_multi_objective_algorithm_on_one_objective_is_refused_not_hung(
+    tmp_path, algorithm, experiment
+):
+    # issue 61: NSGA-III's reference-direction loop never ended on one objective (the
+    # default experiment); SMS-EMOA's hypervolume raised a ValueError at generation 1
+    out = tmp_path / "r"
+    code = (
+        "from evolvers.drivers.pymoo_runner import PymooRun\n"
+        "from evolvers.evaluation.experiments import get_experiment\n"
+        "from softgym.exceptions import InvalidParameterError\n"
+        "try:\n"
+        f"    PymooRun(get_experiment({experiment!r}, pop_size=4), {str(out)!r}, "
+        f"algorithm={algorithm!r})\n"
+        "except InvalidParameterError as e:\n"
+        "    print('REFUSED', e)\n"
+    )
+    stdout = refused_in_child(code, timeout=60)
+    assert f"'{algorithm}' needs at least 2 objectives" in stdout and "nsga2" in stdout
+    assert not out.exists()
