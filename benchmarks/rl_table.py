@@ -26,11 +26,12 @@ DATA = Path(__file__).resolve().parent / "data" / "rl"
 
 
 def load_runs(root: Path = DATA / "ppo") -> dict[str, list[dict]]:
-    """Stored runs by task, seeds in order."""
+    """Stored runs by task (``"push (sensing)"`` for the sensing observation), seeds in order."""
     runs: dict[str, list[dict]] = {}
     for path in sorted(root.glob("*/run.json")):
         run = json.loads(path.read_text())
-        runs.setdefault(run["task"], []).append(run)
+        sensing = run["settings"].get("observe", "blind") == "sensing"
+        runs.setdefault(run["task"] + (" (sensing)" if sensing else ""), []).append(run)
     for task in runs:
         runs[task].sort(key=lambda r: r["settings"]["seed"])
     return runs
@@ -64,7 +65,7 @@ def table(runs: dict[str, list[dict]]) -> str:
         steps = ", ".join(f"{r['num_timesteps'] // 1000}k" for r in rs)
         ppo = ", ".join(f"{v:.3g}{'' if done else '*'}" for v, done in vals)
         above = sum(v > r["baselines"]["sinusoid"][0] for (v, _), r in zip(vals, rs))
-        e = evo.get(task)
+        e = evo.get(rs[0]["task"])
         ev = f"{e['evolved_median']:.3g} [{e['evolved_min']:.3g}, {e['evolved_max']:.3g}]" if e else "-"
         lines.append(
             f"| {task} | {len(rs)} | {steps} ({rs[0]['timesteps'] // 1000}k) | {ppo} | "
@@ -93,8 +94,8 @@ def plot(runs: dict[str, list[dict]], out: str | Path) -> Path:
                 ax.plot(t / 1000, v, color=f"C{k}", label=f"PPO seed {run['settings']['seed']}")
         ax.axhline(rs[0]["baselines"]["sinusoid"][0], color="k", ls=":", label="sinusoid")
         ax.axhline(np.mean(rs[0]["baselines"]["random"]), color="grey", ls="--", label="random")
-        if task in evo:
-            ax.axhline(evo[task]["evolved_median"], color="C3", ls="-.", label="evolved (3 s)")
+        if rs[0]["task"] in evo:
+            ax.axhline(evo[rs[0]["task"]]["evolved_median"], color="C3", ls="-.", label="evolved (3 s)")
         ax.set_title(f"{task} ({rs[0]['action_mode']} actions)", fontsize=9)
         ax.set_xlabel("env steps (k)", fontsize=8)
         ax.set_ylabel("episode return", fontsize=8)

@@ -67,7 +67,8 @@ def test_stored_ppo_baseline_runs_are_resumable_records():
         run = json.loads((d / "run.json").read_text())
         assert run["command"].startswith("python benchmarks/rl_ppo.py ")
         assert f"--run-dir benchmarks/data/rl/ppo/{d.name}" in run["command"]
-        assert d.name == f"{run['task']}-s{run['settings']['seed']}"
+        sensing = "-sensing" if run["settings"].get("observe") == "sensing" else ""
+        assert d.name == f"{run['task']}{sensing}-s{run['settings']['seed']}"
         steps = [t for t, _ in run["eval_curve"]]
         assert steps == sorted(steps) and steps[-1] == run["num_timesteps"]
         assert run["finished"] == (run["num_timesteps"] >= run["timesteps"]) == ("final" in run)
@@ -85,7 +86,8 @@ def test_rl_table_prints_every_task_and_draws_the_curves(tmp_path):
     text = _script("rl_table.py", "--out", out).stdout
     by_task = {}
     for d in (DATA / "ppo").glob("*/run.json"):
-        task = json.loads(d.read_text())["task"]
+        run = json.loads(d.read_text())
+        task = run["task"] + (" (sensing)" if run["settings"].get("observe") == "sensing" else "")
         by_task[task] = by_task.get(task, 0) + 1
     for task, n in by_task.items():
         assert f"| {task} | {n} |" in text
