@@ -99,7 +99,8 @@ def main(argv=None) -> None:
     if not args.no_append:
         text = results_log.heading("bench_sensing.py", details=[f"batch {args.batch}", f"{threads} threads"])
         text += (f"\n`python benchmarks/bench_sensing.py --batch {args.batch} --tasks {' '.join(args.tasks)} "
-                 f"--control-dt {' '.join(f'{d:g}' for d in args.control_dt)}`\n\n")  # fmt: skip
+                 f"--control-dt {' '.join(f'{d:g}' for d in args.control_dt)} --steps {args.steps} "
+                 f"--threads {threads}`\n\n")  # fmt: skip
         results_log.append(text + head + "\n|---|---|---|---|---|---|\n" + "\n".join(rows) + "\n")
 
 
