@@ -206,7 +206,8 @@ def repair_run(run: Path, resumed_at: int | None, dry_run: bool) -> None:
         counts = repair_checkpoint(state, arrays, resumed_at)
         print(f"{path}: {json.dumps(counts)}")
         if not dry_run:
-            save_checkpoint(ckpt_dir, int(doc["step"]), state, arrays, keep=len(paths) + 1)
+            save_checkpoint(ckpt_dir, int(doc["step"]), state, arrays, keep=len(paths) + 1,
+                            identity=doc.get("identity"))  # still the run's own checkpoint
         last_state, last_counts = state, counts
     if dry_run or last_state is None:
         return

@@ -4,13 +4,15 @@ A checkpoint is a pair of files written into one folder::
 
     ckpt-000007.npz   numeric arrays (numpy's npz, loaded with allow_pickle=False)
     ckpt-000007.json  {"schema", "version", "step", "npz", "npz_sha256",
-                       "state_sha256", "state": {...}}
+                       "identity", "state": {...}, "sha256"}
 
 Both are written to a temporary file, flushed to disk and renamed into place,
 the npz first: the JSON is the commit record, so a checkpoint exists only
 once both halves are complete. The JSON holds the SHA-256 of the npz and of
 its own state, so truncation or corruption of either file is detected and
-raises :class:`~softgym.exceptions.CheckpointError` naming the file. The
+raises :class:`~softgym.exceptions.CheckpointError` naming the file. The JSON's
+``sha256`` covers every other field of it (the run's identity and the step
+included: :func:`json_sha256`, the one digest of JSON data). The
 previous ``keep - 1`` checkpoints stay on disk, so a bad latest checkpoint
 never destroys the last good one: :func:`load_latest_intact` falls back to it
 and says so in one logged line.
@@ -24,7 +26,9 @@ any array is allocated), and nothing is unpickled.
 
 A checkpoint knows its run: :func:`save_checkpoint` can record the run's
 identity (e.g. its id and the hash of its settings) and :func:`load_checkpoint`
-refuses one whose identity differs, whatever its file name; a checkpoint
+refuses one whose identity differs or that records none, whatever its file
+name (a deleted identity breaks the checksum; a re-signed one without it is
+still refused); a checkpoint
 whose name disagrees with the step it records is refused too, so the newest
 checkpoint is always the one with the highest recorded step. :class:`RunLock`
 gives one writer at a time a run folder.
@@ -60,17 +64,21 @@ __all__ = [
     "IntactCheckpoint",
     "MAX_CHECKPOINT_BYTES",
     "MAX_JSON_BYTES",
+    "MAX_PATH_DEPTH",
     "RunLock",
     "atomic_write_bytes",
     "atomic_write_json",
     "atomic_write_text",
+    "check_path_depth",
     "latest_checkpoint",
     "list_checkpoints",
     "load_checkpoint",
     "load_latest_intact",
+    "json_sha256",
     "loads_json",
     "read_capped",
     "read_json",
+    "read_json_lines",
     "remove_stale_temp_files",
     "rng_from_state",
     "rng_state",
@@ -82,8 +90,9 @@ __all__ = [
 
 #: ``"schema"`` field of a checkpoint's JSON half.
 CHECKPOINT_SCHEMA = "softgym.checkpoint"
-#: Newest checkpoint version this softgym writes and reads.
-CHECKPOINT_VERSION = 1
+#: Newest checkpoint version this softgym writes and reads (1: the checksum covered
+#: the state alone; 2: ``sha256`` covers the whole record, identity included).
+CHECKPOINT_VERSION = 2
 
 _NAME = re.compile(r"^ckpt-(\d{6,})\.json$")
 _NPZ_NAME = re.compile(r"^ckpt-\d{6,}\.npz$")
@@ -101,6 +110,9 @@ RNG_BIT_GENERATORS: dict[str, type[np.random.BitGenerator]] = {
 #: Largest JSON document :func:`read_json` reads (bytes): a run's state of the
 #: biggest study population is under 1 MiB.
 MAX_JSON_BYTES = 64 * 2**20
+#: Most folders a path softgym writes may have (Python creates missing folders one
+#: call per level: a path thousands of folders deep would exhaust the recursion limit).
+MAX_PATH_DEPTH = 256
 #: Largest array file of a checkpoint :func:`load_checkpoint` reads (bytes).
 MAX_CHECKPOINT_BYTES = 2 * 2**30
 
@@ -264,6 +276,23 @@ def loads_json(text: str | bytes, what: str, error: type[Exception] = Checkpoint
         raise error(f"{what}: corrupt or truncated JSON ({exc!s:.200})") from None
 
 
+def check_path_depth(path: str | os.PathLike[str], what: str = "path") -> Path:
+    """``path`` as a Path, if it has at most :data:`MAX_PATH_DEPTH` parts.
+
+    Raises
+    ------
+    CheckpointError
+        Naming ``what`` and the depth, for a deeper path.
+    """
+    p = Path(path)
+    if len(p.parts) > MAX_PATH_DEPTH:
+        raise CheckpointError(
+            f"{what} {str(p)[:60]!r}... is {len(p.parts)} folders deep, more than the "
+            f"{MAX_PATH_DEPTH} softgym writes into; give a shorter path"
+        )
+    return p
+
+
 def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
     """Write ``data`` to ``path`` through a temporary file, fsync and rename.
 
@@ -274,7 +303,7 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
     naming it, as does a write that fails (naming ``path``, not the
     temporary file).
     """
-    path = Path(path)
+    path = check_path_depth(path, "file")
     if path.is_dir():
         raise CheckpointError(f"{path} is a folder: cannot write a file there")
     try:
@@ -341,12 +370,57 @@ def read_json(path: str | os.PathLike[str], cap: int = MAX_JSON_BYTES) -> Any:
     return loads_json(data, str(path))
 
 
+def read_json_lines(path: str | os.PathLike[str], cap: int = MAX_JSON_BYTES) -> list[dict[str, Any]]:
+    """The JSON objects of a JSON-lines file (a run's ``log.jsonl``, ``notes.jsonl``), one
+    per line, blank lines skipped; through :func:`read_capped`, so a FIFO or an oversized
+    file is refused without blocking.
+
+    Raises
+    ------
+    CheckpointError
+        Naming the file (and the line), if it is missing, not a regular file, larger
+        than ``cap``, not UTF-8, or holds a line that is not a JSON object.
+    """
+    path = Path(path)
+    data = read_capped(path, cap, "JSON lines")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise CheckpointError(f"{path}: not UTF-8 text ({exc!s:.120})") from None
+    rows = []
+    for n, line in enumerate(text.splitlines(), 1):
+        if not line.strip():
+            continue
+        row = loads_json(line, f"{path}: line {n}")
+        if not isinstance(row, dict):
+            raise CheckpointError(f"{path}: line {n} is not a JSON object")
+        rows.append(row)
+    return rows
+
+
 def _sha256(data: bytes) -> str:
     return hashlib.sha256(data).hexdigest()
 
 
-def _state_digest(state: Any) -> str:
-    return _sha256(json.dumps(state, sort_keys=True, allow_nan=True).encode("utf-8"))
+def json_sha256(obj: Any) -> str:
+    """The SHA-256 (hex) of plain JSON data, keys sorted: the one digest of JSON data
+    (a checkpoint's record, a run's settings in its ``identity.json``).
+
+    Raises
+    ------
+    InvalidParameterError
+        If ``obj`` is not plain JSON data or is nested too deeply to be written.
+    """
+    try:
+        text = json.dumps(obj, sort_keys=True, allow_nan=True)
+    except (TypeError, ValueError, RecursionError) as exc:
+        raise InvalidParameterError(f"not plain JSON data: {exc!s:.200}") from None
+    return _sha256(text.encode("utf-8"))
+
+
+def _record_digest(doc: Mapping[str, Any]) -> str:
+    """The checksum of a version-2 checkpoint record: every field but ``sha256``."""
+    return json_sha256({k: v for k, v in doc.items() if k != "sha256"})
 
 
 def list_checkpoints(directory: str | os.PathLike[str]) -> list[Path]:
@@ -394,8 +468,9 @@ def save_checkpoint(
         previous good one).
     identity : mapping, optional
         Plain-JSON data naming the run the checkpoint belongs to (e.g. its
-        run id and the hash of its settings); :func:`load_checkpoint` given
-        an identity refuses a checkpoint that records another one.
+        run id and the hash of its settings), covered by the checksum;
+        :func:`load_checkpoint` given an identity refuses a checkpoint that
+        records another one or none.
 
     Returns
     -------
@@ -416,23 +491,20 @@ def save_checkpoint(
             raise CheckpointError(f"array {k!r} has dtype object; checkpoints never pickle")
     np.savez(buf, **{k: np.asarray(v) for k, v in arrays.items()})
     npz_bytes = buf.getvalue()
-    atomic_write_bytes(directory / f"{stem}.npz", npz_bytes)
-    state = dict(state)
-    try:
-        state_digest = _state_digest(state)
-    except (TypeError, ValueError) as exc:
-        raise InvalidParameterError(f"checkpoint state is not plain JSON data: {exc}") from None
     doc = {
         "schema": CHECKPOINT_SCHEMA,
         "version": CHECKPOINT_VERSION,
         "step": int(step),
         "npz": f"{stem}.npz",
         "npz_sha256": _sha256(npz_bytes),
-        "state_sha256": state_digest,
-        "state": state,
+        "identity": None if identity is None else _to_json(dict(identity)),
+        "state": dict(state),
     }
-    if identity is not None:
-        doc["identity"] = dict(identity)
+    try:
+        doc["sha256"] = _record_digest(doc)
+    except InvalidParameterError as exc:
+        raise InvalidParameterError(f"checkpoint state or identity is {exc}") from None
+    atomic_write_bytes(directory / f"{stem}.npz", npz_bytes)
     path = directory / f"{stem}.json"
     atomic_write_json(path, doc, indent=None)
     ckpts = list_checkpoints(directory)
@@ -455,9 +527,9 @@ def load_checkpoint(
     path : path
         The checkpoint's JSON file (or a folder: its latest checkpoint).
     identity : mapping, optional
-        The run's identity: a checkpoint that records another identity is
-        refused, whatever its file name (one written before checkpoints
-        recorded identities, with none, is accepted).
+        The run's identity: a checkpoint that records another identity, or
+        none, is refused, whatever its file name (None: no identity is
+        checked, for a run folder written before runs had identities).
 
     Returns
     -------
@@ -471,7 +543,8 @@ def load_checkpoint(
         Naming the file, if either half is missing, not a regular file,
         larger than :data:`MAX_CHECKPOINT_BYTES`, truncated, corrupt, of
         another schema or of a newer version, if its name disagrees with the
-        step it records, or if it belongs to another run.
+        step it records, or if it belongs to another run or (``identity``
+        given) records no run.
     """
     path = Path(path)
     if path.is_dir():
@@ -493,7 +566,14 @@ def load_checkpoint(
             f"(up to {CHECKPOINT_VERSION})"
         )
     state = doc.get("state")
-    if not isinstance(state, dict) or _state_digest(state) != doc.get("state_sha256"):
+    if version >= 2:  # the checksum covers the whole record: identity and step included
+        try:
+            intact = doc.get("sha256") == _record_digest(doc)
+        except InvalidParameterError:
+            intact = False
+        if not intact or not isinstance(state, dict):
+            raise CheckpointError(f"{path}: checkpoint record is corrupt (checksum mismatch)")
+    elif not isinstance(state, dict) or _v1_state_digest(state) != doc.get("state_sha256"):
         raise CheckpointError(f"{path}: checkpoint state is corrupt (checksum mismatch)")
     step = doc.get("step")
     if isinstance(step, bool) or not isinstance(step, int) or step < 0:
@@ -505,10 +585,15 @@ def load_checkpoint(
             f"{path}: its name says step {int(named.group(1))} but it records step {step}; "
             f"a renamed checkpoint is not resumed"
         )
-    # a checkpoint written before checkpoints recorded identities carries none:
-    # it is taken on the strength of the run's other checks (its config.json)
     recorded = doc.get("identity")
-    if identity is not None and recorded is not None and recorded != _to_json(dict(identity)):
+    if identity is not None and recorded is None:
+        # its identity deleted (a version-1 record, or one re-signed without it): a
+        # checkpoint copied from another run would become this run's history
+        raise CheckpointError(
+            f"{path}: records no run identity, and this run ({_describe(dict(identity))}) "
+            f"resumes only its own checkpoints; it is not resumed"
+        )
+    if identity is not None and recorded != _to_json(dict(identity)):
         raise CheckpointError(
             f"{path}: belongs to another run (it records {_describe(recorded)}, "
             f"this run is {_describe(dict(identity))}); it is not resumed"
@@ -532,6 +617,14 @@ def load_checkpoint(
     state = dict(state)
     state["step"] = step
     return state, arrays
+
+
+def _v1_state_digest(state: Any) -> str:
+    """A version-1 checkpoint's checksum: its state alone."""
+    try:
+        return json_sha256(state)
+    except InvalidParameterError:
+        return ""
 
 
 def _describe(identity: Any) -> str:
@@ -701,6 +794,7 @@ class RunLock:
 
     def acquire(self) -> None:
         """Take the lock or raise :class:`RunFolderLockedError` naming the holder."""
+        check_path_depth(self.directory, "run folder")
         self.directory.mkdir(parents=True, exist_ok=True)
         # never through a symbolic link (it could truncate a file outside the run folder),
         # never a FIFO or device (opened without blocking, then refused)

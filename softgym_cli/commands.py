@@ -47,11 +47,10 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
 def _cmd_replay(args: argparse.Namespace) -> int:
     from evolvers.evaluation.experiments import Experiment
-    from evolvers.recording.recorder import read_run_config
+    from evolvers.recording.recorder import read_best_designs, read_run_config
     from softgym.design import RobotDesign
     from softgym.evaluate import evaluate
     from softgym.exceptions import InvalidParameterError, SoftGymError
-    from softgym.io import read_json
     from softgym.render.figures import (
         plot_robot,
         plot_trajectory,
@@ -63,11 +62,9 @@ def _cmd_replay(args: argparse.Namespace) -> int:
     try:  # every file through the capped reader: a FIFO is refused, never waited on
         cfg = read_run_config(run_dir)
         design = RobotDesign.load(run_dir / "best_design.json")
-        best = read_json(run_dir / "best_designs.json")["best"][0]
+        best = read_best_designs(run_dir)[0]
         experiment = Experiment.from_dict(cfg["experiment"])
-        if not isinstance(best, dict):
-            raise TypeError("best_designs.json: 'best' holds no design entry")
-    except (OSError, ValueError, KeyError, TypeError, IndexError, SoftGymError) as exc:
+    except SoftGymError as exc:
         print(f"softgym replay: {run_dir} is not a finished run folder ({exc})", file=sys.stderr)
         return 2
     exp = cfg["experiment"]
@@ -124,6 +121,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
 
     from evolvers.recording.recorder import config_difference, read_run_config
     from softgym.render.figures import figure_path, plot_compare, read_log
+    from softgym.validate import is_real, show
 
     figure_path(args.out)  # a format matplotlib writes, checked before the runs are read
 
@@ -153,6 +151,12 @@ def _cmd_compare(args: argparse.Namespace) -> int:
                            if k.endswith("_best")})  # fmt: skip
             print(f"softgym compare: {d} did not record {metric!r} (it has: {', '.join(have) or 'no generation yet'}); "
                   f"pick a metric every run has with --metric", file=sys.stderr)  # fmt: skip
+            return 2
+    for d, rows in logs.items():  # every generation's value a number (a damaged log is named)
+        bad = next((n for n, r in enumerate(rows, 1) if not is_real(r.get(column))), None)
+        if bad is not None:
+            print(f"softgym compare: {Path(d) / 'log.jsonl'}: line {bad} has no number "
+                  f"{column!r} (got {show(rows[bad - 1].get(column))})", file=sys.stderr)  # fmt: skip
             return 2
     labelled: dict[str, list] = {}
     base = configs[next(iter(configs))]
@@ -191,10 +195,10 @@ def _cmd_view(args: argparse.Namespace) -> int:
         seconds = exp.seconds if seconds is None else seconds
         name = f"{src.name}: best robot ({exp.name})"
         if "poet" in cfg:  # POET: the best robot of its pairs, on its own terrain
-            from softgym.io import read_json
+            from evolvers.drivers.poet import read_pairs
             from softgym.tasks.terrain_genome import TerrainGenome
 
-            pair = max(read_json(src / "pairs.json")["pairs"], key=lambda p: (p["score"], -p["id"]))
+            pair = max(read_pairs(src), key=lambda p: (p["score"], -p["id"]))
             design = RobotDesign.from_dict(pair["design"])
             if args.task is None:
                 terrain = TerrainGenome.from_dict(pair["terrain"]).terrain(exp.shape)

@@ -7,6 +7,7 @@ import logging
 import sys
 
 from softgym.exceptions import SoftGymError
+from softgym.io import check_path_depth
 from softgym_cli.commands import add_tool_parsers
 from softgym_cli.flags import HelpFormatter, global_flags, installed_version, subcommands
 from softgym_cli.runs import add_evolve_parser, add_poet_parser, add_qd_parser, explicit_flags
@@ -54,6 +55,9 @@ def main(argv: list[str] | None = None) -> int:
     for name in ("softgym", "evolvers"):
         logging.getLogger(name).setLevel(level)
     try:
+        for dest in ("out", "compare_out", "report_out", "export_out"):  # every path written
+            if isinstance(getattr(args, dest, None), str):
+                check_path_depth(getattr(args, dest), "--out")
         return int(args.func(args))
     except (SoftGymError, OSError) as exc:  # bad input or a file problem: one line, exit 2
         if args.debug:

@@ -527,15 +527,26 @@ def cmd_poet(args: argparse.Namespace) -> int:
 
 def _cmd_poet_compare(args: argparse.Namespace) -> int:
     from evolvers.drivers.poet import plot_annecs
-    from softgym.render.figures import read_log
+    from softgym.render.figures import figure_path, read_log
+    from softgym.validate import is_int, is_real, show
 
+    figure_path(args.compare_out)  # a format matplotlib writes, checked before the runs are read
     groups: dict[str, list] = {}
     for d in args.runs:
         cfg = read_run_config(d)
         if "poet" not in cfg:
             raise CheckpointError(f"{d}: not a POET run folder (softgym poet)")
-        label = "POET" if cfg["poet"]["generator"] == "mutate" else "random terrains (control)"
-        groups.setdefault(label, []).append(read_log(d))
+        generator = cfg["poet"].get("generator") if isinstance(cfg["poet"], dict) else None
+        if not isinstance(generator, str):
+            raise CheckpointError(f"{Path(d) / 'config.json'}: 'poet' needs the string "
+                                  f"'generator', got {show(generator)}")  # fmt: skip
+        rows = read_log(d)
+        for n, row in enumerate(rows, 1):
+            if not (is_real(row.get("annecs")) and is_int(row.get("generation"))):
+                raise CheckpointError(f"{Path(d) / 'log.jsonl'}: line {n} needs a number 'annecs' "
+                                      f"and an integer 'generation'")  # fmt: skip
+        label = "POET" if generator == "mutate" else "random terrains (control)"
+        groups.setdefault(label, []).append(rows)
     path = plot_annecs(groups, args.compare_out)
     for label, runs in groups.items():
         finals = sorted(rows[-1]["annecs"] if rows else 0 for rows in runs)

@@ -260,3 +260,144 @@ def test_replay_shorter_than_the_settling_time_and_of_a_fifo_is_one_line(tmp_pat
         code = ("from softgym_cli import main\n"
                 f"print('REFUSED' if main(['replay', {str(run)!r}, '--no-gif']) == 2 else 'RAN')\n")  # fmt: skip
         refused_in_child(code, timeout=60)
+
+
+@pytest.fixture(scope="module")
+def finished_run(tmp_path_factory):
+    """A finished tiny evolve run (one generation), copied by each test that damages it."""
+    run = tmp_path_factory.mktemp("finished") / "run"
+    assert main(["evolve", "--out", str(run), "--generations", "0", "--no-gif", *TINY]) == 0
+    return run
+
+
+def _copy(run, tmp_path, name="run"):
+    import shutil
+
+    shutil.copytree(run, tmp_path / name, ignore=shutil.ignore_patterns(".lock"))
+    return tmp_path / name
+
+
+def _edit_json(path, edit):
+    import json
+
+    doc = json.loads(path.read_text())
+    edit(doc)
+    path.write_text(json.dumps(doc))
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs")
+def test_study_report_plan_and_resume_over_fifos_never_block(tmp_path, capsys):
+    # issue 61, hang 2: study report read config.json, best_designs.json and scenario.json
+    # with read_text, and --plan / a resume read log.jsonl and config.json so: a FIFO there
+    # blocked for ever. Every run-folder read goes through the capped reader now.
+    import shutil
+
+    argv = ["study", "--scenarios", "basic", "--seeds", "1", *SMALL["study"]]
+    argv.remove("--quiet")  # each run's line names why it failed
+    root = tmp_path / "a"
+    assert main([*argv, "--out", str(root)]) == 0
+    capsys.readouterr()
+    shutil.copytree(root, tmp_path / "b")
+    shutil.copytree(root, tmp_path / "c")
+    for name, files in (("a", ["basic/seed-0/config.json"]), ("b", ["basic/seed-0/log.jsonl"]),
+                        ("c", ["basic/seed-0/best_designs.json", "basic/scenario.json"])):  # fmt: skip
+        for f in files:
+            (tmp_path / name / f).unlink()
+            os.mkfifo(tmp_path / name / f)
+    calls = []
+    for name in "abc":
+        out = str(tmp_path / name)
+        calls += [["study", "report", out, "--out", str(tmp_path / f"report-{name}")]]
+        if name != "c":
+            calls += [[*argv, "--out", out, "--plan"], [*argv, "--out", out]]
+    code = ("import contextlib, io\nfrom softgym_cli import main\n"
+            f"for argv in {calls!r}:\n"
+            "    err, out = io.StringIO(), io.StringIO()\n"
+            "    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(out):\n"
+            "        rc = main(argv)\n"
+            "    print('REFUSED' if 'Traceback' not in err.getvalue() else 'TRACEBACK', rc,\n"
+            "          repr(err.getvalue() + out.getvalue()))\n")  # fmt: skip
+    lines = refused_in_child(code, timeout=120).splitlines()
+    assert len(lines) == len(calls) and all(line.startswith("REFUSED") for line in lines), lines
+    report_a, plan_a, run_a, report_b, plan_b, run_b, report_c = lines
+    assert report_a.startswith("REFUSED 2") and report_b.startswith("REFUSED 2")  # the run skipped
+    assert plan_a.startswith("REFUSED 0") and plan_b.startswith("REFUSED 0")
+    assert run_a.startswith("REFUSED 1") and "config.json" in run_a and "not a regular file" in run_a
+    assert run_b.startswith("REFUSED 0")  # the checkpoint resumed: the log is not read
+    assert report_c.startswith("REFUSED 0")  # the run reported; its best robot left out
+    assert (tmp_path / "report-c" / "README.md").is_file()
+
+
+@pytest.mark.parametrize(
+    ("file", "edit", "needle"),
+    [
+        ("config.json", lambda d: d["experiment"].update(objectives=5), "'objectives'"),
+        ("config.json", lambda d: d["experiment"].pop("name"), "'name' is missing"),
+        ("config.json", lambda d: d.update(seed="x"), "'seed' must be an integer"),
+        ("config.json", lambda d: d.pop("backend"), "'backend' must be a string"),
+        ("best_designs.json", lambda d: d.update(best=[5]), "'best'[0] needs the object 'design'"),
+    ],
+)  # fmt: skip
+def test_malformed_run_files_are_one_line_in_view_compare_replay_and_resume(
+    finished_run, tmp_path, capsys, file, edit, needle
+):
+    # issue 61, item 11: a malformed key was a KeyError or TypeError traceback
+    run = _copy(finished_run, tmp_path)
+    _edit_json(run / file, edit)
+    before = sorted(p.name for p in run.rglob("*"))
+    commands = [["replay", str(run), "--no-gif"]]
+    if file == "config.json":
+        commands += [["view", str(run)], ["compare", str(run), "--out", str(tmp_path / "c.png")],
+                     ["evolve", "--out", str(run), "--resume", "--no-figures", "--quiet"]]  # fmt: skip
+    for argv in commands:
+        line = _one_line_error(capsys, argv, argv[0])
+        assert needle in line and str(run / file) in line, line
+    assert sorted(p.name for p in run.rglob("*")) == before  # nothing written
+
+
+def test_malformed_logs_and_pairs_are_one_line_in_compare_view_and_poet_compare(
+    finished_run, tmp_path, capsys
+):
+    import json
+
+    run = _copy(finished_run, tmp_path)
+    log = run / "log.jsonl"
+    log.write_text(log.read_text() + json.dumps({"generation": 1}) + "\n")  # no metrics
+    line = _one_line_error(capsys, ["compare", str(run), "--out", str(tmp_path / "c.png")], "compare")
+    assert str(log) in line and "line 2 has no number" in line
+    # a POET run's pairs.json with a pair that lacks its score
+    _edit_json(run / "config.json", lambda d: d.update(poet={"generator": "mutate"}))
+    (run / "pairs.json").write_text(json.dumps({"pairs": [{"id": 0}]}))
+    line = _one_line_error(capsys, ["view", str(run)], "view")
+    assert str(run / "pairs.json") in line and "'pairs'[0]['score'] must be a number" in line
+    line = _one_line_error(capsys, ["poet", "compare", str(run), "--out", str(tmp_path / "p.png")],
+                           "poet")  # fmt: skip
+    assert str(log) in line and "'annecs'" in line
+    _edit_json(run / "config.json", lambda d: d.update(poet=5))
+    line = _one_line_error(capsys, ["poet", "compare", str(run), "--out", str(tmp_path / "p.png")],
+                           "poet")  # fmt: skip
+    assert "'generator'" in line
+    # a figure format matplotlib cannot write, refused before any run is read
+    line = _one_line_error(capsys, ["poet", "compare", str(tmp_path / "none"), "--out",
+                                    str(tmp_path / "a.xyz")], "poet")  # fmt: skip
+    assert "a.xyz" in line and "not a format matplotlib writes" in line
+    assert not (tmp_path / "a.xyz").exists() and not (tmp_path / "p.png").exists()
+
+
+def test_an_edited_config_is_refused_on_resume_in_one_line(finished_run, tmp_path, capsys):
+    # issue 61, item 4: an edited population size resumed as the same run
+    run = _copy(finished_run, tmp_path)
+    _edit_json(run / "config.json", lambda d: d["experiment"].update(pop_size=6))
+    line = _one_line_error(capsys, ["evolve", "--out", str(run), "--resume", "--no-figures",
+                                    "--quiet"], "evolve")  # fmt: skip
+    assert "config.json was changed after the run started" in line and "identity.json" in line
+
+
+def test_an_out_path_thousands_of_folders_deep_is_one_line(tmp_path, monkeypatch, capsys):
+    # issue 61, item 11: a RecursionError traceback (folders are created one call per level)
+    monkeypatch.chdir(tmp_path)
+    deep = "a/" * 2000
+    for argv in (["evolve", *SMALL["evolve"]], ["compare", str(tmp_path)], ["view", str(tmp_path)]):
+        line = _one_line_error(capsys, [*argv, "--out", deep], argv[0])
+        assert "2000 folders deep, more than the 256" in line
+    assert list(tmp_path.iterdir()) == []

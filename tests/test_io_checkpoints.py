@@ -31,9 +31,13 @@ def _rewrite(path, mutate):
     """Apply ``mutate`` to a checkpoint JSON and fix its checksums, so deeper checks run."""
     doc = json.loads(path.read_text())
     mutate(doc)
-    if isinstance(doc.get("state"), dict):
-        doc["state_sha256"] = sio._state_digest(doc["state"])
+    _resign(doc)
     path.write_text(json.dumps(doc))
+
+
+def _resign(doc):
+    """Fix a checkpoint record's checksum after tampering (what a forger can always do)."""
+    doc["sha256"] = sio.json_sha256({k: v for k, v in doc.items() if k != "sha256"})
 
 
 def _set_npz(json_path, npz_bytes):
@@ -181,9 +185,37 @@ def test_a_checkpoint_of_another_run_is_refused(tmp_path):
     sio.save_checkpoint(tmp_path, 2, {"x": 2}, identity=other)
     found = sio.load_latest_intact(tmp_path, identity=mine)
     assert found.state["step"] == 1 and "belongs to another run" in found.message
-    # a checkpoint written before checkpoints had identities is still resumed
+    # a checkpoint that records no identity is read only where no identity is asked for
+    # (a run folder from before runs had identities)
     sio.save_checkpoint(tmp_path / "old", 1, {"x": 1})
-    assert sio.load_checkpoint(tmp_path / "old", identity=mine)[0]["x"] == 1
+    assert sio.load_checkpoint(tmp_path / "old")[0]["x"] == 1
+    with pytest.raises(CheckpointError, match="records no run identity"):
+        sio.load_checkpoint(tmp_path / "old", identity=mine)
+
+
+def test_a_checkpoint_whose_identity_was_deleted_is_refused(tmp_path):
+    # issue 61, item 4: a checkpoint copied from another run with its "identity" key
+    # deleted resumed silently; the checksum covers the identity now, and a checkpoint
+    # re-signed without one is refused all the same
+    mine = {"run_id": "abc", "config_sha256": "1" * 64}
+    path = sio.save_checkpoint(tmp_path, 1, {"x": 1}, identity=mine)
+    doc = json.loads(path.read_text())
+    del doc["identity"]
+    path.write_text(json.dumps(doc))
+    with pytest.raises(CheckpointError, match="ckpt-000001.json: checkpoint record is corrupt"):
+        sio.load_checkpoint(path, identity=mine)
+    with pytest.raises(CheckpointError, match="checksum mismatch"):
+        sio.load_checkpoint(path)  # whoever reads it
+    _rewrite(path, lambda d: None)  # re-signed without the identity
+    with pytest.raises(CheckpointError, match="ckpt-000001.json: records no run identity"):
+        sio.load_checkpoint(path, identity=mine)
+    # the step is covered too (the name check aside)
+    path = sio.save_checkpoint(tmp_path / "s", 2, {"x": 1}, identity=mine)
+    doc = json.loads(path.read_text())
+    doc["identity"]["run_id"] = "xyz"
+    path.write_text(json.dumps(doc))
+    with pytest.raises(CheckpointError, match="checksum mismatch"):
+        sio.load_checkpoint(path)
 
 
 def test_run_lock_refuses_a_second_writer_naming_the_holder(tmp_path):
@@ -308,8 +340,8 @@ def test_tampered_checkpoint_json_loads_or_raises_checkpoint_error(
         doc["state"]["values"] = value
     else:
         doc[key] = value
-    if fix_checksum and isinstance(doc.get("state"), dict):
-        doc["state_sha256"] = sio._state_digest(doc["state"])
+    if fix_checksum:
+        _resign(doc)
     latest.write_text(json.dumps(doc, allow_nan=True))
 
     def load_and_restore():

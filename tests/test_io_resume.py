@@ -94,3 +94,47 @@ def test_resume_removes_the_temporary_files_of_a_killed_write(tmp_path):
     assert run.generation == 1
     assert not any(p.exists() for p in stale)
     assert not list(out.rglob("*.tmp*"))
+
+
+@pytest.mark.parametrize(
+    ("array", "state"),
+    [
+        ({"pop_traces": [0.0]}, None),
+        ({"cache_traces": []}, None),
+        ({"cache_metrics": [0.5] * 10}, None),
+        ({"pop_traces": [[0.0] * 7] * 3}, None),
+        (None, {"rows": [1]}),
+        (None, {"hall_of_fame": [{}]}),
+        (None, {"hall_of_fame": [5]}),
+    ],
+)  # fmt: skip
+def test_a_re_signed_checkpoint_of_wrong_shapes_is_a_checkpoint_error(tmp_path, array, state):
+    # issue 61, item 11: a checkpoint re-signed (checksums fixed) with arrays of other shapes or
+    # entries of other types was an IndexError, TypeError or KeyError traceback on resume
+    import hashlib
+    import io
+
+    import numpy as np
+
+    from softgym.exceptions import CheckpointError
+    from softgym.io import json_sha256
+
+    exp = get_experiment("controller-tournament", **{**TINY, "seconds": 0.5})
+    out = tmp_path / "run"
+    EvolutionRun(exp, out, seed=1, generations=0, figures=False, gif=False, progress=False).run()
+    ckpt = list_checkpoints(out / "checkpoints")[-1]
+    doc = json.loads(ckpt.read_text())
+    if array is not None:
+        with np.load(ckpt.with_suffix(".npz")) as z:
+            arrays = {k: z[k] for k in z.files}
+        arrays.update({k: np.asarray(v) for k, v in array.items()})
+        buf = io.BytesIO()
+        np.savez(buf, **arrays)
+        ckpt.with_suffix(".npz").write_bytes(buf.getvalue())
+        doc["npz_sha256"] = hashlib.sha256(buf.getvalue()).hexdigest()
+    doc["state"].update(state or {})
+    doc["sha256"] = json_sha256({k: v for k, v in doc.items() if k != "sha256"})
+    ckpt.write_text(json.dumps(doc))
+    run = EvolutionRun(exp, out, seed=1, generations=1, figures=False, gif=False, progress=False)
+    with pytest.raises(CheckpointError, match="checkpoint content is invalid|checkpoint is damaged"):
+        run.run(resume=True)

@@ -210,7 +210,8 @@ class Driver:
         try:
             self._fresh()
             self._restore(*loaded)
-        except (KeyError, TypeError, ValueError) as exc:
+        except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
+            # a re-signed checkpoint whose arrays or entries have the wrong shapes or types
             raise CheckpointError(
                 f"{self.checkpoint_dir}: checkpoint content is invalid ({exc!r})"
             ) from exc

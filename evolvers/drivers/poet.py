@@ -90,11 +90,12 @@ from evolvers.operators.genome import Individual
 from evolvers.operators.selection import sel_fitness_tournament
 from evolvers.operators.variation import make_children
 from softgym.design import CONTROLLER_BOUNDS, Controller
-from softgym.exceptions import InvalidParameterError
-from softgym.io import rng_from_state, rng_state
+from softgym.exceptions import CheckpointError, InvalidParameterError
+from softgym.io import read_json, rng_from_state, rng_state
 from softgym.render.figures import pyplot
 from softgym.tasks import Task
 from softgym.tasks.terrain_genome import TerrainGenome
+from softgym.validate import is_int, is_real, show
 
 __all__ = [
     "GENERATORS",
@@ -109,9 +110,41 @@ __all__ = [
     "plot_annecs",
     "poet_experiment",
     "poet_thresholds",
+    "read_pairs",
 ]
 
 log = logging.getLogger("evolvers")
+
+#: The keys of a pair in ``pairs.json`` that its readers use, and what each must be.
+_PAIR_KEYS = {"id": (is_int, "an integer"), "score": (is_real, "a number"),
+              "design": (lambda v: isinstance(v, dict), "an object"),
+              "terrain": (lambda v: isinstance(v, dict), "an object"),
+              "describe": (lambda v: isinstance(v, str), "a string")}  # fmt: skip
+
+
+def read_pairs(run_dir: str | Path) -> list[dict[str, Any]]:
+    """The pairs of a POET run folder's ``pairs.json`` (through the capped reader).
+
+    Raises
+    ------
+    CheckpointError
+        Naming the file and the key, if it is missing, not a regular file,
+        oversized, malformed, or holds no pair.
+    """
+    path = Path(run_dir) / "pairs.json"
+    doc = read_json(path)
+    pairs = doc.get("pairs") if isinstance(doc, dict) else None
+    if not isinstance(pairs, list) or not pairs:
+        raise CheckpointError(f"{path}: 'pairs' must be a non-empty list of pairs, got {show(pairs)}")
+    for i, pair in enumerate(pairs):
+        if not isinstance(pair, dict):
+            raise CheckpointError(f"{path}: 'pairs'[{i}] must be an object, got {show(pair)}")
+        for key, (check, what) in _PAIR_KEYS.items():
+            if not check(pair.get(key)):
+                raise CheckpointError(
+                    f"{path}: 'pairs'[{i}][{key!r}] must be {what}, got {show(pair.get(key))}"
+                )
+    return pairs
 
 #: Enhanced POET's BipedalWalker rewards: minimal-criterion band, reproduction threshold, solved.
 POET_REWARDS: dict[str, float] = {

@@ -44,6 +44,8 @@ from __future__ import annotations
 
 import logging
 import math
+import os
+import sys
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, fields
 from pathlib import Path
@@ -73,6 +75,27 @@ from softgym.io import (
     rng_state,
 )
 from softgym.render.figures import pyplot
+
+
+def _numba_cache_in_user_folder() -> None:
+    """Point numba's cache (pyribs compiles through numba, whose ``cache=True`` functions
+    write beside their source, in site-packages) at the user's cache folder,
+    ``$XDG_CACHE_HOME/softgym/numba`` (``~/.cache/softgym/numba``; Windows:
+    ``%LOCALAPPDATA%/softgym/numba``), unless ``NUMBA_CACHE_DIR`` is set already.
+    """
+    if os.environ.get("NUMBA_CACHE_DIR"):
+        return  # the user's own setting
+    if sys.platform == "win32":  # pragma: no cover - Windows only
+        base = os.environ.get("LOCALAPPDATA") or os.path.expanduser("~")
+    else:
+        base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    os.environ["NUMBA_CACHE_DIR"] = os.path.join(base, "softgym", "numba")
+    config = sys.modules.get("numba.core.config")
+    if config is not None:  # numba imported already: it read the variable then
+        config.CACHE_DIR = os.environ["NUMBA_CACHE_DIR"]
+
+
+_numba_cache_in_user_folder()  # before pyribs imports numba
 
 try:
     from ribs.archives import CVTArchive, GridArchive, k_means_centroids

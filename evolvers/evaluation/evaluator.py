@@ -169,11 +169,22 @@ class PhenotypeCache:
         cache = cls()
         if "cache_keys" not in arrays:
             return cache
+        for name in ("cache_keys", "cache_metrics"):
+            if name in arrays and (arrays[name].ndim != 1 or arrays[name].dtype.kind != "U"):
+                raise CheckpointError(
+                    f"{name}: expected a 1-D array of names, got {arrays[name].dtype} of shape "
+                    f"{arrays[name].shape}; the checkpoint is damaged"
+                )
         if "cache_metrics" in arrays:
             names = tuple(str(m) for m in arrays["cache_metrics"].tolist())
         else:
             names = _UNNAMED_CACHE_COLUMNS
         values = np.asarray(arrays["cache_values"], dtype=np.float64)
+        if values.ndim == 2 and values.shape[0] != len(arrays["cache_keys"]):
+            raise CheckpointError(
+                f"cache_values: {values.shape[0]} rows for {len(arrays['cache_keys'])} cached "
+                "results; the checkpoint is damaged"
+            )
         if values.ndim != 2 or values.shape[1] != len(names):
             raise CheckpointError(
                 f"cache_values: {values.shape[-1] if values.ndim else 0} columns for "

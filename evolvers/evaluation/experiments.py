@@ -377,17 +377,53 @@ class Experiment:
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Experiment:
-        """Inverse of :meth:`to_dict` (also reads older run folders' ``terrain`` key)."""
+        """Inverse of :meth:`to_dict` (also reads older run folders' ``terrain`` key).
+
+        Raises
+        ------
+        InvalidParameterError
+            Naming the key, if ``data`` is not an experiment's record (a missing,
+            unknown or malformed key).
+        """
+        if not isinstance(data, Mapping):
+            raise InvalidParameterError(f"an experiment must be an object, got {show(data)}")
         kw = dict(data)
         if "terrain" in kw:  # before the task layer: "terrain": "flat" | "fence"
             kw["task"] = kw.pop("terrain")
+        known = {f.name for f in fields(cls)}
+        unknown = sorted(str(k) for k in kw if k not in known)
+        if unknown:
+            raise InvalidParameterError(
+                f"experiment: unknown key {unknown[0]!r:.60}; the keys are {sorted(known)}"
+            )
+        for name in ("name", "objectives", "rules", "logged", "cppn_outputs", "shape"):
+            if name not in kw:
+                raise InvalidParameterError(f"experiment: the key {name!r} is missing")
         if isinstance(kw.get("task"), Mapping):
             kw["task"] = Terrain.from_dict(dict(kw["task"]))
-        kw["objectives"] = tuple(Objective(**o) for o in kw["objectives"])
-        kw["rules"] = CompositionRules.from_dict(kw["rules"])
+        objectives = kw["objectives"]
+        if not isinstance(objectives, list) or not all(isinstance(o, Mapping) for o in objectives):
+            raise InvalidParameterError(
+                f"experiment: 'objectives' must be a list of objects, got {show(objectives)}"
+            )
+        try:
+            kw["objectives"] = tuple(Objective(**o) for o in objectives)
+        except TypeError as exc:  # a missing or unknown key of an objective
+            raise InvalidParameterError(f"experiment: 'objectives' {exc!s:.120}") from None
+        if not isinstance(kw["rules"], Mapping):
+            raise InvalidParameterError(f"experiment: 'rules' must be an object, got {show(kw['rules'])}")
+        try:
+            kw["rules"] = CompositionRules.from_dict(kw["rules"])
+        except (TypeError, KeyError, ValueError) as exc:
+            raise InvalidParameterError(f"experiment: 'rules' is malformed ({exc!s:.120})") from None
         for name in ("logged", "cppn_outputs", "shape"):
+            if not isinstance(kw[name], (list, tuple)):
+                raise InvalidParameterError(f"experiment: {name!r} must be a list, got {show(kw[name])}")
             kw[name] = tuple(kw[name])
-        return cls(**kw)
+        try:
+            return cls(**kw)
+        except (TypeError, ValueError, KeyError, AttributeError) as exc:
+            raise InvalidParameterError(f"experiment: a malformed key ({exc!s:.160})") from None
 
 
 _FIT = Objective("norm_final_dist", True)

@@ -32,6 +32,7 @@ from softgym.design import CPPN, MATERIAL_TREE_4, CompositionRules, Controller, 
 from softgym.design.brain import BrainSpec
 from softgym.design.robot import RobotDesign
 from softgym.exceptions import InvalidParameterError
+from softgym.validate import show
 
 __all__ = [
     "INITIAL_MATERIAL_GENES",
@@ -277,7 +278,24 @@ class Individual:
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> Individual:
-        """Inverse of :meth:`to_dict` (dicts without ``brain`` / ``body`` load with None)."""
+        """Inverse of :meth:`to_dict` (dicts without ``brain`` / ``body`` load with None).
+
+        Raises
+        ------
+        InvalidParameterError
+            Naming the key, if ``data`` is not an individual's record.
+        """
+        if not isinstance(data, Mapping):
+            raise InvalidParameterError(f"an individual must be an object, got {show(data)}")
+        try:
+            return cls._from_record(data)
+        except KeyError as exc:
+            raise InvalidParameterError(f"individual: the key {exc.args[0]!r} is missing") from None
+        except (TypeError, ValueError, AttributeError, IndexError, OverflowError) as exc:
+            raise InvalidParameterError(f"individual: a malformed key ({exc!s:.160})") from None
+
+    @classmethod
+    def _from_record(cls, data: Mapping[str, Any]) -> Individual:
         brain = data.get("brain")
         spec = None
         if brain is not None:

@@ -33,7 +33,6 @@ from __future__ import annotations
 import contextlib
 import csv
 import datetime as _dt
-import hashlib
 import io
 import json
 import logging
@@ -47,22 +46,25 @@ from typing import Any
 import numpy as np
 
 from evolvers.evaluation.evaluator import EvalStats
-from evolvers.evaluation.experiments import Experiment
+from evolvers.evaluation.experiments import MAX_SEED, Experiment
 from evolvers.operators.genome import Individual
 from evolvers.recording.rows import log_row, population_summary
 from softgym.evaluate import caller_shows_progress
-from softgym.exceptions import CheckpointError, InvalidParameterError
+from softgym.exceptions import CheckpointError, InvalidParameterError, SoftGymError
 from softgym.io import (
     RunLock,
     atomic_write_json,
     atomic_write_text,
+    json_sha256,
     latest_checkpoint,
     load_latest_intact,
     read_json,
+    read_json_lines,
     remove_stale_temp_files,
     save_checkpoint,
     temp_file_target,
 )
+from softgym.validate import show
 
 __all__ = [
     "HALL_OF_FAME_SIZE",
@@ -71,6 +73,8 @@ __all__ = [
     "RunRecorder",
     "add_run_note",
     "config_difference",
+    "read_best_designs",
+    "read_run_config",
     "read_run_notes",
 ]
 
@@ -103,12 +107,9 @@ def read_run_notes(run_dir: str | os.PathLike[str]) -> list[dict[str, Any]]:
         If ``notes.jsonl`` is not JSON lines.
     """
     path = Path(run_dir) / NOTES_FILE
-    if not path.exists():
+    if not (path.exists() or path.is_symlink()):
         return []
-    try:
-        return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
-    except ValueError as exc:
-        raise CheckpointError(f"{path}: not JSON lines ({exc})") from None
+    return read_json_lines(path)
 
 
 #: ``"schema"`` of a run's config.json.
@@ -165,7 +166,42 @@ def read_run_config(out: str | Path) -> dict[str, Any]:
     cfg = read_json(path)  # CheckpointError naming the file if it is missing or corrupt
     if not isinstance(cfg, dict) or not isinstance(cfg.get("experiment"), dict):
         raise CheckpointError(f"{path}: not a softgym run config")
+    try:
+        Experiment.from_dict(cfg["experiment"])
+    except SoftGymError as exc:
+        raise CheckpointError(f"{path}: 'experiment' is not a valid experiment ({exc})") from None
+    seed, backend = cfg.get("seed"), cfg.get("backend")
+    if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed <= MAX_SEED:
+        raise CheckpointError(f"{path}: 'seed' must be an integer in [0, {MAX_SEED}], got {show(seed)}")
+    if not isinstance(backend, str):
+        raise CheckpointError(f"{path}: 'backend' must be a string, got {show(backend)}")
+    gens = cfg.get("generations", 0)
+    if isinstance(gens, bool) or not isinstance(gens, int) or gens < 0:
+        raise CheckpointError(f"{path}: 'generations' must be an integer >= 0, got {show(gens)}")
     return cfg
+
+
+def read_best_designs(out: str | Path) -> list[dict[str, Any]]:
+    """The hall of fame of a run folder's ``best_designs.json``, best first (through the
+    capped reader): each entry a dict with ``design`` and ``objectives`` objects.
+
+    Raises
+    ------
+    CheckpointError
+        Naming the file and the key, if it is missing, not a regular file, oversized,
+        malformed, or holds no entry.
+    """
+    path = Path(out) / "best_designs.json"
+    doc = read_json(path)
+    best = doc.get("best") if isinstance(doc, dict) else None
+    if not isinstance(best, list) or not best:
+        raise CheckpointError(f"{path}: 'best' must be a non-empty list of entries, got {show(best)}")
+    for i, entry in enumerate(best):
+        for key in ("design", "objectives"):
+            value = entry.get(key) if isinstance(entry, dict) else None
+            if not isinstance(value, dict):
+                raise CheckpointError(f"{path}: 'best'[{i}] needs the object {key!r}, got {show(value)}")
+    return best
 
 
 def config_difference(recorded: Any, given: Any, name: str = "") -> str | None:
@@ -188,6 +224,13 @@ def config_difference(recorded: Any, given: Any, name: str = "") -> str | None:
     if recorded == given:
         return None
     return f"{name}: {recorded!r} (recorded) != {given!r}"
+
+
+def _settings_sha256(config: Mapping[str, Any]) -> str:
+    """The digest of a run's settings (its config.json but ``generations``, which a resume
+    may extend): ``config_sha256`` of ``identity.json``.
+    """
+    return json_sha256({k: v for k, v in config.items() if k != "generations"})
 
 
 class RunRecorder:
@@ -240,6 +283,9 @@ class RunRecorder:
         #: settings): a checkpoint of another run copied into this folder is never
         #: resumed. Not a setting: config.json (what runs are compared by) holds none.
         self.identity: dict[str, str] | None = None
+        # a folder resumed from before runs had identities gets one with its first new
+        # checkpoint (until then its checkpoints, which record none, stay resumable)
+        self._identity_unwritten = False
         self.rows: list[dict[str, Any]] = []
         self.hall_of_fame: list[dict[str, Any]] = []
         self.evaluations_total = 0
@@ -289,10 +335,42 @@ class RunRecorder:
                 "could be overwritten; choose an empty or new folder (another --out)"
             )
 
-    def _new_identity(self) -> None:
-        digest = hashlib.sha256(json.dumps(self.config, sort_keys=True).encode()).hexdigest()
-        self.identity = {"run_id": uuid.uuid4().hex, "config_sha256": digest}
+    def _new_identity(self, write: bool = True) -> None:
+        self.identity = {"run_id": uuid.uuid4().hex, "config_sha256": _settings_sha256(self.config)}
+        self._identity_unwritten = True
+        if write:
+            self._write_identity()
+
+    def _write_identity(self) -> None:
         atomic_write_json(self.out / IDENTITY_FILE, self.identity)
+        self._identity_unwritten = False
+
+    def _recorded_identity(self, cfg: Mapping[str, Any]) -> dict[str, str] | None:
+        """The run's identity from ``identity.json`` (None in a folder written before runs
+        had one), its ``config_sha256`` checked against config.json's settings.
+
+        Raises
+        ------
+        CheckpointError
+            If ``identity.json`` is not an identity, or config.json was edited after
+            the run started (an edited population size would resume as the same run).
+        """
+        path = self.out / IDENTITY_FILE
+        if not (path.exists() or path.is_symlink()):
+            return None
+        ident = read_json(path)
+        if not (isinstance(ident, dict) and all(isinstance(ident.get(k), str)
+                                                for k in ("run_id", "config_sha256"))):  # fmt: skip
+            raise CheckpointError(
+                f"{path}: not a run identity (the strings run_id and config_sha256 expected)"
+            )
+        if ident["config_sha256"] != _settings_sha256(cfg):
+            raise CheckpointError(
+                f"{self.out / 'config.json'} was changed after the run started (its settings no "
+                f"longer match config_sha256 in {path}); restore it, or start a new run in "
+                "another --out"
+            )
+        return {"run_id": ident["run_id"], "config_sha256": ident["config_sha256"]}
 
     def _write_config(self) -> None:
         atomic_write_json(self.out / "config.json", {**self.config, "generations": self.generations})
@@ -334,7 +412,9 @@ class RunRecorder:
         cfg_path = self.out / "config.json"
         if not cfg_path.exists():
             return None
-        cfg = read_json(cfg_path)
+        cfg = read_run_config(self.out)
+        # config.json as the run started (identity.json holds its digest), then as given
+        recorded_identity = self._recorded_identity(cfg)
         for key in self.config:
             if key in ("schema", "version"):
                 continue
@@ -350,24 +430,35 @@ class RunRecorder:
                     f"{self.out} was started with another {diff or key}; "
                     "resume with the run's own settings (softgym evolve --out DIR --resume)"
                 )
-        ident = read_json(self.out / IDENTITY_FILE) if (self.out / IDENTITY_FILE).exists() else None
-        if isinstance(ident, dict) and all(isinstance(ident.get(k), str)
-                                           for k in ("run_id", "config_sha256")):  # fmt: skip
-            self.identity = {"run_id": ident["run_id"], "config_sha256": ident["config_sha256"]}
+        # the settings as recorded (a reworded description or an older spelling is the same
+        # run): config.json keeps matching its digest in identity.json
+        self.config = {k: v for k, v in cfg.items() if k != "generations"}
+        if recorded_identity is not None:
+            self.identity = recorded_identity
         else:  # a folder written before runs had an identity: it gets one from now on
-            self._new_identity()
+            self._new_identity(write=False)
         # what a killed write left (.NAME.tmpPID): this run holds the folder's lock
         remove_stale_temp_files(self.out)
         if not self._has_checkpoint():
+            if self._identity_unwritten:
+                self._write_identity()
             return None
-        # a checkpoint that records another run's identity (copied in, whatever its
-        # name) is skipped, and the run's own newest one resumed, or none: an error
-        state, arrays, _, _ = load_latest_intact(self.checkpoint_dir, identity=self.identity)
+        # a checkpoint that records another run's identity, or none (copied in, whatever
+        # its name), is skipped, and the run's own newest one resumed, or none: an error
+        state, arrays, _, _ = load_latest_intact(
+            self.checkpoint_dir, identity=None if self._identity_unwritten else self.identity
+        )
         try:
             self.rows = list(state["rows"])
             self.hall_of_fame = list(state["hall_of_fame"])
             self.evaluations_total = int(state["evaluations_total"])
             self.wall_total = float(state["wall_total"])
+            if not all(isinstance(r, dict) for r in self.rows):
+                raise TypeError("'rows' must be a list of objects")
+            for h in self.hall_of_fame:  # as update_hall_of_fame and write_best read them
+                if not (isinstance(h, dict) and isinstance(h.get("generation"), int)):
+                    raise TypeError("'hall_of_fame' entries need an integer 'generation'")
+                Individual.from_dict(h.get("individual"))
         except (KeyError, TypeError, ValueError) as exc:
             raise CheckpointError(
                 f"{self.checkpoint_dir}: checkpoint content is invalid ({exc!r})"
@@ -518,10 +609,13 @@ class RunRecorder:
             "population": population_summary(population),
             **{k: getattr(self, k) for k in _RECORDER_KEYS},
         }
-        return save_checkpoint(
+        path = save_checkpoint(
             self.checkpoint_dir, generation, full, dict(arrays), keep=KEEP_CHECKPOINTS,
             identity=self.identity,
         )
+        if self._identity_unwritten:  # after the checkpoint: a kill between leaves no
+            self._write_identity()  # identity.json that the folder's checkpoints lack
+        return path
 
     def write_log(self) -> None:
         """Write log.csv and log.jsonl (atomic)."""

@@ -4,7 +4,6 @@
 
 from __future__ import annotations
 
-import json
 import logging
 import os
 from dataclasses import dataclass, field
@@ -14,9 +13,11 @@ from typing import Any
 import numpy as np
 
 from evolvers.operators.genome import Individual
-from evolvers.recording.recorder import read_run_notes
-from softgym.exceptions import CheckpointError
+from evolvers.recording.recorder import read_best_designs, read_run_config, read_run_notes
+from softgym.exceptions import CheckpointError, SoftGymError
+from softgym.io import read_json
 from softgym.render.figures import read_log
+from softgym.validate import is_int, show
 
 __all__ = [
     "CLAIM_SCENARIOS",
@@ -177,33 +178,48 @@ def load_runs(root: str | os.PathLike[str]) -> dict[str, list[RunData]]:
     root = Path(root)
     runs: dict[str, list[RunData]] = {}
     for cfg_path in sorted(root.rglob("config.json")):
-        try:
-            cfg = json.loads(cfg_path.read_text())
-        except (OSError, ValueError):
+        run_dir = cfg_path.parent
+        try:  # every file through the capped reader: a FIFO is refused, never waited on
+            cfg = read_json(cfg_path)
+        except CheckpointError as exc:
+            log.warning("skipping a run: %s", exc)
             continue
         if not isinstance(cfg, dict) or cfg.get("schema") != "softgym.run":
             continue
-        run_dir = cfg_path.parent
-        scenario = cfg["experiment"]["name"]
-        sc_path = run_dir.parent / "scenario.json"
-        if sc_path.exists():
-            try:
-                scenario = json.loads(sc_path.read_text())["name"]
-            except (OSError, ValueError, KeyError):
-                pass
-        try:
+        try:  # one damaged run must not stop the report: it is named and skipped
+            cfg = read_run_config(run_dir)
             rows = read_log(run_dir)
-        except CheckpointError as exc:  # one damaged run must not stop the report
+            for n, row in enumerate(rows, 1):
+                if not is_int(row.get("generation")):
+                    raise CheckpointError(
+                        f"{run_dir / 'log.jsonl'}: line {n} needs an integer 'generation', "
+                        f"got {show(row.get('generation'))}"
+                    )
+        except CheckpointError as exc:
             log.warning("skipping a run: %s", exc)
             continue
         if not rows:  # started, no generation logged yet: nothing to report
             log.info("skipping %s: no generation logged yet", run_dir)
             continue
+        scenario = cfg["experiment"]["name"]
+        sc_path = run_dir.parent / "scenario.json"
+        if sc_path.exists() or sc_path.is_symlink():
+            try:
+                name = read_json(sc_path).get("name")
+                if not isinstance(name, str):
+                    raise CheckpointError(f"{sc_path}: 'name' must be a string, got {show(name)}")
+                scenario = name
+            except (CheckpointError, AttributeError) as exc:
+                log.warning("%s: grouped by its experiment's name (%s)", run_dir, exc)
         best = None
-        try:
-            best = json.loads((run_dir / "best_designs.json").read_text())["best"][0]
-        except (OSError, ValueError, KeyError, IndexError):
-            pass
+        if (run_dir / "best_designs.json").exists():
+            try:
+                best = read_best_designs(run_dir)[0]
+                if "genome" in best:
+                    Individual.from_dict(best["genome"])
+            except SoftGymError as exc:
+                log.warning("%s: no best robot (%s: %s)", run_dir, run_dir / "best_designs.json", exc)
+                best = None
         gens = int(cfg.get("generations", -1))
         complete = (
             (run_dir / "final_population.json").exists()

@@ -67,8 +67,8 @@ from evolvers.evaluation.experiments import (
     check_seed,
     get_experiment,
 )
-from softgym.exceptions import InvalidParameterError, SoftGymError
-from softgym.io import atomic_write_json
+from softgym.exceptions import CheckpointError, InvalidParameterError, SoftGymError
+from softgym.io import atomic_write_json, read_json_lines
 from softgym.validate import is_int, show
 
 __all__ = [
@@ -369,34 +369,36 @@ def plan(
     return specs
 
 
+def _logged_rows(run_dir: Path) -> list[dict[str, Any]]:
+    """The rows of a run folder's ``log.jsonl`` through the capped reader (a FIFO or an
+    oversized file is refused, never waited on); [] if it has none or it is damaged
+    (a resume rewrites it from the checkpoint, or names what blocks it).
+    """
+    path = Path(run_dir) / "log.jsonl"
+    if not (path.exists() or path.is_symlink()):
+        return []
+    try:
+        rows = read_json_lines(path)
+    except CheckpointError:
+        return []
+    return rows if all(is_int(r.get("generation")) for r in rows) else []
+
+
 def _last_generation(run_dir: Path) -> int:
-    path = run_dir / "log.jsonl"
-    if not path.exists():
-        return -1
-    last = -1
-    for line in path.read_text().splitlines():
-        if line.strip():
-            try:
-                last = int(json.loads(line)["generation"])
-            except (ValueError, KeyError, TypeError):
-                return -1
-    return last
+    rows = _logged_rows(run_dir)
+    return int(rows[-1]["generation"]) if rows else -1
 
 
 def _generation_seconds(run_dir: Path) -> tuple[int, float]:
     """(last generation logged, wall seconds its generations took); (-1, 0) without a log."""
-    path = run_dir / "log.jsonl"
-    last, total = -1, 0.0
-    if not path.exists():
-        return last, total
-    for line in path.read_text().splitlines():
+    rows = _logged_rows(run_dir)
+    total = 0.0
+    for row in rows:
         try:
-            row = json.loads(line)
-            last = int(row["generation"])
             total += float(row.get("wall_time") or 0.0)
-        except (ValueError, KeyError, TypeError):
+        except (TypeError, ValueError):
             continue
-    return last, total
+    return (int(rows[-1]["generation"]) if rows else -1), total
 
 
 def _settings_key(spec: RunSpec) -> tuple[str, str]:
@@ -457,18 +459,24 @@ def run_status(run_dir: str | Path, generations: int) -> str:
 def settings_difference(spec: RunSpec) -> str | None:
     """Where the run folder's config.json differs from ``spec`` (experiment or seed), or None.
 
-    None also when the folder has no readable config.json yet (nothing ran).
-    A complete run with other settings (e.g. a scenario whose overrides
-    changed) must not be counted as this spec's run.
+    None also when the folder has no config.json yet (nothing ran); one that
+    cannot be read (a FIFO, an oversized or malformed file, a missing key) is a
+    difference naming the file. A complete run with other settings (e.g. a
+    scenario whose overrides changed) must not be counted as this spec's run.
     """
-    from evolvers.recording.recorder import config_difference
+    from evolvers.recording.recorder import config_difference, read_run_config
 
-    try:
-        cfg = json.loads((Path(spec.out) / "config.json").read_text())
-        recorded = Experiment.from_dict(cfg["experiment"]).to_dict()
-        seed = int(cfg["seed"])
-    except (OSError, ValueError, KeyError, TypeError):
+    path = Path(spec.out) / "config.json"
+    if not (path.exists() or path.is_symlink()):
         return None
+    try:
+        cfg = read_run_config(spec.out)  # the capped reader: a FIFO is refused at once
+        recorded = Experiment.from_dict(cfg["experiment"]).to_dict()
+        seed = cfg.get("seed")
+        if not is_int(seed):
+            raise CheckpointError(f"{path}: 'seed' must be an integer, got {show(seed)}")
+    except SoftGymError as exc:
+        return f"its config.json cannot be read: {exc}"
     if seed != spec.seed:
         return f"seed: {seed} (recorded) != {spec.seed}"
     given = spec.experiment.to_dict()

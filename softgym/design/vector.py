@@ -25,7 +25,7 @@ or score a violation in your objective.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -34,6 +34,7 @@ from softgym.design.controller import CONTROLLER_BOUNDS, Controller
 from softgym.design.material import default_palette
 from softgym.design.robot import RobotDesign, check_grid_shape, largest_component_mask
 from softgym.exceptions import InvalidParameterError
+from softgym.validate import is_int, show
 
 __all__ = ["CONTROLLER_GENES", "DesignVector"]
 
@@ -75,9 +76,21 @@ class DesignVector:
         palette: Any = None,
         fixed_controller: Controller | None = None,
     ) -> None:
+        if not isinstance(shape, (list, tuple, np.ndarray)):
+            raise InvalidParameterError(f"shape must be 3 integers (nx, ny, nz), got {show(shape)}")
         self.shape = check_grid_shape(tuple(shape), "shape")
+        if not isinstance(materials, (list, tuple, np.ndarray)) or not all(
+            is_int(m) and 0 <= m <= 127 for m in materials
+        ):
+            raise InvalidParameterError(
+                f"materials must be a list of material ids (integers in 0..127), got {show(materials)}"
+            )
         self.materials = np.asarray(list(materials), dtype=np.int8)
         self.palette = default_palette() if palette is None else palette
+        if not isinstance(self.palette, Mapping):
+            raise InvalidParameterError(
+                f"palette must map material ids to Materials (default_palette()), got {show(palette)}"
+            )
         if self.materials.size < 2 or len(set(self.materials.tolist())) != self.materials.size:
             raise InvalidParameterError(
                 f"materials must list at least two distinct ids, got {list(materials)}"
@@ -85,6 +98,12 @@ class DesignVector:
         missing = [int(m) for m in self.materials if m != 0 and int(m) not in self.palette]
         if missing:
             raise InvalidParameterError(f"materials {missing} are not in the palette")
+        if not isinstance(controller, (bool, np.bool_)):
+            raise InvalidParameterError(f"controller must be True or False, got {show(controller)}")
+        if fixed_controller is not None and not isinstance(fixed_controller, Controller):
+            raise InvalidParameterError(
+                f"fixed_controller must be a Controller or None, got {show(fixed_controller)}"
+            )
         self.controller = bool(controller)
         self.fixed_controller = fixed_controller or Controller()
         self.n_cells = int(np.prod(self.shape))
@@ -105,7 +124,10 @@ class DesignVector:
         return cells + (list(CONTROLLER_GENES) if self.controller else [])
 
     def _check(self, x: Any) -> np.ndarray:
-        v = np.asarray(x, dtype=np.float64)
+        try:
+            v = np.asarray(x, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise InvalidParameterError(f"expected a vector of numbers, got {show(x)} ({exc!s:.80})") from None
         if v.shape != (self.size,):
             raise InvalidParameterError(f"expected a vector of shape ({self.size},), got {v.shape}")
         if not np.isfinite(v).all():
@@ -153,6 +175,8 @@ class DesignVector:
         InvalidParameterError
             If the design's shape differs or it uses a material not in ``materials``.
         """
+        if not isinstance(design, RobotDesign):
+            raise InvalidParameterError(f"expected a RobotDesign, got {show(design)}")
         grid = np.asarray(design.grid)
         if grid.shape != self.shape:
             raise InvalidParameterError(f"design shape {grid.shape} != encoding shape {self.shape}")

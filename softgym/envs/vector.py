@@ -27,6 +27,7 @@ from softgym.envs.walker import (
     ActionMap,
     action_space,
     check_render_options,
+    check_temperatures,
     load_design,
     make_batch,
     observation_space,
@@ -218,7 +219,8 @@ class SoftWalkerVectorEnv(VectorEnv):
         <softgym.envs.walker.SoftWalkerEnv.action_from_temperatures>`, for
         ``fraction`` of shape (num_envs, n_cells); returns float32 of that shape.
         """
-        return self._action_map.from_temperatures(fraction)
+        f = check_temperatures(fraction, self.action_space.shape)
+        return self._action_map.from_temperatures(f)
 
     # ------------------------------------------------------------------- API
     def _infos(self, with_mask: bool = False) -> dict[str, Any]:

@@ -21,7 +21,7 @@ from gymnasium import logger, spaces
 
 from softgym.design.robot import RobotDesign, default_walker
 from softgym.engine import SimConfig, Simulation
-from softgym.exceptions import InvalidDesignError, InvalidParameterError
+from softgym.exceptions import InvalidActionError, InvalidDesignError, InvalidParameterError
 from softgym.tasks import (
     OBS_POSITION_BOUND,
     OBS_VELOCITY_BOUND,
@@ -46,6 +46,7 @@ __all__ = [
     "MAX_FRAME_SIDE",
     "action_space",
     "check_render_options",
+    "check_temperatures",
     "load_design",
     "make_config",
     "make_batch",
@@ -213,6 +214,29 @@ def make_batch(
     if max_episode_steps is not None:
         warn_if_cut_short(max_episode_steps, batch.control_dt, batch.episode_seconds)
     return batch
+
+
+def check_temperatures(fraction: Any, shape: tuple[int, ...]) -> np.ndarray:
+    """``fraction`` as float64 of ``shape``, each value in [-1, 1] (the argument of
+    :meth:`SoftWalkerEnv.action_from_temperatures` and its vector env's).
+
+    Raises
+    ------
+    InvalidActionError
+        Naming the shape expected and given, or a value that is not a number in [-1, 1].
+    """
+    try:
+        f = np.asarray(fraction, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InvalidActionError(f"temperature fractions must be numbers, got {_show(fraction)} "
+                                 f"({exc!s:.80})") from None  # fmt: skip
+    if f.shape != tuple(shape):
+        raise InvalidActionError(
+            f"temperature fractions must have shape {tuple(shape)} (one per cell), got {f.shape}"
+        )
+    if not (np.isfinite(f).all() and np.abs(f).max(initial=0.0) <= 1.0):
+        raise InvalidActionError("temperature fractions must be finite numbers in [-1, 1]")
+    return f
 
 
 class SoftWalkerEnv(gym.Env):
@@ -523,7 +547,7 @@ class SoftWalkerEnv(gym.Env):
         ``"contraction"`` a command that would expand a muscle leaves it at
         rest (the seed's law without its hold). Returns float32 of shape (n_cells,).
         """
-        f = np.asarray(fraction, dtype=np.float64)
+        f = check_temperatures(fraction, self.action_space.shape)
         return self._action_map.from_temperatures(f.reshape(1, -1))[0]
 
     @property

@@ -131,26 +131,12 @@ def read_log(run_dir: str | os.PathLike[str]) -> list[dict[str, Any]]:
         Naming the file and line, if a line is not a JSON object (the log is
         written atomically, so this is damage, not a run still writing).
     """
-    from softgym.exceptions import CheckpointError
-    from softgym.io import MAX_JSON_BYTES, loads_json, read_capped
+    from softgym.io import read_json_lines
 
     path = Path(run_dir) / "log.jsonl"
-    if not path.exists():
+    if not (path.exists() or path.is_symlink()):
         return []
-    data = read_capped(path, MAX_JSON_BYTES, "log")
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError as exc:
-        raise CheckpointError(f"{path}: cannot be read ({exc})") from None
-    rows = []
-    for n, line in enumerate(text.splitlines(), 1):
-        if not line.strip():
-            continue
-        row = loads_json(line, f"{path}: line {n}")
-        if not isinstance(row, dict):
-            raise CheckpointError(f"{path}: line {n} is not a JSON object")
-        rows.append(row)
-    return rows
+    return read_json_lines(path)
 
 
 def plot_fitness_trend(

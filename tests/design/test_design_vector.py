@@ -62,3 +62,21 @@ def test_cma_example_runs(tmp_path):
     )  # fmt: skip
     assert res.returncode == 0, res.stderr
     assert "iteration 2" in res.stdout and RobotDesign.load(out).n_voxels > 0
+
+
+@pytest.mark.parametrize(
+    "kwargs",
+    [{"shape": None}, {"shape": 5}, {"materials": "ab"}, {"materials": None}, {"materials": 5},
+     {"materials": [1.5, 2]}, {"materials": [0, 300]}, {"palette": 5}, {"controller": "x"},
+     {"fixed_controller": 5}],
+)  # fmt: skip
+def test_bad_arguments_are_invalid_parameter_errors(kwargs):
+    # issue 61, item 11: TypeError, ValueError or OverflowError tracebacks
+    with pytest.raises(InvalidParameterError):
+        DesignVector(**kwargs)
+    dv = DesignVector(shape=(2, 2, 2))
+    for bad in ("abc", [object()] * dv.size):
+        with pytest.raises(InvalidParameterError, match="expected a vector of numbers"):
+            dv.decode(bad)
+    with pytest.raises(InvalidParameterError, match="expected a RobotDesign"):
+        dv.encode(5)

@@ -115,3 +115,18 @@ def test_the_vector_env_maps_actions_as_the_single_env():
     np.testing.assert_array_equal(
         venv.action_from_temperatures(f), np.stack([env.unwrapped.action_from_temperatures(x) for x in f])
     )
+
+
+@pytest.mark.parametrize("bad", [np.zeros(1), np.zeros(N + 1), np.zeros((2, N)), np.full(N, 2.0),
+                                 np.full(N, np.nan), "x"])  # fmt: skip
+def test_action_from_temperatures_of_the_wrong_length_is_an_invalid_action_error(bad):
+    # issue 61, item 11: a length-1 vector was broadcast to every cell; N + 1 a numpy ValueError
+    from softgym.envs.vector import SoftWalkerVectorEnv
+    from softgym.exceptions import InvalidActionError
+
+    env = gym.make("SoftWalker-Flat-v0").unwrapped
+    with pytest.raises(InvalidActionError, match="temperature fractions"):
+        env.action_from_temperatures(bad)
+    venv = SoftWalkerVectorEnv(num_envs=2)
+    with pytest.raises(InvalidActionError, match="temperature fractions"):
+        venv.action_from_temperatures(np.stack([bad] * 2) if np.ndim(bad) == 1 else np.zeros(N))

@@ -5,6 +5,7 @@ archive logic is the point, not the physics. One run simulates, with figures.
 """
 
 import json
+import os
 
 import numpy as np
 import pytest
@@ -187,3 +188,22 @@ def test_simulated_run_writes_figures_and_exports_elites(tmp_path):
     RobotDesign.load(index.parent / best["files"][0])
     with pytest.raises(CheckpointError):
         export_elites(tmp_path / "nope")
+
+
+def test_numba_caches_in_the_users_cache_folder_not_site_packages(tmp_path):
+    # issue 61, item 9: `softgym qd` wrote numba's cache (pyribs -> numba) into site-packages
+    import subprocess
+    import sys
+
+    code = ("import importlib, os\n"
+            "import evolvers.drivers.qd as qd, numba.core.config as c\n"
+            "print(os.environ['NUMBA_CACHE_DIR'], c.CACHE_DIR)\n"  # the user's own, kept
+            "del os.environ['NUMBA_CACHE_DIR']\n"
+            "importlib.reload(qd)\n"  # numba imported already: its config follows too
+            "print(os.environ['NUMBA_CACHE_DIR'], c.CACHE_DIR)\n")  # fmt: skip
+    env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path / "cache"),
+           "NUMBA_CACHE_DIR": str(tmp_path / "mine")}  # fmt: skip
+    res = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                         timeout=120)  # fmt: skip
+    mine, default = str(tmp_path / "mine"), str(tmp_path / "cache" / "softgym" / "numba")
+    assert res.stdout.split() == [mine, mine, default, default], res.stderr[-2000:]

@@ -132,6 +132,57 @@ def test_a_checkpoint_copied_in_from_another_run_is_never_resumed(tmp_path):
         EvolutionRun(tiny(), b, seed=1, generations=1, figures=False).run(resume=True)
 
 
+def test_a_copied_checkpoint_without_identity_and_an_edited_config_are_refused(tmp_path):
+    # issue 61, item 4: a's checkpoint with its identity deleted (and re-signed) resumed
+    # as b's history; an edited population size in config.json resumed as the same run
+    import shutil
+
+    from softgym.io import json_sha256
+
+    a, b = tmp_path / "a", tmp_path / "b"
+    EvolutionRun(tiny(), a, seed=1, generations=1, figures=False, gif=False).run()
+    EvolutionRun(tiny(), b, seed=1, generations=0, figures=False, gif=False).run()
+    for p in (b / "checkpoints").glob("ckpt-*"):
+        p.unlink()
+    newest_a = list_checkpoints(a / "checkpoints")[-1]
+    shutil.copy(newest_a.with_suffix(".npz"), b / "checkpoints" / "ckpt-000001.npz")
+    doc = json.loads(newest_a.read_text())
+    del doc["identity"]
+    doc["sha256"] = json_sha256({k: v for k, v in doc.items() if k != "sha256"})
+    (b / "checkpoints" / "ckpt-000001.json").write_text(json.dumps(doc))
+    log = (b / "log.jsonl").read_text()
+    with pytest.raises(CheckpointError, match="records no run identity"):
+        EvolutionRun(tiny(), b, seed=1, generations=2, figures=False).run(resume=True)
+    assert (b / "log.jsonl").read_text() == log  # a's history never became b's
+
+    cfg = json.loads((a / "config.json").read_text())
+    cfg["experiment"]["pop_size"] = 6
+    (a / "config.json").write_text(json.dumps(cfg))
+    before = sorted(p.name for p in a.rglob("*"))
+    with pytest.raises(CheckpointError, match="config.json was changed after the run started"):
+        EvolutionRun(tiny(pop_size=6), a, seed=1, generations=2, figures=False).run(resume=True)
+    assert sorted(p.name for p in a.rglob("*")) == before  # nothing written
+
+
+def test_a_run_from_before_identities_resumes_and_gets_one(tmp_path):
+    out = tmp_path / "r"
+    EvolutionRun(tiny(), out, seed=1, generations=0, figures=False, gif=False).run()
+    (out / "identity.json").unlink()
+    from softgym.io import json_sha256
+
+    for path in list_checkpoints(out / "checkpoints"):  # as a checkpoint of then
+        doc = json.loads(path.read_text())
+        doc["identity"] = None
+        doc["sha256"] = json_sha256({k: v for k, v in doc.items() if k != "sha256"})
+        path.write_text(json.dumps(doc))
+    run = EvolutionRun(tiny(), out, seed=1, generations=1, figures=False, gif=False)
+    run.run(resume=True)
+    assert run.generation == 1
+    ident = json.loads((out / "identity.json").read_text())
+    assert json.loads(list_checkpoints(out / "checkpoints")[-1].read_text())["identity"] == ident
+    EvolutionRun(tiny(), out, seed=1, generations=2, figures=False, gif=False).run(resume=True)
+
+
 def test_a_second_writer_of_a_run_folder_is_refused_naming_the_first(tmp_path):
     import os
 

@@ -59,7 +59,9 @@ def _damage(run: Path) -> None:
             shifted = _shift({**{m: row[f"top_{m}"] for m in COUNTS}, "diverged": 0.0,
                               "norm_final_dist": 0, "max_xy_dist": 0, "l_coefficient": 0})  # fmt: skip
             row.update({f"top_{m}": shifted.get(m, math.nan) for m in COUNTS})
-        save_checkpoint(run / "checkpoints", read_json(path)["step"], state, arrays, keep=10)
+        doc = read_json(path)
+        save_checkpoint(run / "checkpoints", doc["step"], state, arrays, keep=10,
+                        identity=doc["identity"])  # fmt: skip
 
 
 def test_a_damaged_checkpoint_is_refused_and_the_repair_restores_it_exactly(tmp_path):
