@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import softgym
 from softgym.design import BrainSpec, RobotDesign, default_walker
@@ -126,3 +128,27 @@ def test_a_finer_control_step_scored_every_trace_interval_reports_evaluates_metr
     want = softgym.evaluate([default_walker()], task=t)
     for k in ("norm_final_dist", "max_xy_dist", "l_coefficient", "score"):
         assert got[k][0] == pytest.approx(want[k][0], rel=1e-9, abs=1e-12), k
+
+
+@settings(max_examples=12, deadline=None)
+@given(
+    st.tuples(st.integers(1, 4), st.integers(1, 4), st.integers(1, 3)),
+    st.integers(0, 2**31 - 1),
+    st.sampled_from(["flat", "push", "gap", "turn"]),
+)
+def test_any_body_carries_a_distributed_brain_whose_outputs_are_bounded(shape, seed, task):
+    rng = np.random.default_rng(seed)
+    grid = rng.choice([0, 1, 3, 4], size=shape).astype(np.int8)
+    grid[0, 0, 0] = 3  # at least one voxel
+    body = RobotDesign(grid).largest_component()
+    spec = brain_spec("distributed", get_task(task), (6, 6, 6), hidden=3, signals=1)
+    b = _brain_batch([body.replace(brain=spec.random(seed, scale=3.0))], task, grid=body.shape)
+    for _ in range(3):
+        out = b.brains.outputs()
+        assert out.shape == (1, b.n_cells) and np.all(np.abs(out) <= 1.0)
+        assert np.all(out[~b.filled_mask] == 0.0)  # empty cells drive nothing
+        b.brains.step()
+        b.advance()
+        b.update(np.ones(1, dtype=bool))
+    obs = b.sensing.observation(b.clock(), b.period)
+    assert np.isfinite(obs).all() and np.all(np.abs(obs) <= sensing_layout(get_task(task), body.shape).bounds())
