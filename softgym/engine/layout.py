@@ -30,6 +30,7 @@ __all__ = [
     "Layout",
     "as_body",
     "build_layout",
+    "memory_estimate",
     "obstacle_cells",
     "obstacle_mass_and_center",
     "time_step",
@@ -52,6 +53,31 @@ def as_body(obj: Any) -> Body:
     )
 
 
+def _lattice_ball(hops: int) -> int:
+    """Lattice cells within ``hops`` face steps of a cell, itself included (63 for 3)."""
+    return sum(
+        2 * (hops - abs(i) - abs(j)) + 1
+        for i in range(-hops, hops + 1) for j in range(-hops, hops + 1) if abs(i) + abs(j) <= hops
+    )
+
+
+def _hop_chunk(hops: int) -> int:
+    # rows of _hop_neighbours per chunk: ~64k (row, voxel) pairs of a lattice body
+    # reached, so its temporaries stay near 10 MB whatever the body's size
+    return max(16, 65536 // _lattice_ball(hops))
+
+
+def _unique_sorted(x: np.ndarray) -> np.ndarray:
+    # np.unique(x), by a sort and a mask (np.unique's hash table was 6x slower here)
+    x = np.sort(x)
+    if x.size > 1:
+        keep = np.empty(x.size, dtype=bool)
+        keep[0] = True
+        np.not_equal(x[1:], x[:-1], out=keep[1:])
+        x = x[keep]
+    return x
+
+
 def _hop_neighbours(n: int, v1: np.ndarray, v2: np.ndarray, hops: int):
     """Voxels within ``hops`` bond hops of each voxel (itself excluded), as CSR.
 
@@ -61,27 +87,48 @@ def _hop_neighbours(n: int, v1: np.ndarray, v2: np.ndarray, hops: int):
     index : ndarray of shape (start[-1],), int64
         Row ``i`` (``index[start[i]:start[i+1]]``) lists, sorted, the voxels
         reachable from ``i`` through at most ``hops`` links.
+
+    A breadth-first search from every voxel at once, in chunks of rows
+    (:func:`_hop_chunk`): linear in voxels, and its temporaries stay small (one
+    search over every row sorted pairs of all rows, 20 s for 125k voxels).
     """
     src = np.concatenate([v1, v2]).astype(np.int64)
     dst = np.concatenate([v2, v1]).astype(np.int64)
     order = np.argsort(src, kind="stable")
-    adj_start = np.concatenate([[0], np.cumsum(np.bincount(src, minlength=n))])
+    adj_start = np.zeros(n + 1, dtype=np.int64)
+    np.cumsum(np.bincount(src, minlength=n), out=adj_start[1:])
     adj = dst[order]
-    reach = np.arange(n, dtype=np.int64) * (n + 1)  # pairs (a, b) encoded a * n + b
-    frontier = reach
-    for _ in range(hops):
-        a, b = np.divmod(frontier, n)
-        deg = adj_start[b + 1] - adj_start[b]
-        rep_a = np.repeat(a, deg)
-        offs = np.repeat(adj_start[b], deg) + (np.arange(deg.sum()) - np.repeat(np.cumsum(deg) - deg, deg))
-        new = np.unique(rep_a * n + adj[offs])
-        frontier = np.setdiff1d(new, reach, assume_unique=True)
-        reach = np.union1d(reach, frontier)
-    a, b = np.divmod(reach, n)
-    keep = a != b
-    a, b = a[keep], b[keep]  # np.union1d sorted: rows by a, then b
-    start = np.concatenate([[0], np.cumsum(np.bincount(a, minlength=n))])
-    return start, b
+    del src, dst, order
+    counts = np.zeros(n, dtype=np.int64)
+    rows_of: list[np.ndarray] = []
+    chunk = _hop_chunk(hops)
+    for r0 in range(0, n, chunk):
+        r1 = min(n, r0 + chunk)
+        # pairs (a, b), a a row of the chunk, encoded (a - r0) * n + b, kept sorted
+        reach = np.arange(r1 - r0, dtype=np.int64) * n + np.arange(r0, r1, dtype=np.int64)
+        frontier = reach
+        for _ in range(hops):
+            a, b = np.divmod(frontier, n)
+            lo = adj_start[b]
+            deg = adj_start[b + 1] - lo
+            total = int(deg.sum())
+            if total == 0:
+                break
+            # the neighbours of every frontier voxel: adj[lo[k]:lo[k] + deg[k]]
+            offs = np.arange(total, dtype=np.int64) + np.repeat(lo - (np.cumsum(deg) - deg), deg)
+            new = _unique_sorted(np.repeat(a * n, deg) + adj[offs])
+            pos = np.searchsorted(reach, new)
+            fresh = reach[np.minimum(pos, reach.size - 1)] != new
+            frontier = new[fresh]
+            reach = np.insert(reach, pos[fresh], frontier)  # stays sorted: rows by a, then b
+        a, b = np.divmod(reach, n)
+        keep = a + r0 != b
+        counts[r0:r1] = np.bincount(a[keep], minlength=r1 - r0)
+        rows_of.append(b[keep])
+    start = np.zeros(n + 1, dtype=np.int64)
+    np.cumsum(counts, out=start[1:])
+    index = np.concatenate(rows_of) if rows_of else np.zeros(0, dtype=np.int64)
+    return start, index
 
 
 #: The seed's obstacle voxels (its material 5, docs/PHYSICS.md): E (Pa), density (kg/m^3).
@@ -510,6 +557,130 @@ def _line_aligned(x: np.ndarray) -> np.ndarray:
     return out
 
 
+# ---------------------------------------------------------------------- memory
+# Bytes of what a Simulation allocates, per item (build_layout's arrays, robot after
+# robot; tests/engine/test_memory.py checks these tables against a built layout)
+#: per voxel: 14 float64 scalars (mass, inv_mass, inv_inertia, cte, cos/sin_phase,
+#: k_floor, c_floor, c_global, rot_damp, mu_s, mu_k, scale, temp), seed_rank and
+#: excl_start (int64), the vectors pos, vel, angvel, ext_force (3), quat, col_ref (4),
+#: force (FM_STRIDE), rot (9) and faces, fixed, surface (int8)
+_VOXEL_BYTES = 14 * 8 + 2 * 8 + 8 * (3 * 4 + 4 * 2 + _core.FM_STRIDE + 9) + 3
+#: per link: v1, v2, link_sa, homog, k_axial, k_torsion, k_bend, c_axial, c_bend,
+#: c_torsion (8 bytes each) and axis (int32); the padded rows (_link_rows) apart
+_LINK_BYTES = 10 * 8 + 4
+#: per voxel, what Simulation keeps besides the layout's arrays: the initial state
+#: (its _VOXEL_STATE: pos, vel, quat, angvel, rot, scale, temp, ext_force, col_ref)
+#: and the grid indices (int64, 3)
+_VOXEL_KEPT = 8 * (3 + 3 + 4 + 3 + 9 + 1 + 1 + 3 + 4) + 3 * 8
+#: per robot: its counters, time steps, traces of 8 samples, their initial copies
+#: and its contact cache's header, rounded up
+_ROBOT_BYTES = 4096
+#: per voxel with self-collision: the contact cache's lists (_contact.pyx,
+#: _alloc_lists: cells 16, row 8, ref 24, sur 32, sur_idx 16, hit 8 bytes) and the
+#: spatial hash's cell table (at most 8 entries of 8 bytes a voxel)
+_CONTACT_VOXEL_BYTES = 104 + 64
+#: rows of the kernels' scratch per voxel and per link, one block per thread
+#: (_core.advance: SOFTGYM_VOXEL_ROWS, N_LINK_OUT); the seed model's link
+#: passes work in fixed chunks and touch no per-link rows
+_SCRATCH_ROWS = 25
+#: the all-pairs contact test's largest robot (_contact.pyx ALL_PAIRS_MAX): its
+#: exclusion bits, a row of words per surface voxel
+_ALL_PAIRS_MAX = 768
+#: per seed-model obstacle cell: obs (4 float64) and obs_rank; the contact cache's
+#: cell entry (run) and obstacle_cells' temporaries (lattice cells, np.unique: build)
+_OBSTACLE_BYTES = 40
+_OBSTACLE_RUN_BYTES = 16
+_OBSTACLE_BUILD_BYTES = 96
+
+
+def _component_counts(filled: np.ndarray, fixed: np.ndarray | None, hops: int) -> tuple[int, int, int]:
+    """(voxels, links, exclusion entries at most) of one component, from its grid alone.
+
+    Links as :func:`_component` and :func:`_robot_entry` make them (face neighbours,
+    those between two fixed voxels dropped); the exclusion lists at most
+    ``_lattice_ball(hops) - 1`` a voxel (bond hops are at least lattice steps: exact
+    inside a solid body, an upper bound elsewhere).
+    """
+    n = int(np.count_nonzero(filled))
+    links = 0
+    for ax in range(3):
+        lo = [slice(None)] * 3
+        hi = [slice(None)] * 3
+        lo[ax] = slice(0, -1)
+        hi[ax] = slice(1, None)
+        both = filled[tuple(lo)] & filled[tuple(hi)]
+        if fixed is not None:
+            both &= ~(fixed[tuple(lo)] & fixed[tuple(hi)])
+        links += int(np.count_nonzero(both))
+    return n, links, n * min(_lattice_ball(hops) - 1, max(n - 1, 0))
+
+
+def memory_estimate(bodies: list[Body], terrains: list, config: SimConfig, n_threads: int = 1) -> dict[str, int]:
+    """Bytes a Simulation of these robots needs at its peak, counted before anything is built.
+
+    From the robots' grids alone (no layout is made): their voxels, links and
+    exclusion-list entries (an upper bound: ``_component_counts``), times the bytes
+    each one takes in what is allocated (the tables above). Returns the parts:
+
+    ``arrays``
+        the layout's arrays (``Simulation._a``: padded link rows included);
+    ``kept``
+        what the Simulation keeps besides (initial state, grid indices);
+    ``build``
+        the layout's temporaries at the build's peak: a second copy of the exclusion
+        lists (made robot by robot, then joined) and of the grid indices;
+    ``run``
+        what the first steps allocate: the kernels' scratch (one block per thread)
+        and, with self-collision, the contact cache's lists;
+    ``total``
+        the peak: ``arrays + max(build, kept + run)``.
+
+    Not counted: the centre-of-mass traces past their first 8 samples (checked as
+    they grow, :meth:`Simulation.advance_to`) and the contact pairs the run finds
+    (a few per surface voxel of a folded body). Within 25 % of the measured peak RSS
+    (``tests/engine/test_memory.py``, ``benchmarks/bench_memory.py``).
+    """
+    cfg = config
+    hops = int(cfg.collision_exclusion)
+    single = cfg.effective_link_precision == "single"
+    n = links = excl = obstacles = boxes = 0
+    max_n = max_links = 0
+    contacts = 0
+    for body, terrain in zip(bodies, terrains):
+        fixed = None if body.fixed is None else np.asarray(body.fixed) != 0
+        rn, rl, re = _component_counts(np.asarray(body.grid) > 0, fixed, hops)
+        for blk in terrain.objects:
+            bn, bl, be = _component_counts(np.asarray(blk.cells, dtype=bool), None, hops)
+            rn, rl, re = rn + bn, rl + bl, re + be
+        n, links, excl = n + rn, links + rl, excl + re
+        max_n, max_links = max(max_n, rn), max(max_links, rl)
+        if cfg.self_collision:
+            m = min(rn, _ALL_PAIRS_MAX)
+            contacts += _CONTACT_VOXEL_BYTES * rn + 8 * 512 + 8 * m * (m // 64 + 2)
+        if cfg.model == "seed" and terrain.box_contact == "auto":
+            # lattice boxes become obstacle voxels (obstacle_cells), at most MAX_OBSTACLE_VOXELS
+            vol = sum(float(np.prod(np.subtract(b.hi, b.lo))) for b in terrain.boxes)
+            obstacles += int(min(max(vol, 0.0), MAX_OBSTACLE_VOXELS))
+        else:
+            boxes += len(terrain.boxes)
+    n_robots = len(bodies)
+    stride = int(_core.row_stride(links))
+    w = 4 if single else 8  # link_last's floats
+    # c_seed (8 float64 rows), link_last (9 rows), k_seed32 (11 float32 rows, single only)
+    rows = stride * (8 * 8 + 9 * w + (11 * 4 if single else 0))
+    arrays = (_VOXEL_BYTES * n + _LINK_BYTES * links + rows + 8 * excl
+              + _OBSTACLE_BYTES * obstacles + 48 * boxes + _ROBOT_BYTES * n_robots)
+    kept = _VOXEL_KEPT * n + (8 + 9 * w) * links  # + link_sa, link_last copies
+    build = 8 * excl + 24 * n + _OBSTACLE_BUILD_BYTES * obstacles
+    per_thread = 8 * _SCRATCH_ROWS * (int(_core.row_stride(max_n))
+                                      + (int(_core.row_stride(max_links)) if cfg.model != "seed" else 0))
+    run = per_thread * max(1, min(int(n_threads), n_robots)) + contacts + _OBSTACLE_RUN_BYTES * obstacles
+    total = arrays + max(build, kept + run)
+    return {"voxels": n, "links": links, "exclusions": excl, "obstacles": obstacles,
+            "arrays": arrays, "kept": kept,
+            "build": build, "run": run, "total": total}
+
+
 def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layout:
     """Lay out robots and their terrains (one each, validated) for the kernel.
 
@@ -529,31 +700,37 @@ def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layou
 
     entries = [_robot_entry(body, terrain, cfg) for body, terrain in zip(bodies, terrains)]
     for e in entries:
+        off = vox_start[-1]
         for name, value in e["vox"].items():
             per_vox.setdefault(name, []).append(value)
         for name, value in e["link"].items():
             # the entry's voxel indices, offset to the batch's
-            per_link.setdefault(name, []).append(value + vox_start[-1] if name in ("v1", "v2") else value)
+            per_link.setdefault(name, []).append(value + off if name in ("v1", "v2") and off else value)
         axis_counts.append(e["axis_count"])
         dts.append(e["dt"])
         masses.append(e["mass"])
-        body_end.append(vox_start[-1] + e["n_own"])
+        body_end.append(off + e["n_own"])
         grid_index.append(e["grid_index"])
-        excl.append(e["excl_idx"] + vox_start[-1])
-        vox_start.append(vox_start[-1] + e["n"])
+        excl.append(e["excl_idx"] + off if off else e["excl_idx"])
+        vox_start.append(off + e["n"])
         link_start.append(link_start[-1] + e["n_links"])
+    # from here the parts live only in per_vox, per_link and excl: each is freed as soon
+    # as its batch array is made, so the build holds about one copy of the layout
+    # (layout_bytes counts it)
+    del entries, e
 
     n_vox = vox_start[-1]
     a: dict[str, np.ndarray] = {}
-    for name, parts in per_vox.items():
-        a[name] = np.ascontiguousarray(np.concatenate(parts))
+    for name in list(per_vox):
+        a[name] = np.ascontiguousarray(np.concatenate(per_vox.pop(name)))
     a["fixed"] = a["fixed"].astype(np.int8)
     a["surface"] = a["surface"].astype(np.int8)
     a["excl_start"] = np.concatenate([[0], np.cumsum(a.pop("excl_count"))]).astype(np.intp)
-    a["excl_idx"] = np.ascontiguousarray(np.concatenate(excl), dtype=np.intp)
+    a["excl_idx"] = np.ascontiguousarray(excl[0] if len(excl) == 1 else np.concatenate(excl), dtype=np.intp)
+    del excl
     a.update(_terrain_arrays(terrains, cfg))
-    for name, parts in per_link.items():
-        a[name] = np.ascontiguousarray(np.concatenate(parts))
+    for name in list(per_link):
+        a[name] = np.ascontiguousarray(np.concatenate(per_link.pop(name)))
     for name in ("v1", "v2"):
         a[name] = a[name].astype(np.intp)
     # (8, n_links): one row per constant, for the kernel's vector loops

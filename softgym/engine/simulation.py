@@ -63,6 +63,7 @@ from softgym.engine.layout import (  # noqa: F401 (re-exported: the public API i
     _hop_neighbours,
     as_body,
     build_layout,
+    memory_estimate,
     obstacle_cells,
     obstacle_mass_and_center,
     time_step,
@@ -197,29 +198,36 @@ class Simulation:
         self._contacts = _core.ContactCache(self.n_robots)
         self._t_target = 0.0
 
-    #: Memory budget (bytes) of one Simulation: its state, its layout's temporaries
-    #: and its traces. Checked before anything is allocated (construction, and each
-    #: :meth:`advance_to` for the traces), so a batch or a trace interval that would
-    #: exhaust the machine is refused with a typed error instead; raise it on the
-    #: class or an instance for a larger machine.
+    #: Memory budget (bytes) of one Simulation: its arrays, what it keeps besides, its
+    #: layout's temporaries, its kernels' scratch and contact cache, and its traces.
+    #: Checked before anything is allocated (construction, and each :meth:`advance_to`
+    #: for the traces), so a batch or a trace interval that would exhaust the machine
+    #: is refused with a typed error instead; raise it on the class or an instance for
+    #: a larger machine.
     max_bytes: float = 8 * 2**30
 
-    #: Upper bound of the bytes one voxel takes while a Simulation is built and
-    #: run: ~75 float64 of state and scratch, and the layout's self-collision
-    #: exclusion lists (voxels within ``collision_exclusion`` bond hops, at most
-    #: 63 for 3 hops, built through temporaries of ~8 int64 each).
-    bytes_per_voxel: int = 75 * 8 + 63 * 8 * 8
-
     def _check_memory(self) -> None:
-        n = sum(int(np.count_nonzero(b.grid)) for b in self.bodies)
-        n += sum(sum(int(np.prod(blk.shape)) for blk in t.objects) for t in self.terrains)
-        need = n * self.bytes_per_voxel
+        # from the grids alone, before the layout is built: the bytes of what is allocated
+        # (softgym.engine.layout.memory_estimate), within 25 % of the measured peak RSS
+        est = memory_estimate(self.bodies, self.terrains, self.config, self.n_threads)
+        self._memory = est
+        need = est["total"]
         if need > self.max_bytes:
             raise InvalidParameterError(
-                f"{self.n_robots} robots of {n} voxels in all need about {need / 2**30:.1f} GiB, "
-                f"over Simulation.max_bytes = {self.max_bytes / 2**30:.1f} GiB; simulate fewer "
-                f"or smaller robots per batch, or raise the budget"
+                f"{self.n_robots} robots of {est['voxels']} voxels and {est['links']} links in "
+                f"all need about {need / 2**30:.1f} GiB, over Simulation.max_bytes = "
+                f"{self.max_bytes / 2**30:.1f} GiB; simulate fewer or smaller robots per batch, "
+                f"or raise the budget"
             )
+
+    @property
+    def estimated_memory(self) -> dict[str, int]:
+        """The bytes this Simulation was estimated to need at its peak, by part.
+
+        What :attr:`max_bytes` is checked against before the layout is built
+        (:func:`softgym.engine.layout.memory_estimate`: ``total`` and its parts).
+        """
+        return dict(self._memory)
 
     # ------------------------------------------------------------------ layout
     def _terrains(self, terrain: Any) -> list:
@@ -687,7 +695,8 @@ class Simulation:
         """Centre-of-mass samples per robot to reach ``t_end``, refused past :attr:`max_bytes`."""
         need = t_end / self.config.trace_interval + 3
         per_sample = 8 * (1 + 3 + len(_core.AUX_NAMES)) * self.n_robots
-        if need * per_sample > self.max_bytes - self.nbytes:
+        # on top of the rest of the peak (memory_estimate; its traces' first 8 samples)
+        if need * per_sample > self.max_bytes - self._memory["total"]:
             raise InvalidParameterError(
                 f"SimConfig.trace_interval = {self.config.trace_interval:g} s up to t = "
                 f"{t_end:g} s means {need:.3g} centre-of-mass samples per robot "

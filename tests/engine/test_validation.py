@@ -86,10 +86,11 @@ def test_materials_beyond_physical_ranges_are_refused_naming_the_range(field, va
 
 
 def test_a_batch_beyond_the_memory_budget_is_refused_before_anything_is_allocated():
-    # issue 31: 2 robots at the grid cap (100^3) died in the layout at 3.8 GB after 92 s
+    # issue 31: 2 robots at the grid cap (100^3) died in the layout at 3.8 GB after 92 s;
+    # they need ~4.6 GB since issue 61 (the layout no longer doubles its peak): 6 need ~13 GiB
     import time
 
-    bodies = [Body.uniform(np.ones((100, 100, 100)))] * 2
+    bodies = [Body.uniform(np.ones((100, 100, 100)))] * 6
     t0 = time.perf_counter()
     with pytest.raises(InvalidParameterError, match="GiB, over Simulation.max_bytes"):
         Simulation(bodies)
