@@ -15,7 +15,9 @@
   of fame, atomic checkpoints, figures) for every driver.
 * :mod:`evolvers.drivers` - drivers with exact resume, each a
   :class:`~evolvers.drivers.base.Driver` (the one run skeleton: construction, generation
-  loop, progress, Ctrl-C, checkpoint, resume): :class:`EvolutionRun` (the seed's loop),
+  loop, progress, Ctrl-C, checkpoint, resume; a :class:`Budget` of simulations,
+  robot-seconds, wall time or a target score besides the generations):
+  :class:`EvolutionRun` (the seed's loop),
   :class:`~evolvers.drivers.deap_runner.DeapRun` (the same loop on a DEAP toolbox),
   :class:`~evolvers.drivers.pymoo_runner.PymooRun` (any pymoo algorithm through ask and
   tell: NSGA-II, NSGA-III, SMS-EMOA, GA...); open-ended search:
@@ -28,6 +30,7 @@ The DEAP, pymoo and Dask modules are imported on demand (``from evolvers.drivers
 """
 
 from evolvers.drivers.base import Driver, IdCounter
+from evolvers.drivers.budget import Budget
 from evolvers.drivers.runner import EvolutionRun
 from evolvers.evaluation.evaluator import Evaluator, PhenotypeCache
 from evolvers.evaluation.experiments import (
@@ -55,6 +58,7 @@ from evolvers.recording.recorder import RunRecorder
 
 __all__ = [
     "EXPERIMENTS",
+    "Budget",
     "Driver",
     "EvolutionRun",
     "Evaluator",

@@ -1,10 +1,11 @@
 """The commands that drive a resumable run folder: ``evolve``, ``qd`` and ``poet``.
 
 They share one skeleton: :func:`add_run_flags` (``--out``, ``--resume``,
-``--dask``, ``--workers``, ``--threads``, ``--no-figures``), :func:`build_run`
-(a run from the flags: the recorded config under ``--resume``, the Dask
-client, the resume command) and :func:`run_command` (SIGTERM as Ctrl-C, one
-interrupt message, the JSON summary).
+``--dask``, ``--workers``, ``--threads``, ``--no-figures``, and the budget:
+``--max-evals``, ``--max-robot-seconds``, ``--max-wall-seconds``, ``--target-score``),
+:func:`build_run` (a run from the flags: the recorded config under ``--resume``, the
+budget, the Dask client, the resume command) and :func:`run_command` (SIGTERM as
+Ctrl-C, one interrupt message, the JSON summary with the budget that stopped the run).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from evolvers.drivers.budget import BUDGET_FLAGS, Budget
 from evolvers.evaluation.experiments import CONTROLLERS, Experiment, get_experiment
 from evolvers.recording.recorder import RunInterrupted, read_run_config
 from softgym.exceptions import CheckpointError, InvalidParameterError, SoftGymError
@@ -33,6 +35,7 @@ __all__ = [
     "add_qd_parser",
     "add_run_flags",
     "build_run",
+    "run_budget",
     "controller_overrides",
     "load_body",
     "quiet_dask",
@@ -57,6 +60,22 @@ def add_run_flags(p: argparse.ArgumentParser, out: str, gif: bool = True) -> Non
     p.add_argument("--threads", type=int,
                    help="OpenMP threads of local simulations (default: all usable CPUs)")  # fmt: skip
     p.add_argument("--no-figures", action="store_true", help="write no figures at the end")
+    budget = p.add_argument_group(
+        "budget", "the run stops after the generation at which the first of these (or its "
+        "generations) is reached; every count goes on across --resume, where a flag not "
+        "typed keeps the recorded limit and a larger one continues a stopped run")
+    budget.add_argument("--max-evals", metavar="N",
+                        help="simulations (phenotypes read from the run's cache are not counted; "
+                        "default: no limit)")  # fmt: skip
+    budget.add_argument("--max-robot-seconds", metavar="S",
+                        help="simulated seconds summed over the simulated robots (default: no limit)")
+    budget.add_argument("--max-wall-seconds", metavar="S",
+                        help="wall-clock seconds of the run, every sitting summed (not "
+                        "reproducible, unlike the others; default: no limit)")  # fmt: skip
+    budget.add_argument("--target-score", metavar="X",
+                        help="the best score found (the fitness; qd: the archive's best; poet: "
+                        "the best pair's) reaches X (<= X for a minimised fitness; a negative X "
+                        "with an exponent as --target-score=-1e3; default: none)")  # fmt: skip
     if gif:
         p.add_argument("--no-gif", action="store_true", help="no GIF of the best robot")
 
@@ -170,16 +189,57 @@ def recorded_config(args: argparse.Namespace) -> dict[str, Any] | None:
     return read_run_config(args.out)
 
 
+def run_budget(args: argparse.Namespace, cfg: dict[str, Any] | None) -> Budget:
+    """The run's :class:`~evolvers.drivers.budget.Budget`: each typed budget flag, else (under
+    ``--resume``) the limit config.json records.
+
+    Raises
+    ------
+    InvalidParameterError
+        A typed limit out of its range (naming the flag and the range).
+    CheckpointError
+        A recorded budget that is not one (naming the file).
+    """
+    recorded: dict[str, Any] = {}
+    if cfg is not None and cfg.get("budget"):
+        try:
+            recorded = Budget.from_dict(cfg["budget"]).to_dict()
+        except InvalidParameterError as exc:
+            raise CheckpointError(f"{Path(args.out) / 'config.json'}: 'budget' is invalid ({exc})") from None
+    typed = {k: _number(getattr(args, k)) for k in BUDGET_FLAGS if getattr(args, k, None) is not None}
+    return Budget.from_dict({**recorded, **typed})
+
+
+def _number(text: str) -> Any:
+    """A budget flag's value as a number (an int when it reads as one, ``1e4`` included);
+    text that reads as none stays text, for :class:`Budget` to refuse in one line naming
+    the flag.
+    """
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        value = float(text)
+    except ValueError:
+        return text
+    return int(value) if value.is_integer() else value
+
+
 def build_run(args: argparse.Namespace, stack: contextlib.ExitStack, make: Maker) -> Any:
     """The run a command's flags describe.
 
     ``make(args, cfg)`` names the run class, its experiment and its own
     keywords (``cfg``: the recorded config under ``--resume``, else None);
-    the rest is the same for every command: the Dask client (kept open in
-    ``stack``) as a ``DaskBatchFn``, threads, figures, GIF, progress, and the
-    shell command that resumes.
+    the rest is the same for every command: the budget (:func:`run_budget`,
+    checked before anything starts), the Dask client (kept open in ``stack``) as
+    a ``DaskBatchFn``, threads, figures, GIF, progress, and the shell command
+    that resumes.
     """
-    run_cls, experiment, kw = make(args, recorded_config(args))
+    cfg = recorded_config(args)
+    budget = run_budget(args, cfg)
+    run_cls, experiment, kw = make(args, cfg)
+    kw["budget"] = budget
     if args.dask:
         from evolvers.evaluation.distributed import DaskBatchFn, dask_client
 
@@ -231,7 +291,10 @@ def run_command(args: argparse.Namespace, unit: str, make: Maker,
     finally:
         signal.signal(signal.SIGTERM, previous)
     figures = run.out / "figures"
-    out = {**summary(run, result), "wall_seconds": round(time.perf_counter() - t0, 2),
+    record = run.budget_record()
+    out = {**summary(run, result), "stopped_by": run.stopped_by,
+           "budget": {"limits": record["limits"], "used": record["used"]},
+           "wall_seconds": round(time.perf_counter() - t0, 2),
            "out": str(run.out),
            "figures": sorted(str(p) for p in figures.glob("*")) if figures.exists() else []}  # fmt: skip
     print(json.dumps(out, indent=2))

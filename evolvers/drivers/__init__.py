@@ -3,6 +3,8 @@
 * :mod:`~evolvers.drivers.base` - :class:`~evolvers.drivers.base.Driver` (construction,
   generation loop, progress, Ctrl-C, checkpoint, exact resume) and the one
   :class:`~evolvers.drivers.base.IdCounter`;
+* :mod:`~evolvers.drivers.budget` - :class:`~evolvers.drivers.budget.Budget`: what stops a
+  run besides its generations (simulations, robot-seconds, wall time, a target score);
 * :mod:`~evolvers.drivers.runner` - :class:`~evolvers.drivers.runner.EvolutionRun`, the
   seed's loop (the native backend);
 * :mod:`~evolvers.drivers.deap_runner` - the same loop on a DEAP toolbox;

@@ -13,7 +13,14 @@ A driver (:class:`~evolvers.drivers.runner.EvolutionRun`, ``DeapRun``, ``PymooRu
   JSON-ready dict, plain arrays, extra log columns and the individuals the
   recorder logs; :meth:`Driver._restore` - the inverse.
 * :attr:`Driver.label`, :meth:`Driver.result`, and :meth:`Driver.finish`
-  where the driver writes more than the recorder.
+  where the driver writes more than the recorder; :meth:`Driver.best_score` where
+  the target score is not the hall of fame's best fitness (QD, POET).
+
+The loop stops on the run's budget (:mod:`evolvers.drivers.budget`): its generations,
+or a :class:`~evolvers.drivers.budget.Budget` of simulations, robot-seconds, wall time or
+a target score, whichever comes first, checked once here between generations; every
+count is checkpointed and goes on across resumes (:attr:`Driver.stopped_by` names the
+budget that ended the run).
 
 Everything on disk goes through one :class:`~evolvers.recording.recorder.RunRecorder`
 at ``self.recorder``; :class:`Driver` also shows its views (log rows, hall of
@@ -23,6 +30,7 @@ an uninterrupted run with the same seed.
 
 from __future__ import annotations
 
+import logging
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -30,6 +38,7 @@ from typing import Any
 
 import numpy as np
 
+from evolvers.drivers.budget import Budget, BudgetUsage
 from evolvers.evaluation.evaluator import BatchFn, EvalStats, Evaluator
 from evolvers.evaluation.experiments import (
     Experiment,
@@ -42,7 +51,9 @@ from evolvers.recording.recorder import RunRecorder
 from softgym.exceptions import CheckpointError, InvalidParameterError
 from softgym.io import RunLock
 
-__all__ = ["Checkpoint", "Driver", "IdCounter"]
+__all__ = ["Budget", "Checkpoint", "Driver", "IdCounter"]
+
+log = logging.getLogger("evolvers")
 
 
 class IdCounter:
@@ -91,6 +102,13 @@ class Driver:
         ``evolvers`` logger at INFO).
     extra_config : dict, optional
         The driver's settings in config.json (checked on resume).
+    budget : Budget or dict, optional
+        More limits than the generations: simulations, robot-seconds, wall time, a
+        target score (:class:`~evolvers.drivers.budget.Budget`); the run stops at the
+        first reached, checked between generations. Recorded in config.json; a resume
+        takes the one given and counts on from the checkpoint (a larger budget continues a
+        run that a smaller one stopped, ending exactly as a run given it from the start;
+        not so for ``max_wall_seconds``: wall time is by nature not reproducible).
 
     Raises
     ------
@@ -122,6 +140,7 @@ class Driver:
         gif: bool = True,
         progress: bool = True,
         extra_config: dict[str, Any] | None = None,
+        budget: Budget | dict[str, Any] | None = None,
     ) -> None:
         if isinstance(out, str) and not out.strip():
             # Path("") is the current folder: a run written there by accident
@@ -130,6 +149,7 @@ class Driver:
             )
         gens = experiment.generations if generations is None else generations
         gens = check_generations(gens, f"{self.unit}s")
+        self.budget = budget if isinstance(budget, Budget) else Budget.from_dict(budget)
         experiment, gens = smoke_sizes(experiment, gens)
         self.experiment = experiment
         self.out = Path(out)
@@ -144,6 +164,11 @@ class Driver:
             out, experiment, self.seed, self.backend, figures and self.recorder_figures,
             gif and self.recorder_figures, extra_config=extra_config, progress=progress,
         )  # fmt: skip
+        self.recorder.budget = self.budget.to_dict()
+        #: The budget that ended the last :meth:`run` (a name of
+        #: :data:`~evolvers.drivers.budget.STOP_ORDER`), None before one ended.
+        self.stopped_by: str | None = None
+        self._sitting: tuple[float, float] = (time.perf_counter(), 0.0)
         #: What :class:`RunInterrupted` tells the user to type (the CLI puts its command here).
         self.resume_command = (
             f"{type(self).__name__}(experiment, {str(self.out)!r}, seed={self.seed}).run(resume=True)"
@@ -184,6 +209,50 @@ class Driver:
         """What :meth:`run` returns (the final population by default)."""
         return self.population
 
+    @property
+    def score_maximized(self) -> bool:
+        """Whether :meth:`best_score` is better larger (the target is reached at >=, else <=)."""
+        return self.experiment.fitness.maximize
+
+    def best_score(self) -> float | None:
+        """The score a ``target_score`` budget compares: the best value of the run's fitness
+        found so far (the hall of fame's first), None before any.
+        """
+        if not self.hall_of_fame:
+            return None
+        ind = self.hall_of_fame[0]["individual"]
+        name = self.experiment.fitness.name
+        value = ind.get("age") if name == "age" else ind.get("objectives", {}).get(name)
+        return None if value is None else float(value)
+
+    # ------------------------------------------------------------------ the budget
+    def budget_used(self) -> BudgetUsage:
+        """How much of each budget the run has used so far (every sitting)."""
+        rec = self.recorder
+        return BudgetUsage(
+            generation=self.generation, evaluations=rec.evaluations_total,
+            robot_seconds=rec.robot_seconds_total, wall_seconds=rec.wall_clock_total,
+            best_score=self.best_score(),
+        )  # fmt: skip
+
+    def budget_reached(self) -> str | None:
+        """The budget the run has reached (the first of
+        :data:`~evolvers.drivers.budget.STOP_ORDER`), None while it goes on.
+        """
+        return self.budget.reached(self.budget_used(), self.generations, self.score_maximized)
+
+    def budget_record(self) -> dict[str, Any]:
+        """The budget as checkpoints and summaries record it: ``limits`` (the generations
+        and the :class:`~evolvers.drivers.budget.Budget`'s), ``used``
+        (:class:`~evolvers.drivers.budget.BudgetUsage`) and ``stopped_by`` (None while the
+        run goes on).
+        """
+        return {
+            "limits": {"generations": self.generations, **self.budget.to_dict()},
+            "used": self.budget_used().to_dict(),
+            "stopped_by": self.budget_reached(),
+        }
+
     # ------------------------------------------------------------------ the loop
     def start(self) -> None:
         """Create the run folder (refusing one that holds another run's checkpoints)."""
@@ -218,7 +287,12 @@ class Driver:
         return True
 
     def run(self, resume: bool = False) -> Any:
-        """Run (or continue from the last checkpoint) until :attr:`generations`.
+        """Run (or continue from the last checkpoint) until the budget: :attr:`generations`,
+        or the first limit of :attr:`budget` reached (:attr:`stopped_by` names it).
+
+        A resumed run counts on from its checkpoint (simulations, robot-seconds, wall
+        seconds of every sitting); one whose budget is already spent only writes its
+        final files.
 
         Returns
         -------
@@ -226,11 +300,15 @@ class Driver:
         """
         # one writer per run folder: a second run into it is refused, naming the first
         with RunLock(self.out):
+            self.stopped_by = None
+            sitting = time.perf_counter()
             if not (resume and self.resume()):
                 self.start()
+            # this sitting's wall time (its resume included) adds to the sittings before it
+            self._sitting = (sitting, self.recorder.wall_clock_total)
             self.recorder.open_progress(self.generation, self.generations, self.label)
             try:
-                while self.generation < self.generations:
+                while (reason := self.budget_reached()) is None:
                     t0 = time.perf_counter()
                     stats = self._step()
                     self._end_generation(stats, time.perf_counter() - t0)
@@ -239,21 +317,27 @@ class Driver:
                 raise self.recorder.interrupted(done, self.resume_command) from exc
             finally:
                 self.recorder.close_progress()
+            self.stopped_by = reason
+            if reason != "generations":
+                log.info("%s: stopped by its budget %s at %s %d (%s)", self.out, reason,
+                         self.unit, self.generation, self.budget_used())  # fmt: skip
             self.finish()
         return self.result()
 
     def _end_generation(self, stats: EvalStats, wall: float) -> None:
-        """Log row, checkpoint, files, callback."""
+        """Log row, checkpoint (with the budget), files, callback."""
         state, arrays, columns, individuals = self._checkpoint_state()
+        start, before = self._sitting
         row = self.recorder.end_generation(
-            self.generation, individuals, stats, wall, state, arrays, columns=columns
-        )
+            self.generation, individuals, stats, wall, state, arrays, columns=columns,
+            elapsed=before + (time.perf_counter() - start), budget=self.budget_record,
+        )  # fmt: skip
         if self.on_generation is not None:
             self.on_generation(self, row)
 
     def finish(self) -> None:
         """Write the final population, the best designs and the figures."""
-        self.recorder.finish(self.generation, self.population)
+        self.recorder.finish(self.generation, self.population, self.stopped_by)
 
     # ------------------------------------------------------------------ the record
     @property

@@ -84,6 +84,7 @@ from typing import Any
 import numpy as np
 
 from evolvers.drivers.base import Checkpoint, Driver, IdCounter
+from evolvers.drivers.budget import Budget
 from evolvers.evaluation.evaluator import BatchFn, EvalStats, Evaluator, JobsFn, PhenotypeCache
 from evolvers.evaluation.experiments import Experiment, get_experiment
 from evolvers.operators.genome import Individual
@@ -512,6 +513,10 @@ class PoetRun(Driver):
         Write the figures when the run finishes.
     progress : bool
         A tqdm bar over the iterations (each iteration is also logged at INFO).
+    budget : Budget or dict, optional
+        Limits besides the iterations (:class:`~evolvers.drivers.budget.Budget`); its
+        ``target_score`` is reached when a pair's best robot scores it on its terrain
+        (:meth:`best_score`).
     """
 
     backend = "poet"
@@ -531,6 +536,7 @@ class PoetRun(Driver):
         on_iteration: Callable[[PoetRun, dict[str, Any]], None] | None = None,
         figures: bool = True,
         progress: bool = True,
+        budget: Budget | dict[str, Any] | None = None,
     ) -> None:
         if experiment is not None and (experiment.evolve_brain or not experiment.evolve_body):
             raise InvalidParameterError(
@@ -543,7 +549,7 @@ class PoetRun(Driver):
         super().__init__(
             poet_experiment() if experiment is None else experiment, out, seed, int(iterations),
             batch_fn, n_threads, on_iteration, figures, False, progress,
-            extra_config={"poet": self.config.to_dict()},
+            extra_config={"poet": self.config.to_dict()}, budget=budget,
         )  # fmt: skip
 
     def _evaluator(self, batch_fn: BatchFn | None, n_threads: int | None, progress: bool) -> Evaluator:
@@ -589,6 +595,17 @@ class PoetRun(Driver):
     def result(self) -> list[Pair]:
         """Every pair, active and archived, in order of creation (what :meth:`run` returns)."""
         return list(self.pairs)
+
+    @property
+    def score_maximized(self) -> bool:
+        """POET's scores are distances: better larger."""
+        return True
+
+    def best_score(self) -> float | None:
+        """The best score of any pair's best robot on its own terrain (active or archived):
+        the ``target_score`` budget's score; None before the first iteration.
+        """
+        return max((p.best_score for p in self.pairs), default=None)
 
     def active(self) -> list[Pair]:
         """Active pairs, oldest first."""
@@ -933,7 +950,7 @@ class PoetRun(Driver):
                 "robot": p.best.to_dict(), "design": p.best.design(exp.shape).to_dict(),
             } for p in self.pairs],
         })  # fmt: skip
-        self.recorder.finish(self.iteration, [p.best for p in self.active()])
+        self.recorder.finish(self.iteration, [p.best for p in self.active()], self.stopped_by)
         if self.figures:
             try:
                 self.write_figures()

@@ -430,6 +430,18 @@ class QDRun(Driver):
         """:func:`archive_stats` of the archive."""
         return archive_stats(self.archive)
 
+    @property
+    def score_maximized(self) -> bool:
+        """The archive's objective is maximised."""
+        return True
+
+    def best_score(self) -> float | None:
+        """The archive's best objective (``qd_best``; the ``target_score`` budget's score),
+        None while the archive is empty.
+        """
+        best = self.stats()["qd_best"]
+        return None if math.isnan(best) else float(best)
+
     # ------------------------------------------------------------------ the loop
     def objective_values(self, individuals: Sequence[Individual]) -> np.ndarray:
         """The archive objective of evaluated individuals: the metric clipped at 0.
@@ -460,7 +472,7 @@ class QDRun(Driver):
 
     def finish(self) -> None:
         """Final population (the elites), best designs, the run's figures and the archive's."""
-        self.recorder.finish(self.generation, self.elites())
+        self.recorder.finish(self.generation, self.elites(), self.stopped_by)
         if self.figures:
             try:
                 self.write_figures()

@@ -213,6 +213,9 @@ class EvalStats:
     #: New, valid individuals whose phenotype was already simulated earlier in the run
     #: (or twice in this call): the seed's "patterns loop".
     n_repeated: int = 0
+    #: Simulated seconds summed over the simulated robots (each its task's ``seconds``;
+    #: cached results count none): what a run's ``max_robot_seconds`` budget counts.
+    robot_seconds: float = 0.0
 
 
 def worst_objectives() -> dict[str, float]:
@@ -354,7 +357,8 @@ class Evaluator:
             outs = self.jobs_fn(
                 [([pending[k].design(exp.shape) for k in keys], task) for task, keys in groups]
             )
-            for (_, keys), res in zip(groups, outs):
+            for (task, keys), res in zip(groups, outs):
+                stats.robot_seconds += len(keys) * float(task.seconds)
                 for i, key in enumerate(keys):
                     # (a batch function of an older softgym, or a fake, may not report "score")
                     obj = {m: float(res[m][i]) for m in STORED_METRICS if m in res}

@@ -3,9 +3,11 @@
 A :class:`RunRecorder` owns what a run leaves on disk; a driver owns its search
 loop and hands the recorder each finished generation::
 
-    config.json            experiment, seed, backend (what resume checks), generations
+    config.json            experiment, seed, backend (what resume checks), generations,
+                           the budget's other limits (``budget``, when set)
     log.csv, log.jsonl     one row per generation: best/median/mean/worst of
-                           every objective, evaluations, cache hits, wall time,
+                           every objective, evaluations, robot-seconds, cache hits,
+                           wall time (the generation's, and the run's over sittings),
                            the best individual's genes and composition (top_*),
                            repeated phenotypes, obstacle crossings
                            (rows.py)
@@ -19,8 +21,9 @@ loop and hands the recorder each finished generation::
     notes.jsonl            remarks on the run's history that its numbers cannot tell
                            (e.g. a repair, :func:`add_run_note`); study reports quote them
 
-A checkpoint holds the recorder's state (log rows, hall of fame, totals) and
-whatever the driver adds (its random states, counters, the phenotype cache).
+A checkpoint holds the recorder's state (log rows, hall of fame, totals: simulations,
+robot-seconds, wall time; the run's ``budget``: its limits, what is used, what stopped it)
+and whatever the driver adds (its random states, counters, the phenotype cache).
 
 The recorder also shows the run's progress (a tqdm bar over generations, off
 with ``progress=False``), logs one line per generation to the ``evolvers``
@@ -39,7 +42,7 @@ import logging
 import math
 import os
 import uuid
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -121,7 +124,12 @@ HALL_OF_FAME_SIZE = 5
 #: Checkpoints kept on disk (older ones are removed).
 KEEP_CHECKPOINTS = 3
 # the recorder's part of a checkpoint's state
-_RECORDER_KEYS = ("rows", "hall_of_fame", "evaluations_total", "wall_total")
+_RECORDER_KEYS = (
+    "rows", "hall_of_fame", "evaluations_total", "wall_total", "robot_seconds_total",
+    "wall_clock_total",
+)  # fmt: skip
+#: Entries of config.json that a resume may change (not settings: no part of the run's identity).
+_EXTENDABLE = ("generations", "budget")
 
 
 class RunInterrupted(KeyboardInterrupt):
@@ -178,6 +186,8 @@ def read_run_config(out: str | Path) -> dict[str, Any]:
     gens = cfg.get("generations", 0)
     if isinstance(gens, bool) or not isinstance(gens, int) or gens < 0:
         raise CheckpointError(f"{path}: 'generations' must be an integer >= 0, got {show(gens)}")
+    if not isinstance(cfg.get("budget", {}), dict):
+        raise CheckpointError(f"{path}: 'budget' must be an object of limits, got {show(cfg['budget'])}")
     return cfg
 
 
@@ -227,10 +237,10 @@ def config_difference(recorded: Any, given: Any, name: str = "") -> str | None:
 
 
 def _settings_sha256(config: Mapping[str, Any]) -> str:
-    """The digest of a run's settings (its config.json but ``generations``, which a resume
-    may extend): ``config_sha256`` of ``identity.json``.
+    """The digest of a run's settings (its config.json but ``generations`` and ``budget``,
+    which a resume may extend): ``config_sha256`` of ``identity.json``.
     """
-    return json_sha256({k: v for k, v in config.items() if k != "generations"})
+    return json_sha256({k: v for k, v in config.items() if k not in _EXTENDABLE})
 
 
 class RunRecorder:
@@ -290,7 +300,14 @@ class RunRecorder:
         self.hall_of_fame: list[dict[str, Any]] = []
         self.evaluations_total = 0
         self.wall_total = 0.0
+        #: Simulated seconds summed over the simulated robots, every sitting.
+        self.robot_seconds_total = 0.0
+        #: Wall-clock seconds of the run, every sitting (checkpoint writes included; the
+        #: ``wall_total`` of the log counts the generations' own time).
+        self.wall_clock_total = 0.0
         self.generations: int | None = None
+        #: The budget's limits beyond the generations (config.json's ``budget``; empty: none).
+        self.budget: dict[str, Any] = {}
 
     @property
     def checkpoint_dir(self) -> Path:
@@ -373,7 +390,10 @@ class RunRecorder:
         return {"run_id": ident["run_id"], "config_sha256": ident["config_sha256"]}
 
     def _write_config(self) -> None:
-        atomic_write_json(self.out / "config.json", {**self.config, "generations": self.generations})
+        extendable = {"generations": self.generations}
+        if self.budget:
+            extendable["budget"] = dict(self.budget)
+        atomic_write_json(self.out / "config.json", {**self.config, **extendable})
 
     def _same(self, key: str, recorded: Any) -> bool:
         if key != "experiment":
@@ -432,7 +452,7 @@ class RunRecorder:
                 )
         # the settings as recorded (a reworded description or an older spelling is the same
         # run): config.json keeps matching its digest in identity.json
-        self.config = {k: v for k, v in cfg.items() if k != "generations"}
+        self.config = {k: v for k, v in cfg.items() if k not in _EXTENDABLE}
         if recorded_identity is not None:
             self.identity = recorded_identity
         else:  # a folder written before runs had an identity: it gets one from now on
@@ -453,6 +473,11 @@ class RunRecorder:
             self.hall_of_fame = list(state["hall_of_fame"])
             self.evaluations_total = int(state["evaluations_total"])
             self.wall_total = float(state["wall_total"])
+            # checkpoints from before budgets: every simulation ran the experiment's seconds
+            self.robot_seconds_total = float(state.get(
+                "robot_seconds_total", self.evaluations_total * float(self.experiment.seconds)
+            ))  # fmt: skip
+            self.wall_clock_total = float(state.get("wall_clock_total", self.wall_total))
             if not all(isinstance(r, dict) for r in self.rows):
                 raise TypeError("'rows' must be a list of objects")
             for h in self.hall_of_fame:  # as update_hall_of_fame and write_best read them
@@ -558,6 +583,8 @@ class RunRecorder:
         state: Mapping[str, Any],
         arrays: Mapping[str, np.ndarray],
         columns: Mapping[str, Any] | None = None,
+        elapsed: float | None = None,
+        budget: Callable[[], Mapping[str, Any]] | None = None,
     ) -> dict[str, Any]:
         """Book-keeping after a generation: totals, log row, checkpoint, log files, best designs.
 
@@ -575,6 +602,12 @@ class RunRecorder:
         columns : dict, optional
             More log columns of the driver (e.g. a quality-diversity archive's
             QD-score and coverage), added to the row before it is checkpointed.
+        elapsed : float, optional
+            The run's wall-clock seconds so far, every sitting (default: the total adds
+            ``wall``).
+        budget : callable, optional
+            ``budget()``, called once the totals count this generation: the run's budget
+            (limits, use, what stopped it), checkpointed as ``budget``.
 
         Returns
         -------
@@ -583,12 +616,20 @@ class RunRecorder:
         """
         self.wall_total += wall
         self.evaluations_total += stats.n_simulated
+        self.robot_seconds_total += stats.robot_seconds
+        self.wall_clock_total = self.wall_clock_total + wall if elapsed is None else float(elapsed)
         row = log_row(
             self.experiment, generation, population, stats, wall,
             self.evaluations_total, self.wall_total,
         )  # fmt: skip
+        row.update(
+            robot_seconds=stats.robot_seconds, robot_seconds_total=self.robot_seconds_total,
+            wall_clock_total=self.wall_clock_total,
+        )  # fmt: skip
         row.update(columns or {})
         self.rows.append(row)
+        if budget is not None:
+            state = {**state, "budget": dict(budget())}
         self.checkpoint(generation, population, state, arrays)
         self.write_log()
         self.write_best()
@@ -693,12 +734,18 @@ class RunRecorder:
             if old.name not in keep:
                 old.unlink(missing_ok=True)
 
-    def finish(self, generation: int, population: Sequence[Individual]) -> None:
-        """Write the final population, the best designs and the figures."""
+    def finish(self, generation: int, population: Sequence[Individual],
+               stopped_by: str | None = None) -> None:  # fmt: skip
+        """Write the final population (with the budget that stopped the run), the best
+        designs and the figures.
+        """
         self.close_progress()
+        final: dict[str, Any] = {"generation": generation}
+        if stopped_by is not None:
+            final["stopped_by"] = stopped_by
         atomic_write_json(
             self.out / "final_population.json",
-            {"generation": generation, "population": population_summary(population)},
+            {**final, "population": population_summary(population)},
         )
         self.write_best()
         if self.figures:

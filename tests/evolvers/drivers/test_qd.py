@@ -27,7 +27,7 @@ from softgym.design import RobotDesign  # noqa: E402
 from softgym.exceptions import CheckpointError, InvalidParameterError  # noqa: E402
 from softgym.metrics import composition_counts  # noqa: E402
 
-_WALL = {"wall_time", "wall_total"}
+_WALL = {"wall_time", "wall_total", "wall_clock_total"}
 
 
 def fake_batch_fn(designs, task):
