@@ -141,7 +141,18 @@ def _kernel_levels():
     archflags = os.environ.get("ARCHFLAGS", "").split()[1::2]
     if not target.endswith(("x86_64", "amd64")) or any(a != "x86_64" for a in archflags):
         return []
-    return [lvl for lvl in ("v3", "v4") if _compiler_takes(f"-march=x86-64-{lvl}")]
+    levels = [lvl for lvl in ("v3", "v4") if _compiler_takes(f"-march=x86-64-{lvl}")]
+    dropped = [f"x86-64-{lvl}" for lvl in ("v3", "v4") if lvl not in levels]
+    if dropped:  # a build without them runs at the portable kernel's speed: say so in the log
+        cc = os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc"
+        warnings.warn(
+            f"softgym: the compiler ({cc}) does not take -march={' / -march='.join(dropped)}; "
+            f"the kernel variant(s) {', '.join(dropped)} are NOT built (a CPU that has them runs "
+            "an older, slower build; `softgym info` shows the build in use); a newer GCC or "
+            "Clang builds them.",
+            stacklevel=1,
+        )
+    return levels
 
 
 class BuildExt(build_ext):

@@ -38,12 +38,17 @@ poet
     with terrains, score matrices, admissions, transfers and ANNECS per
     iteration, and figures; ``poet compare RUN...`` plots ANNECS of runs
     (POET against the random-terrain control).
+info
+    The installed version, the kernel build in use (baseline, x86-64-v3,
+    x86-64-v4), the builds installed and whether OpenMP is on.
 
 ``--resume`` reads the experiment and settings from the run folder (a folder
 that holds no run is an error). Ctrl-C stops within a fraction of a second and
 prints the command that resumes. ``-v`` shows log lines (and Dask's), ``-q``
-hides progress bars; both go before or after the subcommand. ``--help`` shows
-every default; ``--version`` the installed version.
+hides progress bars; both go before or after the subcommand. The options of
+``qd``, ``poet`` and ``study`` go before or after their default ``run``. Every
+flag is checked before a run folder is created. ``--help`` shows every default;
+``--version`` the installed version and the kernel build in use.
 """
 
 from softgym_cli.parser import main

@@ -1,5 +1,5 @@
 """The commands that read or render what exists: ``simulate``, ``replay``, ``compare``,
-``view``, ``convert`` and ``experiments``.
+``view``, ``convert``, ``experiments`` and ``info``.
 """
 
 from __future__ import annotations
@@ -11,7 +11,94 @@ import time
 from pathlib import Path
 from typing import Any
 
-__all__ = ["add_tool_parsers"]
+__all__ = ["add_tool_parsers", "describe_folder", "kernel_info", "kernel_line"]
+
+
+def kernel_info() -> dict[str, Any]:
+    """The compiled engine in use: its kernel build, the builds installed and OpenMP."""
+    import os
+
+    from softgym.engine import omp_max_threads, openmp_enabled
+    from softgym.engine._cpu import cpu_level
+    from softgym.engine._dispatch import available_kernels, installed_kernels, kernel_build
+
+    return {
+        "kernel": kernel_build(),
+        "forced_by": "SOFTGYM_KERNEL" if os.environ.get("SOFTGYM_KERNEL") else None,
+        "installed": installed_kernels(),
+        "this_cpu_runs": available_kernels(),
+        # 4, 3, or 1 (below v3); 0: not x86-64
+        "cpu_level": f"x86-64-v{cpu_level()}" if cpu_level() else "not x86-64",
+        "openmp": bool(openmp_enabled()),
+        "threads": int(omp_max_threads()) if openmp_enabled() else 1,
+    }
+
+
+def kernel_line() -> str:
+    """One line: the kernel build in use, the builds installed, OpenMP on or off."""
+    k = kernel_info()
+    forced = " (SOFTGYM_KERNEL)" if k["forced_by"] else ""
+    omp = f"OpenMP on ({k['threads']} threads)" if k["openmp"] else "OpenMP off (built serially)"
+    return (f"kernel {k['kernel']}{forced}; installed: {', '.join(k['installed'])}; {omp}")
+
+
+def describe_folder(path: str | Path) -> tuple[str, str] | None:
+    """What a folder is, as (kind, the commands that read it), or None for no softgym folder.
+
+    Kinds: ``study`` (a study's root: study.json), ``poet``, ``qd`` and ``evolve`` (a run
+    folder, told apart by its config.json's sections). Reads config.json through the capped
+    reader; a folder whose config.json does not read is None.
+    """
+    from evolvers.recording.recorder import read_run_config
+    from softgym.exceptions import SoftGymError
+
+    folder = Path(path)
+    if (folder / "study.json").is_file() or (folder / "scenario.json").is_file():
+        root = folder if (folder / "study.json").is_file() else folder.parent
+        return ("a study's folder (softgym study)",
+                f"softgym study report {root}; replay or view one of its runs, e.g. "
+                f"{root}/SCENARIO/seed-0")  # fmt: skip
+    if not (folder / "config.json").is_file():
+        return None
+    try:
+        cfg = read_run_config(folder)
+    except (SoftGymError, OSError):
+        return None
+    if "poet" in cfg:
+        return ("a POET run folder (softgym poet)",
+                f"softgym view {folder} (its best pair), softgym poet compare {folder}")  # fmt: skip
+    if "qd" in cfg:
+        return ("a QD run folder (softgym qd)",
+                f"softgym replay/view/compare {folder}, softgym qd export {folder}")  # fmt: skip
+    return ("an evolve run folder (softgym evolve)",
+            f"softgym replay/view/compare {folder}")  # fmt: skip
+
+
+def _cmd_info(args: argparse.Namespace) -> int:
+    import platform
+
+    from softgym_cli.flags import installed_version
+
+    k = kernel_info()
+    forced = " (forced by SOFTGYM_KERNEL)" if k["forced_by"] else " (the newest this CPU runs)"
+    lines = [
+        ("softgym", installed_version()),
+        ("python", f"{platform.python_version()} ({platform.machine()})"),
+        ("kernel in use", k["kernel"] + forced),
+        ("kernels installed", ", ".join(k["installed"])),
+        ("this CPU runs", f"{', '.join(k['this_cpu_runs'])} (CPU level: {k['cpu_level']})"),
+        ("OpenMP", f"on, {k['threads']} threads" if k["openmp"] else "off (built serially)"),
+    ]
+    missing = [f"x86-64-v{n}" for n in (3, 4) if f"x86-64-v{n}" not in k["installed"]]
+    if missing and k["cpu_level"] != "not x86-64":
+        lines.append(("not built", f"{', '.join(missing)} (the compiler lacked "
+                      "-march=x86-64-vN, or SOFTGYM_PORTABLE / SOFTGYM_NATIVE was set)"))  # fmt: skip
+    if args.json:
+        print(json.dumps({"softgym": installed_version(), **k}, indent=2))
+    else:
+        for name, value in lines:
+            print(f"{name + ':':18s} {value}")
+    return 0
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
@@ -59,13 +146,21 @@ def _cmd_replay(args: argparse.Namespace) -> int:
     )
 
     run_dir = Path(args.run_dir)
+    if args.video:  # the extra before any simulation, not after
+        _require_video()
+    kind = describe_folder(run_dir) if run_dir.is_dir() else None
+    if kind is not None and not kind[0].startswith(("an evolve", "a QD")):
+        print(f"softgym replay: {run_dir} is {kind[0]}, which replay does not read; "
+              f"try {kind[1]}", file=sys.stderr)  # fmt: skip
+        return 2
     try:  # every file through the capped reader: a FIFO is refused, never waited on
         cfg = read_run_config(run_dir)
         design = RobotDesign.load(run_dir / "best_design.json")
         best = read_best_designs(run_dir)[0]
         experiment = Experiment.from_dict(cfg["experiment"])
     except SoftGymError as exc:
-        print(f"softgym replay: {run_dir} is not a finished run folder ({exc})", file=sys.stderr)
+        print(f"softgym replay: {run_dir} is not a finished run folder of softgym evolve or "
+              f"qd ({exc})", file=sys.stderr)  # fmt: skip
         return 2
     exp = cfg["experiment"]
     seconds = float(experiment.seconds if args.seconds is None else args.seconds)
@@ -104,6 +199,21 @@ def _cmd_replay(args: argparse.Namespace) -> int:
                "recorded": best.get("objectives"), "files": [str(p) for p in paths]}  # fmt: skip
     print(json.dumps(summary, indent=2))
     return 0
+
+
+def _require_video() -> None:
+    """Refuse ``--video`` at once when the ``video`` extra is missing (before simulating)."""
+    from softgym.render.frames import MissingVideoExtraError
+    from softgym_cli.flags import extra_hint
+
+    try:
+        import imageio.v2  # noqa: F401
+        import imageio_ffmpeg  # noqa: F401
+    except ImportError as exc:
+        raise MissingVideoExtraError(
+            f"--video needs imageio and imageio-ffmpeg ({exc.name} is missing): "
+            f"{extra_hint('video')}; or drop --video"
+        ) from None
 
 
 def _config_key(cfg: dict) -> str:
@@ -266,7 +376,8 @@ def add_tool_parsers(sub: Any) -> None:
     p.add_argument("--seconds", type=float, help="simulated seconds (default: the run's)")
     p.add_argument("--out", help="output folder (default: RUN_DIR/replay)")
     p.add_argument("--no-gif", action="store_true", help="no GIF")
-    p.add_argument("--video", action="store_true", help='also an MP4 (pip install ".[video]")')
+    p.add_argument("--video", action="store_true", help='also an MP4 (the video extra: pip install "softgym[video]", or '
+                   'pip install -e ".[video]" in a checkout)')
     p.set_defaults(func=_cmd_replay)
 
     p = sub.add_parser(
@@ -304,3 +415,12 @@ def add_tool_parsers(sub: Any) -> None:
 
     p = sub.add_parser("experiments", help="list the named experiments")
     p.set_defaults(func=_cmd_experiments)
+
+    p = sub.add_parser(
+        "info", help="the installed version, the kernel build in use, the builds installed, OpenMP",
+        description="Which compiled engine runs: the kernel build in use (baseline, x86-64-v3: "
+        "AVX2, x86-64-v4: AVX-512; SOFTGYM_KERNEL forces one), the builds this installation "
+        "holds and this CPU runs, and whether OpenMP threads the batch.",
+    )  # fmt: skip
+    p.add_argument("--json", action="store_true", help="the same as one JSON object")
+    p.set_defaults(func=_cmd_info)

@@ -8,12 +8,35 @@ import sys
 
 from softgym.exceptions import SoftGymError
 from softgym.io import check_path_depth
-from softgym_cli.commands import add_tool_parsers
-from softgym_cli.flags import HelpFormatter, global_flags, installed_version, subcommands
+from softgym_cli.commands import add_tool_parsers, kernel_line
+from softgym_cli.flags import (
+    HelpFormatter,
+    global_flags,
+    installed_version,
+    plain,
+    subcommands,
+    with_checkout_hint,
+)
 from softgym_cli.runs import add_evolve_parser, add_poet_parser, add_qd_parser, explicit_flags
 from softgym_cli.study import add_study_parser
 
 __all__ = ["main"]
+
+
+class _VersionAction(argparse.Action):
+    """``--version``: the installed version and the kernel build in use (imported only then)."""
+
+    def __init__(self, option_strings: list[str], dest: str = argparse.SUPPRESS,
+                 default: str = argparse.SUPPRESS, help: str | None = None) -> None:  # fmt: skip
+        super().__init__(option_strings, dest=dest, default=default, nargs=0, help=help)
+
+    def __call__(self, parser, namespace, values, option_string=None):  # noqa: D102
+        print(f"softgym {installed_version()}")
+        try:
+            print(kernel_line())
+        except SoftGymError as exc:  # e.g. a SOFTGYM_KERNEL this machine cannot run
+            print(f"kernel: {' '.join(str(exc).split())}")
+        parser.exit()
 
 
 def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
@@ -21,10 +44,12 @@ def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
     import softgym_cli
 
     parser = argparse.ArgumentParser(
-        prog="softgym", description=softgym_cli.__doc__.split("\n")[0],
+        prog="softgym", description=plain(softgym_cli.__doc__.split("\n")[0]),
         formatter_class=HelpFormatter,
     )  # fmt: skip
-    parser.add_argument("--version", action="version", version=f"softgym {installed_version()}")
+    parser.add_argument("--version", action=_VersionAction,
+                        help="the installed version, the kernel build in use and OpenMP "
+                        "(softgym info: every detail)")  # fmt: skip
     global_flags(parser, None)
     parser.add_argument(
         "--debug", action="store_true", help="show the traceback of an error (before the command)"
@@ -62,6 +87,6 @@ def main(argv: list[str] | None = None) -> int:
     except (SoftGymError, OSError) as exc:  # bad input or a file problem: one line, exit 2
         if args.debug:
             raise
-        message = " ".join(str(exc).split()) or type(exc).__name__
+        message = with_checkout_hint(" ".join(str(exc).split()) or type(exc).__name__)
         print(f"softgym {args.command}: {message}", file=sys.stderr)
         return 2

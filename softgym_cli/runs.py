@@ -26,7 +26,7 @@ from evolvers.drivers.budget import BUDGET_FLAGS, Budget
 from evolvers.evaluation.experiments import CONTROLLERS, Experiment, get_experiment
 from evolvers.recording.recorder import RunInterrupted, read_run_config
 from softgym.exceptions import CheckpointError, InvalidParameterError, SoftGymError
-from softgym_cli.flags import subcommands
+from softgym_cli.flags import extra_hint, options_after, subcommands
 
 __all__ = [
     "add_controller_flags",
@@ -35,6 +35,8 @@ __all__ = [
     "add_qd_parser",
     "add_run_flags",
     "build_run",
+    "check_run_flags",
+    "check_threads",
     "run_budget",
     "controller_overrides",
     "load_body",
@@ -45,8 +47,9 @@ __all__ = [
 #: What builds a run: ``make(args, cfg) -> (run class, experiment, keywords)``.
 Maker = Callable[[argparse.Namespace, dict[str, Any] | None], tuple[type, Experiment, dict[str, Any]]]
 
-_DASK_HELP = ('evaluate on Dask: a LocalCluster or an existing scheduler '
-              '(pip install ".[distributed]"; default: local simulations, no Dask)')  # fmt: skip
+_DASK_HELP = ('evaluate on Dask: a LocalCluster or an existing scheduler (the distributed '
+              'extra: pip install "softgym[distributed]", or pip install -e ".[distributed]" '
+              'in a checkout; default: local simulations, no Dask)')  # fmt: skip
 
 
 def add_run_flags(p: argparse.ArgumentParser, out: str, gif: bool = True) -> None:
@@ -226,6 +229,49 @@ def _number(text: str) -> Any:
     return int(value) if value.is_integer() else value
 
 
+def check_threads(threads: Any) -> None:
+    """``--threads``: None (all usable CPUs) or an integer >= 1.
+
+    Raises
+    ------
+    InvalidParameterError
+        Naming the flag, before anything is written.
+    """
+    if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int)
+                                or threads < 1):  # fmt: skip
+        raise InvalidParameterError(
+            f"--threads must be an integer >= 1 (OpenMP threads), got {threads!r}; leave it "
+            "out for all usable CPUs"
+        )
+
+
+def settling_seconds(experiment: Experiment) -> float:
+    """The seconds a robot of ``experiment`` settles before it is measured."""
+    return float(experiment.make_task().config().init_time)
+
+
+def check_run_flags(args: argparse.Namespace, experiment: Experiment) -> None:
+    """What a run's flags describe, checked before anything is created: the threads, the
+    robot grid, the simulated seconds (typed, they must outlast the settling time, which no
+    fitness counts).
+
+    Raises
+    ------
+    InvalidParameterError, InvalidDesignError
+        One line naming the flag.
+    """
+    from softgym.design.robot import check_grid_shape
+
+    check_threads(args.threads)
+    check_grid_shape(experiment.shape, "--shape")
+    settle = settling_seconds(experiment)
+    if getattr(args, "seconds", None) is not None and not experiment.seconds > settle:
+        raise InvalidParameterError(
+            f"--seconds must be more than the {settle:g} s settling time (a robot is measured "
+            f"only after it; every fitness would be ~0), got {experiment.seconds:g}"
+        )
+
+
 def build_run(args: argparse.Namespace, stack: contextlib.ExitStack, make: Maker) -> Any:
     """The run a command's flags describe.
 
@@ -239,6 +285,7 @@ def build_run(args: argparse.Namespace, stack: contextlib.ExitStack, make: Maker
     cfg = recorded_config(args)
     budget = run_budget(args, cfg)
     run_cls, experiment, kw = make(args, cfg)
+    check_run_flags(args, experiment)  # all of it before a folder, a bar or a Dask cluster
     kw["budget"] = budget
     if args.dask:
         from evolvers.evaluation.distributed import DaskBatchFn, dask_client
@@ -291,12 +338,18 @@ def run_command(args: argparse.Namespace, unit: str, make: Maker,
     finally:
         signal.signal(signal.SIGTERM, previous)
     figures = run.out / "figures"
+    drawn = sorted(str(p) for p in figures.glob("*")) if figures.exists() else []
+    if args.no_figures and drawn:  # an earlier sitting's figures, left as they were
+        print(f"softgym {args.command}: --no-figures: {figures} holds figures of an earlier "
+              "sitting, not redrawn (drop --no-figures to draw them for this one)",
+              file=sys.stderr)  # fmt: skip
+        drawn = []
     record = run.budget_record()
     out = {**summary(run, result), "stopped_by": run.stopped_by,
            "budget": {"limits": record["limits"], "used": record["used"]},
            "wall_seconds": round(time.perf_counter() - t0, 2),
            "out": str(run.out),
-           "figures": sorted(str(p) for p in figures.glob("*")) if figures.exists() else []}  # fmt: skip
+           "figures": drawn}  # fmt: skip
     print(json.dumps(out, indent=2))
     return 0
 
@@ -373,6 +426,10 @@ def _evolve_run(args: argparse.Namespace, cfg: dict | None) -> tuple[type, Exper
               "backend": args.backend, "algorithm": args.algorithm,
               "generations": args.generations}  # fmt: skip
     kw: dict[str, Any] = {"seed": st["seed"], "generations": st["generations"]}
+    if st["backend"] == "pymoo" and args.selection is not None:
+        print(f"softgym evolve: warning: --selection {args.selection} is ignored with "
+              f"--backend pymoo (pymoo's {st['algorithm']} does its own survival)",
+              file=sys.stderr)  # fmt: skip
     if st["backend"] == "deap":
         from evolvers.drivers.deap_runner import DeapRun as Run
     elif st["backend"] == "pymoo":
@@ -513,31 +570,37 @@ def add_qd_parser(sub: Any) -> None:
         "robot of its body descriptors (default: stiff x filled fraction, 128 x 128 cells, "
         "Mouret & Clune 2015). A resumable run folder with log (QD-score, coverage, best), "
         "checkpoints, heatmap and best designs; 'softgym qd export RUN' writes the elites as "
-        'design files. Needs pip install ".[qd]".',
+        f"design files. Needs the qd extra: {extra_hint('qd')}.",
     )
-    p.add_argument("--experiment", help="experiment whose task, rules and genes are used "
-                   "(default: basic, CPPN bodies; softgym experiments lists them)")  # fmt: skip
-    p.add_argument("--generations", type=int, help="batches after the first (default: 20)")
-    p.add_argument("--batch", type=int, help="robots per generation (default: 16)")
-    p.add_argument("--seed", type=int, help="seed of the run (default: 0)")
-    add_run_flags(p, "runs/qd")
-    p.add_argument("--descriptors", nargs="+", metavar="NAME",
-                   help="body descriptors: stiff filled muscle height elongation "
-                   "(default: stiff filled)")  # fmt: skip
-    p.add_argument("--cells", type=int, nargs="+",
-                   help="grid: cells per descriptor (one value for all; default: 128); "
-                   "cvt: the number of centroids")  # fmt: skip
-    p.add_argument("--archive", choices=["grid", "cvt"],
-                   help="GridArchive or CVTArchive (default: grid)")  # fmt: skip
-    p.add_argument("--objective", choices=["norm_final_dist", "max_xy_dist"],
-                   help="maximised metric (default: the experiment's fitness)")  # fmt: skip
-    p.add_argument("--task", metavar="TASK[:ARG=V,...]|FILE.json",
-                   help="the world (default: the experiment's)")  # fmt: skip
-    p.add_argument("--seconds", type=float, help="simulated seconds per evaluation (default: 5)")
-    p.add_argument("--shape", type=int, nargs=3, metavar=("NX", "NY", "NZ"),
-                   help="robot grid (default: 6 6 6)")  # fmt: skip
-    add_controller_flags(p)
-    ss = subcommands(p, "qd_command", default="run")
+
+    def options(p: argparse.ArgumentParser) -> None:
+        p.add_argument("--experiment", help="experiment whose task, rules and genes are used "
+                       "(default: basic, CPPN bodies; softgym experiments lists them)")  # fmt: skip
+        p.add_argument("--generations", type=int, help="batches after the first (default: 20)")
+        p.add_argument("--batch", type=int, help="robots per generation (default: 16)")
+        p.add_argument("--seed", type=int, help="seed of the run (default: 0)")
+        add_run_flags(p, "runs/qd")
+        p.add_argument("--descriptors", nargs="+", metavar="NAME",
+                       help="body descriptors: stiff filled muscle height elongation "
+                       "(default: stiff filled)")  # fmt: skip
+        p.add_argument("--cells", type=int, nargs="+",
+                       help="grid: cells per descriptor (one value for all; default: 128); "
+                       "cvt: the number of centroids")  # fmt: skip
+        p.add_argument("--archive", choices=["grid", "cvt"],
+                       help="GridArchive or CVTArchive (default: grid)")  # fmt: skip
+        p.add_argument("--objective", choices=["norm_final_dist", "max_xy_dist"],
+                       help="maximised metric (default: the experiment's fitness)")  # fmt: skip
+        p.add_argument("--task", metavar="TASK[:ARG=V,...]|FILE.json",
+                       help="the world (default: the experiment's)")  # fmt: skip
+        p.add_argument("--seconds", type=float, help="simulated seconds per evaluation (default: 5)")
+        p.add_argument("--shape", type=int, nargs=3, metavar=("NX", "NY", "NZ"),
+                       help="robot grid (default: 6 6 6)")  # fmt: skip
+        add_controller_flags(p)
+
+    options(p)
+    ss = subcommands(p, "qd_command", default="run", default_help="run or resume (the "
+                     "default; the options go before or after it)", command="qd")  # fmt: skip
+    options_after(p, ss.choices["run"], options)
     r = ss.add_parser("export", help="write a QD run's elites as design files (.json, .vxa)")
     r.add_argument("run", help="a softgym qd run folder")
     r.add_argument("--out", dest="export_out", help="folder (default: RUN/elites)")
@@ -630,33 +693,39 @@ def add_poet_parser(sub: Any) -> None:
         "terrains); thresholds are voxel lengths of max_xy_dist (POET's 25-340 band, 200 "
         "reproduction and 230 solved map to 3.76-13.35, 9.09 and 10).",
     )
-    p.add_argument("--iterations", type=int, help="iterations after the first (default: 40)")
-    p.add_argument("--pop", type=int, help="robots per pair (default: 8)")
-    p.add_argument("--seed", type=int, help="seed of the run (default: 0)")
-    add_run_flags(p, "runs/poet", gif=False)
-    p.add_argument("--generator", choices=["mutate", "random"],
-                   help="candidate terrains: mutants of eligible parents or uniform draws "
-                   "(the random-terrain control) (default: mutate)")  # fmt: skip
-    for flag, what, default, kind in (
-        ("--reproduce-every", "K: iterations between reproductions", "5", int),
-        ("--transfer-every", "T: iterations between transfers", "5", int),
-        ("--max-children", "candidate terrains per round", "8", int),
-        ("--max-admitted", "terrains admitted per round", "1", int),
-        ("--max-active", "active pairs before the oldest retire", "8", int),
-        ("--mc-low", "minimal criterion, low end", "3.76", float),
-        ("--mc-high", "minimal criterion, high end", "13.35", float),
-        ("--repro-threshold", "score to reproduce", "9.09", float),
-        ("--solved-threshold", "score that solves", "10", float),
-        ("--score-cap", "scores saturate here, like a finished BipedalWalker course", "none",
-         float),
-    ):  # fmt: skip
-        p.add_argument(flag, type=kind, help=f"{what} (default: {default})")
-    p.add_argument("--start-terrain", metavar="GENOME.json",
-                   help="the first pair's terrain genome (default: flat)")  # fmt: skip
-    p.add_argument("--seconds", type=float, help="simulated seconds per evaluation (default: 3)")
-    p.add_argument("--shape", type=int, nargs=3, metavar=("NX", "NY", "NZ"),
-                   help="robot grid (default: 4 4 4)")  # fmt: skip
-    ss = subcommands(p, "poet_command", default="run")
+
+    def options(p: argparse.ArgumentParser) -> None:
+        p.add_argument("--iterations", type=int, help="iterations after the first (default: 40)")
+        p.add_argument("--pop", type=int, help="robots per pair (default: 8)")
+        p.add_argument("--seed", type=int, help="seed of the run (default: 0)")
+        add_run_flags(p, "runs/poet", gif=False)
+        p.add_argument("--generator", choices=["mutate", "random"],
+                       help="candidate terrains: mutants of eligible parents or uniform draws "
+                       "(the random-terrain control) (default: mutate)")  # fmt: skip
+        for flag, what, default, kind in (
+            ("--reproduce-every", "K: iterations between reproductions", "5", int),
+            ("--transfer-every", "T: iterations between transfers", "5", int),
+            ("--max-children", "candidate terrains per round", "8", int),
+            ("--max-admitted", "terrains admitted per round", "1", int),
+            ("--max-active", "active pairs before the oldest retire", "8", int),
+            ("--mc-low", "minimal criterion, low end", "3.76", float),
+            ("--mc-high", "minimal criterion, high end", "13.35", float),
+            ("--repro-threshold", "score to reproduce", "9.09", float),
+            ("--solved-threshold", "score that solves", "10", float),
+            ("--score-cap", "scores saturate here, like a finished BipedalWalker course", "none",
+             float),
+        ):  # fmt: skip
+            p.add_argument(flag, type=kind, help=f"{what} (default: {default})")
+        p.add_argument("--start-terrain", metavar="GENOME.json",
+                       help="the first pair's terrain genome (default: flat)")  # fmt: skip
+        p.add_argument("--seconds", type=float, help="simulated seconds per evaluation (default: 3)")
+        p.add_argument("--shape", type=int, nargs=3, metavar=("NX", "NY", "NZ"),
+                       help="robot grid (default: 4 4 4)")  # fmt: skip
+
+    options(p)
+    ss = subcommands(p, "poet_command", default="run", default_help="run or resume (the "
+                     "default; the options go before or after it)", command="poet")  # fmt: skip
+    options_after(p, ss.choices["run"], options)
     r = ss.add_parser("compare", help="ANNECS over iterations of POET runs and controls, one figure")
     r.add_argument("runs", nargs="+", metavar="RUN", help="softgym poet run folders")
     r.add_argument("--out", dest="compare_out", default="runs/poet_annecs.png", help="figure file")

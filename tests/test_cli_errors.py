@@ -9,16 +9,16 @@ from fuzzing import refused_in_child  # tests/fuzzing.py
 from softgym.exceptions import CheckpointError, InvalidDesignError, SoftGymError
 from softgym_cli import main
 
-TINY = ["--pop", "4", "--seconds", "0.5", "--shape", "4", "4", "4", "--quiet", "--no-figures"]
+TINY = ["--pop", "4", "--seconds", "1.2", "--shape", "4", "4", "4", "--quiet", "--no-figures"]
 #: One short generation of a few small robots per run command (what a refused input would
 #: have started, had it been taken: never a long run, even on a softgym without the check).
 SMALL = {
     "evolve": ["--generations", "0", "--no-gif", *TINY],
-    "qd": ["--generations", "0", "--batch", "4", "--seconds", "0.5", "--shape", "4", "4", "4",
+    "qd": ["--generations", "0", "--batch", "4", "--seconds", "1.2", "--shape", "4", "4", "4",
            "--quiet", "--no-figures", "--no-gif"],
-    "poet": ["--iterations", "0", "--pop", "4", "--seconds", "0.5", "--shape", "4", "4", "4",
+    "poet": ["--iterations", "0", "--pop", "4", "--seconds", "1.2", "--shape", "4", "4", "4",
              "--quiet", "--no-figures"],
-    "study": ["--generations", "0", "--pop", "4", "--seconds", "0.5", "--shape", "4", "4", "4",
+    "study": ["--generations", "0", "--pop", "4", "--seconds", "1.2", "--shape", "4", "4", "4",
               "--quiet"],
 }  # fmt: skip
 
@@ -115,7 +115,9 @@ def test_version_and_global_flags_on_either_side(capsys):
     with pytest.raises(SystemExit) as exit_:
         main(["--version"])
     assert exit_.value.code == 0
-    assert capsys.readouterr().out.strip() == f"softgym {version('softgym')}"
+    first, kernel = capsys.readouterr().out.strip().splitlines()
+    assert first == f"softgym {version('softgym')}"
+    assert kernel.startswith("kernel ") and "installed: baseline" in kernel and "OpenMP" in kernel
     import softgym
 
     assert softgym.__version__ == version("softgym")  # one source: pyproject.toml

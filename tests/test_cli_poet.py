@@ -4,7 +4,7 @@ import json
 
 from softgym_cli import main
 
-_TINY = ["--pop", "3", "--seconds", "1", "--shape", "3", "3", "3", "--reproduce-every", "1",
+_TINY = ["--pop", "3", "--seconds", "1.2", "--shape", "3", "3", "3", "--reproduce-every", "1",
          "--transfer-every", "1", "--no-figures", "--quiet"]  # fmt: skip
 
 

@@ -8,7 +8,7 @@ pytest.importorskip("ribs")
 
 from softgym_cli import main  # noqa: E402
 
-_TINY = ["--batch", "4", "--shape", "4", "4", "4", "--seconds", "1", "--cells", "8",
+_TINY = ["--batch", "4", "--shape", "4", "4", "4", "--seconds", "1.2", "--cells", "8",
          "--no-figures", "--quiet"]  # fmt: skip
 
 

@@ -337,7 +337,10 @@ def plan(
     Raises
     ------
     InvalidParameterError
-        For an unknown study or scenario, or seeds/generations below 1 / 0.
+        For an unknown study or scenario, seeds/generations below 1 / 0, or n_threads
+        below 1 (before anything is written).
+    InvalidDesignError
+        For a ``shape`` override that is no robot grid.
     """
     st = get_study(study) if isinstance(study, str) else study
     chosen = [st[name] for name in scenarios] if scenarios else list(st.scenarios)
@@ -348,6 +351,14 @@ def plan(
     if generations is not None:
         generations = check_generations(generations)
     first_seed = check_seed(first_seed, "first_seed")
+    if n_threads is not None and (not is_int(n_threads) or n_threads < 1):
+        raise InvalidParameterError(
+            f"n_threads (--threads) must be an integer >= 1, got {show(n_threads)}"
+        )
+    if "shape" in overrides:
+        from softgym.design.robot import check_grid_shape
+
+        overrides["shape"] = check_grid_shape(overrides["shape"], "shape (--shape)")
     if isinstance(out, str) and not out.strip():
         raise InvalidParameterError(f"the study's root folder (--out) must name a folder, got {out!r}")
     root = Path(out)
@@ -576,6 +587,7 @@ def run_study(
     scheduler: str | None = None,
     study: str = "seed-report",
     on_result: Callable[[dict[str, Any]], None] | None = None,
+    on_start: Callable[[RunSpec], None] | None = None,
 ) -> list[dict[str, Any]]:
     """Run a study's runs: skip complete ones, resume interrupted ones, start the rest.
 
@@ -595,6 +607,9 @@ def run_study(
         The study's name (recorded in study.json).
     on_result : callable, optional
         Called with each run's result (:func:`run_one`) as it finishes.
+    on_start : callable, optional
+        Called with each run's spec as it starts (on Dask: as it is submitted to the
+        cluster, which starts it when a worker is free).
 
     Returns
     -------
@@ -631,6 +646,8 @@ def run_study(
 
     if scheduler is None and workers <= 1:
         for s in ordered:
+            if on_start is not None:
+                on_start(s)
             try:
                 res = run_one(s)
             except Exception as exc:  # a bug in one run must not stop the others
@@ -657,6 +674,8 @@ def run_study(
             s = next(pending, None)
             if s is None:
                 return
+            if on_start is not None:
+                on_start(s)
             key = f"{s.scenario}-seed-{s.seed}-{tag}"
             fut = client.submit(run_one, s.to_dict(), pure=False, retries=2, key=key)
             futures[fut] = s

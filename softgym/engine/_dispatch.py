@@ -29,7 +29,14 @@ from pathlib import Path
 from softgym.engine._cpu import cpu_level
 from softgym.exceptions import InvalidParameterError
 
-__all__ = ["FUSED_KERNELS", "KERNELS", "available_kernels", "install", "kernel_build"]
+__all__ = [
+    "FUSED_KERNELS",
+    "KERNELS",
+    "available_kernels",
+    "install",
+    "installed_kernels",
+    "kernel_build",
+]
 
 #: Kernel builds by name: (folder beside this file, x86-64 level it needs).
 KERNELS: dict[str, tuple[str | None, int]] = {
@@ -67,6 +74,13 @@ def available_kernels() -> list[str]:
     """The kernel builds present in this installation that this CPU runs, oldest first."""
     level = cpu_level()
     return [n for n, (_, need) in KERNELS.items() if level >= need and _files(n) is not None]
+
+
+def installed_kernels() -> list[str]:
+    """The kernel builds present in this installation, oldest first, whether or not this CPU
+    runs them (:func:`available_kernels`: the ones it runs).
+    """
+    return [n for n in KERNELS if _files(n) is not None]
 
 
 class _KernelFinder(importlib.abc.MetaPathFinder):
