@@ -48,6 +48,7 @@ import random
 import shutil
 import sys
 import time
+import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -95,6 +96,8 @@ def parse_args(argv: list[str] | None) -> argparse.Namespace:
     ap.add_argument("--checkpoint-every", type=int, default=25_000, help="env steps (with --run-dir)")
     ap.add_argument("--pause-at", type=int, default=None, help="stop at the first checkpoint >= this")
     ap.add_argument("--json", action="store_true", help="print the run's record as the last line")
+    ap.add_argument("--lean", metavar="RUN_DIR", default=None,
+                    help="store a finished run's checkpoint without its optimizer state, then exit")
     ap.add_argument("--verbose", action="store_true", help="SB3's training log every update")
     return ap.parse_args(argv)
 
@@ -153,14 +156,38 @@ def _sha256(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()
 
 
+#: The member of SB3's model.zip that only resuming needs (Adam's moments: twice the policy).
+OPTIMIZER_MEMBER = "policy.optimizer.pth"
+
+
+def lean_model(path: Path) -> None:
+    """Drop the optimizer state from a model.zip (in place, atomically): the final policy stays.
+
+    A finished run is never resumed, so its stored checkpoint keeps the policy
+    (``policy.pth``), SB3's data and the VecNormalize statistics, a third of the
+    size; :func:`load_final_policy` loads it.
+    """
+    tmp = path.with_suffix(".lean")
+    with zipfile.ZipFile(path) as z, zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as out:
+        for info in z.infolist():
+            if info.filename != OPTIMIZER_MEMBER:
+                out.writestr(info.filename, z.read(info.filename))
+    tmp.replace(path)
+
+
 def save_checkpoint(run_dir: Path, model, venv, record: dict) -> None:
-    """Write ``ckpt.new/`` (model, VecNormalize, RNG states, record) and swap it in."""
+    """Write ``ckpt.new/`` (model, VecNormalize, RNG states, record) and swap it in.
+
+    A finished run's model is stored lean (:func:`lean_model`: no optimizer state).
+    """
     import torch
 
     new, cur, old = run_dir / CKPT_NEW, run_dir / CKPT, run_dir / CKPT_OLD
     shutil.rmtree(new, ignore_errors=True)
     new.mkdir(parents=True)
     model.save(new / "model.zip")
+    if record.get("finished"):
+        lean_model(new / "model.zip")
     np.savez(
         new / "vecnormalize.npz",
         obs_mean=venv.obs_rms.mean, obs_var=venv.obs_rms.var, obs_count=venv.obs_rms.count,
@@ -196,6 +223,47 @@ def find_checkpoint(run_dir: Path) -> Path | None:
     return None
 
 
+def make_lean(run_dir: Path) -> None:
+    """Store a finished run's checkpoint lean (:func:`lean_model`), its checksums updated."""
+    ckpt = Path(run_dir) / CKPT
+    state = json.loads((ckpt / "state.json").read_text())
+    if not state.get("finished"):
+        raise SystemExit(f"{run_dir}: not finished; an unfinished run keeps its optimizer to resume")
+    lean_model(ckpt / "model.zip")
+    state["files"] = {name: _sha256(ckpt / name) for name in state["files"]}
+    (ckpt / "state.json").write_text(json.dumps(state))
+
+
+def load_final_policy(run_dir: Path) -> tuple[Any, Any, str, dict]:
+    """A finished run's final policy on a fresh single env: ``(model, venv, env id, env kwargs)``.
+
+    The policy's weights from the stored ``policy.pth`` and the observation
+    statistics from ``vecnormalize.npz`` (checksums checked), in a PPO of the
+    run's settings; ``model.predict(venv.normalize_obs(obs))`` acts as it did.
+    """
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.save_util import load_from_zip_file
+    from stable_baselines3.common.vec_env import VecMonitor, VecNormalize
+
+    from softgym.envs.sb3 import make_sb3_vec_env
+
+    ckpt = Path(run_dir) / CKPT
+    state = json.loads((ckpt / "state.json").read_text())
+    for name, digest in state["files"].items():
+        if _sha256(ckpt / name) != digest:
+            raise SystemExit(f"{ckpt / name}: checksum mismatch; not loading it")
+    st, eid, kw = state["settings"], state["env"], state["env_kwargs"]
+    venv = VecNormalize(VecMonitor(make_sb3_vec_env(eid, n_envs=1, seed=st["seed"], n_threads=1, **kw)),
+                        gamma=st["gamma"], training=False)  # fmt: skip
+    with np.load(ckpt / "vecnormalize.npz", allow_pickle=False) as z:
+        venv.obs_rms.mean, venv.obs_rms.var, venv.obs_rms.count = z["obs_mean"], z["obs_var"], float(z["obs_count"])
+    model = PPO("MlpPolicy", venv, device="cpu", policy_kwargs={
+        "log_std_init": st["log_std_init"], "net_arch": list(st["net_arch"])})  # fmt: skip
+    _, params, _ = load_from_zip_file(ckpt / "model.zip", device="cpu")
+    model.policy.load_state_dict(params["policy"])
+    return model, venv, eid, kw
+
+
 def load_checkpoint(ckpt: Path, venv, model_cls) -> tuple[Any, dict]:
     """The model (on ``venv``) and record of a checkpoint; restores VecNormalize and the RNGs."""
     import torch
@@ -228,6 +296,9 @@ def load_checkpoint(ckpt: Path, venv, model_cls) -> tuple[Any, dict]:
 # ------------------------------------------------------------------ main
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
+    if args.lean:
+        make_lean(Path(args.lean))
+        return 0
     raw = sys.argv[1:] if argv is None else list(argv)
     shown = [a for i, a in enumerate(raw) if a != "--pause-at" and (i == 0 or raw[i - 1] != "--pause-at")]
     command = "python benchmarks/rl_ppo.py " + " ".join(shown)
@@ -265,7 +336,15 @@ def main(argv: list[str] | None = None) -> int:
         VecMonitor(make_sb3_vec_env(eid, n_envs=args.n_envs, seed=args.seed, n_threads=1, **kw)),
         gamma=args.gamma,
     )
-    if ckpt is not None:
+    if ckpt is not None and json.loads((ckpt / "state.json").read_text()).get("finished"):
+        record = json.loads((run_dir / "run.json").read_text())
+        if args.timesteps > record["timesteps"]:
+            raise SystemExit(f"{run_dir} finished at {record['timesteps']} env steps and keeps its "
+                             "final policy only (no optimizer state): start a new --run-dir")  # fmt: skip
+        print(f"{run_dir}: finished", file=sys.stderr)
+        ckpt = None
+        model = None
+    elif ckpt is not None:
         model, record = load_checkpoint(ckpt, venv, PPO)
         if record["settings"] != settings:
             diff = {k: (record["settings"].get(k), v) for k, v in settings.items() if record["settings"].get(k) != v}
@@ -307,7 +386,7 @@ def main(argv: list[str] | None = None) -> int:
     target = args.timesteps if args.pause_at is None else min(args.timesteps, args.pause_at)
     every = max(rollout, -(-args.checkpoint_every // rollout) * rollout) if run_dir else target
     first = ckpt is None
-    while model.num_timesteps < target:
+    while model is not None and model.num_timesteps < target:
         t0 = time.perf_counter()
         chunk = min(every, -(-(target - model.num_timesteps) // rollout) * rollout)
         start = model.num_timesteps

@@ -62,3 +62,13 @@ def test_a_stored_run_resumes_only_with_its_settings_and_its_own_files(tmp_path)
     res = subprocess.run([sys.executable, str(SCRIPT), *TINY, "--run-dir", str(tmp_path)],
                          capture_output=True, text=True, timeout=300)  # fmt: skip
     assert res.returncode != 0 and "checksum mismatch" in res.stderr
+
+
+def test_a_finished_run_keeps_its_final_policy_lean(tmp_path):
+    _run("--run-dir", str(tmp_path))
+    with zipfile.ZipFile(tmp_path / "ckpt" / "model.zip") as z:
+        names = z.namelist()
+    assert "policy.pth" in names and "policy.optimizer.pth" not in names
+    again = _run("--run-dir", str(tmp_path), "--json")  # finished: nothing trained or rewritten
+    assert "finished" in again.stderr
+    assert json.loads(again.stdout.splitlines()[-1]) == json.loads((tmp_path / "run.json").read_text())
