@@ -1,4 +1,6 @@
-# C scalar types of the engine, in one place (see STYLE.md rule 2).
+# C scalar types of the engine, in one place: the engine's modules take their scalar types
+# from here and declare none of their own (the restrict pointer types are _batch.pxd's);
+# docs/ARCHITECTURE.md, "Folders", lists the engine's files.
 from libc.stdint cimport int8_t, int32_t, int64_t
 
 ctypedef double float64_t      # every physical quantity (SI units)
