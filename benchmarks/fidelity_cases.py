@@ -406,9 +406,53 @@ def fence_cases() -> list[Case]:
     return cases
 
 
+# --------------------------------------------------------------------------------------------
+# Held-out bodies
+# --------------------------------------------------------------------------------------------
+
+#: Counts of the held-out set: plain seed-style draws and draws that contain bone, from
+#: seeds no other set uses (no formulation was tuned on them).
+HELDOUT_COUNTS = dict(plain=64, bone=26)
+
+
+def heldout_bodies() -> list[Case]:
+    """Seed-style random CPPN bodies kept out of every tuning (:data:`HELDOUT_COUNTS`), set ``"heldout"``.
+
+    * ``held_pNN``: ``Individual.random(default_rng([16, 7, NN]))`` under the seed's rules;
+    * ``held_bNN``: the first draws of ``default_rng([16, 8, i])``, i = 0, 1, ..., that
+      contain bone.
+
+    They are the paired fidelity comparison's main sample (``benchmarks/fidelity_seed.py
+    --paired``): a formulation change is judged on bodies it was not developed on.
+    """
+    cases = []
+    for n in range(HELDOUT_COUNTS["plain"]):
+        ind = _random_individual((16, 7, n))
+        cases.append(
+            _random_case(f"held_p{n:02d}", "heldout", ind, seed=[16, 7, n], rules="seed", mutations=0)
+        )
+    i = found = 0
+    while found < HELDOUT_COUNTS["bone"]:
+        ind = _random_individual((16, 8, i))
+        if (ind.grid() == BONE).any():
+            cases.append(
+                _random_case(
+                    f"held_b{found:02d}", "heldout", ind, seed=[16, 8, i], rules="seed", mutations=0
+                )
+            )
+            found += 1
+        i += 1
+    return cases
+
+
 def case_sets() -> dict[str, list[Case]]:
-    """``{"structured": [...], "random": [...], "fence": [...]}``."""
-    return {"structured": structured_bodies(), "random": random_bodies(), "fence": fence_cases()}
+    """``{"structured": [...], "random": [...], "fence": [...], "heldout": [...]}``."""
+    return {
+        "structured": structured_bodies(),
+        "random": random_bodies(),
+        "fence": fence_cases(),
+        "heldout": heldout_bodies(),
+    }
 
 
 def all_cases(sets: Iterable[str] = ("structured", "random", "fence")) -> list[Case]:

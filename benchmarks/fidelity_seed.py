@@ -36,6 +36,21 @@ oracle's sample steps, as a fraction of the oracle's displacement scale).
     python benchmarks/fidelity_seed.py --first-draw 10      # softgym's draws 10-18: other samples
     python benchmarks/fidelity_seed.py --samples 1          # one sample (draws 1-3)
 
+The paired comparison of two formulations (presets or builds) on the same cases and
+draws, against the seed's engine (``softgym.fidelity.paired_comparison``: bootstrap
+confidence intervals on the differences and a non-inferiority verdict)::
+
+    python benchmarks/fidelity_seed.py --paired single double            # runs what is missing
+    SOFTGYM_KERNEL=baseline python benchmarks/fidelity_seed.py --record baseline
+    python benchmarks/fidelity_seed.py --paired baseline double --samples 3
+
+Labels ``single``, ``double`` (the seed model's link precisions) and ``corotational`` are
+presets run on demand with the kernel build in use; any other label is what ``--record
+LABEL`` stored (the current ``--model`` / ``--link-precision`` and kernel build). Values
+(one per case, regime and draw) go to ``--store`` (default
+``benchmarks/data/fidelity_paired/values.json``, resumable: stored values are not run
+again); the comparison to ``--report-out`` (default ``comparison.json`` beside it).
+
 Values under 0.01 voxel lengths are raised to 0.01 before ratios are taken (a
 body that stays put in both engines agrees, whatever its 1e-4 wobble).
 """
@@ -57,19 +72,30 @@ sys.path.insert(0, str(HERE))
 
 import fidelity_cases as fc  # noqa: E402
 
-from softgym.engine import SimConfig, Simulation  # noqa: E402
+from softgym.engine import SimConfig, Simulation, kernel_build  # noqa: E402
 from softgym.fidelity import (  # noqa: E402
     METRIC,
+    PAIRED_MARGINS,
     SOFTGYM_METRIC,
     fence_terrain,
     mean_figures,
     micro_trace,
+    paired_comparison,
     sample_draws,
     targets_met,
 )
+from softgym.io import atomic_write_json, read_json  # noqa: E402
 from softgym.metrics import dilute, walk_metrics  # noqa: E402
 
 DATA = HERE / "data" / "seed_engine"
+PAIRED = HERE / "data" / "fidelity_paired"
+#: Labels the paired comparison runs on demand: SimConfig fields of each.
+PRESETS: dict[str, dict[str, Any]] = {
+    "single": {"model": "seed", "link_precision": "single"},
+    "double": {"model": "seed", "link_precision": "double"},
+    "corotational": {"model": "corotational", "link_precision": None},
+}
+ALL_SETS = "heldout,structured,random,fence"
 FLOOR = 0.01  # voxel lengths: smaller distances count as "stays put"
 MOVES = 1.0  # voxel lengths: a body "moves"
 ORACLE_HALVES = ((1, 2, 3), (4, 5, 6))  # perturbed oracle draws split in two halves
@@ -197,12 +223,185 @@ def compare(cases, oracle, ours, groups, terrain: str = "flat",
     return report
 
 
+# ------------------------------------------------------------------- paired comparison
+def _key(case: str, regime: str, draw: int) -> str:
+    return f"{case}|{regime}|{draw}"
+
+
+def _git_commit() -> str:
+    import subprocess
+
+    try:
+        out = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=HERE, capture_output=True,
+                             text=True, timeout=10)  # fmt: skip
+        return out.stdout.strip() or "unknown"
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+
+
+def load_store(path: Path) -> dict[str, Any]:
+    """The stored per-draw values of every label (an empty store if the file is absent)."""
+    if not path.exists():
+        return {"header": {"what": "softgym's metric per (case, regime, draw) for each label of "
+                                   "benchmarks/fidelity_seed.py's paired comparison",
+                           "key": "case|regime|draw", "value": "NormFinalDist on flat ground, "
+                           "MaxXYDist (the seed's diluted centre of mass) on the fence; null: diverged"},
+                "labels": {}}  # fmt: skip
+    data = read_json(path)
+    if not isinstance(data, dict) or not isinstance(data.get("labels"), dict):
+        raise SystemExit(f"{path}: not a paired-comparison store (no 'labels' object)")
+    return data
+
+
+def record(store: dict[str, Any], path: Path, labels: dict[str, SimConfig], cases: list[Any],
+           draws: list[int], threads: int | None, chunk: int = 48) -> dict[str, int]:  # fmt: skip
+    """Run each label's config on every (case, regime, draw) it lacks, the labels side by
+    side (set by set, the first set first; regime, terrain), storing after each chunk.
+    Returns the runs added per label."""
+    for label, cfg in labels.items():
+        entry = store["labels"].setdefault(label, {"values": {}})
+        conf = {"model": cfg.model, "link_precision": cfg.effective_link_precision,
+                "kernel": kernel_build()}  # fmt: skip
+        old = entry.get("config")
+        if old and old != conf:
+            raise SystemExit(f"label {label!r} was stored with {old}, this run is {conf}: "
+                             "use another label or another --store")  # fmt: skip
+        entry["config"] = conf
+        entry.setdefault("commits", [])
+        if _git_commit() not in entry["commits"]:
+            entry["commits"].append(_git_commit())
+    n_run = dict.fromkeys(labels, 0)
+    sets = list(dict.fromkeys(c.set for c in cases))
+    for set_, regime, terrain in ((s, r, t) for s in sets for r in fc.REGIMES for t in ("flat", "fence")):
+        todo = [(c, d) for c in cases if c.terrain == terrain and c.set == set_ for d in draws]
+        world = fence_terrain() if terrain == "fence" else None
+        for start in range(0, len(todo), chunk):
+            for label, cfg in labels.items():
+                values = store["labels"][label]["values"]
+                part = [(c, d) for c, d in todo[start:start + chunk]
+                        if _key(c.name, regime, d) not in values]  # fmt: skip
+                if not part:
+                    continue
+                designs = [fc.case_design(c, regime, d) for c, d in part]
+                r = Simulation(designs, cfg, n_threads=threads, terrain=world).run(5.0)
+                if terrain == "fence":
+                    r = dilute(r)
+                got = walk_metrics(r)[SOFTGYM_METRIC[METRIC[terrain]]]
+                for (c, d), v, div in zip(part, got, r.diverged):
+                    values[_key(c.name, regime, d)] = None if div or not math.isfinite(v) else float(v)
+                n_run[label] += len(part)
+                atomic_write_json(path, store)
+                print(f"  {label}: {set_} {regime} {terrain} {min(start + chunk, len(todo))}/{len(todo)}",
+                      flush=True)  # fmt: skip
+    return n_run
+
+
+def paired_tables(store: dict[str, Any], a: str, b: str, cases: list[Any], oracle: dict,
+                  groups: list[list[int]], oracle_draws: tuple[int, ...],
+                  n_resamples: int = 4000) -> dict[str, Any]:  # fmt: skip
+    """Label ``a`` against ``b`` per terrain and regime, on the held-out cases and on all,
+    and pooled over the regimes (:func:`softgym.fidelity.paired_comparison`)."""
+    va, vb = store["labels"][a]["values"], store["labels"][b]["values"]
+    out: dict[str, Any] = {}
+    for terrain in ("flat", "fence"):
+        for subset in ("heldout", "all"):
+            chosen = [c for c in cases if c.terrain == terrain and (subset == "all" or c.set == "heldout")]
+            pooled: list[tuple[Any, Any, float]] = []
+            for regime in list(fc.REGIMES) + ["pooled"]:
+                if regime == "pooled":
+                    rows = pooled
+                else:
+                    rows, skipped = [], 0
+                    for c in chosen:
+                        ref = [oracle.get((c.name, regime, d), np.nan) for d in oracle_draws]
+                        xa = [[va.get(_key(c.name, regime, d)) for d in g] for g in groups]
+                        xb = [[vb.get(_key(c.name, regime, d)) for d in g] for g in groups]
+                        flat = [x for g in xa + xb for x in g]
+                        if np.isnan(ref).any() or any(x is None for x in flat):
+                            skipped += 1
+                            continue
+                        rows.append(([float(np.median(g)) for g in xa], [float(np.median(g)) for g in xb],
+                                     float(np.median(ref))))  # fmt: skip
+                    pooled += rows
+                if len(rows) < 3:
+                    continue
+                xa_, xb_, ref_ = (np.array(x) for x in zip(*rows))
+                res = paired_comparison(xa_, xb_, ref_, n_resamples=n_resamples)
+                if regime != "pooled":
+                    res["skipped"] = skipped
+                out.setdefault(terrain, {}).setdefault(subset, {})[regime] = res
+    return out
+
+
+def print_paired(report: dict[str, Any], a: str, b: str) -> None:
+    print(f"paired comparison: {a!r} (A) against {b!r} (B), on the same cases and draws; loss = A "
+          f"farther from the seed's engine than B (95 % BCa bootstrap interval over cases); "
+          f"margins {PAIRED_MARGINS}")  # fmt: skip
+    print(f"{'terrain':7s} {'cases':8s} {'regime':7s} {'n':>4s} {'|log10| A/B':>13s} {'loss [95 % CI]':>24s}"
+          f" {'rank corr A/B':>14s} {'loss [95 % CI]':>24s} {'<=2x A/B':>10s} {'loss [95 % CI]':>24s}"
+          f" {'A/B wins':>9s}  verdict")  # fmt: skip
+    for terrain, subsets in report.items():
+        for subset, regimes in subsets.items():
+            for regime, r in regimes.items():
+                f = r["figures"]
+                cells = []
+                for key, fmt in (("abs_log10", "{:.3f}"), ("spearman", "{:.3f}"), ("within_2x", "{:.0%}")):
+                    x = f[key]
+                    cells.append(f"{fmt.format(x['a'])}/{fmt.format(x['b'])}".rjust(13 if key == 'abs_log10' else 14 if key == 'spearman' else 10))
+                    cells.append(f"{x['loss']:+.3f} [{x['low']:+.3f}, {x['high']:+.3f}]".rjust(24))
+                verdict = "no loss" if r["no_loss"] else "LOSS NOT RULED OUT"
+                print(f"{terrain:7s} {subset:8s} {regime:7s} {r['n_cases']:4d} {' '.join(cells)} "
+                      f"{r['wins']['a']:>4d}/{r['wins']['b']:<4d}  {verdict}")  # fmt: skip
+
+
+def paired_main(a, labels: list[str]) -> int:
+    store_path = Path(a.store)
+    store = load_store(store_path)
+    sets = [s for s in a.sets.split(",") if s]
+    cases, oracle = load_oracle(sets)
+    if a.quick:
+        by_set: dict[str, list] = {}
+        for c in cases:
+            by_set.setdefault(c.set, []).append(c)
+        cases = [c for cs in by_set.values() for c in cs[:12]]
+    groups = sample_draws(a.first_draw, a.draws, a.samples)
+    draws = [d for g in groups for d in g]
+    if a.record:
+        cfg = SimConfig(model=a.model, link_precision=a.link_precision)
+        n = record(store, store_path, {a.record: cfg}, cases, draws, a.threads)
+        print(f"label {a.record!r}: {n[a.record]} runs added to {store_path}")
+        return 0
+    for label in labels:
+        if label not in PRESETS and label not in store["labels"]:
+            raise SystemExit(f"label {label!r} is neither a preset ({', '.join(PRESETS)}) nor stored "
+                             f"in {store_path}: record it with --record {label}")  # fmt: skip
+    presets = {x: SimConfig(**PRESETS[x]) for x in labels if x in PRESETS}
+    for label, n in record(store, store_path, presets, cases, draws, a.threads).items():
+        if n:
+            print(f"label {label!r}: {n} runs added to {store_path}")
+    oracle_draws = tuple(int(x) for x in a.oracle_draws.split(","))
+    report = {"a": labels[0], "b": labels[1], "sets": sets, "draws": groups, "oracle_draws": oracle_draws,
+              "margins": PAIRED_MARGINS,
+              "configs": {x: store["labels"][x].get("config") for x in labels},
+              "commits": {x: store["labels"][x].get("commits") for x in labels},
+              "tables": paired_tables(store, labels[0], labels[1], cases, oracle, groups, oracle_draws,
+                                      a.resamples)}  # fmt: skip
+    print_paired(report["tables"], labels[0], labels[1])
+    out = Path(a.report_out) if a.report_out else store_path.parent / "comparison.json"
+    atomic_write_json(out, report)
+    print(f"comparison written to {out}")
+    if a.json:
+        print(json.dumps(report))
+    return 0
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--model", default="seed", choices=["seed", "corotational"])
     ap.add_argument("--link-precision", default=None, choices=["double", "single"],
                     help="SimConfig.link_precision of the seed model")
-    ap.add_argument("--sets", default="structured,random,fence")
+    ap.add_argument("--sets", default=None,
+                    help="case sets (default: structured,random,fence; paired: with heldout too)")
     ap.add_argument("--draws", type=int, default=3,
                     help="perturbed softgym draws per case and sample (>= 3)")
     ap.add_argument("--samples", type=int, default=3,
@@ -220,13 +419,27 @@ def main() -> int:
     ap.add_argument("--halves", default="1,2,3/4,5,6",
                     help="oracle draws of the two halves (a preview on partial data: 0/1)")
     ap.add_argument("--json", action="store_true")
+    ap.add_argument("--paired", nargs=2, metavar=("A", "B"),
+                    help="compare label A against label B on the same cases and draws (presets: "
+                         f"{', '.join(PRESETS)}; others from --record)")
+    ap.add_argument("--record", metavar="LABEL",
+                    help="store this build's and --model / --link-precision's values under LABEL")
+    ap.add_argument("--store", default=str(PAIRED / "values.json"),
+                    help="the paired comparison's values file")
+    ap.add_argument("--report-out", default=None, help="where the comparison JSON goes")
+    ap.add_argument("--oracle-draws", default="0,1,2,3,4,5,6",
+                    help="the seed's engine's draws whose median is each case's reference (paired)")
+    ap.add_argument("--resamples", type=int, default=4000, help="bootstrap resamples (paired)")
     a = ap.parse_args()
     if a.first_draw < 1:
         ap.error("--first-draw must be >= 1")
     if a.samples < 1 or a.draws < 1:
         ap.error("--samples and --draws must be >= 1")
+    if a.paired or a.record:
+        a.sets = a.sets or ALL_SETS
+        return paired_main(a, list(a.paired or []))
     t0 = time.perf_counter()
-    sets = [s for s in a.sets.split(",") if s]
+    sets = [s for s in (a.sets or "structured,random,fence").split(",") if s]
     cases, oracle = load_oracle(sets)
     if a.quick:
         by_set: dict[str, list] = {}

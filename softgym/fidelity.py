@@ -24,7 +24,11 @@ data and the tests (``tests/engine/test_seed_oracle.py``):
 * :func:`sample_draws`, :func:`mean_figures`, :func:`targets_met`: softgym's draws in
   samples of the oracle halves' size, the samples' figures averaged, and the targets
   judged on that mean (one sample's strong-regime figures move as much as any change of
-  bits moves them).
+  bits moves them);
+* :func:`paired_comparison` and :data:`PAIRED_MARGINS`: two formulations (presets,
+  builds) run on the same cases and draws, each case's distance from the seed's engine
+  compared in pairs, with bootstrap confidence intervals on the differences and a
+  non-inferiority verdict: whether "this change costs no fidelity" holds.
 
 The statistics of one sample (rank correlation against the engine's own
 self-agreement, the within-2x share, moved-vs-still mismatches) live in
@@ -35,6 +39,8 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -64,6 +70,7 @@ __all__ = [
     "load_evolved",
     "mean_figures",
     "micro_trace",
+    "paired_comparison",
     "perturb",
     "perturbed_voxel",
     "sample_draws",
@@ -355,4 +362,189 @@ def targets_met(soft: dict[str, float], self_: dict[str, float]) -> dict[str, bo
         "spearman": bool(soft["spearman"] >= 0.9 * self_["spearman"]),
         "within_2x": bool(soft["within_2x"] >= 0.9 * self_["within_2x"]),
         "moved_vs_still": bool(soft["moved_vs_still"] == 0),
+    }
+
+
+#: Non-inferiority margins of :func:`paired_comparison`: how much worse than formulation B
+#: formulation A may be and still "cost no fidelity". ``abs_log10``: the mean per-case
+#: |log10(softgym / seed engine)| (0.02 is a 4.7 % larger typical ratio); ``spearman``: the
+#: rank correlation with the seed's engine; ``within_2x``: the share of cases within a
+#: factor 2 of it.
+PAIRED_MARGINS: dict[str, float] = {"abs_log10": 0.02, "spearman": 0.02, "within_2x": 0.03}
+
+
+def _ranks(x: np.ndarray) -> np.ndarray:
+    from scipy.stats import rankdata
+
+    return rankdata(x, axis=-1)
+
+
+def _pearson(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    x = x - x.mean(axis=-1, keepdims=True)
+    y = y - y.mean(axis=-1, keepdims=True)
+    den = np.sqrt((x * x).sum(axis=-1) * (y * y).sum(axis=-1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(den > 0, (x * y).sum(axis=-1) / np.where(den > 0, den, 1.0), np.nan)
+
+
+def paired_comparison(
+    a,
+    b,
+    reference,
+    *,
+    floor: float = 0.01,
+    margins: dict[str, float] | None = None,
+    confidence: float = 0.95,
+    n_resamples: int = 4000,
+    seed: int = 0,
+) -> dict[str, Any]:
+    """Formulation A against formulation B, paired on the same cases and draws.
+
+    Each case's distance (voxel lengths) is its median over a sample of perturbed draws;
+    both formulations ran the same draws of the same cases, so case difficulty and the
+    draws cancel in the differences. Three figures, each as A's *loss* against B
+    (positive: A is farther from the seed's engine):
+
+    * ``abs_log10``: mean over cases of A's |log10(A / ref)| minus B's (each case's error
+      is its mean over the samples);
+    * ``spearman``: B's rank correlation with the reference minus A's (each the mean over
+      the samples; ties get average ranks);
+    * ``within_2x``: B's share of (case, sample) pairs within 2x of the reference minus A's.
+
+    Confidence intervals come from :func:`scipy.stats.bootstrap` (BCa, resampling cases
+    with their pairs). A *costs no fidelity* against B on a figure when the interval's
+    upper end is at most that figure's margin (a non-inferiority test); ``"better"`` /
+    ``"worse"`` when the interval excludes 0.
+
+    Parameters
+    ----------
+    a, b : array_like of shape (n_cases, n_samples)
+        Per case and sample, the median distance of formulation A / B.
+    reference : array_like of shape (n_cases,)
+        The seed's engine's per-case distance (e.g. the median of its draws).
+    floor : float
+        Distances under it are raised to it before ratios (a body both leave still agrees).
+    margins : dict, optional
+        Non-inferiority margins by figure (default :data:`PAIRED_MARGINS`).
+    confidence : float
+        Confidence level of the intervals, in (0, 1).
+    n_resamples : int
+        Bootstrap resamples (>= 100).
+    seed : int
+        Seed of the bootstrap's random generator.
+
+    Returns
+    -------
+    dict
+        ``n_cases``, ``n_samples``, per figure ``{"a", "b", "loss", "low", "high",
+        "margin", "no_loss", "direction"}`` under ``figures``, ``wins`` (cases where A's
+        error is smaller, larger, equal), and ``no_loss`` (every figure non-inferior).
+
+    Raises
+    ------
+    InvalidParameterError
+        For shapes that differ, fewer than 3 cases, non-finite or negative distances, or
+        a confidence, resample count or margin out of range.
+    """
+    from scipy.stats import bootstrap
+
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    ref = np.asarray(reference, dtype=np.float64)
+    if a.ndim == 1:
+        a = a[:, None]
+    if b.ndim == 1:
+        b = b[:, None]
+    if a.ndim != 2 or a.shape != b.shape or ref.shape != (a.shape[0],):
+        raise InvalidParameterError(
+            f"paired_comparison needs a and b of one shape (n_cases, n_samples) and a "
+            f"reference of shape (n_cases,), got {a.shape}, {b.shape} and {ref.shape}"
+        )
+    if a.shape[0] < 3 or a.shape[1] < 1:
+        raise InvalidParameterError(
+            f"paired_comparison needs at least 3 cases and 1 sample, got {a.shape}"
+        )
+    for name, x in (("a", a), ("b", b), ("reference", ref)):
+        if not np.all(np.isfinite(x)) or np.any(x < 0):
+            raise InvalidParameterError(f"paired_comparison: {name} must be finite distances >= 0")
+    if not 0.0 < float(confidence) < 1.0:
+        raise InvalidParameterError(f"confidence must be in (0, 1), got {confidence!r}")
+    if int(n_resamples) < 100:
+        raise InvalidParameterError(f"n_resamples must be >= 100, got {n_resamples!r}")
+    if not (isinstance(floor, (int, float)) and math.isfinite(floor) and floor > 0):
+        raise InvalidParameterError(f"floor must be a number > 0, got {floor!r}")
+    marg = dict(PAIRED_MARGINS)
+    marg.update(margins or {})
+    for k, v in marg.items():
+        if k not in PAIRED_MARGINS or not (math.isfinite(float(v)) and float(v) >= 0):
+            raise InvalidParameterError(
+                f"margins: keys in {sorted(PAIRED_MARGINS)} with values >= 0, got {k!r}: {v!r}"
+            )
+    n, s = a.shape
+    la = np.log10(np.maximum(a, floor) / np.maximum(ref, floor)[:, None])
+    lb = np.log10(np.maximum(b, floor) / np.maximum(ref, floor)[:, None])
+    ea, eb = np.abs(la), np.abs(lb)
+    wa = (ea <= math.log10(2.0)).mean(axis=1)
+    wb = (eb <= math.log10(2.0)).mean(axis=1)
+    lref = np.log10(np.maximum(ref, floor))
+
+    def figures(ea_, eb_, wa_, wb_, la_, lb_, lref_, axis=-1):
+        # la_, lb_: (..., n, s) moved to (..., s, n) for the per-sample correlations
+        ra = _ranks(np.moveaxis(la_ + lref_[..., None], -2, -1))
+        rb = _ranks(np.moveaxis(lb_ + lref_[..., None], -2, -1))
+        rr = _ranks(lref_)[..., None, :]
+        rho_a = _pearson(ra, np.broadcast_to(rr, ra.shape)).mean(axis=-1)
+        rho_b = _pearson(rb, np.broadcast_to(rr, rb.shape)).mean(axis=-1)
+        return np.stack([ea_.mean(axis=-1) - eb_.mean(axis=-1), rho_b - rho_a,
+                         wb_.mean(axis=-1) - wa_.mean(axis=-1), rho_a, rho_b])
+
+    point = figures(ea.mean(axis=1), eb.mean(axis=1), wa, wb, la, lb, lref)
+
+    def statistic(ea_, eb_, wa_, wb_, ia, axis=-1):
+        # ia: resampled case indices (float), to gather the per-sample rows
+        idx = ia.astype(np.intp)
+        return figures(ea_, eb_, wa_, wb_, la[idx], lb[idx], lref[idx])[:3]
+
+    data = (ea.mean(axis=1), eb.mean(axis=1), wa, wb, np.arange(n, dtype=np.float64))
+    losses = point[:3]
+    if np.allclose(ea, eb) and np.allclose(wa, wb) and np.allclose(la, lb):
+        low = high = losses.copy()  # identical results: no interval to draw
+    else:
+        with warnings.catch_warnings():  # an undefined BCa interval falls back below
+            warnings.simplefilter("ignore")
+            res = bootstrap(data, statistic, paired=True, vectorized=True,
+                            n_resamples=int(n_resamples), confidence_level=float(confidence),
+                            method="BCa", random_state=np.random.default_rng(int(seed)))  # fmt: skip
+        low, high = (np.asarray(res.confidence_interval.low, dtype=np.float64),
+                     np.asarray(res.confidence_interval.high, dtype=np.float64))  # fmt: skip
+        bad = ~(np.isfinite(low) & np.isfinite(high))
+        if bad.any():  # BCa undefined (a degenerate figure): the percentile interval
+            res = bootstrap(data, statistic, paired=True, vectorized=True,
+                            n_resamples=int(n_resamples), confidence_level=float(confidence),
+                            method="percentile", random_state=np.random.default_rng(int(seed)))  # fmt: skip
+            low = np.where(bad, res.confidence_interval.low, low)
+            high = np.where(bad, res.confidence_interval.high, high)
+    values = {
+        "abs_log10": (float(ea.mean()), float(eb.mean())),
+        "spearman": (float(point[3]), float(point[4])),
+        "within_2x": (float(wa.mean()), float(wb.mean())),
+    }
+    out_fig = {}
+    for i, key in enumerate(("abs_log10", "spearman", "within_2x")):
+        lo, hi = float(low[i]), float(high[i])
+        out_fig[key] = {
+            "a": values[key][0], "b": values[key][1], "loss": float(losses[i]),
+            "low": lo, "high": hi, "margin": float(marg[key]),
+            "no_loss": bool(hi <= marg[key]),
+            "direction": "worse" if lo > 0 else ("better" if hi < 0 else "no difference shown"),
+        }  # fmt: skip
+    per_case = ea.mean(axis=1) - eb.mean(axis=1)
+    return {
+        "n_cases": int(n),
+        "n_samples": int(s),
+        "confidence": float(confidence),
+        "figures": out_fig,
+        "wins": {"a": int(np.sum(per_case < 0)), "b": int(np.sum(per_case > 0)),
+                 "tie": int(np.sum(per_case == 0))},  # fmt: skip
+        "no_loss": all(f["no_loss"] for f in out_fig.values()),
     }

@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 from softgym.design.robot import RobotDesign
 from softgym.exceptions import InvalidDesignError, InvalidParameterError
 from softgym.fidelity import (
+    PAIRED_MARGINS,
     PERTURBATION,
     REGIMES,
     case_design,
@@ -20,6 +21,7 @@ from softgym.fidelity import (
     check_grid,
     load_evolved,
     mean_figures,
+    paired_comparison,
     perturb,
     perturbed_voxel,
     sample_draws,
@@ -152,3 +154,105 @@ def test_the_fidelity_benchmark_refuses_empty_samples():
     res = _fidelity_cli("--samples", "0")
     assert res.returncode == 2
     assert "--samples and --draws must be >= 1" in res.stderr
+
+
+# ------------------------------------------------------------------ paired comparison
+def _pairs(seed=1, n=150, s=3, noise_a=0.2, noise_b=0.4):
+    rng = np.random.default_rng(seed)
+    ref = np.exp(rng.normal(size=n))
+    a = ref[:, None] * np.exp(rng.normal(scale=noise_a, size=(n, s)))
+    b = ref[:, None] * np.exp(rng.normal(scale=noise_b, size=(n, s)))
+    return a, b, ref
+
+
+def test_the_paired_comparison_finds_the_formulation_closer_to_the_seed_engine():
+    a, b, ref = _pairs()
+    res = paired_comparison(a, b, ref, n_resamples=1000)
+    assert res["n_cases"] == 150 and res["n_samples"] == 3
+    for key, fig in res["figures"].items():
+        assert fig["high"] < 0, key  # A better on every figure
+        assert fig["direction"] == "better" and fig["no_loss"]
+        assert fig["low"] <= fig["loss"] <= fig["high"]
+    assert res["no_loss"] and res["wins"]["a"] > res["wins"]["b"]
+    worse = paired_comparison(b, a, ref, n_resamples=1000)
+    assert not worse["no_loss"]
+    assert all(f["direction"] == "worse" and not f["no_loss"] for f in worse["figures"].values())
+    # the figures are A's and B's own: |log10| errors and rank correlations
+    fa = res["figures"]
+    assert fa["abs_log10"]["a"] == pytest.approx(np.abs(np.log10(a / ref[:, None])).mean())
+    assert fa["spearman"]["a"] > fa["spearman"]["b"]
+
+
+def test_identical_formulations_cost_nothing_and_near_ones_fall_within_the_margins():
+    a, _, ref = _pairs()
+    same = paired_comparison(a, a.copy(), ref)
+    for fig in same["figures"].values():
+        assert fig["loss"] == 0.0 and fig["low"] == fig["high"] == 0.0 and fig["no_loss"]
+    # a change of the last bits moves a few cases a little: no loss beyond the margins
+    rng = np.random.default_rng(3)
+    near = a * np.exp(rng.normal(scale=1e-3, size=a.shape))
+    res = paired_comparison(near, a, ref, n_resamples=1000)
+    assert res["no_loss"]
+    assert all(abs(f["loss"]) < PAIRED_MARGINS[k] for k, f in res["figures"].items())
+    # a margin of 0 asks for proof that A is at least as good
+    strict = paired_comparison(near, a, ref, n_resamples=1000, margins={"abs_log10": 0.0})
+    assert strict["figures"]["abs_log10"]["margin"] == 0.0
+
+
+def test_bodies_both_formulations_leave_still_agree_with_the_seed_engine():
+    ref = np.array([1e-4, 2.0, 3.0, 5.0])
+    a = np.array([[3e-3], [2.0], [3.0], [5.0]])
+    res = paired_comparison(a, a * [[1.0], [1.0], [1.0], [1.0]], ref)
+    assert res["figures"]["abs_log10"]["a"] == 0.0  # 3e-3 and 1e-4 both floored to 0.01
+    assert res["figures"]["within_2x"]["a"] == 1.0
+
+
+def test_the_paired_comparison_refuses_what_it_cannot_compare():
+    a, b, ref = _pairs(n=10)
+    with pytest.raises(InvalidParameterError, match="one shape"):
+        paired_comparison(a, b[:, :2], ref)
+    with pytest.raises(InvalidParameterError, match="one shape"):
+        paired_comparison(a, b, ref[:5])
+    with pytest.raises(InvalidParameterError, match="at least 3 cases"):
+        paired_comparison(a[:2], b[:2], ref[:2])
+    bad = a.copy()
+    bad[0, 0] = np.nan
+    with pytest.raises(InvalidParameterError, match="finite distances"):
+        paired_comparison(bad, b, ref)
+    with pytest.raises(InvalidParameterError, match="finite distances"):
+        paired_comparison(a, b, -ref)
+    with pytest.raises(InvalidParameterError, match="confidence must be in"):
+        paired_comparison(a, b, ref, confidence=1.0)
+    with pytest.raises(InvalidParameterError, match="n_resamples must be"):
+        paired_comparison(a, b, ref, n_resamples=10)
+    with pytest.raises(InvalidParameterError, match="margins"):
+        paired_comparison(a, b, ref, margins={"speed": 0.1})
+    with pytest.raises(InvalidParameterError, match="floor"):
+        paired_comparison(a, b, ref, floor=0.0)
+
+
+def test_the_fidelity_benchmark_records_labels_and_compares_them_in_pairs(tmp_path):
+    store = tmp_path / "values.json"
+    common = ("--sets", "structured", "--quick", "--samples", "1", "--draws", "1", "--store", str(store))
+    res = _fidelity_cli("--record", "mine", *common)
+    assert res.returncode == 0, res.stderr
+    assert "36 runs added" in res.stdout  # 12 cases x 3 regimes x 1 draw
+    data = json.loads(store.read_text())
+    mine = data["labels"]["mine"]
+    assert mine["config"]["link_precision"] == "single" and len(mine["values"]) == 36
+    assert "cube_active_minus|medium|1" in mine["values"] or all("|1" in k for k in mine["values"])
+    again = _fidelity_cli("--record", "mine", *common)
+    assert again.returncode == 0 and "0 runs added" in again.stdout  # stored values are not rerun
+    clash = _fidelity_cli("--record", "mine", "--link-precision", "double", *common)
+    assert clash.returncode != 0 and "was stored with" in clash.stderr
+    res = _fidelity_cli("--paired", "mine", "double", "--resamples", "200", "--json", *common)
+    assert res.returncode == 0, res.stderr
+    report = json.loads(res.stdout.strip().splitlines()[-1])
+    assert report["a"] == "mine" and report["b"] == "double"
+    assert report["configs"]["double"]["link_precision"] == "double"
+    table = report["tables"]["flat"]["all"]
+    assert set(table) >= {"gentle", "medium", "strong", "pooled"}
+    assert table["pooled"]["n_cases"] == sum(table[r]["n_cases"] for r in ("gentle", "medium", "strong"))
+    assert (tmp_path / "comparison.json").exists()
+    unknown = _fidelity_cli("--paired", "nobody", "double", *common)
+    assert unknown.returncode != 0 and "--record nobody" in unknown.stderr

@@ -46,7 +46,7 @@ import fidelity_cases as fc  # noqa: E402
 from softgym.design.robot import RobotDesign  # noqa: E402
 from softgym.design.vxa import to_vxa  # noqa: E402
 
-SETS = ("structured", "random", "fence")
+SETS = ("structured", "random", "fence", "heldout")
 TRACE_DT = 0.1
 METRICS = ("NormFinalDist", "MaxXYDist", "TimeMaxXYDist", "LCoefficient")
 _NO_BCS = "<Fixed_Regions><NumFixed>0</NumFixed></Fixed_Regions>"
