@@ -96,3 +96,10 @@ def test_rl_table_prints_every_task_and_draws_the_curves(tmp_path):
     assert "| flat | 3 |" in text and "4.56 [4.45, 4.73]" in text
     evolved = json.loads((DATA / "baselines" / "evolved_controllers.json").read_text())
     assert len(evolved["tasks"]) == 16 and evolved["tasks"]["flat"]["evolved_median"] == 4.56
+    # swim's actions; on flat the sampled sinusoid (2.91, all 3 seeds above it) beside the
+    # engine's continuous drive (4.38, 2 of 3 above it)
+    assert "| swim | 1 | temperature (symmetric) |" in text
+    assert "| flat | 3 | contraction |" in text and "| 3/3 | 2.91 | 2/3 | 4.38 |" in text
+    # the engine of each run: its commit, or the commits that stored it
+    for d in (DATA / "ppo").glob("*/run.json"):
+        assert f"  {d.parent.name}: " in text
