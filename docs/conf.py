@@ -35,6 +35,12 @@ autodoc_default_options = {"show-inheritance": True}
 napoleon_google_docstring = False
 napoleon_numpy_docstring = True
 napoleon_use_rtype = False
+# the env docstrings' Gymnasium sections (Gymnasium's cartpole: Description, Action Space,
+# ... Version History), rendered as headed sections like numpydoc's Notes
+napoleon_custom_sections = [
+    "Description", "Action Space", "Observation Space", "Rewards", "Starting State",
+    "Episode End", "Info", "Version History",
+]  # fmt: skip
 nitpicky = False
 # An unqualified name in a numpydoc type ("ndarray, shape (n, 3)", "Terrain") may match an
 # object documented both where it is defined and where a package re-exports it: Sphinx
@@ -57,22 +63,6 @@ def _physics_in_toctree(app, docname, source):
         )
 
 
-# Docstrings that are not yet valid reStructuredText (Markdown tables, unbalanced
-# backquotes), in modules this site's writer does not own: shown verbatim as literal
-# blocks, so the build stays strict everywhere else. Fix the docstring, then drop it here.
-NOT_YET_RST = {
-    "softgym.envs.walker.SoftWalkerEnv",
-    "softgym.envs.vector.SoftWalkerVectorEnv",
-}
-
-
-def _verbatim_if_not_rst(app, what, name, obj, options, lines):
-    qualname = f"{getattr(obj, '__module__', '')}.{getattr(obj, '__qualname__', '')}"
-    if qualname in NOT_YET_RST and lines:
-        lines[:] = ["::", "", *(f"    {line}" for line in lines), ""]
-
-
 def setup(app):
     """Sphinx hooks of this configuration."""
     app.connect("source-read", _physics_in_toctree)
-    app.connect("autodoc-process-docstring", _verbatim_if_not_rst)

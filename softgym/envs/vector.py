@@ -64,14 +64,13 @@ class SoftWalkerVectorEnv(VectorEnv):
     Parameters
     ----------
     num_envs : int
-        Number of robots, 1..:data:`MAX_NUM_ENVS` (not a bool or float).
+        Number of robots, from 1 to :data:`MAX_NUM_ENVS` (not a bool or float).
     designs : sequence of RobotDesign or paths, optional
         One design per robot (they may differ; each must fit ``grid_shape``).
     design : RobotDesign or path, optional
         One design for every robot (default: the embedded walker). Give
         ``design`` or ``designs``, not both.
-    task, episode_seconds, control_dt, actuation, self_collision, grid_shape,
-    sim_config, terrain, render_mode, width, height, drive, action_mode
+    task, episode_seconds, control_dt, actuation, self_collision, grid_shape, sim_config, terrain, render_mode, width, height, drive, action_mode, observe
         As for :class:`~softgym.envs.walker.SoftWalkerEnv` (a ``terrain``
         is the same world for every robot).
     n_threads : int, optional

@@ -242,8 +242,8 @@ def check_temperatures(fraction: Any, shape: tuple[int, ...]) -> np.ndarray:
 class SoftWalkerEnv(gym.Env):
     """A 3-D voxel soft robot that must walk, on flat ground, out of a fence or up stairs.
 
-    ## Description
-
+    Description
+    -----------
     One robot (by default the embedded 6x6x6 walker, :func:`~softgym.design.default_walker`)
     is simulated by softgym's lattice engine with the seed study's settings
     (evosoro / Ev-SoftBots: 1 cm voxels, thermal muscles, floor friction,
@@ -287,8 +287,8 @@ class SoftWalkerEnv(gym.Env):
     The spaces depend on ``grid_shape`` only, never on the body, so any two
     bodies of one grid share them (and one vector env can hold both).
 
-    ## Action Space
-
+    Action Space
+    ------------
     ``Box(-1, 1, (nx * ny * nz,), float32)``: one entry per grid cell, in
     C order (x slowest, z fastest: ``action.reshape(grid_shape)[i, j, k]``
     drives voxel ``(i, j, k)``). Entries of empty and passive cells are
@@ -339,17 +339,20 @@ class SoftWalkerEnv(gym.Env):
     error). A refused action, or one holding NaN or infinity, raises
     :class:`~softgym.exceptions.InvalidActionError` before the state is touched.
 
-    ## Observation Space
-
+    Observation Space
+    -----------------
     ``Box(low, high, (6 * nx * ny * nz + 5,), float32)`` (1301 for 6x6x6):
 
-    | Index                          | Observation                                        | Unit                | Bound |
-    |--------------------------------|----------------------------------------------------|---------------------|-------|
-    | ``6 c + 0 .. 6 c + 2``         | cell ``c``'s voxel centre minus the centre of mass (x, y, z) | voxel lengths | +-50 |
-    | ``6 c + 3 .. 6 c + 5``         | cell ``c``'s voxel velocity minus the CM velocity   | voxel lengths / s   | +-500 |
-    | ``6 n .. 6 n + 2``             | centre-of-mass velocity (x, y, z)                  | voxel lengths / s   | +-500 |
-    | ``6 n + 3``                    | ``sin(2 pi t / period)``                           |                     | +-1   |
-    | ``6 n + 4``                    | ``cos(2 pi t / period)``                           |                     | +-1   |
+    ======================  =======================================================  =================  =====
+    index                   observation                                              unit               bound
+    ======================  =======================================================  =================  =====
+    ``6 c + 0 .. 6 c + 2``  cell ``c``'s voxel centre minus the centre of mass       voxel lengths      +-50
+                            (x, y, z)
+    ``6 c + 3 .. 6 c + 5``  cell ``c``'s voxel velocity minus the CM velocity        voxel lengths / s  +-500
+    ``6 n .. 6 n + 2``      centre-of-mass velocity (x, y, z)                        voxel lengths / s  +-500
+    ``6 n + 3``             ``sin(2 pi t / period)``                                                    +-1
+    ``6 n + 4``             ``cos(2 pi t / period)``                                                    +-1
+    ======================  =======================================================  =================  =====
 
     ``c`` is the cell's C-order index, ``n = nx * ny * nz`` (so
     ``obs[:6 * n].reshape(nx, ny, nz, 6)`` is a grid of features); empty cells
@@ -367,8 +370,8 @@ class SoftWalkerEnv(gym.Env):
     :func:`~softgym.tasks.sensing.sensing_layout` ``(task, grid_shape).size``
     values (1747 for push on 6x6x6); each task's page lists them.
 
-    ## Rewards
-
+    Rewards
+    -------
     The per-step progress of the task metric, in voxel lengths: on Flat the
     increase of ``NormFinalDist = |CM_xy(t) - CM_xy(t0)| / L``; on Wall and
     Stairs the increase of ``MaxXYDist = max(|dx|, |dy|) / L`` (the seed's
@@ -379,16 +382,16 @@ class SoftWalkerEnv(gym.Env):
     episode forfeits its progress: the diverging step's reward makes its
     return 0.
 
-    ## Starting State
-
+    Starting State
+    --------------
     The robot is placed with its grid's corner at the origin, at rest on the
     floor, and settles for ``SimConfig.init_time`` (1 s, the seed's
     ``InitCmTime``) with its muscles idle inside :meth:`reset` (the settled
     state is computed once and reused). The start is deterministic: the
     engine has no noise, and ``seed`` only seeds ``np_random``.
 
-    ## Episode End
-
+    Episode End
+    -----------
     * Termination: the robot diverged (non-finite state or runaway strain);
       ``info["diverged"]`` is True. Its state stays frozen. A robot that
       diverges while settling (an unstable design or ``sim_config``) starts
@@ -398,8 +401,8 @@ class SoftWalkerEnv(gym.Env):
       so the episode lasts its seconds whatever ``control_dt``
       (``control_dt=0.005`` gives 800 steps of 4 s).
 
-    ## Info
-
+    Info
+    ----
     The task's metrics (:meth:`softgym.tasks.EpisodeBatch.metrics`, computed by
     :func:`softgym.metrics.walk_metrics_from_arrays` like :func:`softgym.evaluate`'s):
     ``norm_final_dist``, ``max_xy_dist`` (voxel lengths, since the episode
@@ -411,50 +414,77 @@ class SoftWalkerEnv(gym.Env):
     :data:`softgym.metrics.WORST_FITNESS` for the metrics, as the seed does.
     :meth:`reset`'s info also holds ``muscle_mask`` (bool, one per cell).
 
-    ## Arguments
+    Parameters
+    ----------
+    design : RobotDesign, str, os.PathLike or None, default None
+        A :class:`~softgym.design.RobotDesign` or the path of its JSON file; None: the
+        default walker.
+    task : str, Task, Terrain or path, default "flat"
+        A task name (``"flat"``, ``"wall"``, ``"stairs"``...: set by the id), a
+        :class:`softgym.tasks.Task`, a :class:`~softgym.terrain.Terrain` or a terrain
+        JSON file (anything :func:`softgym.tasks.get_task` reads).
+    episode_seconds : float or None, default None
+        Controlled time per episode (s); None: the task's ``seconds`` minus the
+        settling time (4 s: the seed's fitness window).
+    control_dt : float, default 0.05
+        Seconds each action is held (about 78 engine steps of the default walker), a
+        finite number in (0, 10] s.
+    actuation : {"seed", "symmetric"} or None, default None
+        ``"seed"``: muscles only contract; ``"symmetric"``: they also expand. None
+        keeps ``sim_config``'s (the seed's).
+    self_collision : bool or None, default None
+        Voxel-voxel contact within the robot; None keeps ``sim_config``'s (on).
+    grid_shape : sequence of 3 ints, default (6, 6, 6)
+        The lattice the spaces are built on (each 1 to 1000, at most 10^6 cells;
+        floats such as 6.5 are refused); the design must fit in it (placed at its
+        corner).
+    sim_config : SimConfig or None, default None
+        The engine's settings (default the seed's). Its ``trace_interval`` is
+        ignored: the env keeps its own centre-of-mass samples.
+    terrain : Terrain or None, default None
+        A world replacing the task's.
+    render_mode : {"rgb_array"} or None, default None
+        ``"rgb_array"``: :meth:`render` returns an H x W x 3 uint8 frame (see
+        :class:`softgym.render.VoxelRenderer`).
+    width : int, default 320
+        Frame width in pixels, from 1 to 4096.
+    height : int, default 240
+        Frame height in pixels, from 1 to 4096.
+    n_threads : int or None, default 1
+        Engine threads, None or an int from 1 to 1024 (a single robot cannot use
+        more than 1).
+    max_episode_steps : int or None, default None
+        An extra cap on the steps per episode: None or an int from 1 to
+        :data:`softgym.tasks.episode.MAX_STEPS_PER_EPISODE` (not a bool or a float),
+        checked by the env. ``gym.make(id, max_episode_steps=...)`` is different:
+        Gymnasium consumes it for a ``TimeLimit`` wrapper (the ids register none;
+        ``-1`` means none; Gymnasium raises its own TypeError or ValueError for bad
+        values) and the env never receives it; the env's own cap goes through
+        ``SoftWalkerEnv(max_episode_steps=k)`` or ``make_vec``.
+    drive : {"action", "controller"}, default "action"
+        ``"controller"``: the design's own sinusoidal controller drives the muscles
+        as in :func:`softgym.evaluate` and the seed, and actions are ignored (the
+        open-loop baseline; with ``control_dt`` equal to the task's
+        ``trace_interval`` an episode reports exactly ``softgym.evaluate``'s
+        metrics).
+    action_mode : {"contraction", "temperature"} or None, default None
+        See Action Space; None: contraction under the seed's actuation law,
+        temperature under ``"symmetric"``.
+    observe : {"blind", "sensing"}, default "blind"
+        ``"blind"``: the table of Observation Space; ``"sensing"``: every sensor and
+        the task's senses (the ``-Sensing-v0`` ids set it).
 
-    ```python
-    gym.make("SoftWalker-Wall-v0", design=None, episode_seconds=4.0, control_dt=0.05,
-             actuation=None, self_collision=None, grid_shape=(6, 6, 6), render_mode=None,
-             action_mode=None)
-    ```
+    Examples
+    --------
+    >>> import gymnasium as gym
+    >>> import softgym  # registers the ids
+    >>> env = gym.make("SoftWalker-Wall-v0", control_dt=0.05, action_mode="contraction")
+    >>> obs, info = env.reset(seed=0)
+    >>> obs.shape
+    (1301,)
 
-    * ``design``: a :class:`~softgym.design.RobotDesign` or the path of its JSON file; None: the default walker.
-    * ``task``: a task name (``"flat"``, ``"wall"``, ``"stairs"``: set by the id), a
-      :class:`softgym.tasks.Task`, a :class:`~softgym.terrain.Terrain` or a terrain JSON file
-      (anything :func:`softgym.tasks.get_task` reads).
-    * ``episode_seconds``: controlled time per episode; default the task's ``seconds`` minus
-      the settling time (4 s: the seed's fitness window).
-    * ``control_dt``: seconds each action is held (0.05 s, about 78 engine steps of the default
-      walker), a finite number in (0, 10] s.
-    * ``actuation``: ``"seed"`` (muscles only contract) or ``"symmetric"``; None keeps ``sim_config``'s (the seed's).
-    * ``self_collision``: voxel-voxel contact within the robot, a bool; None keeps ``sim_config``'s (on).
-    * ``grid_shape``: the lattice the spaces are built on, 3 ints (each 1..1000, at most 10^6
-      cells; floats such as 6.5 are refused); the design must fit in it (placed at its corner).
-    * ``sim_config``: a :class:`~softgym.engine.SimConfig` (default the seed's). Its
-      ``trace_interval`` is ignored: the env keeps its own centre-of-mass samples.
-    * ``terrain``: a :class:`~softgym.terrain.Terrain` replacing the task's.
-    * ``render_mode``: None or ``"rgb_array"`` (an H x W x 3 uint8 frame, see
-      :class:`softgym.render.VoxelRenderer`); ``width``, ``height``: frame size (320 x 240),
-      ints in 1..4096 pixels.
-    * ``n_threads``: engine threads, None or an int in 1..1024 (1: a single robot cannot use more).
-    * ``max_episode_steps``: an extra cap on the steps per episode: None or an int in
-      1..:data:`softgym.tasks.episode.MAX_STEPS_PER_EPISODE` (not a bool or a float), checked
-      by the env. ``gym.make(id, max_episode_steps=...)`` is different: Gymnasium consumes it
-      for a ``TimeLimit`` wrapper (the ids register none; ``-1`` means none; Gymnasium
-      raises its own TypeError or ValueError for bad values) and the env never receives it;
-      the env's own cap goes through ``SoftWalkerEnv(max_episode_steps=k)`` or ``make_vec``.
-    * ``action_mode``: ``"contraction"``, ``"temperature"`` (see Action Space) or None: contraction
-      under the seed's actuation law, temperature under ``"symmetric"``.
-    * ``observe``: ``"blind"`` (default: the table above) or ``"sensing"`` (every sensor and
-      the task's senses; the ``-Sensing-v0`` ids set it).
-    * ``drive``: ``"action"`` (default) or ``"controller"``: the design's own sinusoidal
-      controller drives the muscles as in :func:`softgym.evaluate` and the seed, and actions
-      are ignored (the open-loop baseline; with ``control_dt`` equal to the task's
-      ``trace_interval`` an episode reports exactly ``softgym.evaluate``'s metrics).
-
-    ## Version History
-
+    Version History
+    ---------------
     * ``-Sensing-v0`` (new ids beside the ``-v0`` ones, which are unchanged): the
       sensing observation (``observe="sensing"``).
 
