@@ -518,7 +518,9 @@ def save_checkpoint(
 
 
 def load_checkpoint(
-    path: str | os.PathLike[str], identity: Mapping[str, Any] | None = None
+    path: str | os.PathLike[str],
+    identity: Mapping[str, Any] | None = None,
+    settings_sha256: str | None = None,
 ) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     """Read and verify a checkpoint written by :func:`save_checkpoint`.
 
@@ -530,6 +532,13 @@ def load_checkpoint(
         The run's identity: a checkpoint that records another identity, or
         none, is refused, whatever its file name (None: no identity is
         checked, for a run folder written before runs had identities).
+    settings_sha256 : str, optional
+        For a run folder without a recorded identity (``identity`` None): the
+        digest of its settings. A checkpoint that records an identity must
+        record these settings (it is then the run's own, written before a kill
+        left the folder without its identity file), and one that records none
+        must be a version-1 record, written before runs had identities; any
+        other is refused.
 
     Returns
     -------
@@ -598,6 +607,22 @@ def load_checkpoint(
             f"{path}: belongs to another run (it records {_describe(recorded)}, "
             f"this run is {_describe(dict(identity))}); it is not resumed"
         )
+    if identity is None and settings_sha256 is not None:
+        if recorded is None and version >= 2:
+            # every version-2 writer records the run: one without is another run's,
+            # re-signed after its identity was deleted
+            raise CheckpointError(
+                f"{path}: records no run identity; in a folder without one, only a "
+                f"checkpoint written before runs had identities (version 1) resumes "
+                f"without it; it is not resumed"
+            )
+        if recorded is not None and (
+            not isinstance(recorded, dict) or recorded.get("config_sha256") != settings_sha256
+        ):
+            raise CheckpointError(
+                f"{path}: belongs to another run (it records {_describe(recorded)}, whose "
+                f"settings are not this folder's config.json); it is not resumed"
+            )
     npz_name = doc.get("npz")
     if not isinstance(npz_name, str) or not _NPZ_NAME.match(npz_name):
         # a plain ckpt-NNNNNN.npz beside the JSON: never a path to somewhere else
@@ -703,7 +728,9 @@ class IntactCheckpoint(NamedTuple):
 
 
 def load_latest_intact(
-    directory: str | os.PathLike[str], identity: Mapping[str, Any] | None = None
+    directory: str | os.PathLike[str],
+    identity: Mapping[str, Any] | None = None,
+    settings_sha256: str | None = None,
 ) -> IntactCheckpoint:
     """The newest checkpoint of ``directory`` that verifies, skipping corrupt newer ones.
 
@@ -723,6 +750,8 @@ def load_latest_intact(
         another run, or one renamed to a step it does not record, is skipped
         like a corrupt one (and named in the message); a folder with none of
         the run's own raises.
+    settings_sha256 : str, optional
+        For a folder without a recorded identity (see :func:`load_checkpoint`).
 
     Returns
     -------
@@ -742,7 +771,7 @@ def load_latest_intact(
     skipped: list[tuple[Path, str]] = []
     for path in reversed(ckpts):
         try:
-            state, arrays = load_checkpoint(path, identity)
+            state, arrays = load_checkpoint(path, identity, settings_sha256)
         except CheckpointError as exc:
             skipped.append((path, str(exc)))
             continue

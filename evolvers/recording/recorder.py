@@ -465,9 +465,19 @@ class RunRecorder:
             return None
         # a checkpoint that records another run's identity, or none (copied in, whatever
         # its name), is skipped, and the run's own newest one resumed, or none: an error
-        state, arrays, _, _ = load_latest_intact(
-            self.checkpoint_dir, identity=None if self._identity_unwritten else self.identity
-        )
+        legacy = self._identity_unwritten
+        state, arrays, found, _ = load_latest_intact(
+            self.checkpoint_dir, identity=None if legacy else self.identity,
+            settings_sha256=self.identity["config_sha256"] if legacy else None,
+        )  # fmt: skip
+        if legacy:  # a folder without identity.json
+            recorded = read_json(found).get("identity")
+            if isinstance(recorded, dict) and isinstance(recorded.get("run_id"), str):
+                # the run's own checkpoint (its settings checked): a kill came between it
+                # and identity.json, which the run keeps
+                self.identity = {"run_id": recorded["run_id"],
+                                 "config_sha256": recorded["config_sha256"]}  # fmt: skip
+                self._write_identity()
         try:
             self.rows = list(state["rows"])
             self.hall_of_fame = list(state["hall_of_fame"])

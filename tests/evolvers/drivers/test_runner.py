@@ -164,23 +164,70 @@ def test_a_copied_checkpoint_without_identity_and_an_edited_config_are_refused(t
     assert sorted(p.name for p in a.rglob("*")) == before  # nothing written
 
 
+def _as_version_1(path):
+    """Rewrite a checkpoint as a version-1 record of before run identities."""
+    from softgym.io import _v1_state_digest
+
+    doc = json.loads(path.read_text())
+    doc.pop("sha256")
+    doc.update(version=1, identity=None, state_sha256=_v1_state_digest(doc["state"]))
+    path.write_text(json.dumps(doc))
+
+
 def test_a_run_from_before_identities_resumes_and_gets_one(tmp_path):
     out = tmp_path / "r"
     EvolutionRun(tiny(), out, seed=1, generations=0, figures=False, gif=False).run()
     (out / "identity.json").unlink()
-    from softgym.io import json_sha256
-
     for path in list_checkpoints(out / "checkpoints"):  # as a checkpoint of then
-        doc = json.loads(path.read_text())
-        doc["identity"] = None
-        doc["sha256"] = json_sha256({k: v for k, v in doc.items() if k != "sha256"})
-        path.write_text(json.dumps(doc))
+        _as_version_1(path)
     run = EvolutionRun(tiny(), out, seed=1, generations=1, figures=False, gif=False)
     run.run(resume=True)
     assert run.generation == 1
     ident = json.loads((out / "identity.json").read_text())
     assert json.loads(list_checkpoints(out / "checkpoints")[-1].read_text())["identity"] == ident
     EvolutionRun(tiny(), out, seed=1, generations=2, figures=False, gif=False).run(resume=True)
+
+
+def test_a_folder_without_its_identity_resumes_only_its_own_checkpoints(tmp_path):
+    # a kill between a run's first checkpoint and identity.json: the run resumes and keeps
+    # its identity; a version-2 checkpoint re-signed without one, or one of a run with other
+    # settings, copied into such a folder is refused (it would become this run's history)
+    import shutil
+
+    from softgym.io import json_sha256
+
+    out, ref = tmp_path / "r", tmp_path / "ref"
+    EvolutionRun(tiny(), ref, seed=1, generations=2, figures=False, gif=False).run()
+    EvolutionRun(tiny(), out, seed=1, generations=1, figures=False, gif=False).run()
+    ident = json.loads((out / "identity.json").read_text())
+    (out / "identity.json").unlink()
+    run = EvolutionRun(tiny(), out, seed=1, generations=2, figures=False, gif=False)
+    run.run(resume=True)
+    assert json.loads((out / "identity.json").read_text()) == ident  # the same run
+    def fitness(d):
+        return [(r["generation"], r["norm_final_dist_best"], r["norm_final_dist_median"])
+                for r in map(json.loads, (d / "log.jsonl").read_text().splitlines())]  # fmt: skip
+
+    assert fitness(out) == fitness(ref)  # as if never interrupted
+
+    other = tmp_path / "other"
+    EvolutionRun(tiny(pop_size=6), other, seed=3, generations=1, figures=False, gif=False).run()
+    (out / "identity.json").unlink()
+    for p in (out / "checkpoints").glob("ckpt-*"):
+        p.unlink()
+    newest = list_checkpoints(other / "checkpoints")[-1]
+    for suffix in (".json", ".npz"):
+        shutil.copy(newest.with_suffix(suffix), out / "checkpoints" / f"ckpt-000001{suffix}")
+    log = (out / "log.jsonl").read_text()
+    with pytest.raises(CheckpointError, match="whose settings are not this folder's config.json"):
+        EvolutionRun(tiny(), out, seed=1, generations=3, figures=False).run(resume=True)
+    doc = json.loads(newest.read_text())
+    doc["identity"] = None
+    doc["sha256"] = json_sha256({k: v for k, v in doc.items() if k != "sha256"})
+    (out / "checkpoints" / "ckpt-000001.json").write_text(json.dumps(doc))
+    with pytest.raises(CheckpointError, match="only a checkpoint written before runs had identities"):
+        EvolutionRun(tiny(), out, seed=1, generations=3, figures=False).run(resume=True)
+    assert (out / "log.jsonl").read_text() == log  # nothing of the other run became this one's
 
 
 def test_a_second_writer_of_a_run_folder_is_refused_naming_the_first(tmp_path):
