@@ -138,3 +138,83 @@ def test_a_re_signed_checkpoint_of_wrong_shapes_is_a_checkpoint_error(tmp_path, 
     run = EvolutionRun(exp, out, seed=1, generations=1, figures=False, gif=False, progress=False)
     with pytest.raises(CheckpointError, match="checkpoint content is invalid|checkpoint is damaged"):
         run.run(resume=True)
+
+
+def _mutations(arrays, state):
+    """Wrong shapes and types for every array and every list, dict or count of a checkpoint."""
+    import numpy as np
+
+    out = []
+    for k, v in arrays.items():
+        out.append((f"{k} as a scalar", {k: np.asarray(0.0)}, {}))
+        if v.ndim >= 2:
+            out.append((f"{k} one column short", {k: v[..., :-1]}, {}))
+    for k, v in state.items():
+        if isinstance(v, list):
+            out.append((f"{k} [5]", {}, {k: [5]}))
+        elif isinstance(v, dict):
+            out.append((f"{k} a list", {}, {k: [1]}))
+        elif isinstance(v, (int, float)) and not isinstance(v, bool):
+            out.append((f"{k} a string", {}, {k: "x"}))
+    return out
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("backend", [*sorted(RUNS), "qd"])
+def test_every_backend_resumes_a_re_signed_checkpoint_to_a_typed_error_or_a_run(tmp_path, backend):
+    # a checkpoint re-signed (checksums fixed) with each array of another shape and each
+    # list, object or count of another type: a typed error or a run, never a traceback,
+    # on every backend (a negative count is refused: it would corrupt the budgets)
+    import hashlib
+    import io
+    import shutil
+
+    import numpy as np
+
+    from softgym.exceptions import CheckpointError, SoftGymError
+    from softgym.io import json_sha256
+
+    if backend == "qd":
+        pytest.importorskip("ribs")
+        from evolvers.drivers.qd import QDRun
+
+        cls, exp_name, kw = QDRun, "controller-tournament", {"figures": False, "progress": False}
+    else:
+        cls, exp_name = RUNS[backend][2], RUNS[backend][3]
+        kw = {"figures": False, "gif": False, "progress": False}
+    exp = get_experiment(exp_name, **{**TINY, "seconds": 0.5})
+    src = tmp_path / "src"
+    cls(exp, src, seed=1, generations=1, **kw).run()
+    ckpt = list_checkpoints(src / "checkpoints")[-1]
+    with np.load(ckpt.with_suffix(".npz")) as z:
+        arrays = {k: z[k] for k in z.files}
+    state = json.loads(ckpt.read_text())["state"]
+    typed = 0
+    for label, new_arrays, new_state in [*_mutations(arrays, state),
+                                         ("evaluations_total -1", {}, {"evaluations_total": -1})]:  # fmt: skip
+        out = tmp_path / "m"
+        shutil.rmtree(out, ignore_errors=True)
+        shutil.copytree(src, out)
+        ckpts = list_checkpoints(out / "checkpoints")
+        for old in ckpts[:-1]:
+            old.unlink()
+            old.with_suffix(".npz").unlink()
+        doc = json.loads(ckpts[-1].read_text())
+        if new_arrays:
+            buf = io.BytesIO()
+            np.savez(buf, **{**arrays, **new_arrays})
+            ckpts[-1].with_suffix(".npz").write_bytes(buf.getvalue())
+            doc["npz_sha256"] = hashlib.sha256(buf.getvalue()).hexdigest()
+        doc["state"].update(new_state)
+        doc["sha256"] = json_sha256({k: v for k, v in doc.items() if k != "sha256"})
+        ckpts[-1].write_text(json.dumps(doc))
+        try:
+            cls(exp, out, seed=1, generations=2, **kw).run(resume=True)
+        except SoftGymError:
+            typed += 1
+        except Exception as exc:  # pragma: no cover - the failure this test exists for
+            pytest.fail(f"{backend}, {label}: {type(exc).__name__}: {exc}")
+        if label == "evaluations_total -1":
+            with pytest.raises(CheckpointError, match="counts .* must be finite and >= 0"):
+                cls(exp, out, seed=1, generations=2, **kw).run(resume=True)
+    assert typed > 0

@@ -488,6 +488,10 @@ class RunRecorder:
                 "robot_seconds_total", self.evaluations_total * float(self.experiment.seconds)
             ))  # fmt: skip
             self.wall_clock_total = float(state.get("wall_clock_total", self.wall_total))
+            counts = (self.evaluations_total, self.wall_total, self.robot_seconds_total,
+                      self.wall_clock_total)  # fmt: skip
+            if not all(math.isfinite(x) and x >= 0 for x in counts):
+                raise ValueError("the run's counts (evaluations, seconds) must be finite and >= 0")
             if not all(isinstance(r, dict) for r in self.rows):
                 raise TypeError("'rows' must be a list of objects")
             for h in self.hall_of_fame:  # as update_hall_of_fame and write_best read them
