@@ -367,7 +367,7 @@ def targets_met(soft: dict[str, float], self_: dict[str, float]) -> dict[str, bo
 
 #: Non-inferiority margins of :func:`paired_comparison`: how much worse than formulation B
 #: formulation A may be and still "cost no fidelity". ``abs_log10``: the mean per-case
-#: |log10(softgym / seed engine)| (0.02 is a 4.7 % larger typical ratio); ``spearman``: the
+#: ``abs(log10(softgym / seed engine))`` (0.02 is a 4.7 % larger typical ratio); ``spearman``: the
 #: rank correlation with the seed's engine; ``within_2x``: the share of cases within a
 #: factor 2 of it.
 PAIRED_MARGINS: dict[str, float] = {"abs_log10": 0.02, "spearman": 0.02, "within_2x": 0.03}
@@ -405,7 +405,7 @@ def paired_comparison(
     draws cancel in the differences. Three figures, each as A's *loss* against B
     (positive: A is farther from the seed's engine):
 
-    * ``abs_log10``: mean over cases of A's |log10(A / ref)| minus B's (each case's error
+    * ``abs_log10``: mean over cases of A's ``abs(log10(A / ref))`` minus B's (each case's error
       is its mean over the samples);
     * ``spearman``: B's rank correlation with the reference minus A's (each the mean over
       the samples; ties get average ranks);
