@@ -20,7 +20,8 @@
   :class:`EvolutionRun` (the seed's loop),
   :class:`~evolvers.drivers.deap_runner.DeapRun` (the same loop on a DEAP toolbox),
   :class:`~evolvers.drivers.pymoo_runner.PymooRun` (any pymoo algorithm through ask and
-  tell: NSGA-II, NSGA-III, SMS-EMOA, GA...); open-ended search:
+  tell: NSGA-II, NSGA-III, SMS-EMOA, GA, CMA-ES...),
+  :class:`~evolvers.drivers.random_search.RandomSearchRun` (random search); open-ended search:
   :mod:`~evolvers.drivers.qd` (MAP-Elites on pyribs) and :mod:`~evolvers.drivers.poet`
   (co-evolution of robots and terrains after Enhanced POET).
 * :mod:`evolvers.study` - the seed study over many seeds and its report (nothing else

@@ -430,12 +430,18 @@ def _evolve_run(args: argparse.Namespace, cfg: dict | None) -> tuple[type, Exper
         print(f"softgym evolve: warning: --selection {args.selection} is ignored with "
               f"--backend pymoo (pymoo's {st['algorithm']} does its own survival)",
               file=sys.stderr)  # fmt: skip
+    if st["backend"] == "random" and args.selection is not None:
+        print(f"softgym evolve: warning: --selection {args.selection} is ignored with "
+              "--backend random (random search keeps the best by the fitness)",
+              file=sys.stderr)  # fmt: skip
     if st["backend"] == "deap":
         from evolvers.drivers.deap_runner import DeapRun as Run
     elif st["backend"] == "pymoo":
         from evolvers.drivers.pymoo_runner import PymooRun as Run
 
         kw["algorithm"] = st["algorithm"]
+    elif st["backend"] == "random":
+        from evolvers.drivers.random_search import RandomSearchRun as Run
     else:
         from evolvers.drivers.runner import EvolutionRun as Run
     return Run, st["experiment"], kw
@@ -469,12 +475,15 @@ def add_evolve_parser(sub: Any) -> argparse.ArgumentParser:
     p.add_argument("--pop", type=int, default=15, help="population size")
     p.add_argument("--seed", type=int, default=0, help="seed of the run's random generator")
     add_run_flags(p, "runs/evolve")
-    p.add_argument("--backend", choices=["native", "deap", "pymoo"], default="native",
-                   help="the search loop: softgym's own, a DEAP toolbox, or a pymoo algorithm")  # fmt: skip
+    p.add_argument("--backend", choices=["native", "deap", "pymoo", "random"], default="native",
+                   help="the search loop: softgym's own, a DEAP toolbox, a pymoo algorithm, or "
+                   "random search (fresh random genomes each generation, the best kept)")  # fmt: skip
     p.add_argument("--algorithm", choices=["nsga2", "nsga3", "sms-emoa", "ga", "cmaes"],
                    default="nsga2",
                    help="pymoo algorithm (--backend pymoo; ga optimises the first objective alone; "
-                   "cmaes: pymoo's CMA-ES over the network's weights on a fixed --body)")  # fmt: skip
+                   "cmaes: pymoo's CMA-ES over the design vector, a fixed-topology CPPN's "
+                   "weights and the controller genes, or over the network's weights on a "
+                   "fixed --body)")  # fmt: skip
     p.add_argument("--task", metavar="TASK[:ARG=V,...]|FILE.json",
                    help="the world (default: the experiment's): a task name or a terrain JSON file")  # fmt: skip
     p.add_argument("--seconds", type=float,
@@ -588,8 +597,9 @@ def add_qd_parser(sub: Any) -> None:
                        "cvt: the number of centroids")  # fmt: skip
         p.add_argument("--archive", choices=["grid", "cvt"],
                        help="GridArchive or CVTArchive (default: grid)")  # fmt: skip
-        p.add_argument("--objective", choices=["norm_final_dist", "max_xy_dist"],
-                       help="maximised metric (default: the experiment's fitness)")  # fmt: skip
+        p.add_argument("--objective", choices=["norm_final_dist", "max_xy_dist", "score"],
+                       help="maximised metric (score: the task's own measure; default: the "
+                       "experiment's fitness)")  # fmt: skip
         p.add_argument("--task", metavar="TASK[:ARG=V,...]|FILE.json",
                        help="the world (default: the experiment's)")  # fmt: skip
         p.add_argument("--seconds", type=float, help="simulated seconds per evaluation (default: 5)")

@@ -133,3 +133,25 @@ def test_a_task_string_is_read_once_per_command(tmp_path, monkeypatch, capsys):
     args = ["evolve", "--task", "stairs", "--generations", "1", "--no-figures", "--no-gif"]
     assert main([*args, "--out", str(tmp_path / "r"), *TINY]) == 0
     assert strings == ["stairs"]  # the experiment holds the Task from there to the kernel
+
+
+def test_random_search_and_cmaes_on_the_design_vector_from_the_command_line(tmp_path, capsys):
+    out = tmp_path / "random"
+    flags = ["--experiment", "codesign", "--task", "gap", "--out", str(out), "--no-gif",
+             "--no-figures"]  # fmt: skip
+    assert main(["evolve", "--backend", "random", "--generations", "1", "--selection", "pareto",
+                 *flags, *TINY]) == 0  # fmt: skip
+    captured = capsys.readouterr()
+    assert "--selection pareto is ignored with --backend random" in captured.err
+    summary = json.loads(captured.out)
+    assert summary["backend"] == "random" and summary["evaluations"] == 8
+    assert main(["evolve", "--generations", "2", "--resume", *flags, "--quiet"]) == 0
+    assert json.loads(capsys.readouterr().out)["evaluations"] == 12
+    cma = tmp_path / "cmaes"
+    assert main(["evolve", "--backend", "pymoo", "--algorithm", "cmaes", "--experiment", "codesign",
+                 "--max-evals", "8", "--generations", "50", "--out", str(cma), "--no-gif",
+                 "--no-figures", *TINY]) == 0  # fmt: skip
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["stopped_by"] == "max_evals" and summary["evaluations"] >= 8
+    genome = json.loads((cma / "best_designs.json").read_text())["best"][0]["genome"]
+    assert len(genome["cppn"]["edges"]) == 83  # the fixed-topology CPPN of the design vector

@@ -105,7 +105,8 @@ def _bad_body_file(tmp_path):
         (["--controller", "central", "--body", "BAD"], "--body"),
         (["--controller", "central", "--body", "MISSING"], "--body"),
         (["--controller", "central", "--body", "walker", "--shape", "4", "4", "4"], "shape"),
-        (["--controller", "central", "--backend", "pymoo", "--algorithm", "cmaes"], "fixed body"),
+        (["--body", "walker", "--backend", "pymoo", "--algorithm", "cmaes"], "network"),
+        (["--experiment", "materials", "--backend", "pymoo", "--algorithm", "cmaes"], "genes"),
         (["--experiment", "materials", "--controller", "central", "--body", "walker"], "materials"),
     ],
 )

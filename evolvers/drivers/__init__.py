@@ -8,7 +8,9 @@
 * :mod:`~evolvers.drivers.runner` - :class:`~evolvers.drivers.runner.EvolutionRun`, the
   seed's loop (the native backend);
 * :mod:`~evolvers.drivers.deap_runner` - the same loop on a DEAP toolbox;
-* :mod:`~evolvers.drivers.pymoo_runner` - any pymoo algorithm through ask and tell;
+* :mod:`~evolvers.drivers.pymoo_runner` - any pymoo algorithm through ask and tell
+  (CMA-ES over a design vector or a brain's weights);
+* :mod:`~evolvers.drivers.random_search` - random search, the baseline of every search;
 * :mod:`~evolvers.drivers.qd` - MAP-Elites on pyribs (the ``.[qd]`` extra);
 * :mod:`~evolvers.drivers.poet` - co-evolution of robots and terrains after Enhanced POET.
 

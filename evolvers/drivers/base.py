@@ -218,6 +218,13 @@ class Driver:
         """The score a ``target_score`` budget compares: the best value of the run's fitness
         found so far (the hall of fame's first), None before any.
         """
+        return self.best_so_far()
+
+    def best_so_far(self) -> float | None:
+        """The best value of the experiment's fitness found so far, None before any: the
+        hall of fame's first (every evaluated individual is offered to it). Each log row
+        records it as ``best_so_far`` (the learning curve, over ``evaluations_total``).
+        """
         if not self.hall_of_fame:
             return None
         ind = self.hall_of_fame[0]["individual"]
@@ -327,6 +334,7 @@ class Driver:
     def _end_generation(self, stats: EvalStats, wall: float) -> None:
         """Log row, checkpoint (with the budget), files, callback."""
         state, arrays, columns, individuals = self._checkpoint_state()
+        columns = {**(columns or {}), "best_so_far": self.best_so_far()}
         start, before = self._sitting
         row = self.recorder.end_generation(
             self.generation, individuals, stats, wall, state, arrays, columns=columns,

@@ -10,13 +10,23 @@
   material genes, probability 0.4), :class:`SoftbotMutation` (CPPN mutation
   with validity retries + bounded Gaussian gene mutation) and
   :class:`SoftbotDuplicateElimination` (same phenotype hash).
-* :class:`BrainProblem` and ``algorithm="cmaes"``: pymoo's own CMA-ES
+* ``algorithm="cmaes"``: pymoo's own CMA-ES
   (:class:`pymoo.algorithms.soo.nonconvex.cmaes.CMAES`, which wraps the
-  ``cma`` package) over a brain's weight vector (bounds ``+-WEIGHT_BOUND``) on
-  the experiment's fixed body: each ``x`` is evaluated as the body with
-  ``spec.clipped(x)``; generation 0 is ``pop_size`` random brains
-  (``BrainSpec.random``), the best of which is CMA-ES's ``x0``. Only for an
-  experiment with a fixed ``body`` and a network ``controller``.
+  ``cma`` package) over a real vector, on the experiment's fitness:
+
+  - on a CPPN body, :class:`DesignProblem`: the whole robot as one
+    :class:`~evolvers.operators.encoding.CPPNVector` (the weights of a
+    fixed-topology CPPN, 83 for the 4-output tree; the three controller genes when
+    the experiment evolves them; a network's weights when it has one), decoded
+    through the CPPN genome; generation 0 is ``pop_size`` uniform vectors that draw
+    valid bodies (:class:`DesignSampling`);
+  - on a fixed body with a network controller, :class:`BrainProblem`: the brain's
+    weights (bounds ``+-WEIGHT_BOUND``), each ``x`` evaluated as the body with
+    ``spec.clipped(x)``; generation 0 is ``pop_size`` random brains
+    (``BrainSpec.random``).
+
+  The best of generation 0 is CMA-ES's ``x0``. Not for an experiment that evolves
+  material genes, nor a fixed body with the sinusoid alone.
 * :class:`PymooRun`: a pymoo algorithm (``algorithm=``: NSGA-II by default,
   ``"nsga3"``, ``"sms-emoa"``, ``"ga"``, ``"cmaes"``, or any pymoo algorithm class)
   driven through pymoo's public ask-and-tell interface
@@ -53,6 +63,7 @@ from pymoo.core.sampling import Sampling
 from evolvers.drivers.base import Checkpoint, Driver, IdCounter
 from evolvers.evaluation.evaluator import EvalStats, Evaluator, PhenotypeCache, pack_traces
 from evolvers.evaluation.experiments import Experiment
+from evolvers.operators.encoding import CPPNVector
 from evolvers.operators.genome import Individual
 from evolvers.operators.selection import Objective, minimised_matrix
 from evolvers.operators.variation import (
@@ -73,6 +84,8 @@ __all__ = [
     "ALGORITHMS",
     "BrainProblem",
     "BrainSampling",
+    "DesignProblem",
+    "DesignSampling",
     "MULTI_OBJECTIVE",
     "PymooRun",
     "SoftbotCrossover",
@@ -80,7 +93,9 @@ __all__ = [
     "SoftbotMutation",
     "SoftbotProblem",
     "SoftbotSampling",
+    "VectorProblem",
     "constraint_values",
+    "design_encoding",
     "make_algorithm",
     "n_constraints",
     "problem_objectives",
@@ -271,7 +286,53 @@ class SoftbotDuplicateElimination(ElementwiseDuplicateElimination):
         return a.X[0].phenotype_key(self.shape) == b.X[0].phenotype_key(self.shape)
 
 
-class BrainProblem(Problem):
+class VectorProblem(Problem):
+    """A real-valued pymoo Problem whose vectors decode to individuals (CMA-ES's problems).
+
+    ``F`` is the experiment's fitness, minimised (a maximised one negated); each batch is
+    one batched Simulation (phenotype-cached). :meth:`individuals` gives the
+    :class:`~evolvers.operators.genome.Individual` each evaluated ``x`` became. Subclasses
+    set the bounds and :meth:`make`.
+
+    Parameters
+    ----------
+    experiment : Experiment
+    evaluator : Evaluator
+    next_id : callable
+        Ids of the individuals made.
+    xl, xu : ndarray of shape (n_var,), float64
+        Bounds of the variables.
+    """
+
+    def __init__(self, experiment: Experiment, evaluator: Evaluator, next_id: Any,
+                 xl: np.ndarray, xu: np.ndarray) -> None:  # fmt: skip
+        self.experiment = experiment
+        self.evaluator = evaluator
+        self.next_id = next_id
+        self.objectives = experiment.objectives[:1]
+        self.last_stats = EvalStats()
+        self._made: dict[bytes, Individual] = {}
+        super().__init__(n_var=len(xl), n_obj=1, xl=xl, xu=xu, vtype=float)
+
+    def make(self, x: np.ndarray) -> Individual:
+        """The individual ``x`` decodes to (a fresh id)."""
+        raise NotImplementedError
+
+    def _evaluate(self, X, out, *args, **kwargs):
+        inds = [self.make(x) for x in np.atleast_2d(np.asarray(X, dtype=np.float64))]
+        self.last_stats = self.evaluator.evaluate(inds)
+        self._made = {np.asarray(x, dtype=np.float64).tobytes(): ind for x, ind in zip(X, inds)}
+        out["F"] = minimised_matrix(inds, self.objectives)
+
+    def individuals(self, X: np.ndarray) -> list[Individual]:
+        """The individuals the rows of ``X`` (the last evaluated batch's) became."""
+        try:
+            return [self._made[np.asarray(x, dtype=np.float64).tobytes()] for x in X]
+        except KeyError:
+            raise CheckpointError("a CMA-ES solution was not evaluated in the last batch") from None
+
+
+class BrainProblem(VectorProblem):
     """A brain's weights on an experiment's fixed body, as a real-valued pymoo Problem.
 
     ``n_var`` is the brain's ``n_params``, every variable in ``[-WEIGHT_BOUND,
@@ -297,35 +358,69 @@ class BrainProblem(Problem):
                 "CMA-ES searches a brain's weights on a fixed body: the experiment needs "
                 "controller='central' or 'distributed' and a body"
             )
-        self.experiment = experiment
-        self.evaluator = evaluator
-        self.next_id = next_id
         self.spec, self.body = spec, body
-        self.objectives = experiment.objectives[:1]
-        self.last_stats = EvalStats()
-        self._made: dict[bytes, Individual] = {}
         n = spec.n_params
-        super().__init__(n_var=n, n_obj=1, xl=np.full(n, -WEIGHT_BOUND),
-                         xu=np.full(n, WEIGHT_BOUND), vtype=float)  # fmt: skip
+        super().__init__(experiment, evaluator, next_id, np.full(n, -WEIGHT_BOUND),
+                         np.full(n, WEIGHT_BOUND))  # fmt: skip
 
-    def _evaluate(self, X, out, *args, **kwargs):
-        inds = []
-        for x in np.atleast_2d(np.asarray(X, dtype=np.float64)):
-            ind = Individual(
-                cppn=None, controller=self.body.controller, id=self.next_id(), body=self.body,
-                brain=self.spec.clipped(x).weights, brain_spec=self.spec,
-            )  # fmt: skip
-            inds.append(ind)
-        self.last_stats = self.evaluator.evaluate(inds)
-        self._made = {np.asarray(x, dtype=np.float64).tobytes(): ind for x, ind in zip(X, inds)}
-        out["F"] = minimised_matrix(inds, self.objectives)
+    def make(self, x: np.ndarray) -> Individual:
+        """The fixed body carrying the brain ``spec.clipped(x)``."""
+        return Individual(
+            cppn=None, controller=self.body.controller, id=self.next_id(), body=self.body,
+            brain=self.spec.clipped(x).weights, brain_spec=self.spec,
+        )  # fmt: skip
 
-    def individuals(self, X: np.ndarray) -> list[Individual]:
-        """The individuals the rows of ``X`` (the last evaluated batch's) became."""
-        try:
-            return [self._made[np.asarray(x, dtype=np.float64).tobytes()] for x in X]
-        except KeyError:
-            raise CheckpointError("a CMA-ES solution was not evaluated in the last batch") from None
+
+class DesignProblem(VectorProblem):
+    """A whole robot (body, controller genes, brain) as one real vector: a
+    :class:`~evolvers.operators.encoding.CPPNVector` (a fixed-topology CPPN's weights, then
+    the controller genes when the experiment evolves them, then the brain's weights when it
+    has a network controller), decoded through the CPPN genome.
+
+    A vector whose body breaks the experiment's rules is scored worst, unsimulated (the
+    evaluator's rule for every invalid robot), so it costs no simulation.
+
+    Parameters
+    ----------
+    experiment : Experiment
+        With a CPPN body (no fixed ``body``) and no material genes.
+    evaluator : Evaluator
+    next_id : callable
+        Ids of the individuals made.
+    """
+
+    def __init__(self, experiment: Experiment, evaluator: Evaluator, next_id: Any) -> None:
+        self.encoding = design_encoding(experiment)
+        enc = self.encoding
+        super().__init__(experiment, evaluator, next_id, enc.lower.copy(), enc.upper.copy())
+
+    def make(self, x: np.ndarray) -> Individual:
+        """The robot ``x`` decodes to (:meth:`CPPNVector.individual`)."""
+        return self.encoding.individual(x, self.next_id())
+
+
+def design_encoding(experiment: Experiment) -> CPPNVector:
+    """The :class:`~evolvers.operators.encoding.CPPNVector` CMA-ES searches for ``experiment``:
+    its CPPN outputs, the controller genes when they evolve, its brain when it has one.
+
+    Raises
+    ------
+    InvalidParameterError
+        For a fixed body (CMA-ES searches its brain instead, :class:`BrainProblem`) or an
+        experiment that evolves material genes.
+    """
+    if experiment.body is not None:
+        raise InvalidParameterError(
+            "a design vector draws its own body: the experiment has a fixed body "
+            "(CMA-ES searches its brain's weights, BrainProblem)"
+        )
+    if experiment.evolve_materials:
+        raise InvalidParameterError(
+            f"algorithm 'cmaes' has no vector genes for the material genes that experiment "
+            f"{experiment.name!r} evolves; choose an experiment without materials evolution"
+        )
+    return CPPNVector(experiment.cppn_outputs, controller=experiment.evolve_controller,
+                      brain_spec=experiment.brain_spec())  # fmt: skip
 
 
 class BrainSampling(Sampling):
@@ -339,14 +434,32 @@ class BrainSampling(Sampling):
         return np.stack([self.spec.random(random_state).weights for _ in range(n_samples)])
 
 
-def make_cmaes(experiment: Experiment, sigma: float = 0.1, **kwargs: Any) -> Algorithm:
-    """Pymoo's CMA-ES over a brain's weights (:class:`BrainProblem`).
+class DesignSampling(Sampling):
+    """Uniform design vectors that draw valid bodies (:meth:`CPPNVector.random_valid`):
+    CMA-ES's first population on a CPPN body.
+    """
 
-    ``experiment.pop_size`` random brains (:class:`BrainSampling`) are the
-    first generation; the best is ``x0``; CMA-ES then asks ``pop_size``
-    solutions a generation. ``sigma`` is the initial step in the [0, 1]-normalised
-    box (0.1: 0.6 weight units). cma's stopping tests are off (the run ends at
-    its generations); ``kwargs`` go to :class:`~pymoo.algorithms.soo.nonconvex.cmaes.CMAES`.
+    def __init__(self, experiment: Experiment) -> None:
+        super().__init__()
+        self.encoding = design_encoding(experiment)
+        self.shape, self.rules = experiment.shape, experiment.rules
+
+    def _do(self, problem, n_samples, *args, random_state=None, **kwargs):
+        enc = self.encoding
+        return np.stack([enc.random_valid(random_state, self.shape, self.rules)
+                         for _ in range(n_samples)])  # fmt: skip
+
+
+def make_cmaes(experiment: Experiment, sigma: float = 0.1, **kwargs: Any) -> Algorithm:
+    """Pymoo's CMA-ES over a design vector (:class:`DesignProblem`, a CPPN body) or a
+    brain's weights (:class:`BrainProblem`, a fixed body).
+
+    ``experiment.pop_size`` random vectors (:class:`DesignSampling`, valid bodies;
+    :class:`BrainSampling`) are the first generation; the best is ``x0``; CMA-ES then asks
+    ``pop_size`` solutions a generation. ``sigma`` is the initial step in the
+    [0, 1]-normalised box (0.1: 0.6 brain-weight units, 0.2 CPPN-weight units). cma's
+    stopping tests are off (the run ends at its budget); ``kwargs`` go to
+    :class:`~pymoo.algorithms.soo.nonconvex.cmaes.CMAES`.
     """
     from pymoo.algorithms.soo.nonconvex.cmaes import CMAES
     from pymoo.core.initialization import Initialization
@@ -357,7 +470,10 @@ def make_cmaes(experiment: Experiment, sigma: float = 0.1, **kwargs: Any) -> Alg
     }  # fmt: skip
     opts.update(kwargs)
     algorithm = CMAES(sigma=sigma, pop_size=experiment.pop_size, **opts)
-    algorithm.initialization = Initialization(BrainSampling(experiment))
+    sampling = (
+        BrainSampling(experiment) if experiment.body is not None else DesignSampling(experiment)
+    )
+    algorithm.initialization = Initialization(sampling)
     algorithm.n_sample_points = experiment.pop_size
     return algorithm
 
@@ -409,7 +525,7 @@ def problem_objectives(experiment: Experiment, single_objective: bool = False) -
 
 
 #: Algorithms known by name (``"ga"`` and ``"cmaes"`` are single-objective: they optimise the
-#: experiment's fitness; ``"cmaes"`` only a brain on a fixed body, :func:`make_cmaes`).
+#: experiment's fitness; ``"cmaes"`` a design vector or a brain on a fixed body, :func:`make_cmaes`).
 ALGORITHMS: tuple[str, ...] = ("nsga2", "nsga3", "sms-emoa", "ga", "cmaes")
 
 
@@ -484,9 +600,10 @@ class PymooRun(Driver):
     algorithm : str or callable
         ``"nsga2"`` (default), ``"nsga3"``, ``"sms-emoa"``, ``"ga"``
         (single-objective, on the experiment's fitness), ``"cmaes"`` (pymoo's
-        CMA-ES over the brain's weights, on the fitness; needs an experiment
-        with a fixed ``body`` and a network ``controller``: the controller genes
-        stay the body's), or a pymoo algorithm class or factory
+        CMA-ES on the fitness: over a design vector on a CPPN body,
+        :class:`DesignProblem`; over the brain's weights on a fixed ``body`` with a
+        network ``controller``, whose controller genes stay the body's), or a pymoo
+        algorithm class or factory
         (:func:`make_algorithm`); a fresh algorithm is built for every :meth:`run`.
     algorithm_kwargs : dict, optional
         More keywords for the algorithm (e.g. NSGA-III's ``ref_dirs``).
@@ -506,12 +623,14 @@ class PymooRun(Driver):
                 f"unknown algorithm {algorithm!r}; expected one of {ALGORITHMS}"
             )
         self.cmaes = algorithm == "cmaes"
-        if self.cmaes and (experiment.body is None or not experiment.evolve_brain):
+        if self.cmaes and experiment.body is not None and not experiment.evolve_brain:
             raise InvalidParameterError(
-                "algorithm 'cmaes' searches a brain's weights on a fixed body: it needs a network "
-                "controller ('central' or 'distributed') and a fixed body (--body); with a "
-                "CPPN body use nsga2, nsga3, sms-emoa or ga"
+                "algorithm 'cmaes' on a fixed body searches a brain's weights: it needs a network "
+                "controller ('central' or 'distributed'); or drop the fixed body (--body) for "
+                "CMA-ES over the whole design vector"
             )
+        if self.cmaes and experiment.body is None:
+            design_encoding(experiment)  # refuses material genes, before anything is written
         self.algorithm_spec = algorithm
         self.algorithm_kwargs = dict(algorithm_kwargs or {})
         self.single_objective = (
@@ -537,10 +656,13 @@ class PymooRun(Driver):
             NoveltyArchive(k=exp.pop_size, n_add=2, variant="normalized") if novelty else None
         )
         objectives = exp.objectives[:1] if self.single_objective else exp.objectives
-        self.problem: Problem = (
-            BrainProblem(exp, self.evaluator, self.ids) if self.cmaes
-            else SoftbotProblem(exp, self.evaluator, self.archive, objectives)
-        )  # fmt: skip
+        self.problem: Problem
+        if self.cmaes and exp.body is not None:
+            self.problem = BrainProblem(exp, self.evaluator, self.ids)
+        elif self.cmaes:
+            self.problem = DesignProblem(exp, self.evaluator, self.ids)
+        else:
+            self.problem = SoftbotProblem(exp, self.evaluator, self.archive, objectives)
         self.algorithm: Algorithm = make_algorithm(
             self.algorithm_spec, exp, self.ids, self.problem.n_obj, **self.algorithm_kwargs
         )
@@ -562,7 +684,7 @@ class PymooRun(Driver):
 
     def _individuals(self, problem: Problem, pop: Any) -> list[Individual]:
         """The individuals of a pymoo population (object variables, or CMA-ES's vectors)."""
-        if isinstance(problem, BrainProblem):
+        if isinstance(problem, VectorProblem):
             return problem.individuals(pop.get("X"))
         return [x[0] for x in pop.get("X")]
 

@@ -20,9 +20,12 @@ The pieces are pyribs' own (``pip install "softgym[qd]"``, pyribs 0.12):
   phenotype-cached, or Dask through ``batch_fn``).
 
 The objective is the experiment's fitness (``norm_final_dist`` or
-``max_xy_dist``, voxel lengths), clipped at 0: a diverged robot scores 0, as
+``max_xy_dist``, voxel lengths, or a task's ``score``), floored at
+:data:`OBJECTIVE_FLOORS`: a distance at 0, so a diverged robot scores 0, as
 if it had not moved (pyribs' archives have no infeasibility; its
-``threshold_min`` is for CMA-MAE only).
+``threshold_min`` is for CMA-MAE only); a score, which may be negative (a turn the
+wrong way, progress downhill), at -1000, with the archive's ``qd_score_offset``
+there so that the QD-score counts every elite from the floor.
 
 :class:`QDRun` writes the run folder every driver writes
 (:class:`~evolvers.recording.recorder.RunRecorder`: config, log, hall of fame, atomic
@@ -108,6 +111,7 @@ except ImportError as exc:  # pragma: no cover - the extra is installed in CI
 
 __all__ = [
     "ARCHIVES",
+    "OBJECTIVE_FLOORS",
     "QD_OBJECTIVES",
     "QDConfig",
     "QDRun",
@@ -128,8 +132,11 @@ log = logging.getLogger("evolvers")
 
 #: Archive kinds of :class:`QDConfig`.
 ARCHIVES: tuple[str, ...] = ("grid", "cvt")
-#: Metrics a QD run may maximise (non-negative distances, voxel lengths).
-QD_OBJECTIVES: tuple[str, ...] = ("norm_final_dist", "max_xy_dist")
+#: Metrics a QD run may maximise (non-negative distances, voxel lengths; a task's score).
+QD_OBJECTIVES: tuple[str, ...] = ("norm_final_dist", "max_xy_dist", "score")
+#: The lowest archive objective of each metric (a lower value, e.g. a diverged robot's
+#: WORST_FITNESS, counts as the floor); also the archive's ``qd_score_offset``.
+OBJECTIVE_FLOORS: dict[str, float] = {"norm_final_dist": 0.0, "max_xy_dist": 0.0, "score": -1000.0}
 
 
 @dataclass(frozen=True)
@@ -221,7 +228,8 @@ class QDConfig:
         return cls(**kw)
 
 
-def make_archive(config: QDConfig, seed: int, centroids: np.ndarray | None = None) -> Any:
+def make_archive(config: QDConfig, seed: int, centroids: np.ndarray | None = None,
+                 qd_score_offset: float = 0.0) -> Any:  # fmt: skip
     """An empty pyribs archive of softgym genomes (``solution_dtype=object``).
 
     Parameters
@@ -231,13 +239,17 @@ def make_archive(config: QDConfig, seed: int, centroids: np.ndarray | None = Non
         Seeds the archive's generator and the CVT's k-means.
     centroids : ndarray of shape (n_cells, n_descriptors), float64, optional
         CVT centroids (a checkpoint's); computed when not given.
+    qd_score_offset : float
+        What the QD-score subtracts from each elite's objective (the objective's floor,
+        :data:`OBJECTIVE_FLOORS`).
 
     Returns
     -------
     ribs.archives.GridArchive or ribs.archives.CVTArchive
     """
     ranges = [(0.0, 1.0)] * len(config.descriptors)
-    common = {"solution_dim": (), "ranges": ranges, "seed": int(seed), "solution_dtype": object}
+    common = {"solution_dim": (), "ranges": ranges, "seed": int(seed), "solution_dtype": object,
+              "qd_score_offset": float(qd_score_offset)}  # fmt: skip
     if config.archive == "grid":
         return GridArchive(dims=list(config.cells), **common)
     if centroids is None:
@@ -405,7 +417,8 @@ class QDRun(Driver):
 
     def _fresh(self, centroids: np.ndarray | None = None) -> None:
         super()._fresh()
-        self.archive = make_archive(self.config, self.seed, centroids)
+        self.archive = make_archive(self.config, self.seed, centroids,
+                                    OBJECTIVE_FLOORS[self.objective])  # fmt: skip
         self.emitter = SoftbotEmitter(
             self.archive, self.experiment, self.experiment.pop_size,
             np.random.default_rng(self.seed), self.ids,
@@ -444,14 +457,16 @@ class QDRun(Driver):
 
     # ------------------------------------------------------------------ the loop
     def objective_values(self, individuals: Sequence[Individual]) -> np.ndarray:
-        """The archive objective of evaluated individuals: the metric clipped at 0.
+        """The archive objective of evaluated individuals: the metric, floored at
+        :data:`OBJECTIVE_FLOORS` (0 for a distance).
 
         Returns
         -------
         ndarray of shape (n,), float64
         """
+        floor = OBJECTIVE_FLOORS[self.objective]
         return np.array(
-            [max(float(ind.objectives[self.objective]), 0.0) for ind in individuals],
+            [max(float(ind.objectives[self.objective]), floor) for ind in individuals],
             dtype=np.float64,
         )
 

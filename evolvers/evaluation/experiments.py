@@ -13,9 +13,15 @@ name                        variation              selection       objectives
 ``obstacles``               CPPN + controller GA   Pareto + age    MaxXYDist (max), L coeff. (max), age (min)
 ``obstacles-attempt1``      CPPN                   Pareto          MaxXYDist (max), muscle voxels (min)
 ``obstacles-attempt2``      CPPN + controller GA   tournament (2)  MaxXYDist (max)
+``codesign``                CPPN + controller GA   tournament (2)  the task's score (max)
+``codesign-afpo``           CPPN + controller GA   Pareto + age    the task's score (max), age (min)
 ==========================  =====================  ==============  ============================================
 
-``materials`` is an alias of ``materials-t1``. Obstacle experiments run on the
+``materials`` is an alias of ``materials-t1``. The two ``codesign`` experiments search
+bodies and controllers on any task's own measure (its ``score``, also on the walking
+tasks, whose other experiments select on NormFinalDist or MaxXYDist): the co-design
+leaderboard's search space (benchmarks/leaderboard.py); ``codesign-afpo`` is age-fitness
+Pareto optimisation (Schmidt and Lipson 2011). Obstacle experiments run on the
 ``wall`` task (:mod:`softgym.tasks`: the seed's 1-voxel-high fence, 10-voxel
 interior) with centre-of-mass samples every 0.1 s; ``obstacles`` also applies
 the seed's composition constraints (>= 10 % tissue, >= 1 bone, >= 10 % muscle).
@@ -524,6 +530,26 @@ EXPERIMENTS: dict[str, Experiment] = {
             evolve_controller=True,
             task="wall",
             generations=20,
+        ),
+        Experiment(
+            "codesign",
+            "body and controller co-design on the task's own score, fitness tournament "
+            "(the leaderboard's search space)",
+            (Objective("score", True),),
+            logged=("n_muscle",),
+            selection="tournament",
+            evolve_controller=True,
+            generations=40,
+        ),
+        Experiment(
+            "codesign-afpo",
+            "body and controller co-design on the task's own score, age-fitness Pareto "
+            "(score up, age down)",
+            (Objective("score", True), Objective("age", False)),
+            logged=("n_muscle",),
+            selection="pareto",
+            evolve_controller=True,
+            generations=40,
         ),
     )
 }

@@ -81,11 +81,11 @@ def test_sinusoid_runs_are_unchanged_by_the_brain_fields(tmp_path):
     assert exp.to_dict()["controller"] == "sinusoid" and exp.brain_spec() is None
 
 
-def test_cmaes_needs_a_fixed_body_and_a_brain(tmp_path):
-    with pytest.raises(InvalidParameterError, match="fixed body"):
-        PymooRun(brainy("distributed"), tmp_path / "x", algorithm="cmaes")
+def test_cmaes_on_a_fixed_body_needs_a_brain_and_refuses_material_genes(tmp_path):
     with pytest.raises(InvalidParameterError, match="network"):
         PymooRun(brainy("sinusoid", body=True), tmp_path / "y", algorithm="cmaes")
+    with pytest.raises(InvalidParameterError, match="material genes"):
+        PymooRun(brainy("sinusoid", name="materials"), tmp_path / "x", algorithm="cmaes")
     assert not (tmp_path / "x").exists() and not (tmp_path / "y").exists()
 
 

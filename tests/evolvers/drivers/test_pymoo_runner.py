@@ -107,3 +107,23 @@ def test_a_multi_objective_algorithm_on_one_objective_is_refused_not_hung(
     stdout = refused_in_child(code, timeout=60)
     assert f"'{algorithm}' needs at least 2 objectives" in stdout and "nsga2" in stdout
     assert not out.exists()
+
+
+def test_cmaes_searches_the_design_vector_of_a_cppn_body_and_resumes_exactly(tmp_path):
+    from evolvers.drivers.pymoo_runner import DesignProblem, design_encoding
+
+    exp = tiny("codesign")
+    kw = {"seed": 2, "figures": False, "gif": False, "progress": False, "algorithm": "cmaes"}
+    ref_run = PymooRun(exp, tmp_path / "ref", generations=3, **kw)
+    ref = ref_run.run()
+    assert isinstance(ref_run.problem, DesignProblem)
+    enc = design_encoding(exp)
+    assert ref_run.problem.n_var == enc.size == 86  # 83 CPPN weights, 3 controller genes
+    assert all(len(ind.cppn.hidden) == 7 and len(ind.cppn.edges) == 83 for ind in ref)
+    assert len({ind.controller for ind in ref}) > 1  # the controller genes are searched too
+    best = [r["best_so_far"] for r in ref_run.rows]
+    assert best == sorted(best) and ref_run.rows[-1]["evaluations_total"] > 4
+    # a run extended by resume replays its generations from the cache, then goes on
+    PymooRun(exp, tmp_path / "ext", generations=1, **kw).run()
+    ext = PymooRun(exp, tmp_path / "ext", generations=3, **kw).run(resume=True)
+    assert population_summary(ext) == population_summary(ref)

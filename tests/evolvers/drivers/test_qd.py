@@ -207,3 +207,29 @@ def test_numba_caches_in_the_users_cache_folder_not_site_packages(tmp_path):
                          timeout=120)  # fmt: skip
     mine, default = str(tmp_path / "mine"), str(tmp_path / "cache" / "softgym" / "numba")
     assert res.stdout.split() == [mine, mine, default, default], res.stderr[-2000:]
+
+
+# ---------------------------------------------------------------------- a task's score
+def _scoring_batch_fn(designs, task):
+    """fake_batch_fn with a task score that is negative for most robots."""
+    out = fake_batch_fn(designs, task)
+    d = out["norm_final_dist"]
+    out["score"] = np.where(d < -1e6, -1e7, d - 0.5)
+    return out
+
+
+def test_a_task_score_is_floored_not_clipped_at_zero(tmp_path):
+    from evolvers.drivers.qd import OBJECTIVE_FLOORS
+
+    exp = tiny("codesign", pop_size=6)
+    run = QDRun(exp, tmp_path / "s", seed=1, generations=4, config=QDConfig(cells=(8,)),
+                batch_fn=_scoring_batch_fn, figures=False, progress=False)  # fmt: skip
+    run.run()
+    assert run.objective == "score" and run.archive.qd_score_offset == OBJECTIVE_FLOORS["score"]
+    obj = run.archive.data("objective")
+    assert (obj < 0).any() and (obj >= OBJECTIVE_FLOORS["score"]).all()
+    scores = [max(float(e.objectives["score"]), -1000.0) for e in run.elites()]
+    assert sorted(obj.tolist()) == sorted(scores)
+    assert run.stats()["qd_score"] == pytest.approx(float(np.sum(obj + 1000.0)), rel=1e-12)
+    best = max(h["individual"]["objectives"]["score"] for h in run.hall_of_fame)
+    assert run.rows[-1]["best_so_far"] == best == run.stats()["qd_best"]
