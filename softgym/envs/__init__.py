@@ -7,9 +7,9 @@ id                         world                                       reward (p
 ``SoftWalker-Wall-v0``     the seed's fence (1 voxel high, 2 away)     MaxXYDist progress
 ``SoftWalker-Stairs-v0``   three rings, each one voxel higher          MaxXYDist progress
 ``SoftWalker-<Name>-v0``   the suite's other tasks (softgym.tasks.     the task's score
-                           suite: StairsDown, Rough, Gap, Tunnel,      progress
-                           Incline, Ice, Mud, Jump, Turn, Push,
-                           Carry, Swim, Grow)
+                           KINDS, six families: StairsDown, Gap,       progress
+                           Incline, Goal, Push, Catch, Chimney,
+                           Beam, Balance, Shrink, Squeeze...)
 =========================  ==========================================  =====================
 
 Beside each, ``SoftWalker-<Name>-Sensing-v0`` observes every sensor and the task's own

@@ -4,7 +4,9 @@ A :class:`Task` is a terrain + a duration + a sampling interval + the metrics
 it reports (:func:`softgym.metrics.walk_metrics`, a suite task's measure) + the
 reward an env derives from them. :data:`TASKS` holds the named ones (``flat``,
 ``wall``, ``stairs``, ``fence`` an alias of ``wall``, and the suite of
-:mod:`softgym.tasks.suite`: ``gap``, ``push``, ``swim``...); :func:`get_task` also reads a
+:mod:`softgym.tasks.suite`: ``gap``, ``push``, ``swim``..., each in one of the
+:data:`FAMILIES`: locomotion, terrain, climbing, balancing, manipulation,
+shape change; :func:`tasks_of_family` names a family's tasks); :func:`get_task` also reads a
 :class:`~softgym.terrain.Terrain`, a terrain JSON file or a Task's dict, so a
 custom world goes wherever a task name does. :class:`EpisodeBatch` runs a task
 as control episodes of N robots (what the Gymnasium envs adapt).
@@ -21,7 +23,16 @@ from softgym.tasks.episode import (
     EpisodeBatch,
     observation_size,
 )
-from softgym.tasks.suite import KINDS, Option, TaskKind, flat_layout, stairs_layout, wall_layout
+from softgym.tasks.suite import (
+    FAMILIES,
+    KINDS,
+    Option,
+    TaskKind,
+    flat_layout,
+    stairs_layout,
+    tasks_of_family,
+    wall_layout,
+)
 from softgym.tasks.task import (
     ALIASES,
     REWARDS,
@@ -42,6 +53,7 @@ __all__ = [
     "REWARDS",
     "TASKS",
     "EpisodeBatch",
+    "FAMILIES",
     "KINDS",
     "Option",
     "TaskKind",
@@ -54,5 +66,6 @@ __all__ = [
     "register_task",
     "stairs_layout",
     "task_names",
+    "tasks_of_family",
     "wall_layout",
 ]

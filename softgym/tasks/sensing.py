@@ -17,8 +17,9 @@ The sensing observation of a robot on a grid of ``n`` cells is, in this order:
   axes) and the clock phase ``sin, cos(2 pi t / period)``;
 * **per task**: the task's own senses (:class:`TaskSense`), declared by its
   kind next to its layout and measure (:mod:`softgym.tasks.suite`): an
-  object's position and velocity relative to the robot, a target, the
-  heading turned so far, terrain heights ahead, the slope.
+  object's position and velocity relative to the robot, a target relative
+  to the object or a goal relative to the robot, the heading turned so far,
+  terrain heights ahead, the slope.
 
 :func:`sensing_layout` gives the labels, bounds and input scales of a task on
 a grid (the env's observation space and the task pages' tables);
@@ -154,6 +155,10 @@ def _target(ctx: SenseContext) -> np.ndarray:
     return ctx.params["target"] - ctx.object_cm[:, :2] / ctx.voxel_size
 
 
+def _goal(ctx: SenseContext) -> np.ndarray:
+    return ctx.params["target"] - ctx.cm[:, :2] / ctx.voxel_size
+
+
 def _heading(ctx: SenseContext) -> np.ndarray:
     now = np.arctan2(ctx.aux[:, 4], ctx.aux[:, 3])
     start = np.arctan2(ctx.aux0[:, 4], ctx.aux0[:, 3])
@@ -191,6 +196,8 @@ SENSES: dict[str, TaskSense] = {
                   "their velocity minus the robot's (voxel lengths / s), world frame"),
         TaskSense("target", ("target_dx", "target_dy"), 1000.0, 10.0, _target,
                   "the push target minus the object's centre (x, y; voxel lengths)"),
+        TaskSense("goal", ("goal_dx", "goal_dy"), 1000.0, 10.0, _goal,
+                  "the goal minus the robot's centre of mass (x, y; voxel lengths)"),
         TaskSense("heading", ("turned_sin", "turned_cos"), 1.0, 1.0, _heading,
                   "sine and cosine of the heading turned since the episode start"),
         TaskSense("terrain", _terrain_labels(), HEIGHT_BOUND, 3.0, _terrain,

@@ -18,9 +18,13 @@ stairs     three concentric rings, each 2 voxels wide and   ``max_xy_dist``
 
 The rest of the suite (``stairs_down``, ``rough``, ``gap``, ``tunnel``,
 ``incline``, ``ice``, ``mud``, ``jump``, ``turn``, ``push``, ``carry``,
-``swim``, ``grow``) is defined in :mod:`softgym.tasks.suite`: each has its
-layout, engine settings, measure and difficulty arguments
-(``Task("gap", options={"width": 3})`` or ``get_task("gap:width=3")``).
+``swim``, ``grow``, then ``downhill``, ``moon``, ``goal``, ``hurdles``,
+``course``, ``mattress``, ``chimney``, ``ledge``, ``beam``, ``balance``,
+``stones``, ``push_uphill``, ``throw``, ``catch``, ``lift``, ``shrink``,
+``squeeze``) is defined in :mod:`softgym.tasks.suite`: each has its family
+(:data:`~softgym.tasks.suite.FAMILIES`), layout, engine settings, measure and
+difficulty arguments (``Task("gap", options={"width": 3})`` or
+``get_task("gap:width=3")``).
 
 A custom world is a :class:`~softgym.terrain.Terrain` (or its JSON file),
 accepted wherever a task name is: ``softgym.evaluate(d, task=Terrain.stairs())``,

@@ -61,6 +61,22 @@ def test_gap_push_turn_and_incline_senses():
     assert t[0, 0] < -0.3 and np.linalg.norm(t[0]) == pytest.approx(1.0)
 
 
+def test_the_goal_sense_points_from_the_robot_to_its_goal():
+    assert KINDS["goal"].senses == (SENSES["goal"],)
+    b = _batch([default_walker()], "goal:distance=10,angle=90")  # the goal 10 along -y
+    _, _, t = b.sensing.read(b.clock(), b.period)
+    cm = b.sim.center_of_mass()[0] / b.L
+    np.testing.assert_allclose(t[0], [3.0 - cm[0], -7.0 - cm[1]], atol=1e-9)
+    assert abs(t[0, 0]) < 0.1 and t[0, 1] == pytest.approx(-10.0, abs=0.1)
+    for k in range(20):  # its sinusoid (5 steps a period): the walker shuffles towards -x
+        b.apply(np.full((1, b.n_cells), np.sin(2 * np.pi * k / 5 + 0.5)))
+        b.advance()
+    _, _, later = b.sensing.read(b.clock(), b.period)
+    moved = b.sim.center_of_mass()[0] / b.L
+    assert moved[0] < cm[0] - 0.2
+    np.testing.assert_allclose(later[0], [3.0 - moved[0], -7.0 - moved[1]], atol=1e-9)
+
+
 def test_a_robot_senses_the_same_alone_and_in_a_batch_of_other_bodies():
     small = RobotDesign(np.full((3, 4, 2), 3, dtype=np.int8))
     alone = _batch([default_walker()], "push")
