@@ -2,8 +2,10 @@
 
 Each task's world around the default walker after ``--seconds`` (1 s: the end of
 settling; later, the walker's own controller, the seed's sinusoid) in that task's
-engine settings; movable objects are drawn in grey, worlds below z = 0 lifted
-over the renderer's floor.
+engine settings, the tasks grouped by family (``softgym.tasks.FAMILIES``); movable
+objects are drawn in grey, worlds below z = 0 lifted over the renderer's floor, a
+task's target point (push, goal) marked by a flat tile that is not part of its world,
+and the chimney seen along its walls.
 
     python scripts/task_gallery.py                     # docs/figures/task_gallery.png
     python scripts/task_gallery.py --out gallery.png --seconds 2
@@ -19,10 +21,12 @@ import numpy as np
 from softgym.design import default_walker
 from softgym.engine import Simulation
 from softgym.render import VoxelRenderer
-from softgym.tasks import get_task, task_names
+from softgym.tasks import FAMILIES, KINDS, get_task, tasks_of_family
 from softgym.terrain import Box, Terrain
 
 OBJECT_COLOR = (0.55, 0.55, 0.6)
+#: Camera angles other than the renderer's default, by task: walls that would hide the robot.
+VIEWS = {"chimney": {"azimuth": 0.0, "elevation": 50.0}}
 
 
 def frame(name: str, seconds: float, renderer: VoxelRenderer) -> np.ndarray:
@@ -45,6 +49,10 @@ def frame(name: str, seconds: float, renderer: VoxelRenderer) -> np.ndarray:
         scale = np.concatenate([scale, sim.object_scales(0)])
         colors = np.concatenate([colors, np.tile(OBJECT_COLOR, (len(obj), 1))])
     target = sim.center_of_mass()[0]
+    if "target" in terrain.meta:  # a flat tile on the target point (the figure's, not the world's)
+        tx, ty = terrain.meta["target"][:2]
+        tile = Box((tx - 0.5, ty - 0.5, 0.0), (tx + 0.5, ty + 0.5, 0.3))
+        terrain = Terrain((*terrain.boxes, tile), terrain.floor, name)
     low = min((b.lo[2] for b in terrain.boxes), default=0.0)
     if low < 0:  # the renderer draws a floor at z = 0: lift a world that goes below it
         lift = np.array([0.0, 0.0, -low])
@@ -62,23 +70,23 @@ def main() -> None:
     p.add_argument("--out", default=str(Path(__file__).resolve().parents[1] / "docs" / "figures"
                                         / "task_gallery.png"))  # fmt: skip
     p.add_argument("--seconds", type=float, default=1.0)
-    p.add_argument("--columns", type=int, default=4)
+    p.add_argument("--columns", type=int, default=6)
     args = p.parse_args()
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    names = task_names()
-    renderer = VoxelRenderer(320, 240, pixels_per_voxel=9.0)
+    names = [n for f in FAMILIES for n in tasks_of_family(f)]
     cols = args.columns
     rows = -(-len(names) // cols)
     fig, axes = plt.subplots(rows, cols, figsize=(3.2 * cols, 2.6 * rows))
     for ax in np.ravel(axes):
         ax.axis("off")
     for ax, name in zip(np.ravel(axes), names):
+        renderer = VoxelRenderer(320, 240, pixels_per_voxel=9.0, **VIEWS.get(name, {}))
         ax.imshow(frame(name, args.seconds, renderer))
-        ax.set_title(f"{name} ({get_task(name).reward})", fontsize=9)
+        ax.set_title(f"{name} ({KINDS[name].family})\n{get_task(name).reward}", fontsize=9)
     fig.tight_layout()
     fig.savefig(args.out, dpi=100)
     print(args.out)

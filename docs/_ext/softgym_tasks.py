@@ -1,19 +1,21 @@
 """Sphinx extension: one page per task of the registry (``softgym.tasks.KINDS``).
 
 At ``builder-inited`` it writes ``docs/tasks/index.md`` and ``docs/tasks/<name>.md``
-(generated, git-ignored) from each task's registry entry: its summary, Gym id, score,
-arguments with their defaults and ranges, the engine settings it sets, the world it
-builds around the default 6x6x6 grid, the docstring of its layout function and its
-sensing observation's layout (``softgym.tasks.sensing``). Run it
-alone with ``python docs/_ext/softgym_tasks.py OUT_DIR``.
+(generated, git-ignored) from each task's registry entry: its summary, family, Gym id,
+score, how long ``softgym.evaluate`` and an env episode run it, arguments with their
+defaults and ranges, the engine settings it sets, the world it builds around the default
+6x6x6 grid, the docstring of its layout function and its sensing observation's layout
+(``softgym.tasks.sensing``); the index lists the tasks by family. Run it alone with
+``python docs/_ext/softgym_tasks.py OUT_DIR``.
 """
 
 import inspect
 import sys
 from pathlib import Path
 
-from softgym.envs import env_id
-from softgym.tasks import ALIASES, KINDS, get_task
+from softgym.envs import SoftWalkerEnv, env_id
+from softgym.envs.walker import make_config
+from softgym.tasks import ALIASES, FAMILIES, KINDS, get_task, tasks_of_family
 from softgym.tasks.sensing import CELL_SENSORS, ROBOT_SENSORS, sensing_layout
 
 SHAPE = (6, 6, 6)
@@ -23,6 +25,25 @@ def _fmt(v):
     return f"{v:g}" if isinstance(v, float) else str(v)
 
 
+def durations(name: str) -> tuple[str, str]:
+    """How long ``softgym.evaluate`` and an env episode run task ``name`` by default, in words.
+
+    Read from the code: the task's ``seconds`` and settling time (``SimConfig.init_time``
+    as the task sets it), the env's default ``control_dt`` and its episode (the task's
+    seconds minus the settling, :func:`softgym.envs.walker.make_batch`).
+    """
+    task = get_task(name)
+    settle = float(task.config().init_time)
+    env_settle = float(make_config(None, None, None, task).init_time)
+    control_dt = inspect.signature(SoftWalkerEnv).parameters["control_dt"].default
+    episode = task.seconds - env_settle
+    run = (f"{task.seconds:g} s simulated: {settle:g} s of settling, then {task.seconds - settle:g} s "
+           "scored (`seconds=` changes it)")  # fmt: skip
+    env = (f"{episode:g} s after {env_settle:g} s of settling: {round(episode / control_dt)} steps "
+           f"of {control_dt:g} s (`episode_seconds=`, `control_dt=` change it)")  # fmt: skip
+    return run, env
+
+
 def task_page(name: str) -> str:
     """The Markdown page of one task of the registry."""
     kind = KINDS[name]
@@ -30,6 +51,7 @@ def task_page(name: str) -> str:
     terrain = kind.layout(SHAPE, **defaults)
     task = get_task(name)
     aliases = sorted(a for a, t in ALIASES.items() if t == name)
+    run, episode = durations(name)
     lines = [
         f"# {name}",
         "",
@@ -37,11 +59,13 @@ def task_page(name: str) -> str:
         "",
         "| | |",
         "|---|---|",
+        f"| family | [{kind.family}](index.md#{kind.family}): {FAMILIES[kind.family]} |",
         f"| Gym id | `{env_id(name)}` (blind), `{env_id(name, sensing=True)}` (sensing) |",
         f"| score (`reward`) | `{kind.reward}` |",
         f"| `softgym evolve` | `--task {name}` |",
         f"| `softgym.evaluate` | `task=\"{name}\"` |",
-        f"| duration | {task.seconds:g} s simulated |",
+        f"| `softgym.evaluate` run | {run} |",
+        f"| env episode | {episode} |",
     ]
     if aliases:
         lines.append(f"| aliases | {', '.join(f'`{a}`' for a in aliases)} |")
@@ -95,23 +119,33 @@ def task_page(name: str) -> str:
 
 
 def index_page() -> str:
-    """The tasks' index: a table of every task and the toctree of their pages."""
+    """The tasks' index: a table of the tasks of each family and the toctree of their pages."""
     lines = [
         "# Tasks",
         "",
-        "Every task is defined once in `softgym.tasks` (the registry `softgym.tasks.KINDS`: "
-        "world, engine settings, measure, difficulty arguments) and runs the same way in "
-        "`softgym.evaluate`, its Gym id and `softgym evolve --task NAME`. These pages are "
-        "generated from the registry when the site is built.",
-        "",
-        "| task | Gym id | the world and the goal | score | arguments (default) |",
-        "|---|---|---|---|---|",
+        f"{len(KINDS)} tasks in {len(FAMILIES)} families. Every task is defined once in "
+        "`softgym.tasks` (the registry `softgym.tasks.KINDS`: family, world, engine settings, "
+        "measure, difficulty arguments, senses) and runs the same way in `softgym.evaluate`, "
+        "its Gym id and `softgym evolve --task NAME` "
+        "(`softgym.tasks.tasks_of_family(\"climbing\")` names a family's tasks). These pages "
+        "are generated from the registry when the site is built.",
     ]
-    for name, kind in KINDS.items():
-        args = ", ".join(f"{k} ({_fmt(o.default)})" for k, o in kind.options.items())
-        lines.append(
-            f"| [{name}]({name}.md) | `{env_id(name)}` | {kind.summary} | `{kind.reward}` | {args} |"
-        )
+    for family, what in FAMILIES.items():
+        lines += [
+            "",
+            f"## {family}",
+            "",
+            f"{what[0].upper()}{what[1:]}.",
+            "",
+            "| task | Gym id | the world and the goal | score | arguments (default) |",
+            "|---|---|---|---|---|",
+        ]
+        for name in tasks_of_family(family):
+            kind = KINDS[name]
+            args = ", ".join(f"{k} ({_fmt(o.default)})" for k, o in kind.options.items())
+            lines.append(
+                f"| [{name}]({name}.md) | `{env_id(name)}` | {kind.summary} | `{kind.reward}` | {args} |"
+            )
     lines += [
         "",
         "![The task suite: each task's world around the default walker after settling]"
