@@ -199,9 +199,10 @@ cdef inline void voxel_quat(const Batch* b, intp_t i, float64_t* q) noexcept nog
             q[k] = b.quat[4 * i + k]
 
 
-cdef extern from *:
+cdef extern from "softgym_restrict.h":
     # restrict-qualified pointers: a vectorised kernel's inputs and outputs
-    # never alias, which lets the compiler vectorise it (gathers + SIMD)
-    ctypedef double* f64_rp "double * __restrict__"
-    ctypedef const double* cf64_rp "const double * __restrict__"
-    ctypedef const Py_ssize_t* cintp_rp "const Py_ssize_t * __restrict__"
+    # never alias, which lets the compiler vectorise it (gathers + SIMD); the
+    # qualifier is SOFTGYM_RESTRICT, spelt for each compiler in the header
+    ctypedef double* f64_rp "double * SOFTGYM_RESTRICT"
+    ctypedef const double* cf64_rp "const double * SOFTGYM_RESTRICT"
+    ctypedef const Py_ssize_t* cintp_rp "const Py_ssize_t * SOFTGYM_RESTRICT"

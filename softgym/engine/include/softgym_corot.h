@@ -8,6 +8,7 @@
 #define SOFTGYM_COROT_H
 
 #include <math.h>
+#include "softgym_restrict.h"
 #include "softgym_simd.h"
 
 /* One link's kernel in type T (double, or softgym_vd for SOFTGYM_VLANES links at once:
@@ -169,21 +170,21 @@ static void softgym_corot_rows(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, doubl
    apart; NULL: none), vend the robot's end of voxels */
 SOFTGYM_ALWAYS_INLINE void softgym_corot_links_ax(
     const int ax, Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double inv_L,
-    const Py_ssize_t *__restrict__ v1, const Py_ssize_t *__restrict__ v2,
-    const double *__restrict__ pos, const double *__restrict__ vel,
-    const double *__restrict__ av, const double *__restrict__ rot,
-    const double *__restrict__ scale, const double *__restrict__ k_axial,
-    const double *__restrict__ c_axial, const double *__restrict__ k_bend,
-    const double *__restrict__ c_bend, const double *__restrict__ k_torsion,
-    const double *__restrict__ c_torsion, const double *__restrict__ vr, Py_ssize_t vn,
+    const Py_ssize_t *SOFTGYM_RESTRICT v1, const Py_ssize_t *SOFTGYM_RESTRICT v2,
+    const double *SOFTGYM_RESTRICT pos, const double *SOFTGYM_RESTRICT vel,
+    const double *SOFTGYM_RESTRICT av, const double *SOFTGYM_RESTRICT rot,
+    const double *SOFTGYM_RESTRICT scale, const double *SOFTGYM_RESTRICT k_axial,
+    const double *SOFTGYM_RESTRICT c_axial, const double *SOFTGYM_RESTRICT k_bend,
+    const double *SOFTGYM_RESTRICT c_bend, const double *SOFTGYM_RESTRICT k_torsion,
+    const double *SOFTGYM_RESTRICT c_torsion, const double *SOFTGYM_RESTRICT vr, Py_ssize_t vn,
     Py_ssize_t vend, double *o)
 {
     const int p = (ax + 1) % 3, q = (ax + 2) % 3;
-    double *__restrict__ o_ext = o, *__restrict__ o_fx = o + n, *__restrict__ o_fy = o + 2 * n;
-    double *__restrict__ o_fz = o + 3 * n, *__restrict__ o_m1x = o + 4 * n;
-    double *__restrict__ o_m1y = o + 5 * n, *__restrict__ o_m1z = o + 6 * n;
-    double *__restrict__ o_m2x = o + 7 * n, *__restrict__ o_m2y = o + 8 * n;
-    double *__restrict__ o_m2z = o + 9 * n;
+    double *SOFTGYM_RESTRICT o_ext = o, *SOFTGYM_RESTRICT o_fx = o + n, *SOFTGYM_RESTRICT o_fy = o + 2 * n;
+    double *SOFTGYM_RESTRICT o_fz = o + 3 * n, *SOFTGYM_RESTRICT o_m1x = o + 4 * n;
+    double *SOFTGYM_RESTRICT o_m1y = o + 5 * n, *SOFTGYM_RESTRICT o_m1z = o + 6 * n;
+    double *SOFTGYM_RESTRICT o_m2x = o + 7 * n, *SOFTGYM_RESTRICT o_m2y = o + 8 * n;
+    double *SOFTGYM_RESTRICT o_m2z = o + 9 * n;
     Py_ssize_t li = lo;
 #if defined(SOFTGYM_COROT_ROWS)
     /* with AVX-512, 8 links a vector from the voxels' rows: runs of consecutive voxels

@@ -9,6 +9,7 @@
 
 #include <math.h>
 #include <stdint.h>
+#include "softgym_restrict.h"
 #include "softgym_simd.h"
 
 /* links_seed (_seed.pyx) runs its passes over chunks of SOFTGYM_CHUNK_LINKS links (a
@@ -61,11 +62,11 @@
     const double s1 = (ax) == 1 ? -1.0 : 1.0, s2 = (ax) == 2 ? -1.0 : 1.0
 /* the geometry's output rows 0-9 of the scratch o (row stride n) */
 #define SOFTGYM_SEED_GEOM_OUT(o, n) \
-    double *__restrict__ o_p0 = (o), *__restrict__ o_p1 = (o) + (n); \
-    double *__restrict__ o_p2 = (o) + 2 * (n), *__restrict__ o_qw = (o) + 3 * (n); \
-    double *__restrict__ o_n1 = (o) + 4 * (n), *__restrict__ o_n2 = (o) + 5 * (n); \
-    double *__restrict__ o_n3 = (o) + 6 * (n), *__restrict__ o_nom = (o) + 7 * (n); \
-    double *__restrict__ o_len = (o) + 8 * (n), *__restrict__ o_st = (o) + 9 * (n)
+    double *SOFTGYM_RESTRICT o_p0 = (o), *SOFTGYM_RESTRICT o_p1 = (o) + (n); \
+    double *SOFTGYM_RESTRICT o_p2 = (o) + 2 * (n), *SOFTGYM_RESTRICT o_qw = (o) + 3 * (n); \
+    double *SOFTGYM_RESTRICT o_n1 = (o) + 4 * (n), *SOFTGYM_RESTRICT o_n2 = (o) + 5 * (n); \
+    double *SOFTGYM_RESTRICT o_n3 = (o) + 6 * (n), *SOFTGYM_RESTRICT o_nom = (o) + 7 * (n); \
+    double *SOFTGYM_RESTRICT o_len = (o) + 8 * (n), *SOFTGYM_RESTRICT o_st = (o) + 9 * (n)
 /* v (a double, or a vector of them) rounded to float and stored at row[li] (the geometry's
    float rows of voxel 1's rotation) */
 #define SOFTGYM_PUTF1(row, li, v) ((row)[li] = (float)(v))
