@@ -3,9 +3,12 @@
 Used by ``.ci/run`` after it installs the wheel into a fresh venv, and by
 cibuildwheel's ``test-command``. It checks that ``softgym`` is imported from the
 installed package (never a checkout), prints the version and the kernel build that
-runs, simulates a small batch for a short while and steps one Gymnasium env.
+runs (the one ``SOFTGYM_KERNEL`` names, when set: ``.ci/release`` runs the test under
+each build the CPU has), simulates a small batch for a short while and steps one
+Gymnasium env.
 """
 
+import os
 import sys
 import sysconfig
 from pathlib import Path
@@ -24,6 +27,8 @@ assert here.is_relative_to(site) or here.is_relative_to(plat), (
 )
 print("softgym", softgym.__version__, "from", here.parent)
 print("kernel build:", kernel_build(), "| OpenMP:", softgym.openmp_enabled())
+wanted = os.environ.get("SOFTGYM_KERNEL")
+assert wanted is None or kernel_build() == wanted, (kernel_build(), wanted)
 
 bodies = [Body.uniform(np.ones((3, 3, 3)), cte=0.01) for _ in range(2)]
 rollout = Simulation(bodies, SimConfig(actuation="symmetric")).run(0.2)
