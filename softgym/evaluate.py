@@ -29,7 +29,7 @@ import numpy as np
 
 from softgym.exceptions import InvalidDesignError, InvalidParameterError
 from softgym.tasks import Task, TaskLike, get_task
-from softgym.validate import is_int, positive, show
+from softgym.validate import positive, show, threads
 
 __all__ = [
     "METRIC_KEYS",
@@ -185,9 +185,7 @@ def evaluate(
     if trace_interval is not None:
         changes["trace_interval"] = positive("trace_interval", trace_interval, unit=" (s)")
     if n_threads is not None:
-        if not is_int(n_threads) or n_threads < 1:
-            raise InvalidParameterError(f"n_threads must be an integer >= 1, got {show(n_threads)}")
-        changes["n_threads"] = int(n_threads)
+        changes["n_threads"] = threads(n_threads)
     if config is not None and not isinstance(config, SimConfig):
         raise InvalidParameterError(
             f"config must be a softgym SimConfig (or None for the task's), got {show(config)}"

@@ -17,7 +17,10 @@ import numpy as np
 
 from softgym.exceptions import InvalidParameterError, SoftGymError
 
-__all__ = ["is_int", "is_real", "number", "positive", "show"]
+__all__ = ["MAX_THREADS", "is_int", "is_real", "number", "positive", "show", "threads"]
+
+#: The most OpenMP threads a simulation, env or run accepts.
+MAX_THREADS = 1024
 
 
 def show(value: Any) -> str:
@@ -80,3 +83,17 @@ def positive(
     if not (math.isfinite(v) and v > 0):
         raise error(f"{name} must be a finite number > 0{unit}, got {show(value)}")
     return v
+
+
+def threads(value: Any, name: str = "n_threads") -> int | None:
+    """A thread count as every entry takes it: None (all usable CPUs) or an integer in
+    1..:data:`MAX_THREADS`; anything else raises
+    :class:`~softgym.exceptions.InvalidParameterError` naming ``name`` and the range.
+    """
+    if value is None:
+        return None
+    if not is_int(value) or not 1 <= int(value) <= MAX_THREADS:
+        raise InvalidParameterError(
+            f"{name} must be None or an integer in 1..{MAX_THREADS}, got {show(value)}"
+        )
+    return int(value)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from softgym.exceptions import InvalidParameterError, InvalidTerrainError
-from softgym.validate import is_int, is_real, number, positive, show
+from softgym.validate import MAX_THREADS, is_int, is_real, number, positive, show, threads
 
 
 def test_number_refuses_what_is_not_a_real_number():
@@ -33,3 +33,25 @@ def test_ints_reals_and_how_values_are_shown():
     assert show(10**5000) == "<a 16610-bit integer, too large to print>"
     assert show((1, "a")) == "(1, 'a')" and show([2**70]) == "[<a 71-bit integer, too large to print>]"
     assert len(show("x" * 500)) == 80
+
+
+@pytest.mark.parametrize("bad", [0, -1, 1.5, 2.0, True, "2", MAX_THREADS + 1, [2]])
+def test_every_entry_checks_a_thread_count_the_same_way(bad):
+    # one check, one message: the engine, softgym.evaluate and the envs agree on what a
+    # thread count is (they once had four bounds between them)
+    import gymnasium as gym
+
+    import softgym
+    from softgym.design import default_walker
+    from softgym.engine import Simulation
+
+    msg = rf"n_threads must be None or an integer in 1\.\.{MAX_THREADS}"
+    with pytest.raises(InvalidParameterError, match=msg):
+        threads(bad)
+    with pytest.raises(InvalidParameterError, match=msg):
+        Simulation([default_walker()], n_threads=bad)
+    with pytest.raises(InvalidParameterError, match=msg):
+        softgym.evaluate([default_walker()], seconds=1.5, n_threads=bad)
+    with pytest.raises(InvalidParameterError, match=msg):
+        gym.make("SoftWalker-Flat-v0", n_threads=bad)
+    assert threads(None) is None and threads(np.int64(3)) == 3 and threads(MAX_THREADS) == MAX_THREADS

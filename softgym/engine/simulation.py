@@ -60,7 +60,6 @@ from softgym.engine.layout import (  # noqa: F401 (re-exported: the public API i
     MAX_OBSTACLE_VOXELS,
     OBSTACLE_DENSITY,
     OBSTACLE_YOUNGS_MODULUS,
-    _hop_neighbours,
     as_body,
     build_layout,
     memory_estimate,
@@ -78,6 +77,7 @@ from softgym.exceptions import (
     InvalidTerrainError,
     SimulationDivergedError,
 )
+from softgym.validate import threads
 
 __all__ = ["Simulation", "as_body", "default_num_threads", "time_step", "voxel_steps_per_second"]
 
@@ -183,9 +183,8 @@ class Simulation:
         self.config = SimConfig() if config is None else config
         if not isinstance(self.config, SimConfig):
             raise InvalidParameterError(f"config must be a SimConfig, got {type(config).__name__}")
-        self.n_threads = default_num_threads() if n_threads is None else int(n_threads)
-        if self.n_threads < 1:
-            raise InvalidParameterError(f"n_threads must be >= 1, got {n_threads}")
+        checked = threads(n_threads)
+        self.n_threads = default_num_threads() if checked is None else checked
         self.terrains = self._terrains(terrain)
         if not self.config.self_collision and any(t.objects for t in self.terrains):
             raise InvalidParameterError(

@@ -35,6 +35,7 @@ from softgym.tasks import (
 from softgym.tasks.actions import ACTION_MODES, ActionMap  # noqa: F401 (re-exported)
 from softgym.tasks.episode import MAX_STEPS_PER_EPISODE
 from softgym.terrain import Terrain
+from softgym.validate import threads
 
 __all__ = [
     "ACTION_MODES",
@@ -63,7 +64,6 @@ _NO_ENGINE_TRACE = 1.0e9
 MAX_FRAME_SIDE = 4096
 RENDER_MODES: tuple[str, ...] = ("rgb_array",)
 # engine threads an env may ask for (the engine uses at most one per robot anyway)
-_MAX_THREADS = 1024
 
 
 def _show(value: Any) -> str:
@@ -190,10 +190,7 @@ def make_batch(
     task's ``seconds`` minus the settling time (4 s for the seed's 5 s runs).
     A ``max_episode_steps`` that cuts episodes short warns.
     """
-    if n_threads is not None and (not _is_int(n_threads) or not 1 <= n_threads <= _MAX_THREADS):
-        raise InvalidParameterError(
-            f"n_threads must be None or an integer in 1..{_MAX_THREADS}, got {_show(n_threads)}"
-        )
+    n_threads = threads(n_threads)
     t = get_task(task)
     if terrain is not None:
         if not isinstance(terrain, Terrain):

@@ -103,7 +103,7 @@ def _pull_shut(sim, robot):
 
 def _min_distance_of_colliding_pairs(sim, seconds, hops=3):
     # smallest centre distance over pairs more than `hops` bonds apart, in L
-    from softgym.engine.simulation import _hop_neighbours
+    from softgym.engine.layout import _hop_neighbours
 
     off = sim.voxel_offsets
     a = sim._a
