@@ -161,7 +161,7 @@ def make_config(
             f"sim_config must be a SimConfig, got {type(sim_config).__name__}"
         )
     return (Task() if task is None else task).config(
-        SimConfig() if sim_config is None else sim_config, settings=task is not None,
+        sim_config, settings=task is not None,
         trace_interval=_NO_ENGINE_TRACE, actuation=actuation,
         self_collision=None if self_collision is None else bool(self_collision),
     )  # fmt: skip

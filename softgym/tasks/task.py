@@ -259,11 +259,13 @@ class Task:
         """
         from softgym.engine import SimConfig
 
-        sim = self.engine_settings if settings else {}
-        cfg = SimConfig(**sim) if base is None else base.replace(**sim)
-        changes = {k: v for k, v in overrides.items() if v is not None}
         interval = self.trace_interval if trace_interval is None else trace_interval
-        return cfg.replace(trace_interval=float(interval), **changes)
+        fields = {  # the task's settings, then the trace, then the overrides: one SimConfig
+            **(self.engine_settings if settings else {}),
+            "trace_interval": float(interval),
+            **{k: v for k, v in overrides.items() if v is not None},
+        }
+        return SimConfig(**fields) if base is None else base.replace(**fields)
 
     @property
     def engine_settings(self) -> dict[str, Any]:

@@ -143,3 +143,22 @@ def test_vector_env_actions():
     with pytest.raises(InvalidActionError, match=r"shape \(1, 216\)"):
         one.step(np.zeros(216))  # a batch of one still takes (1, n_cells)
     one.step(np.zeros((1, 216)))
+
+
+def test_an_env_assembles_its_engine_settings_once(monkeypatch):
+    # the task's settings, the trace and the env's overrides become one SimConfig (three
+    # were built per gym.make, each validated), and the task's settings are in it
+    import gymnasium as gym
+
+    from softgym.engine import config as engine_config
+
+    built = []
+    post = engine_config.SimConfig.__post_init__
+    monkeypatch.setattr(engine_config.SimConfig, "__post_init__",
+                        lambda self: (built.append(self), post(self))[1])  # fmt: skip
+    env = gym.make("SoftWalker-Swim-v0", actuation="seed")
+    assert len(built) == 1
+    cfg = built[0]
+    assert cfg.gravity == 0.0 and cfg.fluid_drag > 0  # the swim task's settings
+    assert cfg.actuation == "seed"  # the env's override, applied last
+    env.close()
