@@ -835,9 +835,9 @@ def main(argv: list[str] | None = None) -> int:
     try:
         if args.report:
             text = report(args.out, args.reference, args.figures)
-            print(text)
             if args.doc is not None:
                 write_doc(args.doc, commands_table(args.out, args.reference) + "\n\n" + text)
+            print(text)
             return 0
         return run(args)
     except (SoftGymError, OSError) as exc:
