@@ -739,8 +739,13 @@ def _frame(design: Any, task: str, seconds: float, renderer: Any) -> np.ndarray:
         scale = np.concatenate([scale, sim.object_scales(0)])
         colors = np.concatenate([colors, np.tile((0.55, 0.55, 0.6), (len(obj), 1))])
     target = sim.center_of_mass()[0]
-    low = min((b.lo[2] for b in terrain.boxes), default=0.0)
-    if low < 0:  # the renderer's floor is z = 0: lift a world that goes below it
+    # the renderer's floor is z = 0: lift a world that goes below it, and a robot that fell
+    # below the world (off the edge of a world without a floor), so that both are drawn
+    low = min(
+        min((b.lo[2] for b in terrain.boxes), default=0.0),
+        float(pos[:, 2].min()) / sim.config.voxel_size,
+    )
+    if low < 0:
         lift = np.array([0.0, 0.0, -low])
         terrain = Terrain(
             tuple(Box(np.add(b.lo, lift), np.add(b.hi, lift)) for b in terrain.boxes), True, task
@@ -781,7 +786,7 @@ def draw_gallery(
             f"{t}: {_fmt(c['best_score'])}\n{c['optimizer']}, seed {c['seed']}", fontsize=7
         )
     fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    fig.savefig(path, dpi=100, bbox_inches="tight")
     plt.close(fig)
 
 
