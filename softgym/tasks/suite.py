@@ -188,7 +188,9 @@ def stairs_down_layout(shape: Sequence[int], step_height: float = 1.0, n_steps: 
     bottom = -(n_steps * step_height + 2.0)
     boxes = [_square(c, inner / 2.0, bottom, 0.0)]
     for i in range(n_steps):
-        width = step_width if i < n_steps - 1 else 30.0  # the last step is the ground
+        # the last step is the ground, out past where the fastest robot gets in a task's run
+        # (no floor below: a robot walking off its edge would score while it falls)
+        width = step_width if i < n_steps - 1 else 200.0
         boxes += _ring(c, inner + 2 * i * step_width, width, bottom, -(i + 1) * step_height)
     meta = {"builder": "stairs_down", "step_height": step_height, "n_steps": n_steps,
             "step_width": step_width, "center": list(c)}  # fmt: skip

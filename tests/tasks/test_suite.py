@@ -157,3 +157,16 @@ def test_evolution_on_a_suite_task_selects_on_its_score():
     assert get_experiment("basic", task="gap:width=3").make_task().options["width"] == 3.0
     assert get_experiment("basic", task="swim").make_task().config().fluid_drag > 0
     assert get_experiment("basic").fitness.name == "norm_final_dist"
+
+
+def test_stairs_down_ground_reaches_beyond_what_a_fast_robot_covers():
+    # the pyramid has no floor under it: the ground ring must reach farther than the
+    # fastest evolved walkers get in a task's run (~50 voxel lengths), or a robot walking
+    # off its edge scores max_xy_dist while it falls
+    from softgym.tasks.suite import stairs_down_layout
+
+    for n_steps in (1, 3, 10):
+        world = stairs_down_layout((6, 6, 6), n_steps=n_steps, step_width=10.0)
+        lo = min(b.lo[0] for b in world.boxes), min(b.lo[1] for b in world.boxes)
+        hi = max(b.hi[0] for b in world.boxes), max(b.hi[1] for b in world.boxes)
+        assert min(3.0 - lo[0], 3.0 - lo[1], hi[0] - 3.0, hi[1] - 3.0) >= 150.0
