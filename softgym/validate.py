@@ -85,15 +85,17 @@ def positive(
     return v
 
 
-def threads(value: Any, name: str = "n_threads") -> int | None:
+def threads(value: Any, name: str = "n_threads", absent: str = "None") -> int | None:
     """A thread count as every entry takes it: None (all usable CPUs) or an integer in
     1..:data:`MAX_THREADS`; anything else raises
-    :class:`~softgym.exceptions.InvalidParameterError` naming ``name`` and the range.
+    :class:`~softgym.exceptions.InvalidParameterError` naming ``name``, the range and how
+    all usable CPUs are asked for (``absent``: ``"None"``, or ``"left out"`` for a flag).
     """
     if value is None:
         return None
     if not is_int(value) or not 1 <= int(value) <= MAX_THREADS:
         raise InvalidParameterError(
-            f"{name} must be None or an integer in 1..{MAX_THREADS}, got {show(value)}"
+            f"{name} must be an integer in 1..{MAX_THREADS} ({absent} for all usable CPUs), "
+            f"got {show(value)}"
         )
     return int(value)

@@ -26,6 +26,7 @@ from evolvers.drivers.budget import BUDGET_FLAGS, Budget
 from evolvers.evaluation.experiments import CONTROLLERS, Experiment, get_experiment
 from evolvers.recording.recorder import RunInterrupted, read_run_config
 from softgym.exceptions import CheckpointError, InvalidParameterError, SoftGymError
+from softgym.validate import threads as threads_check
 from softgym_cli.flags import extra_hint, options_after, subcommands
 
 __all__ = [
@@ -230,19 +231,15 @@ def _number(text: str) -> Any:
 
 
 def check_threads(threads: Any) -> None:
-    """``--threads``: None (all usable CPUs) or an integer >= 1.
+    """``--threads``: None (all usable CPUs) or an integer in 1..MAX_THREADS
+    (:func:`softgym.validate.threads`).
 
     Raises
     ------
     InvalidParameterError
         Naming the flag, before anything is written.
     """
-    if threads is not None and (isinstance(threads, bool) or not isinstance(threads, int)
-                                or threads < 1):  # fmt: skip
-        raise InvalidParameterError(
-            f"--threads must be an integer >= 1 (OpenMP threads), got {threads!r}; leave it "
-            "out for all usable CPUs"
-        )
+    threads_check(threads, "--threads", absent="left out")
 
 
 def settling_seconds(experiment: Experiment) -> float:

@@ -17,8 +17,8 @@ from softgym.exceptions import InvalidDesignError, InvalidParameterError, SoftGy
         ({"seconds": True}, "seconds must be a finite number > 0"),  # a bool is not 1 s
         ({"seconds": float("inf")}, "seconds must be a finite number > 0"),
         ({"trace_interval": 0.0}, "trace_interval must be a finite number > 0"),
-        ({"n_threads": "x"}, r"n_threads must be None or an integer in 1\.\.1024"),
-        ({"n_threads": 0}, r"n_threads must be None or an integer in 1\.\.1024"),
+        ({"n_threads": "x"}, r"n_threads must be an integer in 1\.\.1024"),
+        ({"n_threads": 0}, r"n_threads must be an integer in 1\.\.1024"),
         ({"config": "seed"}, "config must be a softgym SimConfig"),
         # the memory budget: 5e9 samples per robot
         ({"trace_interval": 1e-9, "seconds": 5.0}, "raise trace_interval"),

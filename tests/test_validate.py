@@ -45,7 +45,7 @@ def test_every_entry_checks_a_thread_count_the_same_way(bad):
     from softgym.design import default_walker
     from softgym.engine import Simulation
 
-    msg = rf"n_threads must be None or an integer in 1\.\.{MAX_THREADS}"
+    msg = rf"n_threads must be an integer in 1\.\.{MAX_THREADS} \(None for all usable CPUs\)"
     with pytest.raises(InvalidParameterError, match=msg):
         threads(bad)
     with pytest.raises(InvalidParameterError, match=msg):

@@ -69,7 +69,7 @@ from evolvers.evaluation.experiments import (
 )
 from softgym.exceptions import CheckpointError, InvalidParameterError, SoftGymError
 from softgym.io import atomic_write_json, read_json_lines
-from softgym.validate import is_int, show
+from softgym.validate import is_int, show, threads
 
 __all__ = [
     "MAX_SEEDS",
@@ -351,10 +351,7 @@ def plan(
     if generations is not None:
         generations = check_generations(generations)
     first_seed = check_seed(first_seed, "first_seed")
-    if n_threads is not None and (not is_int(n_threads) or n_threads < 1):
-        raise InvalidParameterError(
-            f"n_threads (--threads) must be an integer >= 1, got {show(n_threads)}"
-        )
+    threads(n_threads, "n_threads (--threads)")
     if "shape" in overrides:
         from softgym.design.robot import check_grid_shape
 
