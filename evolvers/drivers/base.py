@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 
 from evolvers.drivers.budget import Budget, BudgetUsage
-from evolvers.evaluation.evaluator import BatchFn, EvalStats, Evaluator
+from evolvers.evaluation.evaluator import BatchFn, EvalStats, Evaluator, PhenotypeCache
 from evolvers.evaluation.experiments import (
     Experiment,
     check_generations,
@@ -197,8 +197,29 @@ class Driver:
         raise NotImplementedError
 
     def _restore(self, state: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
-        """Restore what :meth:`_checkpoint_state` saved (after :meth:`_fresh`)."""
+        """Restore what :meth:`_checkpoint_state` saved (after :meth:`_fresh`; the
+        evaluator's cache and count are restored already).
+        """
         raise NotImplementedError
+
+    # ------------------------------------------------------------------ the evaluator's record
+    #: The checkpoint key of the evaluator's simulation count (the driver writes it, with
+    #: the cache's arrays, beside each driver's own state).
+    EVALUATIONS_KEY = "evaluations_counter"
+
+    def _evaluator_checkpoint(self) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
+        """The evaluator's part of a checkpoint: its simulation count and its cache."""
+        return {self.EVALUATIONS_KEY: self.evaluator.n_evaluations}, self.evaluator.cache.to_arrays()
+
+    def _restore_evaluator(self, state: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
+        """Restore the evaluator's cache and simulation count (the count under the key
+        POET's checkpoints used before the driver owned it, ``n_simulated``, read too).
+        """
+        self.evaluator.cache = PhenotypeCache.from_arrays(arrays)
+        count = state.get(self.EVALUATIONS_KEY, state.get("n_simulated", 0))
+        if isinstance(count, bool) or not isinstance(count, int) or count < 0:
+            raise ValueError(f"{self.EVALUATIONS_KEY} must be an integer >= 0, got {count!r:.40}")
+        self.evaluator.n_evaluations = count
 
     @property
     def label(self) -> str:
@@ -285,6 +306,7 @@ class Driver:
             return False
         try:
             self._fresh()
+            self._restore_evaluator(*loaded)  # first: a driver's restore may evaluate (cached)
             self._restore(*loaded)
         except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
             # a re-signed checkpoint whose arrays or entries have the wrong shapes or types
@@ -334,6 +356,8 @@ class Driver:
     def _end_generation(self, stats: EvalStats, wall: float) -> None:
         """Log row, checkpoint (with the budget), files, callback."""
         state, arrays, columns, individuals = self._checkpoint_state()
+        ev_state, ev_arrays = self._evaluator_checkpoint()
+        state, arrays = {**state, **ev_state}, {**arrays, **ev_arrays}
         columns = {**(columns or {}), "best_so_far": self.best_so_far()}
         start, before = self._sitting
         row = self.recorder.end_generation(

@@ -916,10 +916,9 @@ class PoetRun(Driver):
             "next_pair": self.pair_ids.value,
             "annecs": self.annecs,
             "annecs_archive": self.annecs_archive,
-            "n_simulated": self.n_simulated,
             "pairs": [p.to_dict() for p in self.pairs],
         }
-        return state, self.evaluator.cache.to_arrays(), columns, [p.best for p in active]
+        return state, {}, columns, [p.best for p in active]
 
     def _restore(self, state: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
         self.rng = rng_from_state(state["rng"])
@@ -927,12 +926,10 @@ class PoetRun(Driver):
         self.pair_ids.value = int(state["next_pair"])
         self.annecs = int(state["annecs"])
         self.annecs_archive = int(state["annecs_archive"])
-        self.evaluator.n_evaluations = int(state["n_simulated"])
         self.pairs = [
             Pair.from_dict(d, self.metric, self.config.score_cap) for d in state["pairs"]
         ]
         self.iteration = int(state["generation"])
-        self.evaluator.cache = PhenotypeCache.from_arrays(arrays)
 
     # ------------------------------------------------------------------ outputs
     def finish(self) -> None:

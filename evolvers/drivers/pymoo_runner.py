@@ -61,7 +61,7 @@ from pymoo.core.problem import Problem
 from pymoo.core.sampling import Sampling
 
 from evolvers.drivers.base import Checkpoint, Driver, IdCounter
-from evolvers.evaluation.evaluator import EvalStats, Evaluator, PhenotypeCache, pack_traces
+from evolvers.evaluation.evaluator import EvalStats, Evaluator, pack_traces
 from evolvers.evaluation.experiments import Experiment
 from evolvers.operators.encoding import CPPNVector
 from evolvers.operators.genome import Individual
@@ -742,8 +742,6 @@ class PymooRun(Driver):
         return self.problem.last_stats
 
     def _restore(self, state: dict[str, Any], arrays: dict[str, np.ndarray]) -> None:
-        self.evaluator.cache = PhenotypeCache.from_arrays(arrays)
-        self.evaluator.n_evaluations = int(state.get("evaluations_counter", 0))
         self._replay(self.problem, self.algorithm, state)
 
     def _checkpoint_state(self) -> Checkpoint:
@@ -753,13 +751,11 @@ class PymooRun(Driver):
         arrays = {
             "pop_traces": data, "pop_trace_len": lengths,
             "F": pop.get("F"), "G": pop.get("G"), "CV": pop.get("CV"),
-            **self.evaluator.cache.to_arrays(),
         }  # fmt: skip
         state = {
             "rng": rng_state(algorithm.random_state),
             "next_id": self.ids.value,
             "archive": None if self.archive is None else self.archive.to_dict(),
             "n_eval": int(algorithm.evaluator.n_eval),
-            "evaluations_counter": self.evaluator.n_evaluations,
         }
         return state, arrays, None, self.population

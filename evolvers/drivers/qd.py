@@ -61,7 +61,6 @@ from evolvers.evaluation.descriptors import MOURET_CLUNE_2015, check_descriptors
 from evolvers.evaluation.distributed import MissingExtraError
 from evolvers.evaluation.evaluator import (
     EvalStats,
-    PhenotypeCache,
     pack_traces,
     unpack_traces,
 )
@@ -516,14 +515,12 @@ class QDRun(Driver):
             "archive_threshold": data["threshold"].astype(np.float64),
             "pop_traces": traces,
             "pop_trace_len": lengths,
-            **self.evaluator.cache.to_arrays(),
         }
         if self.config.archive == "cvt":
             arrays["archive_centroids"] = np.asarray(self.archive.centroids, dtype=np.float64)
         state = {
             "rng": rng_state(self.emitter.rng),
             "next_id": self.ids.value,
-            "evaluations_counter": self.evaluator.n_evaluations,
         }
         columns = {
             **self.stats(),
@@ -553,8 +550,6 @@ class QDRun(Driver):
         self.generation = int(state["generation"])
         self.ids.value = int(state["next_id"])
         self.emitter.rng = rng_from_state(state["rng"])
-        self.evaluator.cache = PhenotypeCache.from_arrays(arrays)
-        self.evaluator.n_evaluations = int(state.get("evaluations_counter", 0))
 
 
 # ---------------------------------------------------------------------- figures

@@ -22,7 +22,6 @@ import numpy as np
 from evolvers.drivers.base import Checkpoint, Driver
 from evolvers.evaluation.evaluator import (
     EvalStats,
-    PhenotypeCache,
     pack_traces,
     unpack_traces,
 )
@@ -130,13 +129,12 @@ class EvolutionRun(Driver):
 
     def _checkpoint_state(self) -> Checkpoint:
         data, lengths = pack_traces([ind.trace for ind in self.population])
-        arrays = {"pop_traces": data, "pop_trace_len": lengths, **self.evaluator.cache.to_arrays()}
+        arrays = {"pop_traces": data, "pop_trace_len": lengths}
         state = {
             "rng": rng_state(self.rng),
             "python_random": python_random_state(),
             "next_id": self.ids.value,
             "archive": None if self.archive is None else self.archive.to_dict(),
-            "evaluations_counter": self.evaluator.n_evaluations,
             "backend_state": self._backend_state(),
         }
         return state, arrays, None, self.population
@@ -152,6 +150,4 @@ class EvolutionRun(Driver):
         self.ids.value = int(state["next_id"])
         if state.get("archive") is not None:
             self.archive = NoveltyArchive.from_dict(state["archive"])
-        self.evaluator.n_evaluations = int(state.get("evaluations_counter", 0))
-        self.evaluator.cache = PhenotypeCache.from_arrays(arrays)
         self._restore_backend_state(state.get("backend_state", {}))
