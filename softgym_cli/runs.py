@@ -23,7 +23,8 @@ from pathlib import Path
 from typing import Any
 
 from evolvers.drivers.budget import BUDGET_FLAGS, Budget
-from evolvers.evaluation.experiments import CONTROLLERS, Experiment, get_experiment
+from evolvers.drivers.registry import BACKENDS, PYMOO_ALGORITHMS
+from evolvers.evaluation.experiments import CONTROLLERS, SELECTIONS, Experiment, get_experiment
 from evolvers.recording.recorder import RunInterrupted, read_run_config
 from softgym.exceptions import CheckpointError, InvalidParameterError, SoftGymError
 from softgym.validate import threads as threads_check
@@ -423,25 +424,16 @@ def _evolve_run(args: argparse.Namespace, cfg: dict | None) -> tuple[type, Exper
               "backend": args.backend, "algorithm": args.algorithm,
               "generations": args.generations}  # fmt: skip
     kw: dict[str, Any] = {"seed": st["seed"], "generations": st["generations"]}
-    if st["backend"] == "pymoo" and args.selection is not None:
-        print(f"softgym evolve: warning: --selection {args.selection} is ignored with "
-              f"--backend pymoo (pymoo's {st['algorithm']} does its own survival)",
-              file=sys.stderr)  # fmt: skip
-    if st["backend"] == "random" and args.selection is not None:
-        print(f"softgym evolve: warning: --selection {args.selection} is ignored with "
-              "--backend random (random search keeps the best by the fitness)",
-              file=sys.stderr)  # fmt: skip
-    if st["backend"] == "deap":
-        from evolvers.drivers.deap_runner import DeapRun as Run
-    elif st["backend"] == "pymoo":
-        from evolvers.drivers.pymoo_runner import PymooRun as Run
+    from evolvers.drivers.registry import driver_class
 
+    if not BACKENDS[st["backend"]].selects and args.selection is not None:
+        why = (f"pymoo's {st['algorithm']} does its own survival" if st["backend"] == "pymoo"
+               else f"{BACKENDS[st['backend']].summary}")  # fmt: skip
+        print(f"softgym evolve: warning: --selection {args.selection} is ignored with "
+              f"--backend {st['backend']} ({why})", file=sys.stderr)  # fmt: skip
+    if st["backend"] == "pymoo":
         kw["algorithm"] = st["algorithm"]
-    elif st["backend"] == "random":
-        from evolvers.drivers.random_search import RandomSearchRun as Run
-    else:
-        from evolvers.drivers.runner import EvolutionRun as Run
-    return Run, st["experiment"], kw
+    return driver_class(st["backend"]), st["experiment"], kw
 
 
 def _evolve_summary(run: Any, _: Any) -> dict[str, Any]:
@@ -472,10 +464,10 @@ def add_evolve_parser(sub: Any) -> argparse.ArgumentParser:
     p.add_argument("--pop", type=int, default=15, help="population size")
     p.add_argument("--seed", type=int, default=0, help="seed of the run's random generator")
     add_run_flags(p, "runs/evolve")
-    p.add_argument("--backend", choices=["native", "deap", "pymoo", "random"], default="native",
-                   help="the search loop: softgym's own, a DEAP toolbox, a pymoo algorithm, or "
-                   "random search (fresh random genomes each generation, the best kept)")  # fmt: skip
-    p.add_argument("--algorithm", choices=["nsga2", "nsga3", "sms-emoa", "ga", "cmaes"],
+    p.add_argument("--backend", choices=list(BACKENDS), default="native",
+                   help="the search loop: " + "; ".join(f"{k}: {b.summary}"
+                                                       for k, b in BACKENDS.items()))  # fmt: skip
+    p.add_argument("--algorithm", choices=list(PYMOO_ALGORITHMS),
                    default="nsga2",
                    help="pymoo algorithm (--backend pymoo; ga optimises the first objective alone; "
                    "cmaes: pymoo's CMA-ES over the design vector, a fixed-topology CPPN's "
@@ -488,7 +480,7 @@ def add_evolve_parser(sub: Any) -> argparse.ArgumentParser:
     p.add_argument("--shape", type=int, nargs=3, metavar=("NX", "NY", "NZ"),
                    help="robot grid (default: the experiment's, 6 6 6)")  # fmt: skip
     p.add_argument("--selection",
-                   choices=["pareto", "tournament", "novelty", "novelty-archive", "nsga2"],
+                   choices=list(SELECTIONS),
                    help="override the experiment's selection (native and DEAP backends; "
                    "default: the experiment's)")  # fmt: skip
     add_controller_flags(p)

@@ -1,5 +1,7 @@
 """The searches: one run skeleton and the drivers built on it.
 
+* :mod:`~evolvers.drivers.registry` - the drivers by name (:data:`~evolvers.drivers.registry.BACKENDS`,
+  pymoo's algorithm names): the CLI's choices are read there;
 * :mod:`~evolvers.drivers.base` - :class:`~evolvers.drivers.base.Driver` (construction,
   generation loop, progress, Ctrl-C, checkpoint, exact resume) and the one
   :class:`~evolvers.drivers.base.IdCounter`;

@@ -61,6 +61,7 @@ from pymoo.core.problem import Problem
 from pymoo.core.sampling import Sampling
 
 from evolvers.drivers.base import Checkpoint, Driver, IdCounter
+from evolvers.drivers.registry import PYMOO_ALGORITHMS
 from evolvers.evaluation.evaluator import EvalStats, Evaluator, pack_traces
 from evolvers.evaluation.experiments import Experiment
 from evolvers.operators.encoding import CPPNVector
@@ -525,8 +526,9 @@ def problem_objectives(experiment: Experiment, single_objective: bool = False) -
 
 
 #: Algorithms known by name (``"ga"`` and ``"cmaes"`` are single-objective: they optimise the
-#: experiment's fitness; ``"cmaes"`` a design vector or a brain on a fixed body, :func:`make_cmaes`).
-ALGORITHMS: tuple[str, ...] = ("nsga2", "nsga3", "sms-emoa", "ga", "cmaes")
+#: experiment's fitness; ``"cmaes"`` a design vector or a brain on a fixed body, :func:`make_cmaes`);
+#: the drivers' registry holds them (:data:`evolvers.drivers.registry.PYMOO_ALGORITHMS`).
+ALGORITHMS: tuple[str, ...] = PYMOO_ALGORITHMS
 
 
 def make_algorithm(
