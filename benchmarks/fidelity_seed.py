@@ -376,6 +376,11 @@ def paired_main(a, labels: list[str]) -> int:
             raise SystemExit(f"label {label!r} is neither a preset ({', '.join(PRESETS)}) nor stored "
                              f"in {store_path}: record it with --record {label}")  # fmt: skip
     presets = {x: SimConfig(**PRESETS[x]) for x in labels if x in PRESETS}
+    if a.stored_only:  # compare what is stored (another process may still be adding to it)
+        missing = [x for x in labels if x not in store["labels"]]
+        if missing:
+            raise SystemExit(f"--stored-only: {missing} not stored in {store_path}")
+        presets = {}
     for label, n in record(store, store_path, presets, cases, draws, a.threads).items():
         if n:
             print(f"label {label!r}: {n} runs added to {store_path}")
@@ -430,6 +435,8 @@ def main() -> int:
     ap.add_argument("--oracle-draws", default="0,1,2,3,4,5,6",
                     help="the seed's engine's draws whose median is each case's reference (paired)")
     ap.add_argument("--resamples", type=int, default=4000, help="bootstrap resamples (paired)")
+    ap.add_argument("--stored-only", action="store_true",
+                    help="compare the stored values, running nothing (cases lacking one are left out)")
     a = ap.parse_args()
     if a.first_draw < 1:
         ap.error("--first-draw must be >= 1")
