@@ -56,6 +56,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from softgym.exceptions import CheckpointError, InvalidParameterError, RunFolderLockedError
+from softgym.validate import show
 
 __all__ = [
     "CHECKPOINT_SCHEMA",
@@ -79,6 +80,7 @@ __all__ = [
     "read_capped",
     "read_json",
     "read_json_lines",
+    "read_json_records",
     "remove_stale_temp_files",
     "rng_from_state",
     "rng_state",
@@ -368,6 +370,35 @@ def read_json(path: str | os.PathLike[str], cap: int = MAX_JSON_BYTES) -> Any:
     path = Path(path)
     data = read_capped(path, cap, "JSON")
     return loads_json(data, str(path))
+
+
+def read_json_records(path: str | os.PathLike[str], key: str, what: str) -> list[dict[str, Any]]:
+    """The non-empty list of objects under ``key`` of a JSON file's top-level object (a run
+    folder's ``best_designs.json``, ``pairs.json``...), through :func:`read_json`.
+
+    Parameters
+    ----------
+    path : path
+    key : str
+        The top-level key.
+    what : str
+        What an entry is, for the message (``"pairs"``, ``"entries"``).
+
+    Raises
+    ------
+    CheckpointError
+        Naming the file and the key, if the file is missing, not a regular file,
+        oversized or malformed, or ``key`` is not a non-empty list of objects.
+    """
+    path = Path(path)
+    doc = read_json(path)
+    items = doc.get(key) if isinstance(doc, dict) else None
+    if not isinstance(items, list) or not items:
+        raise CheckpointError(f"{path}: {key!r} must be a non-empty list of {what}, got {show(items)}")
+    for i, item in enumerate(items):
+        if not isinstance(item, dict):
+            raise CheckpointError(f"{path}: {key!r}[{i}] must be an object, got {show(item)}")
+    return items
 
 
 def read_json_lines(path: str | os.PathLike[str], cap: int = MAX_JSON_BYTES) -> list[dict[str, Any]]:

@@ -337,7 +337,7 @@ def test_study_report_plan_and_resume_over_fifos_never_block(tmp_path, capsys):
         ("config.json", lambda d: d["experiment"].pop("name"), "'name' is missing"),
         ("config.json", lambda d: d.update(seed="x"), "'seed' must be an integer"),
         ("config.json", lambda d: d.pop("backend"), "'backend' must be a string"),
-        ("best_designs.json", lambda d: d.update(best=[5]), "'best'[0] needs the object 'design'"),
+        ("best_designs.json", lambda d: d.update(best=[5]), "'best'[0] must be an object, got 5"),
     ],
 )  # fmt: skip
 def test_malformed_run_files_are_one_line_in_view_compare_replay_and_resume(

@@ -3,6 +3,7 @@ followed through a link, an atomic write never replaces a device or a FIFO, and 
 files a killed write leaves are removed by the next holder of the folder."""
 
 import os
+import re
 import subprocess
 import sys
 
@@ -81,3 +82,22 @@ def test_stale_temporary_files_are_removed_and_live_ones_kept(tmp_path):
     assert live.exists() and user.exists()
     assert sio.temp_file_target(stale[0].name) == "log.csv"
     assert sio.temp_file_target("log.csv") is None
+
+
+def test_a_run_files_records_are_a_non_empty_list_of_objects(tmp_path):
+    # one reader for pairs.json and best_designs.json (the key and the file named)
+    import json
+
+    from softgym.exceptions import CheckpointError
+    from softgym.io import read_json_records
+
+    path = tmp_path / "f.json"
+    for doc, needle in (({"x": []}, "'x' must be a non-empty list of things, got []"),
+                        ({"y": [1]}, "'x' must be a non-empty list of things, got None"),
+                        ([1, 2], "'x' must be a non-empty list of things"),
+                        ({"x": [{}, 3]}, "'x'[1] must be an object, got 3")):  # fmt: skip
+        path.write_text(json.dumps(doc))
+        with pytest.raises(CheckpointError, match=re.escape(f"{path}: {needle}")):
+            read_json_records(path, "x", "things")
+    path.write_text(json.dumps({"x": [{"a": 1}]}))
+    assert read_json_records(path, "x", "things") == [{"a": 1}]

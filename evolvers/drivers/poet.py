@@ -92,7 +92,7 @@ from evolvers.operators.selection import sel_fitness_tournament
 from evolvers.operators.variation import make_children
 from softgym.design import CONTROLLER_BOUNDS, Controller
 from softgym.exceptions import CheckpointError, InvalidParameterError
-from softgym.io import read_json, rng_from_state, rng_state
+from softgym.io import read_json_records, rng_from_state, rng_state
 from softgym.render.figures import pyplot
 from softgym.tasks import Task
 from softgym.tasks.terrain_genome import TerrainGenome
@@ -133,13 +133,8 @@ def read_pairs(run_dir: str | Path) -> list[dict[str, Any]]:
         oversized, malformed, or holds no pair.
     """
     path = Path(run_dir) / "pairs.json"
-    doc = read_json(path)
-    pairs = doc.get("pairs") if isinstance(doc, dict) else None
-    if not isinstance(pairs, list) or not pairs:
-        raise CheckpointError(f"{path}: 'pairs' must be a non-empty list of pairs, got {show(pairs)}")
+    pairs = read_json_records(path, "pairs", "pairs")
     for i, pair in enumerate(pairs):
-        if not isinstance(pair, dict):
-            raise CheckpointError(f"{path}: 'pairs'[{i}] must be an object, got {show(pair)}")
         for key, (check, what) in _PAIR_KEYS.items():
             if not check(pair.get(key)):
                 raise CheckpointError(

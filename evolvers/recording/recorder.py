@@ -63,6 +63,7 @@ from softgym.io import (
     load_latest_intact,
     read_json,
     read_json_lines,
+    read_json_records,
     remove_stale_temp_files,
     save_checkpoint,
     temp_file_target,
@@ -202,13 +203,10 @@ def read_best_designs(out: str | Path) -> list[dict[str, Any]]:
         malformed, or holds no entry.
     """
     path = Path(out) / "best_designs.json"
-    doc = read_json(path)
-    best = doc.get("best") if isinstance(doc, dict) else None
-    if not isinstance(best, list) or not best:
-        raise CheckpointError(f"{path}: 'best' must be a non-empty list of entries, got {show(best)}")
+    best = read_json_records(path, "best", "entries")
     for i, entry in enumerate(best):
         for key in ("design", "objectives"):
-            value = entry.get(key) if isinstance(entry, dict) else None
+            value = entry.get(key)
             if not isinstance(value, dict):
                 raise CheckpointError(f"{path}: 'best'[{i}] needs the object {key!r}, got {show(value)}")
     return best
