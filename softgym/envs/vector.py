@@ -70,7 +70,7 @@ class SoftWalkerVectorEnv(VectorEnv):
     design : RobotDesign or path, optional
         One design for every robot (default: the embedded walker). Give
         ``design`` or ``designs``, not both.
-    task, episode_seconds, control_dt, actuation, self_collision, grid_shape, sim_config, terrain, render_mode, width, height, drive, action_mode, observe
+    task, episode_seconds, control_dt, actuation, self_collision, grid_shape, sim_config, terrain, render_mode, width, height, drive, action_mode, observe, reward_shaping
         As for :class:`~softgym.envs.walker.SoftWalkerEnv` (a ``terrain``
         is the same world for every robot).
     n_threads : int, optional
@@ -122,6 +122,7 @@ class SoftWalkerVectorEnv(VectorEnv):
         drive: str = "action",
         observe: str = "blind",
         action_mode: str | None = None,
+        reward_shaping: bool = False,
     ) -> None:
         try:
             mode = AutoresetMode(autoreset_mode)
@@ -168,6 +169,7 @@ class SoftWalkerVectorEnv(VectorEnv):
             control_dt=control_dt, actuation=actuation, self_collision=self_collision,
             grid_shape=grid_shape, sim_config=sim_config, n_threads=n_threads,
             max_episode_steps=max_episode_steps, drive=drive, observe=observe,
+            reward_shaping=reward_shaping,
         )  # fmt: skip
         b = self._batch
         self._action_map = ActionMap(b, action_mode)

@@ -182,6 +182,7 @@ def make_batch(
     max_episode_steps: int | None,
     drive: str,
     observe: str = "blind",
+    reward_shaping: bool = False,
 ) -> EpisodeBatch:
     """The :class:`~softgym.tasks.EpisodeBatch` behind a SoftWalker env (the single and vector envs' shared set-up).
 
@@ -206,7 +207,7 @@ def make_batch(
             )
     batch = EpisodeBatch(
         designs, t, grid_shape, control_dt, episode_seconds, max_episode_steps, config,
-        n_threads=n_threads, drive=drive, observe=observe,
+        n_threads=n_threads, drive=drive, observe=observe, reward_shaping=reward_shaping,
     )  # fmt: skip
     if max_episode_steps is not None:
         warn_if_cut_short(max_episode_steps, batch.control_dt, batch.episode_seconds)
@@ -470,6 +471,12 @@ class SoftWalkerEnv(gym.Env):
     observe : {"blind", "sensing"}, default "blind"
         ``"blind"``: the table of Observation Space; ``"sensing"``: every sensor and
         the task's senses (the ``-Sensing-v0`` ids set it).
+    reward_shaping : bool, default False
+        Add the task's dense guidance to the reward (``push``, ``push_uphill``: the
+        robot's progress toward the box's target; ``gap``: its farthest reach while on
+        top; :attr:`TaskKind.shaping <softgym.tasks.suite.TaskKind.shaping>`), each
+        term's per-step progress times its weight; ``info["score"]`` stays the task's
+        measure. For reinforcement learning on tasks whose measure only moves on success.
 
     Examples
     --------
@@ -517,6 +524,7 @@ class SoftWalkerEnv(gym.Env):
         drive: str = "action",
         action_mode: str | None = None,
         observe: str = "blind",
+        reward_shaping: bool = False,
     ) -> None:
         super().__init__()
         size = check_render_options(render_mode, width, height)
@@ -526,6 +534,7 @@ class SoftWalkerEnv(gym.Env):
             control_dt=control_dt, actuation=actuation, self_collision=self_collision,
             grid_shape=grid_shape, sim_config=sim_config, n_threads=n_threads,
             max_episode_steps=max_episode_steps, drive=drive, observe=observe,
+            reward_shaping=reward_shaping,
         )  # fmt: skip
         b = self._batch
         self.observe = b.observe

@@ -131,6 +131,10 @@ class EpisodeBatch:
         What :meth:`observations` returns: the voxels and a clock
         (:func:`observation_size`), or every sensor
         (:func:`softgym.tasks.sensing.sensing_layout`).
+    reward_shaping : bool
+        Add the task's dense guidance (:attr:`Task.shaping
+        <softgym.tasks.Task.shaping>`: each measure's per-step progress times its weight)
+        to the reward; the score and metrics stay the task's measure.
     """
 
     def __init__(
@@ -146,6 +150,7 @@ class EpisodeBatch:
         n_threads: int | None = None,
         drive: str = "action",
         observe: str = "blind",
+        reward_shaping: bool = False,
     ) -> None:
         if not isinstance(task, Task):
             raise InvalidParameterError(f"task must be a Task, got {type(task).__name__}")
@@ -153,10 +158,14 @@ class EpisodeBatch:
             raise InvalidParameterError(f"drive must be one of {DRIVES}, got {show(drive)}")
         if not isinstance(observe, str) or observe not in OBSERVATIONS:
             raise InvalidParameterError(f"observe must be one of {OBSERVATIONS}, got {show(observe)}")
+        if not isinstance(reward_shaping, (bool, np.bool_)):
+            raise InvalidParameterError(f"reward_shaping must be True or False, got {show(reward_shaping)}")
         self.observe = observe
         self.task = task
         self.drive = drive
         self.metric = task.reward
+        #: The shaping terms the reward adds ((measure, weight), the task's; none unless asked).
+        self.shaping: tuple[tuple[str, float], ...] = task.shaping if reward_shaping else ()
         try:  # integers only, within the design grid caps, before anything is allocated
             self.grid_shape = check_grid_shape(grid_shape, "grid_shape")
         except InvalidDesignError as exc:
@@ -242,6 +251,7 @@ class EpisodeBatch:
         self.aux0 = np.zeros((n, 0))
         self._trace_aux = np.zeros((n, self.max_steps + 1, 0))
         self.score_value = np.zeros(n)
+        self.shaping_value = np.zeros((n, len(self.shaping)))
         # centre of mass (m) and time since placement (s) at the episode start and each step
         self._trace_cm = np.zeros((n, self.max_steps + 1, 3))
         self._trace_t = np.zeros((n, self.max_steps + 1))
@@ -321,11 +331,11 @@ class EpisodeBatch:
         idx = np.arange(int(k.max()) + 1)[None, :]
         return (idx <= k[:, None]) & ((idx % stride == 0) | (idx == k[:, None]))
 
-    def _task_measure(self, k: np.ndarray, stride: int = 1) -> np.ndarray:
-        # the suite task's measure of every robot over its samples 0..k
+    def _task_measure(self, k: np.ndarray, stride: int = 1, name: str | None = None) -> np.ndarray:
+        # the suite task's measure (or ``name``) of every robot over its samples 0..k
         kmax = int(k.max()) + 1
         return task_measure_from_arrays(
-            self.metric, self.cm0, self.aux0, self._trace_cm[:, :kmax], self._trace_aux[:, :kmax],
+            self.metric if name is None else name, self.cm0, self.aux0, self._trace_cm[:, :kmax], self._trace_aux[:, :kmax],
             self._valid(k, stride), self.L, self._params,
         )  # fmt: skip
 
@@ -338,6 +348,7 @@ class EpisodeBatch:
         self.steps[:] = 0
         self.metric_value[:] = 0.0
         self.score_value[:] = 0.0
+        self.shaping_value[:] = 0.0
         # a robot that diverged while settling cannot run: its episodes end at the first step
         self.done_diverged[:] = self._settled["diverged"] != 0
         self._time_offset[:] = 0.0
@@ -359,6 +370,7 @@ class EpisodeBatch:
         self.steps[ids] = 0
         self.metric_value[ids] = 0.0
         self.score_value[ids] = 0.0
+        self.shaping_value[ids] = 0.0
         self.done_diverged[ids] = init["diverged"][ids] != 0
         self._time_offset[ids] = self.sim.time[ids] - self._settled_time[ids]
         self._start_trace(ids)
@@ -472,6 +484,12 @@ class EpisodeBatch:
             reward[ok] = score[ok] - self.score_value[ok]
             reward[newly_div] = 0.0 - self.score_value[newly_div]
             self.score_value[ok] = score[ok]
+            for j, (measure, weight) in enumerate(self.shaping):
+                value = self._task_measure(k, name=measure)
+                # the guidance's progress, forfeited like the score's on a divergence
+                reward[ok] += weight * (value[ok] - self.shaping_value[ok, j])
+                reward[newly_div] -= weight * self.shaping_value[newly_div, j]
+                self.shaping_value[ok, j] = value[ok]
         terminated[stepped] = self.done_diverged[stepped]
         truncated[stepped] = (self.steps[stepped] >= self.max_steps) & ~terminated[stepped]
         return reward, terminated, truncated, self.done_diverged.copy()

@@ -114,6 +114,12 @@ class TaskKind:
         heights ahead...): the task part of the sensing observation.
     family : str
         A key of :data:`FAMILIES` (required).
+    shaping : tuple of (str, float)
+        Dense guidance for reinforcement learning: measures of
+        :data:`softgym.metrics.TASK_MEASURES` whose per-step progress, times its weight,
+        an env adds to its reward when asked (``reward_shaping=True``); the score stays
+        the task's measure. For a task whose measure only moves on success (a box that
+        only moves once pushed, a pit crossed only at its far edge).
 
     Raises
     ------
@@ -129,12 +135,21 @@ class TaskKind:
     sim: Callable[[Mapping[str, Any]], dict[str, Any]] = lambda o: {}
     senses: tuple[TaskSense, ...] = ()
     family: str = ""
+    shaping: tuple[tuple[str, float], ...] = ()
 
     def __post_init__(self) -> None:
         if self.family not in FAMILIES:
             raise InvalidParameterError(
                 f"task {self.name!r}: family must be one of {list(FAMILIES)}, got {self.family!r}"
             )
+        from softgym.metrics.task_measures import TASK_MEASURES
+
+        for measure, weight in self.shaping:
+            if measure not in TASK_MEASURES or not (isinstance(weight, float) and weight > 0):
+                raise InvalidParameterError(
+                    f"task {self.name!r}: shaping needs (measure of TASK_MEASURES, weight > 0) "
+                    f"pairs, got {(measure, weight)!r}"
+                )
 
     def resolve(self, options: Mapping[str, Any] | None) -> dict[str, Any]:
         """Every argument, the given ones checked, the others at their defaults."""
@@ -618,7 +633,7 @@ KINDS: dict[str, TaskKind] = {
             "gap_crossed",
             {"width": Option(2.0, 0.5, 10.0, "width of the pit, voxel lengths"),
              "depth": Option(4.0, 1.0, 20.0, "depth of the pit, voxel lengths")},
-            senses=_TERRAIN, family="terrain",
+            senses=_TERRAIN, family="terrain", shaping=(("top_dist", 0.5),),
         ),
         TaskKind(
             "tunnel", "crawl out under a low roof", tunnel_layout, "max_xy_dist",
@@ -654,6 +669,7 @@ KINDS: dict[str, TaskKind] = {
              "distance": Option(10.0, 1.0, 50.0, "target distance from the box, voxel lengths"),
              "density": Option(5e5, 1e4, 1e7, "the box's density, kg/m^3 (the robot's: 1e6)")},
             senses=(SENSES["object"], SENSES["target"]), family="manipulation",
+            shaping=(("target_progress", 0.5),),
         ),
         TaskKind(
             "carry", "walk with a cap on top without dropping it", carry_layout, "carried_dist",
@@ -760,6 +776,7 @@ KINDS: dict[str, TaskKind] = {
              "angle": Option(5.0, 0.0, 20.0, "slope, degrees (-x uphill)")},
             sim=lambda o: {"incline": -float(o["angle"])},
             senses=(SENSES["object"], SENSES["target"], SENSES["gravity"]), family="manipulation",
+            shaping=(("target_progress", 0.5),),
         ),
         TaskKind(
             "throw", "fling a cube resting on top as far as possible", throw_layout, "object_dist",

@@ -198,6 +198,13 @@ class Task:
         return self.terrain + ":" + ",".join(f"{k}={v!r}" for k, v in sorted(changed.items()))
 
     @property
+    def shaping(self) -> tuple[tuple[str, float], ...]:
+        """Dense guidance an env may add to its reward (:attr:`TaskKind.shaping
+        <softgym.tasks.suite.TaskKind.shaping>`): its kind's, none for a custom terrain.
+        """
+        return KINDS[self.terrain].shaping if isinstance(self.terrain, str) else ()
+
+    @property
     def senses(self) -> tuple:
         """The task's senses (:class:`softgym.tasks.sensing.TaskSense`): its kind's, or for a custom
         terrain the terrain heights ahead where it has boxes and the object where it has objects.

@@ -162,3 +162,36 @@ def test_an_env_assembles_its_engine_settings_once(monkeypatch):
     assert cfg.gravity == 0.0 and cfg.fluid_drag > 0  # the swim task's settings
     assert cfg.actuation == "seed"  # the env's override, applied last
     env.close()
+
+
+@pytest.mark.parametrize("task", ["push", "gap"])
+def test_reward_shaping_adds_the_tasks_guidance_and_leaves_the_score(task):
+    # the return telescopes: the score, plus each shaping measure's end value times its
+    # weight; without shaping the return is the score (the ids' default)
+    from softgym.tasks import get_task
+
+    shaping = get_task(task).shaping
+    assert shaping
+    returns, scores, ends = [], [], []
+    for on in (False, True):
+        env = gym.make(f"SoftWalker-{task.capitalize()}-Sensing-v0", reward_shaping=on)
+        env.reset(seed=0)
+        total = 0.0
+        for t in range(30):
+            a = np.full(env.action_space.shape, np.sin(t * 0.4 * np.pi), dtype=np.float32)
+            _, r, _, _, info = env.step(np.clip(a, env.action_space.low, env.action_space.high))
+            total += float(r)
+        batch = env.unwrapped._batch
+        ends.append(batch.shaping_value[0].copy())
+        returns.append(total)
+        scores.append(float(info["score"]))
+        env.close()
+    assert scores[0] == pytest.approx(scores[1]) and returns[0] == pytest.approx(scores[0])
+    guidance = sum(w * v for (_, w), v in zip(shaping, ends[1]))
+    assert guidance != 0.0
+    assert returns[1] == pytest.approx(scores[1] + guidance)
+
+
+def test_reward_shaping_must_be_a_bool():
+    with pytest.raises(InvalidParameterError, match="reward_shaping must be True or False"):
+        gym.make("SoftWalker-Push-v0", reward_shaping="yes")

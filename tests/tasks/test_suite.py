@@ -170,3 +170,18 @@ def test_stairs_down_ground_reaches_beyond_what_a_fast_robot_covers():
         lo = min(b.lo[0] for b in world.boxes), min(b.lo[1] for b in world.boxes)
         hi = max(b.hi[0] for b in world.boxes), max(b.hi[1] for b in world.boxes)
         assert min(3.0 - lo[0], 3.0 - lo[1], hi[0] - 3.0, hi[1] - 3.0) >= 150.0
+
+
+def test_a_task_kinds_shaping_names_task_measures_with_positive_weights():
+    from softgym.exceptions import InvalidParameterError
+    from softgym.metrics import TASK_MEASURES
+    from softgym.tasks.suite import KINDS, TaskKind, flat_layout
+
+    shaped = {k.name for k in KINDS.values() if k.shaping}
+    assert {"push", "push_uphill", "gap"} <= shaped
+    for kind in KINDS.values():
+        for measure, weight in kind.shaping:
+            assert measure in TASK_MEASURES and weight > 0
+    for bad in ((("speed", 0.5),), (("top_dist", 0.0),), (("top_dist", 1),)):
+        with pytest.raises(InvalidParameterError, match="shaping needs"):
+            TaskKind("t", "t", flat_layout, "x_progress", family="locomotion", shaping=bad)
