@@ -256,3 +256,28 @@ def test_the_fidelity_benchmark_records_labels_and_compares_them_in_pairs(tmp_pa
     assert (tmp_path / "comparison.json").exists()
     unknown = _fidelity_cli("--paired", "nobody", "double", *common)
     assert unknown.returncode != 0 and "--record nobody" in unknown.stderr
+
+
+def test_the_stored_paired_comparison_is_what_its_stored_values_give(tmp_path):
+    # benchmarks/data/fidelity_paired: the per-draw values of both link precisions and the
+    # comparison they gave (fidelity_seed.py --paired single double --stored-only
+    # --oracle-draws 0,1); recomputed from the committed data (the point figures are
+    # exact, the intervals depend on the resamples)
+    stored = DATA.parent / "fidelity_paired"
+    committed = json.loads((stored / "comparison.json").read_text())
+    out = tmp_path / "comparison.json"
+    res = _fidelity_cli("--paired", "single", "double", "--stored-only", "--oracle-draws", "0,1",
+                        "--resamples", "200", "--store", str(stored / "values.json"),
+                        "--report-out", str(out))  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    again = json.loads(out.read_text())
+    assert again["configs"]["single"]["link_precision"] == "single"
+    assert again["configs"]["double"]["link_precision"] == "double"
+    for terrain, subsets in committed["tables"].items():
+        for subset, regimes in subsets.items():
+            for regime, r in regimes.items():
+                mine = again["tables"][terrain][subset][regime]
+                assert mine["n_cases"] == r["n_cases"], (terrain, subset, regime)
+                for key, fig in r["figures"].items():
+                    assert mine["figures"][key]["loss"] == pytest.approx(fig["loss"], abs=1e-12)
+                    assert mine["figures"][key]["a"] == pytest.approx(fig["a"], abs=1e-12)
