@@ -362,7 +362,16 @@ class Experiment:
         )
 
     def replace(self, **changes: Any) -> Experiment:
-        """A copy with some fields changed (e.g. ``pop_size``, ``seconds``, ``shape``)."""
+        """A copy with some fields changed (e.g. ``pop_size``, ``seconds``, ``shape``).
+
+        A ``task`` given as a task JSON file (``Task.to_json``: schema ``softgym.task``)
+        brings its run settings too, as :func:`softgym.evaluate` reads them: its
+        ``seconds``, ``trace_interval`` and ``sim``, unless changed here as well (a typed
+        ``--seconds`` wins over the file's).
+        """
+        if "task" in changes:
+            for key, value in task_file_settings(changes["task"]).items():
+                changes.setdefault(key, value)
         return replace(self, **changes)
 
     def to_dict(self) -> dict[str, Any]:
@@ -559,6 +568,26 @@ EXPERIMENTS["materials"] = EXPERIMENTS["materials-t1"]
 def list_experiments() -> list[str]:
     """Names of the named experiments."""
     return list(EXPERIMENTS)
+
+
+def task_file_settings(task: Any) -> dict[str, Any]:
+    """The run settings of a task JSON file (schema ``softgym.task``): ``seconds``,
+    ``trace_interval`` and ``sim`` as :func:`softgym.tasks.get_task` reads them; ``{}`` for
+    anything else (a task name, a Task, a Terrain or a terrain file carry no run settings of
+    their own here).
+    """
+    if not isinstance(task, (str, os.PathLike)) or not str(task).endswith(".json"):
+        return {}
+    from softgym.io import read_json
+
+    try:
+        doc = read_json(task)
+    except SoftGymError:
+        return {}  # get_task names what is wrong with the file
+    if not (isinstance(doc, Mapping) and doc.get("schema") == "softgym.task"):
+        return {}
+    t = get_task(task)
+    return {"seconds": float(t.seconds), "trace_interval": float(t.trace_interval), "sim": dict(t.sim)}
 
 
 def get_experiment(name: str, **overrides: Any) -> Experiment:

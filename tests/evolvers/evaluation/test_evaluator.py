@@ -182,3 +182,26 @@ def test_one_evaluator_keys_results_by_task_and_phenotype():
     assert st.n_cached == 1 and st.n_simulated == 0 and a.objectives == res[0][0]
     _, st = ev.evaluate_jobs([("wall", wall, [c.child(4)])])
     assert st.n_cached == 1 and len(calls) == 1 and ev.n_evaluations == 4
+
+
+def test_a_task_file_means_the_same_run_to_evolution_and_to_softgym_evaluate(tmp_path):
+    # a task JSON file's seconds, trace_interval and sim were dropped by
+    # `softgym evolve --task t.json` (only its world was kept) while softgym.evaluate used
+    # them: one file, one run; a typed --seconds still wins
+    import json
+
+    from evolvers.evaluation.experiments import get_experiment, task_file_settings
+    from softgym.tasks import get_task
+
+    path = tmp_path / "t.json"
+    task = get_task("ice").replace(seconds=2.5, trace_interval=0.25, sim={"friction": 0.05})
+    path.write_text(json.dumps(task.to_dict()))
+    assert task_file_settings(path) == {"seconds": 2.5, "trace_interval": 0.25,
+                                        "sim": {"friction": 0.05}}  # fmt: skip
+    assert task_file_settings("ice") == {} and task_file_settings(tmp_path / "none.json") == {}
+    exp = get_experiment("controller-tournament", task=str(path))
+    assert (exp.seconds, exp.trace_interval, dict(exp.sim)) == (2.5, 0.25, {"friction": 0.05})
+    assert get_experiment("controller-tournament", task=str(path), seconds=2.0).seconds == 2.0
+    direct = softgym.evaluate([default_walker()], task=str(path))
+    run = softgym.evaluate([default_walker()], task=exp.make_task())
+    assert run["norm_final_dist"][0] == direct["norm_final_dist"][0]
