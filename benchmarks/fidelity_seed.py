@@ -354,10 +354,10 @@ def print_paired(report: dict[str, Any], a: str, b: str) -> None:
                       f"{r['wins']['a']:>4d}/{r['wins']['b']:<4d}  {verdict}")  # fmt: skip
 
 
-def paired_main(a, labels: list[str]) -> int:
-    store_path = Path(a.store)
-    store = load_store(store_path)
-    sets = [s for s in a.sets.split(",") if s]
+def cases_and_draws(a, default_sets: str):
+    """The sets, cases (``--quick``: 12 a set), oracle values and softgym's draws (groups
+    and flat) of the command line."""
+    sets = [s for s in (a.sets or default_sets).split(",") if s]
     cases, oracle = load_oracle(sets)
     if a.quick:
         by_set: dict[str, list] = {}
@@ -365,7 +365,13 @@ def paired_main(a, labels: list[str]) -> int:
             by_set.setdefault(c.set, []).append(c)
         cases = [c for cs in by_set.values() for c in cs[:12]]
     groups = sample_draws(a.first_draw, a.draws, a.samples)
-    draws = [d for g in groups for d in g]
+    return sets, cases, oracle, groups, [d for g in groups for d in g]
+
+
+def paired_main(a, labels: list[str]) -> int:
+    store_path = Path(a.store)
+    store = load_store(store_path)
+    sets, cases, oracle, groups, draws = cases_and_draws(a, ALL_SETS)
     if a.record:
         cfg = SimConfig(model=a.model, link_precision=a.link_precision)
         n = record(store, store_path, {a.record: cfg}, cases, draws, a.threads)
@@ -443,18 +449,9 @@ def main() -> int:
     if a.samples < 1 or a.draws < 1:
         ap.error("--samples and --draws must be >= 1")
     if a.paired or a.record:
-        a.sets = a.sets or ALL_SETS
         return paired_main(a, list(a.paired or []))
     t0 = time.perf_counter()
-    sets = [s for s in (a.sets or "structured,random,fence").split(",") if s]
-    cases, oracle = load_oracle(sets)
-    if a.quick:
-        by_set: dict[str, list] = {}
-        for c in cases:
-            by_set.setdefault(c.set, []).append(c)
-        cases = [c for cs in by_set.values() for c in cs[:12]]
-    groups = sample_draws(a.first_draw, a.draws, a.samples)
-    draws = [d for g in groups for d in g]
+    sets, cases, oracle, groups, draws = cases_and_draws(a, "structured,random,fence")
     halves = tuple(tuple(int(x) for x in h.split(",")) for h in a.halves.split("/"))
     ours = run_softgym(cases, draws, a.model, a.threads, a.link_precision)
     prec = SimConfig(model=a.model, link_precision=a.link_precision).effective_link_precision

@@ -721,38 +721,13 @@ def _quiet():
 def _frame(design: Any, task: str, seconds: float, renderer: Any) -> np.ndarray:
     """``design`` in ``task``'s world after ``seconds`` (scripts/task_gallery.py's view)."""
     from softgym.engine import Simulation
-    from softgym.terrain import Box, Terrain
+    from softgym.render import render_in_world
 
     world = get_task(task)
     terrain = world.terrain_for(design.shape)
     sim = Simulation([design], config=world.config(), terrain=terrain, n_threads=THREADS)
     sim.advance(seconds)
-    table = np.zeros((design.palette.max_id + 1, 3))
-    for k, mat in design.palette.items():
-        table[k] = mat.color[:3]
-    colors = table[design.grid[tuple(sim.grid_index(0).T)]]
-    pos, quat, scale = sim.positions(0), sim.orientations(0), sim.scales(0)
-    if terrain.objects:
-        obj = sim.object_positions(0)
-        pos = np.concatenate([pos, obj])
-        quat = np.concatenate([quat, sim.object_orientations(0)])
-        scale = np.concatenate([scale, sim.object_scales(0)])
-        colors = np.concatenate([colors, np.tile((0.55, 0.55, 0.6), (len(obj), 1))])
-    target = sim.center_of_mass()[0]
-    # the renderer's floor is z = 0: lift a world that goes below it, and a robot that fell
-    # below the world (off the edge of a world without a floor), so that both are drawn
-    low = min(
-        min((b.lo[2] for b in terrain.boxes), default=0.0),
-        float(pos[:, 2].min()) / sim.config.voxel_size,
-    )
-    if low < 0:
-        lift = np.array([0.0, 0.0, -low])
-        terrain = Terrain(
-            tuple(Box(np.add(b.lo, lift), np.add(b.hi, lift)) for b in terrain.boxes), True, task
-        )
-        pos = pos + lift * sim.config.voxel_size
-        target = target + lift * sim.config.voxel_size
-    return renderer.render(pos, quat, scale, colors, terrain=terrain, target=target)
+    return render_in_world(sim, design, terrain, renderer)
 
 
 def draw_gallery(

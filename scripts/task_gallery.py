@@ -20,11 +20,9 @@ import numpy as np
 
 from softgym.design import default_walker
 from softgym.engine import Simulation
-from softgym.render import VoxelRenderer
+from softgym.render import VoxelRenderer, render_in_world
 from softgym.tasks import FAMILIES, KINDS, get_task, tasks_of_family
-from softgym.terrain import Box, Terrain
 
-OBJECT_COLOR = (0.55, 0.55, 0.6)
 #: Camera angles other than the renderer's default, by task: walls that would hide the robot.
 VIEWS = {"chimney": {"azimuth": 0.0, "elevation": 50.0}}
 
@@ -36,32 +34,7 @@ def frame(name: str, seconds: float, renderer: VoxelRenderer) -> np.ndarray:
     terrain = task.terrain_for(design.shape)
     sim = Simulation([design], config=task.config(), terrain=terrain, n_threads=1)
     sim.advance(seconds)
-    table = np.zeros((design.palette.max_id + 1, 3))
-    for k, mat in design.palette.items():
-        table[k] = mat.color[:3]
-    gi = sim.grid_index(0)
-    colors = table[design.grid[tuple(gi.T)]]
-    pos, quat, scale = sim.positions(0), sim.orientations(0), sim.scales(0)
-    if terrain.objects:
-        obj = sim.object_positions(0)
-        pos = np.concatenate([pos, obj])
-        quat = np.concatenate([quat, sim.object_orientations(0)])
-        scale = np.concatenate([scale, sim.object_scales(0)])
-        colors = np.concatenate([colors, np.tile(OBJECT_COLOR, (len(obj), 1))])
-    target = sim.center_of_mass()[0]
-    if "target" in terrain.meta:  # a flat tile on the target point (the figure's, not the world's)
-        tx, ty = terrain.meta["target"][:2]
-        tile = Box((tx - 0.5, ty - 0.5, 0.0), (tx + 0.5, ty + 0.5, 0.3))
-        terrain = Terrain((*terrain.boxes, tile), terrain.floor, name)
-    low = min((b.lo[2] for b in terrain.boxes), default=0.0)
-    if low < 0:  # the renderer draws a floor at z = 0: lift a world that goes below it
-        lift = np.array([0.0, 0.0, -low])
-        terrain = Terrain(
-            tuple(Box(np.add(b.lo, lift), np.add(b.hi, lift)) for b in terrain.boxes), True, name
-        )
-        pos = pos + lift * sim.config.voxel_size
-        target = target + lift * sim.config.voxel_size
-    return renderer.render(pos, quat, scale, colors, terrain=terrain, target=target)
+    return render_in_world(sim, design, terrain, renderer)
 
 
 def main() -> None:

@@ -9,11 +9,13 @@ frames (or rollouts) to an animated GIF, :func:`save_video` to an MP4 (the
 """
 
 from softgym.render.frames import (
+    OBJECT_COLOR,
     OBSTACLE_COLOR,
     MissingVideoExtraError,
     VoxelRenderer,
     overlay_text,
     quaternion_to_matrix,
+    render_in_world,
     render_rollout,
     save_gif,
     save_video,
@@ -22,11 +24,13 @@ from softgym.render.frames import (
 from softgym.render.viewer import write_viewer
 
 __all__ = [
+    "OBJECT_COLOR",
     "OBSTACLE_COLOR",
     "MissingVideoExtraError",
     "VoxelRenderer",
     "overlay_text",
     "quaternion_to_matrix",
+    "render_in_world",
     "render_rollout",
     "save_gif",
     "save_video",

@@ -29,11 +29,13 @@ if TYPE_CHECKING:  # annotations only: softgym.engine loads compiled code
     from softgym.terrain import Terrain
 
 __all__ = [
+    "OBJECT_COLOR",
     "OBSTACLE_COLOR",
     "MissingVideoExtraError",
     "VoxelRenderer",
     "overlay_text",
     "quaternion_to_matrix",
+    "render_in_world",
     "render_rollout",
     "save_gif",
     "save_video",
@@ -427,6 +429,56 @@ def render_rollout(
         grid_index=rollout.grid_index[s],
         terrain=terrain,
     )
+
+
+#: The colour of a task's movable objects (a box, a cap) in :func:`render_in_world`.
+OBJECT_COLOR = (0.55, 0.55, 0.6)
+
+
+def render_in_world(sim: Any, design: Any, terrain: Terrain, renderer: VoxelRenderer,
+                    robot: int = 0) -> np.ndarray:  # fmt: skip
+    """A frame of robot ``robot`` of a running :class:`~softgym.engine.Simulation` in its world.
+
+    Its voxels in their materials' colours (``design``'s palette), the world's movable
+    objects in :data:`OBJECT_COLOR`, a task's target point (``terrain.meta["target"]``)
+    marked with a flat tile that is the figure's, not the world's, and the whole scene
+    lifted above the renderer's floor (z = 0) when the world or the robot (one that fell
+    off a world without a floor) goes below it; the camera aims at the robot's centre of
+    mass.
+
+    Returns
+    -------
+    ndarray of shape (height, width, 3), uint8
+    """
+    from softgym.terrain import Box, Terrain
+
+    table = np.zeros((design.palette.max_id + 1, 3))
+    for k, mat in design.palette.items():
+        table[k] = mat.color[:3]
+    colors = table[design.grid[tuple(sim.grid_index(robot).T)]]
+    pos, quat, scale = sim.positions(robot), sim.orientations(robot), sim.scales(robot)
+    if terrain.objects:
+        obj = sim.object_positions(robot)
+        pos = np.concatenate([pos, obj])
+        quat = np.concatenate([quat, sim.object_orientations(robot)])
+        scale = np.concatenate([scale, sim.object_scales(robot)])
+        colors = np.concatenate([colors, np.tile(OBJECT_COLOR, (len(obj), 1))])
+    target = sim.center_of_mass()[robot]
+    name = terrain.name
+    if "target" in terrain.meta:
+        tx, ty = terrain.meta["target"][:2]
+        tile = Box((tx - 0.5, ty - 0.5, 0.0), (tx + 0.5, ty + 0.5, 0.3))
+        terrain = Terrain((*terrain.boxes, tile), terrain.floor, name)
+    L = sim.config.voxel_size
+    low = min(min((b.lo[2] for b in terrain.boxes), default=0.0), float(pos[:, 2].min()) / L)
+    if low < 0:
+        lift = np.array([0.0, 0.0, -low])
+        terrain = Terrain(
+            tuple(Box(np.add(b.lo, lift), np.add(b.hi, lift)) for b in terrain.boxes), True, name
+        )
+        pos = pos + lift * L
+        target = target + lift * L
+    return renderer.render(pos, quat, scale, colors, terrain=terrain, target=target)
 
 
 def overlay_text(frame: np.ndarray, lines: Sequence[str]) -> np.ndarray:
