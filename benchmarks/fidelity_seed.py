@@ -258,6 +258,7 @@ def record(store: dict[str, Any], path: Path, labels: dict[str, SimConfig], case
     """Run each label's config on every (case, regime, draw) it lacks, the labels side by
     side (set by set, the first set first; regime, terrain), storing after each chunk.
     Returns the runs added per label."""
+    commit = _git_commit() if labels else ""
     for label, cfg in labels.items():
         entry = store["labels"].setdefault(label, {"values": {}})
         conf = {"model": cfg.model, "link_precision": cfg.effective_link_precision,
@@ -268,8 +269,8 @@ def record(store: dict[str, Any], path: Path, labels: dict[str, SimConfig], case
                              "use another label or another --store")  # fmt: skip
         entry["config"] = conf
         entry.setdefault("commits", [])
-        if _git_commit() not in entry["commits"]:
-            entry["commits"].append(_git_commit())
+        if commit not in entry["commits"]:
+            entry["commits"].append(commit)
     n_run = dict.fromkeys(labels, 0)
     sets = list(dict.fromkeys(c.set for c in cases))
     for set_, regime, terrain in ((s, r, t) for s in sets for r in fc.REGIMES for t in ("flat", "fence")):

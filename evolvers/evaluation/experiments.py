@@ -586,7 +586,7 @@ def task_file_settings(task: Any) -> dict[str, Any]:
         return {}  # get_task names what is wrong with the file
     if not (isinstance(doc, Mapping) and doc.get("schema") == "softgym.task"):
         return {}
-    t = get_task(task)
+    t = Task.from_dict(doc)  # the document already read, checked as get_task checks it
     return {"seconds": float(t.seconds), "trace_interval": float(t.trace_interval), "sim": dict(t.sim)}
 
 
