@@ -28,8 +28,8 @@ measure              value (voxel lengths unless said)
 ``peak_height``      the highest centre of mass over the episode above its start
 ``yaw``              ``|heading_end - heading_0|`` unwrapped over the samples (rad): turning
 ``push_progress``    how much nearer the object got to its target (xy)
-``carried_dist``     the object's xy displacement, 0 unless it ends above the robot's centre
-                     of mass (carried, not dropped)
+``carried_dist``     the object's xy displacement, 0 unless it ends on the robot: over its
+                     footprint (the box of its voxel centres) and above its centre of mass
 ``object_dist``      the object's xy displacement from its start to the end (thrown)
 ``object_height``    the object's final height: its centre of mass above z = 0 (caught)
 ``object_rise``      the object's highest centre of mass over the episode above its start,
@@ -195,7 +195,11 @@ def task_measure_from_arrays(
             out = before - after
         elif name == "carried_dist":
             moved = np.linalg.norm(aend[:, 0:2] - a0[:, 0:2], axis=1) / L
-            out = np.where(aend[:, 2] > end[:, 2], moved, 0.0)
+            # on the robot: over its footprint (the box of its voxel centres) and above its
+            # centre of mass; a cap that slid off and lies beside it is not carried
+            over = ((aend[:, 0] >= aend[:, _XLO]) & (aend[:, 0] <= aend[:, _XHI])
+                    & (aend[:, 1] >= aend[:, _YLO]) & (aend[:, 1] <= aend[:, _YHI]))  # fmt: skip
+            out = np.where(over & (aend[:, 2] > end[:, 2]), moved, 0.0)
         elif name == "object_dist":
             out = np.linalg.norm(aend[:, 0:2] - a0[:, 0:2], axis=1) / L
         elif name == "object_height":

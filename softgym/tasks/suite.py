@@ -281,15 +281,19 @@ def push_layout(shape: Sequence[int], size: int = 3, distance: float = 10.0,
     return Terrain((), True, "push", meta, objects=(block,))
 
 
-def carry_layout(shape: Sequence[int], rim: int = 2, density: float = 1e5) -> Terrain:
+def carry_layout(shape: Sequence[int], rim: int = 4, density: float = 1e5) -> Terrain:
     """A cap on the robot: a plate over its grid with a ``rim`` hanging round its top layers.
 
     The cap sits at the self-contact distance (1.5 voxels between centres), so
     it rests on the robot; its rim lets a walking robot drag it along through
-    the frictionless self-contact law.
+    the frictionless self-contact law. The rim hangs at most the grid's height
+    (it never reaches into the floor). With the default rim of 4 the reference
+    walker (:func:`~softgym.design.default_walker`) carries the cap about as
+    far as it walks; with a rim of 1 to 3 it walks out from under it, and
+    with 2 a full 6x6x6 block sheds it while settling.
     """
     nx, ny, nz = (int(s) for s in shape[:3])
-    rim = int(rim)
+    rim = min(int(rim), nz)
     # cell (i, j, k) has its centre at (i - 1, j - 1, nz + 1 - rim + k): the rim 1.5 voxels
     # from the robot's side voxels, the plate 1.5 above its top ones
     cells = np.zeros((nx + 3, ny + 3, rim + 1), dtype=bool)
@@ -673,7 +677,8 @@ KINDS: dict[str, TaskKind] = {
         ),
         TaskKind(
             "carry", "walk with a cap on top without dropping it", carry_layout, "carried_dist",
-            {"rim": Option(2, 0, 4, "depth of the cap's rim round the robot's top, voxels", integer=True),
+            {"rim": Option(4, 0, 4, "depth of the cap's rim round the robot's top, voxels (shallower: "
+                                 "harder to keep on)", integer=True),
              "density": Option(1e5, 1e4, 1e7, "the cap's density, kg/m^3 (the robot's: 1e6)")},
             senses=_OBJECT, family="manipulation",
         ),

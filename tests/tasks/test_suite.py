@@ -128,10 +128,15 @@ def test_peak_height_footprint_swim_and_carry_on_hand_made_samples():
     swim = [[0, 0, 0], [3 * L, 4 * L, 12 * L]]
     assert task_measure_from_arrays("swim_dist", *_arrays(swim, a[:2]), L)[0] == pytest.approx(13)
     robot = [[0, 0, 3 * L], [4 * L, 0, 3 * L]]
-    held = [_aux(obj=(0, 0, 7 * L)), _aux(obj=(4 * L, 0, 7 * L))]
-    dropped = [_aux(obj=(0, 0, 7 * L)), _aux(obj=(4 * L, 0, 1 * L))]
-    assert task_measure_from_arrays("carried_dist", *_arrays(robot, held), L)[0] == pytest.approx(4)
-    assert task_measure_from_arrays("carried_dist", *_arrays(robot, dropped), L)[0] == 0.0
+    # the robot's voxel centres span x -2.5..2.5 L, then 1.5..6.5 L, and y -2.5..2.5 L
+    box0, box1 = (-2.5 * L, 2.5 * L, -2.5 * L, 2.5 * L, 5 * L), (1.5 * L, 6.5 * L, -2.5 * L, 2.5 * L, 5 * L)
+    held = [_aux(obj=(0, 0, 7 * L), box=box0), _aux(obj=(4 * L, 0, 7 * L), box=box1)]
+    dropped = [_aux(obj=(0, 0, 7 * L), box=box0), _aux(obj=(4 * L, 0, 1 * L), box=box1)]
+    # slid off behind the robot, resting higher than its centre of mass: not carried
+    beside = [_aux(obj=(0, 0, 7 * L), box=box0), _aux(obj=(9 * L, 0, 4 * L), box=box1)]
+    carried = [task_measure_from_arrays("carried_dist", *_arrays(robot, c), L)[0]
+               for c in (held, dropped, beside)]  # fmt: skip
+    assert carried == [pytest.approx(4), 0.0, 0.0]
     div = task_measure_from_arrays("swim_dist", *_arrays(swim, a[:2]), L, diverged=[True])
     assert div[0] == WORST_FITNESS
 
