@@ -45,6 +45,10 @@ SHAPES = ((6, 6, 6), (5, 5, 5), (4, 6, 5), (6, 4, 4), (7, 5, 4))
 HIDDEN = 4
 
 
+#: The body sets a study can draw (``--family``).
+FAMILIES = ("random", "lineage")
+
+
 def bodies(n: int, seed: int) -> list:
     """``n`` random valid CPPN bodies (the seed's rules), grid shapes cycling through SHAPES."""
     rng = np.random.default_rng(seed)
@@ -54,6 +58,30 @@ def bodies(n: int, seed: int) -> list:
         shape = SHAPES[i % len(SHAPES)]
         out.append(Individual.random(rng, i, shape=shape, rules=rules).design(shape))
     return out
+
+
+def lineage(n_train: int, n_held: int, seed: int) -> tuple[list, list]:
+    """Bodies of one family: a tree of descendants of one random 6x6x6 CPPN body.
+
+    Each new body is one NEAT mutation (:meth:`CPPN.mutate`, the seed's rules)
+    of a member drawn at random from the family so far (the common ancestor
+    included; it is in neither set); every grid is distinct. The first
+    ``n_train`` are the training bodies, the next ``n_held`` the held-out ones:
+    siblings and cousins, not copies.
+    """
+    rng = np.random.default_rng(seed)
+    rules = CompositionRules.seed()
+    shape = SHAPES[0]
+    family = [Individual.random(rng, 0, shape=shape, rules=rules).cppn]
+    seen = {family[0].to_grid(shape).tobytes()}
+    while len(family) < 1 + n_train + n_held:
+        child = family[rng.integers(len(family))].mutate(rng, shape, is_valid=rules).genome
+        key = child.to_grid(shape).tobytes()
+        if key not in seen:
+            seen.add(key)
+            family.append(child)
+    out = [Individual(cppn=g, id=i).design(shape) for i, g in enumerate(family[1:], 1)]
+    return out[:n_train], out[n_train:]
 
 
 class BrainProblem(Problem):
@@ -95,6 +123,9 @@ def search(task, body_set, spec, candidates, pop, seed, threads) -> BrainProblem
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--task", default="flat")
+    ap.add_argument("--family", choices=FAMILIES, default="random",
+                    help="random: unrelated random CPPN bodies of five grid shapes; lineage: "
+                         "descendants of one random body (default: random)")  # fmt: skip
     ap.add_argument("--train", type=int, default=8)
     ap.add_argument("--held-out", type=int, default=20)
     ap.add_argument("--candidates", type=int, default=320, help="candidate brains per search")
@@ -109,8 +140,11 @@ def main(argv=None) -> None:
         return
     task = get_task(args.task)
     spec = brain_spec("distributed", task, (6, 6, 6), hidden=HIDDEN, signals=1)
-    train = bodies(args.train, seed=10_000 + args.seed)
-    held = bodies(args.held_out, seed=20_000 + args.seed)
+    if args.family == "lineage":
+        train, held = lineage(args.train, args.held_out, seed=30_000 + args.seed)
+    else:
+        train = bodies(args.train, seed=10_000 + args.seed)
+        held = bodies(args.held_out, seed=20_000 + args.seed)
     args.out.mkdir(parents=True, exist_ok=True)
     command = " ".join(["python", "benchmarks/one_brain.py", *sys.argv[1:]])
     gpath = args.out / "generalist.json"
@@ -123,7 +157,7 @@ def main(argv=None) -> None:
         start = softgym.evaluate([b.replace(brain=sinusoid_brain(spec, 2.0)) for b in held],
                                  task=task, n_threads=args.threads)["score"]  # fmt: skip
         atomic_write_json(gpath, {
-            "task": args.task, "train_bodies": args.train, "candidates": args.candidates,
+            "task": args.task, "family": args.family, "train_bodies": args.train, "candidates": args.candidates,
             "train_median": prob.best[0], "curve": prob.curve, "held_out_scores": zero_shot.tolist(),
             "sinusoid_brain_held_out": start.tolist(), "brain": brain.to_dict(),
             "held_out_shapes": [list(b.shape) for b in held], "wall_s": time.time() - t0,
@@ -152,7 +186,7 @@ def report(out: Path) -> str:
     start = np.array(g["sinusoid_brain_held_out"])
     done = sorted(spec)
     sp = np.array([spec[i]["score"] for i in done])
-    lines = [f"task {g['task']}, {g['train_bodies']} training bodies, {g['candidates']} candidate "
+    lines = [f"task {g['task']}, bodies: {g.get('family', 'random')}, {g['train_bodies']} training bodies, {g['candidates']} candidate "
              f"brains per search; held-out bodies with a specialist: {len(done)} of {gen.size}",
              "", "| | median | IQR |", "|---|---|---|"]  # fmt: skip
     for name, v in (("generalist, zero-shot (all held-out)", gen),
