@@ -57,12 +57,17 @@ cdef void _robot_gaps(
     const intp_t* vox_start, const intp_t* body_end, const intp_t* grid, const flag_t* floor,
     const intp_t* box_start, const float64_t* boxes, const intp_t* obs_start,
     const float64_t* obs, double obs_half, intp_t self_hops, intp_t self_max, double cap,
-    float64_t* out, intp_t out0, intp_t* order,
+    float64_t* out, intp_t out0, intp_t* order, float64_t* sweep, intp_t* sweep_idx,
 ) noexcept nogil:
     cdef intp_t a = vox_start[r], e = body_end[r], z = vox_start[r + 1]
     cdef intp_t n = e - a
-    cdef intp_t i, j, k, t, u, key, hops, di, dj, dk
+    cdef intp_t i, j, k, t, u, key, hops, di, dj, dk, stop, ns = 0
     cdef double half, g, x, window, edge = 0.0
+    cdef double xi, yi, zi, dx, dy, dz, d2, reach
+    cdef float64_t* X
+    cdef float64_t* Y
+    cdef float64_t* Z
+    cdef float64_t* H
     cdef bint own = n <= self_max
     for i in range(a, e):
         out[out0 + i - a] = cap
@@ -93,25 +98,52 @@ cdef void _robot_gaps(
         for j in range(e, z):  # the terrain's movable objects
             g = _pair_gap(&pos[3 * i], &pos[3 * j], half + 0.5 * scale[j], cap, g)
         out[out0 + i - a] = min(out[out0 + i - a], g)
-        if not own:
-            continue
-        for u in range(t + 1, n):  # each pair once, both voxels take the gap
-            j = a + order[u]
-            if pos[3 * j] - pos[3 * i] >= window:
-                break
-            if not surface[j]:
-                continue
-            di = grid[3 * i] - grid[3 * j]
-            dj = grid[3 * i + 1] - grid[3 * j + 1]
-            dk = grid[3 * i + 2] - grid[3 * j + 2]
-            hops = (di if di >= 0 else -di) + (dj if dj >= 0 else -dj) + (dk if dk >= 0 else -dk)
-            if hops <= self_hops:
-                continue
-            g = _pair_gap(&pos[3 * i], &pos[3 * j], half + 0.5 * scale[j], cap, cap)
-            if g < out[out0 + i - a]:
-                out[out0 + i - a] = g
-            if g < out[out0 + j - a]:
-                out[out0 + j - a] = g
+        # the surface voxels in x order for the sweep of own pairs: rows of x, y, z and half
+        # edge, n apart
+        sweep[ns] = pos[3 * i]
+        sweep[n + ns] = pos[3 * i + 1]
+        sweep[2 * n + ns] = pos[3 * i + 2]
+        sweep[3 * n + ns] = half
+        sweep_idx[ns] = i
+        ns += 1
+    if not own:
+        return
+    # each pair of surface voxels once, both take the gap. For voxel t, its partners u > t up
+    # to the first whose x is a window or more ahead (beyond it none is within cap); among
+    # them the few within reach + cap (lattice neighbours, mostly) take the branch, where the
+    # gap is the one _pair_gap gives
+    X = sweep
+    Y = sweep + n
+    Z = sweep + 2 * n
+    H = sweep + 3 * n
+    for t in range(ns):
+        xi = X[t]
+        yi = Y[t]
+        zi = Z[t]
+        half = H[t]
+        stop = t + 1
+        while stop < ns and not (X[stop] - xi >= window):
+            stop += 1
+        for u in range(t + 1, stop):
+            dx = xi - X[u]
+            dy = yi - Y[u]
+            dz = zi - Z[u]
+            d2 = dx * dx + dy * dy + dz * dz
+            reach = half + H[u]
+            if d2 < (reach + cap) * (reach + cap):
+                i = sweep_idx[t]
+                j = sweep_idx[u]
+                di = grid[3 * i] - grid[3 * j]
+                dj = grid[3 * i + 1] - grid[3 * j + 1]
+                dk = grid[3 * i + 2] - grid[3 * j + 2]
+                hops = ((di if di >= 0 else -di) + (dj if dj >= 0 else -dj)
+                        + (dk if dk >= 0 else -dk))
+                if hops > self_hops:
+                    g = min(cap, sqrt(d2) - reach)
+                    if g < out[out0 + i - a]:
+                        out[out0 + i - a] = g
+                    if g < out[out0 + j - a]:
+                        out[out0 + j - a] = g
 
 
 def contact_gaps(
@@ -120,7 +152,7 @@ def contact_gaps(
     const flag_t[::1] floor, const intp_t[::1] box_start, const float64_t[:, ::1] boxes,
     const intp_t[::1] obs_start, const float64_t[:, ::1] obs, double obs_edge, intp_t self_hops,
     intp_t self_max, double cap, const intp_t[::1] own_offsets, float64_t[::1] out,
-    intp_t[::1] order, int n_threads,
+    intp_t[::1] order, float64_t[::1] sweep, intp_t[::1] sweep_idx, int n_threads,
 ):
     """Fill ``out`` (one value per robot voxel, in the order of ``own_offsets``) with its
     smallest surface gap (m) to the floor, boxes, obstacle voxels (edge ``obs_edge``),
@@ -129,19 +161,23 @@ def contact_gaps(
     all six bonds (not ``surface``) get ``cap``: they touch nothing. ``order`` holds, per
     robot (its segment of ``own_offsets``), a permutation of its voxels' local indices,
     sorted by x here (kept between calls: the next sort is short); the result does not
-    depend on it."""
+    depend on it. ``sweep`` (4 per robot voxel) and ``sweep_idx`` (1 per robot voxel) are
+    scratch."""
     cdef intp_t n = vox_start.shape[0] - 1
     cdef intp_t r
     cdef const float64_t* bx = &boxes[0, 0] if boxes.shape[0] else NULL
     cdef const float64_t* ob = &obs[0, 0] if obs.shape[0] else NULL
     if out.shape[0] != own_offsets[n] or order.shape[0] != own_offsets[n]:
         raise ValueError("out and order must hold one value per robot voxel")
+    if sweep.shape[0] != 4 * own_offsets[n] or sweep_idx.shape[0] != own_offsets[n]:
+        raise ValueError("sweep and sweep_idx must hold 4 and 1 values per robot voxel")
     if n_threads < 1:
         n_threads = 1
     for r in prange(n, nogil=True, schedule="dynamic", num_threads=n_threads):
         _robot_gaps(r, &pos[0, 0], &scale[0], &surface[0], &vox_start[0], &body_end[0],
                     &grid[0, 0], &floor[0], &box_start[0], bx, &obs_start[0], ob, 0.5 * obs_edge,
-                    self_hops, self_max, cap, &out[0], own_offsets[r], &order[own_offsets[r]])
+                    self_hops, self_max, cap, &out[0], own_offsets[r], &order[own_offsets[r]],
+                    &sweep[4 * own_offsets[r]], &sweep_idx[own_offsets[r]])
 
 
 cdef void _robot_cells(

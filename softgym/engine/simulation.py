@@ -604,20 +604,23 @@ class Simulation:
             a["pos"], a["scale"], a["surface"], a["vox_start"], a["body_end"], self._grid_index,
             a["floor"], a["box_start"], a["boxes"], a["obs_start"], np.ascontiguousarray(a["obs"]),
             float(self.config.voxel_size), self.SELF_TOUCH_HOPS, self.SELF_TOUCH_MAX_VOXELS,
-            float(cap), self._own_offsets.astype(np.intp), out, self._sense_order(), threads,
+            float(cap), self._own_offsets.astype(np.intp), out, *self._sense_scratch(), threads,
         )  # fmt: skip
         return out
 
-    def _sense_order(self) -> np.ndarray:
+    def _sense_scratch(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         # each robot's voxels sorted by x at the last contact_gaps call (local indices), kept
-        # so that the next call's sort is short; any permutation gives the same gaps
-        order = getattr(self, "_order", None)
-        if order is None:
+        # so that the next call's sort is short (any permutation gives the same gaps), and the
+        # sweep's scratch (4 doubles and an index per robot voxel)
+        scratch = getattr(self, "_sense_buffers", None)
+        if scratch is None:
             off = self._own_offsets
             counts = np.diff(off)
-            order = (np.arange(int(off[-1])) - np.repeat(off[:-1], counts)).astype(np.intp)
-            self._order = order
-        return order
+            n = int(off[-1])
+            order = (np.arange(n) - np.repeat(off[:-1], counts)).astype(np.intp)
+            scratch = (order, np.empty(4 * n), np.empty(n, dtype=np.intp))
+            self._sense_buffers = scratch
+        return scratch
 
     def cell_sensors(
         self,
