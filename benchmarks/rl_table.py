@@ -36,13 +36,21 @@ DATA = Path(__file__).resolve().parent / "data" / "rl"
 REPO = Path(__file__).resolve().parents[1]
 
 
+def run_label(run: dict) -> str:
+    """A run's row: its task, ``(sensing)`` for the sensing observation, ``(sensing, shaped)``
+    when it trained on the task's dense guidance too (``rl_ppo.py --shaping``)."""
+    settings = run["settings"]
+    tags = ["sensing"] if settings.get("observe", "blind") == "sensing" else []
+    tags += ["shaped"] if settings.get("shaping") else []
+    return run["task"] + (f" ({', '.join(tags)})" if tags else "")
+
+
 def load_runs(root: Path = DATA / "ppo") -> dict[str, list[dict]]:
-    """Stored runs by task (``"push (sensing)"`` for the sensing observation), seeds in order."""
+    """Stored runs by :func:`run_label` (task and observation), seeds in order."""
     runs: dict[str, list[dict]] = {}
     for path in sorted(root.glob("*/run.json")):
         run = json.loads(path.read_text())
-        sensing = run["settings"].get("observe", "blind") == "sensing"
-        runs.setdefault(run["task"] + (" (sensing)" if sensing else ""), []).append(run)
+        runs.setdefault(run_label(run), []).append(run)
     for task in runs:
         runs[task].sort(key=lambda r: r["settings"]["seed"])
     return runs

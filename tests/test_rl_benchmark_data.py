@@ -68,7 +68,8 @@ def test_stored_ppo_baseline_runs_are_resumable_records():
         assert run["command"].startswith("python benchmarks/rl_ppo.py ")
         assert f"--run-dir benchmarks/data/rl/ppo/{d.name}" in run["command"]
         sensing = "-sensing" if run["settings"].get("observe") == "sensing" else ""
-        assert d.name == f"{run['task']}{sensing}-s{run['settings']['seed']}"
+        shaped = "-shaped" if run["settings"].get("shaping") else ""
+        assert d.name == f"{run['task']}{sensing}{shaped}-s{run['settings']['seed']}"
         steps = [t for t, _ in run["eval_curve"]]
         assert steps == sorted(steps) and steps[-1] == run["num_timesteps"]
         assert run["finished"] == (run["num_timesteps"] >= run["timesteps"]) == ("final" in run)
@@ -87,7 +88,10 @@ def test_rl_table_prints_every_task_and_draws_the_curves(tmp_path):
     by_task = {}
     for d in (DATA / "ppo").glob("*/run.json"):
         run = json.loads(d.read_text())
-        task = run["task"] + (" (sensing)" if run["settings"].get("observe") == "sensing" else "")
+        settings = run["settings"]
+        tags = ["sensing"] if settings.get("observe") == "sensing" else []
+        tags += ["shaped"] if settings.get("shaping") else []
+        task = run["task"] + (f" ({', '.join(tags)})" if tags else "")
         by_task[task] = by_task.get(task, 0) + 1
     for task, n in by_task.items():
         assert f"| {task} | {n} |" in text
