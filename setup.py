@@ -239,6 +239,7 @@ if sys.platform != "win32":
 ENGINE_MODULES = (
     "_core",          # the step loop and the Python entry points
     "_bind",          # binds a batch's arrays and settings to Batch (rendered from contract.py)
+    "_cache",         # ContactCache: self-collision candidates and scratch kept between calls
     "_corotational",  # model 1's link forces
     "_seed",          # model 0's link forces (C passes in include/softgym_seed.h)
     "_contact",       # self-collision (one spatial hash); floor/box laws inline in the .pxd

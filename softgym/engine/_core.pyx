@@ -11,7 +11,8 @@
 # and the drive (_actuate, here). advance() runs the robots of a batch in
 # parallel (OpenMP, one robot per thread at a time): results are
 # deterministic and independent of threads and batching. Its Batch is bound
-# by _bind.pyx (from the table in contract.py).
+# by _bind.pyx (from the table in contract.py); what it keeps between calls
+# (the self-collision candidates, the scratch) is a _cache.ContactCache.
 #
 # The code walks flat arrays through raw pointers; dtypes and shapes are checked
 # once when the batch is laid out (layout.build_layout, contract.check_arrays),
@@ -19,15 +20,12 @@
 
 from cython.parallel cimport prange, parallel, threadid
 from libc.math cimport sin, cos, sqrt, fabs, M_PI
-from libc.stdlib cimport calloc, realloc, free
-from libc.stdint cimport uintptr_t
-
-import numpy as np
 
 from softgym.engine._batch cimport (Batch, STATUS_OK, STATUS_STRAIN, STATUS_NONFINITE,
                                     STATUS_MEMORY, N_AUX, N_LINK_OUT, SOFTGYM_VOXEL_ROWS,
                                     SOFTGYM_FM_STRIDE, MODEL_SEED, ACTUATION_SEED)
 from softgym.engine._bind cimport bind, row_stride
+from softgym.engine._cache cimport ContactCache
 from softgym.engine._contact cimport (Contacts, contacts_corotational, contacts_seed, collide,
                                       collide_obstacles)
 from softgym.engine._corotational cimport links_corotational
@@ -268,77 +266,6 @@ STATUS_NAMES = {
 #: Doubles in a voxel's row of the force scratch ("force": its force in columns 0-2, its
 #: moment in 4-6; _batch.pxd)
 FM_STRIDE = SOFTGYM_FM_STRIDE
-
-
-cdef class ContactCache:
-    """Self-collision candidate lists of a batch's robots, kept between calls.
-
-    Owned by a :class:`~softgym.engine.Simulation`; :meth:`invalidate` must be
-    called whenever voxels are moved from outside the kernel (set_state, reset).
-    Whether and when a list is rebuilt never changes results: a list always
-    holds every touching pair, in sorted order. Also holds the kernels'
-    scratch (one block per thread), reused from call to call.
-    """
-
-    cdef Contacts* items
-    cdef intp_t n
-    cdef float64_t* link_scratch
-    cdef intp_t link_scratch_size
-
-    def __cinit__(self, intp_t n_robots):
-        self.n = n_robots
-        self.items = <Contacts*> calloc(n_robots if n_robots > 0 else 1, sizeof(Contacts))
-        if self.items == NULL:
-            raise MemoryError("cannot allocate the self-collision cache")
-        self.invalidate()
-
-    def pairs(self, intp_t r):
-        """Robot r's self-collision candidate pairs (i, j) as of its last rebuild: an
-        (n_pairs, 2) int array of batch voxel indices, i < j, sorted (a copy)."""
-        if not 0 <= r < self.n:
-            raise IndexError(f"robot {r} not in 0..{self.n - 1}")
-        if self.items[r].n_pairs == 0:
-            return np.empty((0, 2), dtype=np.intp)
-        return np.array(<intp_t[:self.items[r].n_pairs, :2]> self.items[r].pairs)
-
-    def invalidate(self):
-        """Mark every robot's candidate list for a rebuild before its next use."""
-        cdef intp_t r
-        for r in range(self.n):
-            self.items[r].stale = 1
-
-    def __dealloc__(self):
-        cdef intp_t r
-        if self.items != NULL:
-            for r in range(self.n):
-                free(self.items[r].pairs)
-                free(self.items[r].cells)
-                free(self.items[r].row)
-                free(self.items[r].ref)
-                free(self.items[r].opairs)
-                free(self.items[r].ocells)
-                free(self.items[r].dense)
-                free(self.items[r].sur)
-                free(self.items[r].sur_idx)
-                free(self.items[r].hit)
-                free(self.items[r].xbits)
-            free(self.items)
-        free(self.link_scratch)
-
-    cdef float64_t* scratch(self, intp_t size) except NULL:
-        # at least `size` doubles of scratch (contents undefined), starting on a
-        # 64-byte boundary: the passes' rows start on cache lines (their strides are
-        # multiples of 16 doubles), so a 512-bit load or store of a row never spans
-        # two lines. malloc gives 16 bytes, and on an Intel Xeon every vector access
-        # to the rows was split (benchmarks/RESULTS.md)
-        cdef float64_t* p
-        if size > self.link_scratch_size:
-            p = <float64_t*> realloc(self.link_scratch, (size + 8) * sizeof(float64_t))
-            if p == NULL:
-                raise MemoryError("no memory for the kernels' scratch")
-            self.link_scratch = p
-            self.link_scratch_size = size
-        return <float64_t*> ((<uintptr_t> self.link_scratch + 63) & ~(<uintptr_t> 63))
 
 
 def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, ContactCache cache):
