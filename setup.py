@@ -18,6 +18,14 @@ SOFTGYM_NATIVE=1
     Compile the portable kernel with ``-march=native`` too (a local build
     for the building machine alone; never for a wheel).
 
+Generated sources
+-----------------
+``softgym/engine/_batch.pxd`` and ``_bind.pyx`` are rendered from the kernel's
+contract (``softgym/engine/contract.py``: every array and setting that crosses into
+the kernel, and the named codes) and their ``.tp`` templates before anything is
+cythonized, as scikit-learn renders its Tempita templates; both are committed too
+(``python softgym/engine/_codegen.py`` renders them without a build).
+
 Kernel variants and run-time dispatch
 -------------------------------------
 On x86-64 (GCC or Clang) every compiled module of the engine
@@ -45,6 +53,7 @@ allows speculative evaluation; floating-point traps are never enabled).
 """
 
 import glob
+import importlib.util
 import os
 import platform
 import shutil
@@ -229,12 +238,33 @@ if sys.platform != "win32":
 # comes inline from a .pxd or an include/*.h header)
 ENGINE_MODULES = (
     "_core",          # the step loop and the Python entry points
+    "_bind",          # binds a batch's arrays and settings to Batch (rendered from contract.py)
+    "_cache",         # ContactCache: self-collision candidates and scratch kept between calls
     "_corotational",  # model 1's link forces
     "_seed",          # model 0's link forces (C passes in include/softgym_seed.h)
     "_contact",       # self-collision (one spatial hash); floor/box laws inline in the .pxd
     "_integrate",     # the voxel update of both models
     "_record",        # centre of mass, trace, aux, energy
 )
+
+
+def _render_contract():
+    """Render the engine's generated Cython from its contract (softgym/engine/_codegen.py).
+
+    ``_batch.pxd`` and ``_bind.pyx`` come from ``contract.py`` and their ``.tp``
+    templates; a file is rewritten only when its text changes, so an unchanged contract
+    rebuilds nothing. Loaded from its path: the package is not importable before it is
+    built.
+    """
+    path = os.path.join("softgym", "engine", "_codegen.py")
+    spec = importlib.util.spec_from_file_location("_softgym_engine_codegen", path)
+    codegen = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(codegen)
+    for target in codegen.generate():
+        print(f"softgym: rendered {target} from the kernel's contract")
+
+
+_render_contract()
 
 extensions = [
     *(Extension(f"softgym.engine.{m}", [f"softgym/engine/{m}.pyx"], **core_kwargs)

@@ -94,7 +94,8 @@ print("STEPS", int(r.steps[0]), sim.n_voxels, sim.n_links, kernel_build(),
 TOGGLE = "*advance_robot*"
 
 # the engine's modules, by the start of their file names
-ENGINE_MODULES = ("_seed", "_integrate", "_contact", "_core", "_corotational", "_record")
+ENGINE_MODULES = ("_seed", "_integrate", "_contact", "_core", "_corotational", "_record", "_bind",
+                  "_cache")
 
 
 def demangle(name: str) -> str:

@@ -10,22 +10,22 @@
 #   _record.pyx        centre of mass, trace samples, aux, energy
 # and the drive (_actuate, here). advance() runs the robots of a batch in
 # parallel (OpenMP, one robot per thread at a time): results are
-# deterministic and independent of threads and batching.
+# deterministic and independent of threads and batching. Its Batch is bound
+# by _bind.pyx (from the table in contract.py); what it keeps between calls
+# (the self-collision candidates, the scratch) is a _cache.ContactCache.
 #
-# The code walks flat arrays through raw pointers; bounds are checked by the
-# Python wrapper (simulation.py) once, never here.
+# The code walks flat arrays through raw pointers; dtypes and shapes are checked
+# once when the batch is laid out (layout.build_layout, contract.check_arrays),
+# never here.
 
 from cython.parallel cimport prange, parallel, threadid
 from libc.math cimport sin, cos, sqrt, fabs, M_PI
-from libc.stdlib cimport calloc, realloc, free
-from libc.stdint cimport uintptr_t
-
-cimport numpy as cnp
-import numpy as np
 
 from softgym.engine._batch cimport (Batch, STATUS_OK, STATUS_STRAIN, STATUS_NONFINITE,
                                     STATUS_MEMORY, N_AUX, N_LINK_OUT, SOFTGYM_VOXEL_ROWS,
-                                    SOFTGYM_FM_STRIDE)
+                                    SOFTGYM_FM_STRIDE, MODEL_SEED, ACTUATION_SEED)
+from softgym.engine._bind cimport bind, row_stride
+from softgym.engine._cache cimport ContactCache
 from softgym.engine._contact cimport (Contacts, contacts_corotational, contacts_seed, collide,
                                       collide_obstacles)
 from softgym.engine._corotational cimport links_corotational
@@ -42,8 +42,6 @@ from softgym.engine._integrate import refresh_rotations  # noqa: F401 (Python AP
 from softgym.engine._seed import seed_frames  # noqa: F401 (Python API, for tests)
 from softgym.engine._seed import cycle_counts as seed_cycle_counts
 from softgym.engine._integrate import cycle_counts as integrate_cycle_counts
-
-cnp.import_array()
 
 # the robots that the threads of advance step at one time are this many apart
 cdef intp_t ROBOT_SPREAD = 8
@@ -70,7 +68,7 @@ cdef inline float64_t _actuate(Batch* b, intp_t r) noexcept nogil:
         float64_t lo = b.min_scale * L
         float64_t new, s, c, amp, w
         float64_t smax = 0.0
-        int32 seed = b.actuation_mode == 0
+        int32 seed = b.actuation_mode == ACTUATION_SEED
     if b.use_temp[r]:
         for i in range(vs, ve):
             if b.cte[i] == 0.0:
@@ -86,14 +84,14 @@ cdef inline float64_t _actuate(Batch* b, intp_t r) noexcept nogil:
         return smax
     if t < b.init_time:
         return smax  # nominal sizes until the settling time is over (scale starts at L)
-    if b.model == 0:
+    if b.model == MODEL_SEED:
         w = SEED_2PI_DRIVE * (t / b.period[r])  # the seed's sin(2 pi_f (t / T))
     else:
         w = 2.0 * M_PI / b.period[r] * t
     s = sin(w)
     c = cos(w)
     amp = b.temp_amp[r]
-    if seed and b.model == 0:
+    if seed and b.model == MODEL_SEED:
         # the seed step does not use smax: the same sizes without branches, a
         # loop the compiler vectorises (a voxel without expansion, cte 0, or a size
         # outside [min_scale L, L] keeps its size)
@@ -241,7 +239,7 @@ cdef int advance_robot(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
         return STATUS_OK
     if b.steps[r] == 0:
         record(b, r)
-    if b.model == 0:
+    if b.model == MODEL_SEED:
         status = _advance_seed(b, r, target, c)
     else:
         status = _advance_corotational(b, r, target, c)
@@ -253,8 +251,9 @@ cdef int advance_robot(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
 
 
 # ---------------------------------------------------------------------------
-# Python-facing entry points. The wrapper (simulation.py) has validated dtypes,
-# shapes and contiguity; here arrays are only bound to the struct.
+# Python-facing entry points. The layout (layout.build_layout) has checked dtypes
+# and shapes against the contract; here arrays are only bound to the struct
+# (_bind.bind).
 
 #: What each STATUS_* code of a diverged robot means (``diverged_code``).
 STATUS_NAMES = {
@@ -267,238 +266,6 @@ STATUS_NAMES = {
 #: Doubles in a voxel's row of the force scratch ("force": its force in columns 0-2, its
 #: moment in 4-6; _batch.pxd)
 FM_STRIDE = SOFTGYM_FM_STRIDE
-
-#: The arrays that cross into the kernel (bound by _bind; shapes, dtypes and
-#: units in _batch.pxd's Batch): the Python side must provide every one.
-KERNEL_ARRAYS = (
-    "vox_start", "link_start", "link_axis_count", "dt", "steps", "temp_amp", "period",
-    "use_temp", "floor", "box_start", "boxes", "diverged", "diverged_time", "diverged_code",
-    "init_done", "cm_init", "mass_total", "trace_n", "trace_t", "trace_cm",
-    "pos", "vel", "quat", "angvel", "rot", "force", "ext_force", "mass", "inv_mass",
-    "inv_inertia", "scale", "cte", "cos_phase", "sin_phase", "temp", "k_floor", "c_floor",
-    "c_global", "rot_damp", "mu_s", "mu_k", "fixed", "surface", "excl_start", "excl_idx",
-    "seed_rank", "col_ref", "col_acc", "col_vmax", "obs_start", "obs", "obs_rank",
-    "v1", "v2", "axis", "k_axial", "k_torsion", "k_bend", "c_axial", "c_torsion",
-    "c_bend", "c_seed", "k_seed32", "homog", "link_sa", "link_last",
-    "body_end", "aux_init", "trace_aux", "faces",
-)
-
-
-cpdef intp_t row_stride(intp_t n):
-    """The row stride (in elements) of an array of rows of ``n`` per-link or
-    per-voxel values that a kernel pass reads together, lane by lane: ``n`` rounded
-    up to an odd multiple of 16. Rows of float64 are then an odd multiple of 128
-    bytes apart, rows of float32 of 64: consecutive rows fall in different sets of
-    the core's cache. With rows a multiple of 4096 bytes apart (a batch of 256
-    reference robots has 138,240 links: 270 pages) every row fell in one set of
-    the 8-way L1 and the forces pass reads 20 rows at once: the batch ran at two
-    thirds of one robot's rate per voxel (benchmarks/RESULTS.md)."""
-    cdef intp_t s = (n + 15) // 16 * 16
-    if (s // 16) % 2 == 0:
-        s += 16
-    return s
-
-
-def _row_stride_of(cnp.ndarray a, str name):
-    # elements between the rows of a 2-d kernel array whose rows are contiguous
-    if a.ndim != 2 or a.strides[1] != a.itemsize or a.strides[0] % a.itemsize:
-        raise ValueError(f"{name}: each row must be contiguous")
-    return a.strides[0] // a.itemsize
-
-
-cdef inline float64_t* _f(object arrays, str name) except NULL:
-    cdef cnp.ndarray a = arrays[name]
-    return <float64_t*> cnp.PyArray_DATA(a)
-
-
-cdef inline void* _p(object arrays, str name) except NULL:
-    cdef cnp.ndarray a = arrays[name]
-    return cnp.PyArray_DATA(a)
-
-
-cdef int _bind(Batch* b, dict a, dict s) except -1:
-    b.n_robots = s["n_robots"]
-    b.L = s["L"]
-    b.gravity = s["gravity"]
-    b.init_time = s["init_time"]
-    b.min_scale = s["min_scale"]
-    b.max_strain = s["max_strain"]
-    b.trace_interval = s["trace_interval"]
-    b.self_collision = s["self_collision"]
-    b.actuation_mode = s["actuation_mode"]
-    b.model = s["model"]
-    b.bond_zeta = s["bond_zeta"]
-    b.link_f32 = s["link_f32"]
-    b.trace_capacity = a["trace_t"].shape[1]
-    b.fluid_drag = s["fluid_drag"]
-    b.body_end = <intp_t*> _p(a, "body_end")
-    b.aux_init = _f(a, "aux_init")
-    b.trace_aux = _f(a, "trace_aux")
-    b.faces = <flag_t*> _p(a, "faces")
-    b.vox_start = <intp_t*> _p(a, "vox_start")
-    b.link_start = <intp_t*> _p(a, "link_start")
-    b.dt = _f(a, "dt")
-    b.steps = <step_t*> _p(a, "steps")
-    b.temp_amp = _f(a, "temp_amp")
-    b.period = _f(a, "period")
-    b.use_temp = <flag_t*> _p(a, "use_temp")
-    b.floor = <flag_t*> _p(a, "floor")
-    b.box_start = <intp_t*> _p(a, "box_start")
-    b.boxes = _f(a, "boxes") if a["boxes"].shape[0] > 0 else NULL
-    b.diverged = <flag_t*> _p(a, "diverged")
-    b.diverged_time = _f(a, "diverged_time")
-    b.diverged_code = <int32*> _p(a, "diverged_code")
-    b.init_done = <flag_t*> _p(a, "init_done")
-    b.cm_init = _f(a, "cm_init")
-    b.mass_total = _f(a, "mass_total")
-    b.trace_n = <intp_t*> _p(a, "trace_n")
-    b.trace_t = _f(a, "trace_t")
-    b.trace_cm = _f(a, "trace_cm")
-    b.pos = _f(a, "pos")
-    b.vel = _f(a, "vel")
-    b.quat = _f(a, "quat")
-    b.angvel = _f(a, "angvel")
-    b.rot = _f(a, "rot")
-    b.force = _f(a, "force")
-    b.vox_out = NULL  # per thread, set by advance
-    b.state_rows = NULL  # set by the step loops while the state is in the voxel rows
-    b.chunk_out = NULL
-    b.chunk_f32 = NULL
-    b.chunk_link = NULL
-    b.vox_stride = 0
-    b.moment = b.force + 4  # its columns 4-6 (_batch.pxd)
-    b.link_f = NULL  # per thread, set by advance (single-precision links)
-    b.link_fs = 0
-    b.ext_force = _f(a, "ext_force")
-    b.mass = _f(a, "mass")
-    b.inv_mass = _f(a, "inv_mass")
-    b.inv_inertia = _f(a, "inv_inertia")
-    b.scale = _f(a, "scale")
-    b.cte = _f(a, "cte")
-    b.cos_phase = _f(a, "cos_phase")
-    b.sin_phase = _f(a, "sin_phase")
-    b.temp = _f(a, "temp")
-    b.k_floor = _f(a, "k_floor")
-    b.c_floor = _f(a, "c_floor")
-    b.c_global = _f(a, "c_global")
-    b.rot_damp = _f(a, "rot_damp")
-    b.mu_s = _f(a, "mu_s")
-    b.mu_k = _f(a, "mu_k")
-    b.fixed = <flag_t*> _p(a, "fixed")
-    b.seed_rank = <intp_t*> _p(a, "seed_rank")
-    b.col_ref = _f(a, "col_ref")
-    b.col_acc = _f(a, "col_acc")
-    b.col_vmax = _f(a, "col_vmax")
-    b.obs_start = <intp_t*> _p(a, "obs_start")
-    b.obs = _f(a, "obs") if a["obs"].shape[0] > 0 else NULL
-    b.obs_rank = <intp_t*> _p(a, "obs_rank") if a["obs_rank"].shape[0] > 0 else NULL
-    b.surface = <flag_t*> _p(a, "surface")
-    b.link_axis_count = <intp_t*> _p(a, "link_axis_count")
-    b.excl_start = <intp_t*> _p(a, "excl_start")
-    b.excl_idx = <intp_t*> _p(a, "excl_idx") if a["excl_idx"].shape[0] > 0 else NULL
-    # links: a robot without links leaves these arrays empty (never dereferenced)
-    b.n_links = a["v1"].shape[0]
-    b.link_out = NULL  # per thread, set by advance
-    b.link_stride = 0
-    b.link_rows = 0
-    if a["v1"].shape[0] > 0:
-        b.v1 = <intp_t*> _p(a, "v1")
-        b.v2 = <intp_t*> _p(a, "v2")
-        b.axis = <int32*> _p(a, "axis")
-        b.k_axial = _f(a, "k_axial")
-        b.k_torsion = _f(a, "k_torsion")
-        b.k_bend = _f(a, "k_bend")
-        b.c_axial = _f(a, "c_axial")
-        b.c_torsion = _f(a, "c_torsion")
-        b.c_bend = _f(a, "c_bend")
-        b.c_seed = _f(a, "c_seed")
-        b.homog = <lane_flag_t*> _p(a, "homog")
-        b.link_sa = <lane_flag_t*> _p(a, "link_sa")
-        # the rows the forces pass reads with one stride
-        b.link_rows = _row_stride_of(a["link_last"], "link_last")
-        rows_with = "k_seed32" if b.link_f32 else "c_seed"
-        if _row_stride_of(a[rows_with], rows_with) != b.link_rows:
-            raise ValueError(f"{rows_with} and link_last must have one row stride")
-        if b.link_f32:  # the single-precision passes' arrays (float32)
-            b.link_last = NULL
-            b.link_last32 = <float*> _p(a, "link_last")
-            b.k_seed32 = <float*> _p(a, "k_seed32")
-        else:
-            b.link_last = _f(a, "link_last")
-            b.link_last32 = NULL
-            b.k_seed32 = NULL
-    return 0
-
-
-cdef class ContactCache:
-    """Self-collision candidate lists of a batch's robots, kept between calls.
-
-    Owned by a :class:`~softgym.engine.Simulation`; :meth:`invalidate` must be
-    called whenever voxels are moved from outside the kernel (set_state, reset).
-    Whether and when a list is rebuilt never changes results: a list always
-    holds every touching pair, in sorted order. Also holds the kernels'
-    scratch (one block per thread), reused from call to call.
-    """
-
-    cdef Contacts* items
-    cdef intp_t n
-    cdef float64_t* link_scratch
-    cdef intp_t link_scratch_size
-
-    def __cinit__(self, intp_t n_robots):
-        self.n = n_robots
-        self.items = <Contacts*> calloc(n_robots if n_robots > 0 else 1, sizeof(Contacts))
-        if self.items == NULL:
-            raise MemoryError("cannot allocate the self-collision cache")
-        self.invalidate()
-
-    def pairs(self, intp_t r):
-        """Robot r's self-collision candidate pairs (i, j) as of its last rebuild: an
-        (n_pairs, 2) int array of batch voxel indices, i < j, sorted (a copy)."""
-        if not 0 <= r < self.n:
-            raise IndexError(f"robot {r} not in 0..{self.n - 1}")
-        if self.items[r].n_pairs == 0:
-            return np.empty((0, 2), dtype=np.intp)
-        return np.array(<intp_t[:self.items[r].n_pairs, :2]> self.items[r].pairs)
-
-    def invalidate(self):
-        """Mark every robot's candidate list for a rebuild before its next use."""
-        cdef intp_t r
-        for r in range(self.n):
-            self.items[r].stale = 1
-
-    def __dealloc__(self):
-        cdef intp_t r
-        if self.items != NULL:
-            for r in range(self.n):
-                free(self.items[r].pairs)
-                free(self.items[r].cells)
-                free(self.items[r].row)
-                free(self.items[r].ref)
-                free(self.items[r].opairs)
-                free(self.items[r].ocells)
-                free(self.items[r].dense)
-                free(self.items[r].sur)
-                free(self.items[r].sur_idx)
-                free(self.items[r].hit)
-                free(self.items[r].xbits)
-            free(self.items)
-        free(self.link_scratch)
-
-    cdef float64_t* scratch(self, intp_t size) except NULL:
-        # at least `size` doubles of scratch (contents undefined), starting on a
-        # 64-byte boundary: the passes' rows start on cache lines (their strides are
-        # multiples of 16 doubles), so a 512-bit load or store of a row never spans
-        # two lines. malloc gives 16 bytes, and on an Intel Xeon every vector access
-        # to the rows was split (benchmarks/RESULTS.md)
-        cdef float64_t* p
-        if size > self.link_scratch_size:
-            p = <float64_t*> realloc(self.link_scratch, (size + 8) * sizeof(float64_t))
-            if p == NULL:
-                raise MemoryError("no memory for the kernels' scratch")
-            self.link_scratch = p
-            self.link_scratch_size = size
-        return <float64_t*> ((<uintptr_t> self.link_scratch + 63) & ~(<uintptr_t> 63))
 
 
 def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, ContactCache cache):
@@ -525,7 +292,7 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
         intp_t stride = 0, vstride = 0, block, fblock, i, m, vox_at, chunk_at, f32_at, link_at
         intp_t lf_at, lfblock
         float64_t* scratch
-    _bind(&b, arrays, settings)
+    bind(&b, arrays, settings)
     n = b.n_robots
     if targets.shape[0] != n or cache.n != n:
         raise ValueError("targets and cache must hold one entry per robot")
@@ -554,7 +321,7 @@ def advance(dict arrays, dict settings, step_t[::1] targets, int n_threads, Cont
     # of 16 voxels may reach 47 past a robot's last voxel), in doubles
     lf_at = link_at + N_LINK_OUT * SOFTGYM_CHUNK_STRIDE
     b.link_fs = (vstride + 15) // 16 * 16
-    lfblock = (6 * b.link_fs + 64) // 2 if b.link_f32 and b.model == 0 else 0
+    lfblock = (6 * b.link_fs + 64) // 2 if b.link_f32 and b.model == MODEL_SEED else 0
     block = lf_at + lfblock
     scratch = cache.scratch(max(n_threads * block, 1))
     # robots in the order 0, 8, 16, ..., then 1, 9, 17, ...: the robots that the
@@ -590,7 +357,7 @@ def compute_energy(dict arrays, dict settings, float64_t[:, ::1] out):
     """Fill ``out`` (n_robots, 3) with kinetic, elastic and gravitational energy (J)."""
     cdef Batch b
     cdef intp_t r
-    _bind(&b, arrays, settings)
+    bind(&b, arrays, settings)
     for r in range(b.n_robots):
         robot_energy(&b, r, &out[r, 0])
 
@@ -604,7 +371,7 @@ def compute_aux(dict arrays, dict settings, float64_t[:, ::1] out):
     """Fill ``out`` (n_robots, N_AUX) with each robot's current ``robot_aux`` (see ``AUX_NAMES``)."""
     cdef Batch b
     cdef intp_t r
-    _bind(&b, arrays, settings)
+    bind(&b, arrays, settings)
     if out.shape[0] != b.n_robots or out.shape[1] != N_AUX:
         raise ValueError("out must have shape (n_robots, N_AUX)")
     for r in range(b.n_robots):

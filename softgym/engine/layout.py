@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from softgym.engine import _core
+from softgym.engine import _bind, _core, contract
 from softgym.engine.body import Body
 from softgym.engine.config import SimConfig
 from softgym.exceptions import InvalidDesignError, InvalidParameterError
@@ -324,7 +324,7 @@ class Layout:
     Attributes
     ----------
     arrays : dict of str to ndarray
-        Every array of ``_core.KERNEL_ARRAYS`` (and the state the runtime
+        Every array of ``contract.KERNEL_ARRAYS`` (and the state the runtime
         checkpoints), robot after robot: robot ``r`` owns voxels
         ``vox_start[r]:vox_start[r + 1]`` and links
         ``link_start[r]:link_start[r + 1]``.
@@ -523,16 +523,39 @@ def _terrain_arrays(terrains: list, cfg: SimConfig) -> dict[str, np.ndarray]:
 
 
 def _link_rows(rows: np.ndarray) -> np.ndarray:
-    """``rows`` (k, n_links) copied into rows ``_core.row_stride(n_links)`` elements apart.
+    """``rows`` (k, n_links) copied into rows ``_bind.row_stride(n_links)`` elements apart.
 
     A view of shape (k, n_links) whose rows are contiguous: the forces pass reads
     c_seed, k_seed32 and link_last with one row stride (the kernel checks it), and
     padded rows keep apart in the cache at every batch size.
     """
     k, n = rows.shape
-    out = np.zeros((k, _core.row_stride(n)), dtype=rows.dtype)[:, :n]
+    out = np.zeros((k, _bind.row_stride(n)), dtype=rows.dtype)[:, :n]
     out[...] = rows
     return out
+
+
+def _to_contract(a: dict[str, np.ndarray], settings: dict[str, Any]) -> None:
+    """Cast the kernel's arrays of ``a`` to the contract's dtypes (in place), then check
+    every one's dtype and shape (``contract.check_arrays``) and the settings.
+
+    A value that does not keep its kind (a float array where the kernel reads integers)
+    is not cast. Raises RuntimeError naming the array: the layout is wrong, not the input.
+    """
+    try:
+        contract.check_settings(settings)
+        for spec in contract.ARRAYS:
+            x = a.get(spec.name)
+            want = np.dtype(contract.expected_dtype(spec, bool(settings["link_f32"])))
+            if x is None or x.dtype == want:
+                continue
+            if not np.can_cast(x.dtype, want, casting="same_kind"):
+                raise ValueError(f"kernel array {spec.name!r} has dtype {x.dtype}, the kernel "
+                                 f"reads {want} ({spec.ctype})")  # fmt: skip
+            a[spec.name] = x.astype(want)
+        contract.check_arrays(a, {**contract.counts_of(a, settings), **_KERNEL_COUNTS})
+    except ValueError as err:
+        raise RuntimeError(f"softgym engine: the layout breaks the kernel's contract: {err}") from None
 
 
 CACHE_LINE = 64  # bytes
@@ -560,14 +583,35 @@ def _line_aligned(x: np.ndarray) -> np.ndarray:
 # ---------------------------------------------------------------------- memory
 # Bytes of what a Simulation allocates, per item (build_layout's arrays, robot after
 # robot; tests/engine/test_memory.py checks these tables against a built layout)
-#: per voxel: 14 float64 scalars (mass, inv_mass, inv_inertia, cte, cos/sin_phase,
-#: k_floor, c_floor, c_global, rot_damp, mu_s, mu_k, scale, temp), seed_rank and
-#: excl_start (int64), the vectors pos, vel, angvel, ext_force (3), quat, col_ref (4),
-#: force (FM_STRIDE), rot (9) and faces, fixed, surface (int8)
-_VOXEL_BYTES = 14 * 8 + 2 * 8 + 8 * (3 * 4 + 4 * 2 + _core.FM_STRIDE + 9) + 3
-#: per link: v1, v2, link_sa, homog, k_axial, k_torsion, k_bend, c_axial, c_bend,
-#: c_torsion (8 bytes each) and axis (int32); the padded rows (_link_rows) apart
-_LINK_BYTES = 10 * 8 + 4
+
+#: the kernel's constants that the contract's shapes name
+_KERNEL_COUNTS = {"N_AUX": len(_core.AUX_NAMES), "FM_STRIDE": _core.FM_STRIDE}
+
+
+def _bytes_per(count: str, single: bool = False) -> int:
+    """Bytes of the kernel's arrays per ``count`` (``"n_voxels"``...): the contract's arrays
+    whose rows are ``count`` (or ``count + 1``), each row's elements times their size.
+    """
+    total = 0
+    for spec in contract.ARRAYS:
+        if spec.shape[0] in (count, f"{count} + 1"):
+            row = contract.expected_shape(spec, {**_KERNEL_COUNTS, count: 1})[1:]
+            total += int(np.prod(row)) * np.dtype(contract.expected_dtype(spec, single)).itemsize
+    return total
+
+
+def _padded_bytes(single: bool) -> int:
+    """Bytes of the padded link rows (contract ``padded``: c_seed, link_last, k_seed32) per
+    element of their row stride, with or without single-precision links.
+    """
+    return sum(spec.shape[0] * np.dtype(contract.expected_dtype(spec, single)).itemsize
+               for spec in contract.ARRAYS if spec.padded and (single or not spec.single_only))
+
+
+#: per voxel: the per-voxel arrays of the contract (mass, pos, force, excl_start...)
+_VOXEL_BYTES = _bytes_per("n_voxels")
+#: per link: the per-link arrays of the contract but the padded rows (_padded_bytes)
+_LINK_BYTES = _bytes_per("n_links")
 #: per voxel, what Simulation keeps besides the layout's arrays: the initial state
 #: (its _VOXEL_STATE: pos, vel, quat, angvel, rot, scale, temp, ext_force, col_ref)
 #: and the grid indices (int64, 3)
@@ -664,16 +708,16 @@ def memory_estimate(bodies: list[Body], terrains: list, config: SimConfig, n_thr
         else:
             boxes += len(terrain.boxes)
     n_robots = len(bodies)
-    stride = int(_core.row_stride(links))
+    stride = int(_bind.row_stride(links))
     w = 4 if single else 8  # link_last's floats
     # c_seed (8 float64 rows), link_last (9 rows), k_seed32 (11 float32 rows, single only)
-    rows = stride * (8 * 8 + 9 * w + (11 * 4 if single else 0))
+    rows = stride * _padded_bytes(single)
     arrays = (_VOXEL_BYTES * n + _LINK_BYTES * links + rows + 8 * excl
               + _OBSTACLE_BYTES * obstacles + 48 * boxes + _ROBOT_BYTES * n_robots)
     kept = _VOXEL_KEPT * n + (8 + 9 * w) * links  # + link_sa, link_last copies
     build = 8 * excl + 24 * n + _OBSTACLE_BUILD_BYTES * obstacles
-    per_thread = 8 * _SCRATCH_ROWS * (int(_core.row_stride(max_n))
-                                      + (int(_core.row_stride(max_links)) if cfg.model != "seed" else 0))
+    per_thread = 8 * _SCRATCH_ROWS * (int(_bind.row_stride(max_n))
+                                      + (int(_bind.row_stride(max_links)) if cfg.model != "seed" else 0))
     run = per_thread * max(1, min(int(n_threads), n_robots)) + contacts + _OBSTACLE_RUN_BYTES * obstacles
     total = arrays + max(build, kept + run)
     return {"voxels": n, "links": links, "exclusions": excl, "obstacles": obstacles,
@@ -723,19 +767,14 @@ def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layou
     a: dict[str, np.ndarray] = {}
     for name in list(per_vox):
         a[name] = np.ascontiguousarray(np.concatenate(per_vox.pop(name)))
-    a["fixed"] = a["fixed"].astype(np.int8)
-    a["surface"] = a["surface"].astype(np.int8)
-    a["excl_start"] = np.concatenate([[0], np.cumsum(a.pop("excl_count"))]).astype(np.intp)
-    a["excl_idx"] = np.ascontiguousarray(excl[0] if len(excl) == 1 else np.concatenate(excl), dtype=np.intp)
+    a["excl_start"] = np.concatenate([[0], np.cumsum(a.pop("excl_count"))])
+    a["excl_idx"] = np.ascontiguousarray(excl[0] if len(excl) == 1 else np.concatenate(excl))
     del excl
     a.update(_terrain_arrays(terrains, cfg))
     for name in list(per_link):
         a[name] = np.ascontiguousarray(np.concatenate(per_link.pop(name)))
-    for name in ("v1", "v2"):
-        a[name] = a[name].astype(np.intp)
     # (8, n_links): one row per constant, for the kernel's vector loops
     a["c_seed"] = _link_rows(np.asarray(a["c_seed"], dtype=np.float64).reshape(-1, 8).T)
-    a["homog"] = a["homog"].astype(np.int64)
     a["link_sa"] = np.ones(a["v1"].shape[0], dtype=np.int64)  # links start in small-angle mode
     single = cfg.effective_link_precision == "single"
     # see _TRANSPOSED; float32 with single-precision links, whose forces pass keeps float values
@@ -747,7 +786,6 @@ def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layou
         if single
         else np.empty((11, 0), dtype=np.float32)
     )
-    a["axis"] = a["axis"].astype(np.int32)
     a["quat"] = np.zeros((n_vox, 4))
     a["quat"][:, 0] = 1.0
     a["rot"] = np.zeros((n_vox, 9))
@@ -758,12 +796,10 @@ def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layou
     # whole-row vector adds (_batch.pxd)
     a["force"] = np.zeros((n_vox, _core.FM_STRIDE))
     a["ext_force"] = np.ascontiguousarray(a["ext_force"], dtype=np.float64).reshape(-1, 3)
-    a["faces"] = a["faces"].astype(np.int8)
     a["body_end"] = np.asarray(body_end, dtype=np.intp)
     a["aux_init"] = np.zeros((n_robots, len(_core.AUX_NAMES)))
     a["trace_aux"] = np.zeros((n_robots, 8, len(_core.AUX_NAMES)))
     a["scale"] = np.full(n_vox, L)
-    a["seed_rank"] = a["seed_rank"].astype(np.intp)
     a["col_ref"] = np.zeros((n_vox, 4))
     a["col_acc"] = np.full(n_robots, np.inf)  # first step builds the candidates
     a["col_vmax"] = np.zeros(n_robots)
@@ -786,11 +822,6 @@ def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layou
     a["trace_t"] = np.zeros((n_robots, 8))
     a["trace_cm"] = np.zeros((n_robots, 8, 3))
     walls = [obstacle_mass_and_center(t, L) for t in terrains]
-    missing = [k for k in _core.KERNEL_ARRAYS if k not in a]
-    if missing:  # the kernel's declared contract (_core.KERNEL_ARRAYS)
-        raise RuntimeError(f"softgym engine: arrays {missing} missing for the kernel")
-    for name in _core.KERNEL_ARRAYS:
-        a[name] = _line_aligned(a[name])
     settings = {
         "n_robots": n_robots,
         "L": L,
@@ -800,12 +831,15 @@ def build_layout(bodies: list[Body], terrains: list, config: SimConfig) -> Layou
         "max_strain": float(cfg.max_strain),
         "trace_interval": float(cfg.trace_interval),
         "self_collision": int(bool(cfg.self_collision)),
-        "actuation_mode": 0 if cfg.actuation == "seed" else 1,
-        "model": 0 if cfg.model == "seed" else 1,
+        "actuation_mode": contract.ACTUATION[cfg.actuation],
+        "model": contract.MODEL[cfg.model],
         "bond_zeta": float(cfg.bond_damping),
         "fluid_drag": float(cfg.fluid_drag),
         "link_f32": int(single),
     }
+    _to_contract(a, settings)
+    for name in contract.KERNEL_ARRAYS:
+        a[name] = _line_aligned(a[name])
     # robots' own voxels in the kernel arrays (None: no objects, all of them)
     own = [np.arange(vox_start[r], body_end[r]) for r in range(n_robots)]
     counts = np.asarray(body_end) - np.asarray(vox_start[:-1])

@@ -50,7 +50,7 @@ from typing import Any
 
 import numpy as np
 
-from softgym.engine import _core
+from softgym.engine import _cache, _core
 from softgym.engine._openmp import openmp_enabled
 from softgym.engine._sense import cell_sensors as _cell_sensors
 from softgym.engine._sense import contact_gaps as _contact_gaps
@@ -194,7 +194,7 @@ class Simulation:
         self._check_memory()
         self._build()
         self._initial = {k: self._a[k].copy() for k in _STATE}
-        self._contacts = _core.ContactCache(self.n_robots)
+        self._contacts = _cache.ContactCache(self.n_robots)
         self._t_target = 0.0
 
     #: Memory budget (bytes) of one Simulation: its arrays, what it keeps besides, its

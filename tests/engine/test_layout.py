@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from engine_builders import reference_robot, two_material_body
 
-from softgym.engine import SimConfig, Simulation, _core
+from softgym.engine import SimConfig, Simulation, _bind, contract
 from softgym.engine.layout import Layout, build_layout
 from softgym.terrain import Block, Terrain
 
@@ -27,7 +27,7 @@ def test_build_layout_is_complete_and_is_what_simulation_runs(model):
     cfg = SimConfig(model=model, self_collision=True)
     lay = build_layout(bodies, terrains, cfg)
     assert isinstance(lay, Layout)
-    assert set(_core.KERNEL_ARRAYS) <= set(lay.arrays)
+    assert set(contract.KERNEL_ARRAYS) <= set(lay.arrays)
     a = lay.arrays
     assert a["vox_start"][-1] == a["pos"].shape[0]
     assert a["link_start"][-1] == a["v1"].shape[0]
@@ -63,14 +63,14 @@ def test_kernel_arrays_start_on_cache_lines_and_keep_their_row_stride(precision)
     bodies, terrains = _batch()
     cfg = SimConfig(self_collision=True, link_precision=precision)
     a = build_layout(bodies, terrains, cfg).arrays
-    for name in _core.KERNEL_ARRAYS:
+    for name in contract.KERNEL_ARRAYS:
         if a[name].size:
             assert a[name].ctypes.data % 64 == 0, name
     n = a["v1"].shape[0]
     for name in ("c_seed", "link_last", "k_seed32"):
         x = a[name]
         if x.size:
-            assert x.shape[1] == n and x.strides == (_core.row_stride(n) * x.itemsize, x.itemsize)
+            assert x.shape[1] == n and x.strides == (_bind.row_stride(n) * x.itemsize, x.itemsize)
     # the copies hold the layout's values: links start in small-angle mode, quaternions
     # at the identity, each robot's first voxel where its body put it
     assert np.all(a["link_sa"] == 1) and np.all(a["quat"][:, 0] == 1.0)

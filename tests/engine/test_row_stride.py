@@ -4,7 +4,7 @@ The forces pass reads 20 rows of per-link constants and memory at once (c_seed,
 link_last; k_seed32 in single precision). With the batch's link count as their row
 stride, a batch of 256 reference robots (138,240 links) put every row a multiple of
 4096 bytes from the others, all in one set of the 8-way L1, and the batch ran at
-two thirds of one robot's speed per voxel. ``_core.row_stride`` pads the rows; these
+two thirds of one robot's speed per voxel. ``_bind.row_stride`` pads the rows; these
 tests guard the rule, the layout that uses it and that state I/O keeps it.
 """
 
@@ -14,12 +14,12 @@ from engine_builders import reference_robot
 from hypothesis import given
 from hypothesis import strategies as st
 
-from softgym.engine import SimConfig, Simulation, _core
+from softgym.engine import SimConfig, Simulation, _bind
 
 
 @given(st.integers(min_value=0, max_value=10**7))
 def test_row_stride_puts_rows_an_odd_number_of_lines_apart(n):
-    s = _core.row_stride(n)
+    s = _bind.row_stride(n)
     assert n <= s < n + 48
     assert s % 16 == 0 and (s // 16) % 2 == 1
     # float64 rows an odd multiple of 128 bytes apart, float32 of 64: the first 32
@@ -41,7 +41,7 @@ def test_link_rows_are_padded_views_and_state_io_keeps_them(precision):
     for name in names:
         arr = a[name]
         assert arr.shape[1] == n
-        assert arr.strides == (_core.row_stride(n) * arr.itemsize, arr.itemsize)
+        assert arr.strides == (_bind.row_stride(n) * arr.itemsize, arr.itemsize)
     sim.advance(0.05)
     state = sim.get_state()
     assert state["link_last"].shape == (n, 9)
@@ -49,12 +49,12 @@ def test_link_rows_are_padded_views_and_state_io_keeps_them(precision):
     sim.advance(0.05)
     after = sim.get_state()["link_last"]
     sim.set_state(state)  # back, in place: the padded rows stay
-    assert a["link_last"].strides[0] == _core.row_stride(n) * a["link_last"].itemsize
+    assert a["link_last"].strides[0] == _bind.row_stride(n) * a["link_last"].itemsize
     np.testing.assert_array_equal(sim.get_state()["link_last"], state["link_last"])
     sim.advance(0.05)
     np.testing.assert_array_equal(sim.get_state()["link_last"], after)  # resumed exactly
     sim.reset()
-    assert a["link_last"].strides[0] == _core.row_stride(n) * a["link_last"].itemsize
+    assert a["link_last"].strides[0] == _bind.row_stride(n) * a["link_last"].itemsize
     assert not np.any(sim.get_state()["link_last"])
 
 
