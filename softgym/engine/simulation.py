@@ -439,10 +439,12 @@ class Simulation:
 
         ``objects=True`` adds its terrain objects' (the whole entry's momentum).
         """
-        a = self._a
-        p = a["mass"][:, None] * a["vel"]
+        return self._momentum(self._a["mass"][:, None] * self._a["vel"], objects)
+
+    def _momentum(self, p: np.ndarray, objects: bool) -> np.ndarray:
+        # momentum() from the voxels' momenta p (n_voxels, 3)
         if objects:
-            return np.add.reduceat(p, a["vox_start"][:-1], axis=0)
+            return np.add.reduceat(p, self._a["vox_start"][:-1], axis=0)
         if self._own is not None:
             p = p[self._own]
         return np.add.reduceat(p, self._own_offsets[:-1], axis=0)
@@ -567,7 +569,8 @@ class Simulation:
             return np.zeros((self.n_robots, 3))
         total = np.add.reduceat(a["mass"], a["vox_start"][:-1])
         m_obj = total - a["mass_total"]
-        p_obj = self.momentum(objects=True) - self.momentum()
+        p = a["mass"][:, None] * a["vel"]  # the voxels' momenta, once for both sums
+        p_obj = self._momentum(p, True) - self._momentum(p, False)
         with np.errstate(invalid="ignore", divide="ignore"):
             v = p_obj / m_obj[:, None]
         v[m_obj <= 0.0] = 0.0
