@@ -899,6 +899,7 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
 #define SOFTGYM_FOUT_STRIDE SOFTGYM_CHUNK_STRIDE
 #define SOFTGYM_FPICK softgym_pick
 #define SOFTGYM_FMASK long long
+#define SOFTGYM_FCOND(row, li) ((row)[li] != 0.0)
 #include "softgym_seed_forces.h"
 #undef SOFTGYM_FOUT_T
 #undef SOFTGYM_FOUT_STRIDE
@@ -907,6 +908,7 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
 #undef SOFTGYM_FIN_STRIDE
 #undef SOFTGYM_FPICK
 #undef SOFTGYM_FMASK
+#undef SOFTGYM_FCOND
 #if SOFTGYM_F16_LANES
 /* The single-precision forces pass (softgym_seed_forces.h) for the 16 links li..li + 15 in
    the lanes of AVX-512, written in intrinsics: the compiler's loop of the same pass took
@@ -1118,7 +1120,16 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
 #define SOFTGYM_FIN_STRIDE SOFTGYM_CHUNK_FSTRIDE
 #define SOFTGYM_FOUT_T float
 #define SOFTGYM_FOUT_STRIDE SOFTGYM_CHUNK_FSTRIDE
+#if defined(__AVX__)
 #define SOFTGYM_FPICK(c, a, b) ((c) ? (a) : (b))
+#define SOFTGYM_FCOND(row, li) ((row)[li] != 0.0)
+#else
+/* without AVX (SSE2 on x86-64, NEON): a bitwise select, and the double rows' conditions
+   compared in float (the rows hold 1.0 or 0.0), so that every condition is as wide as the
+   lanes: else the loop stays scalar (-fopt-info-vec-missed: control flow in loop) */
+#define SOFTGYM_FPICK softgym_pickf
+#define SOFTGYM_FCOND(row, li) ((float)(row)[li] != 0.0f)
+#endif
 #define SOFTGYM_FMASK int
 #include "softgym_seed_forces.h"
 #undef SOFTGYM_FOUT_T
@@ -1129,6 +1140,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
 #undef SOFTGYM_FIN_STRIDE
 #undef SOFTGYM_FPICK
 #undef SOFTGYM_FMASK
+#undef SOFTGYM_FCOND
 
 /* The pass of links_seed after the geometry, without branches
    so the loop vectorises: each link's mode, small or large angle, with the

@@ -59,7 +59,8 @@ SOFTGYM_ALWAYS_INLINE void SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(const int all_smal
     Py_ssize_t li;
     SOFTGYM_IVDEP
     for (li = lo; li < hi; li++) {
-        SOFTGYM_FMASK sa = all_small ? 1 : sa_[li] != 0.0, changed = chg_[li] != 0.0;
+        SOFTGYM_FMASK sa = all_small ? 1 : SOFTGYM_FCOND(sa_, li);
+        SOFTGYM_FMASK changed = SOFTGYM_FCOND(chg_, li);
         T P0 = P0_[li], P1 = P1_[li], P2 = P2_[li];
         T a1x = zero, a1y = a1y_[li], a1z = a1z_[li];
         T a2x = a2x_[li], a2y = a2y_[li], a2z = a2z_[li];

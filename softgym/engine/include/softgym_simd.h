@@ -59,6 +59,19 @@ static inline double softgym_pick(long long c, double a, double b)
     memcpy(&r, &ua, sizeof r);
     return r;
 }
+/* the same for floats (c 0 or 1: the lanes' conditions of the float passes), for the
+   builds without AVX: there a select before a store becomes a conditional store, which
+   SSE2 has no instruction for, and the loop stays scalar */
+static inline float softgym_pickf(int c, float a, float b)
+{
+    unsigned int ua, ub, m = 0u - (unsigned int)(c != 0);
+    float r;
+    memcpy(&ua, &a, sizeof ua);
+    memcpy(&ub, &b, sizeof ub);
+    ua = (ua & m) | (ub & ~m);
+    memcpy(&r, &ua, sizeof r);
+    return r;
+}
 /* |v|^2 of a voxel's velocity, for the seed's collision schedule (the fastest voxel's
    speed). Where the build fuses multiply-adds, the fusion is written out: the value
    is the same wherever the expression is inlined, (vy vy, then + vx vx and + vz vz
