@@ -108,25 +108,25 @@
    32-byte loads a voxel turned into rows by a 4 x 4 transpose */
 static inline void softgym_corot_gather4(const Py_ssize_t *idx, const double *pos,
                                          const double *vel, const double *av,
-                                         const double *rot, const double *scale, __m256d *r)
+                                         const double *rot, const double *scale, softgym_m4 *r)
 {
     const double *a = pos + 3 * idx[0], *b = pos + 3 * idx[1];
     const double *c = pos + 3 * idx[2], *d = pos + 3 * idx[3];
     SOFTGYM_GATHER_PAIRS(a, b, c, d, 0, r[0], r[1]);
-    r[2] = _mm256_set_pd(d[2], c[2], b[2], a[2]);
+    r[2] = SOFTGYM_M4SET(a[2], b[2], c[2], d[2]);
     a = vel + 3 * idx[0], b = vel + 3 * idx[1], c = vel + 3 * idx[2], d = vel + 3 * idx[3];
     SOFTGYM_GATHER_PAIRS(a, b, c, d, 0, r[3], r[4]);
-    r[5] = _mm256_set_pd(d[2], c[2], b[2], a[2]);
+    r[5] = SOFTGYM_M4SET(a[2], b[2], c[2], d[2]);
     a = av + 3 * idx[0], b = av + 3 * idx[1], c = av + 3 * idx[2], d = av + 3 * idx[3];
     SOFTGYM_GATHER_PAIRS(a, b, c, d, 0, r[6], r[7]);
-    r[8] = _mm256_set_pd(d[2], c[2], b[2], a[2]);
+    r[8] = SOFTGYM_M4SET(a[2], b[2], c[2], d[2]);
     a = rot + 9 * idx[0], b = rot + 9 * idx[1], c = rot + 9 * idx[2], d = rot + 9 * idx[3];
-    SOFTGYM_TRANSPOSE4(_mm256_loadu_pd(a), _mm256_loadu_pd(b), _mm256_loadu_pd(c),
-                       _mm256_loadu_pd(d), r[9], r[10], r[11], r[12]);
-    SOFTGYM_TRANSPOSE4(_mm256_loadu_pd(a + 4), _mm256_loadu_pd(b + 4), _mm256_loadu_pd(c + 4),
-                       _mm256_loadu_pd(d + 4), r[13], r[14], r[15], r[16]);
-    r[17] = _mm256_set_pd(d[8], c[8], b[8], a[8]);
-    r[18] = _mm256_set_pd(scale[idx[3]], scale[idx[2]], scale[idx[1]], scale[idx[0]]);
+    SOFTGYM_TRANSPOSE4(SOFTGYM_M4LOADU(a), SOFTGYM_M4LOADU(b), SOFTGYM_M4LOADU(c),
+                       SOFTGYM_M4LOADU(d), r[9], r[10], r[11], r[12]);
+    SOFTGYM_TRANSPOSE4(SOFTGYM_M4LOADU(a + 4), SOFTGYM_M4LOADU(b + 4), SOFTGYM_M4LOADU(c + 4),
+                       SOFTGYM_M4LOADU(d + 4), r[13], r[14], r[15], r[16]);
+    r[17] = SOFTGYM_M4SET(a[8], b[8], c[8], d[8]);
+    r[18] = SOFTGYM_M4SET(scale[idx[0]], scale[idx[1]], scale[idx[2]], scale[idx[3]]);
 }
 #endif
 
@@ -283,7 +283,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_corot_links_ax(
     /* with AVX2 (and where no rows are given), 4 links a vector from gathered records
        (8 lanes from gathered records spilled: 38 rows live, measured 5 % slower) */
     for (; li + 4 <= hi; li += 4) {
-        __m256d gi[19], gj[19];
+        softgym_m4 gi[19], gj[19];
         softgym_corot_gather4(v1 + li, pos, vel, av, rot, scale, gi);
         softgym_corot_gather4(v2 + li, pos, vel, av, rot, scale, gj);
         softgym_v4 dx = gj[0] - gi[0], dy = gj[1] - gi[1], dz = gj[2] - gi[2];

@@ -70,11 +70,7 @@
 /* v (a double, or a vector of them) rounded to float and stored at row[li] (the geometry's
    float rows of voxel 1's rotation) */
 #define SOFTGYM_PUTF1(row, li, v) ((row)[li] = (float)(v))
-#if defined(SOFTGYM_VLANES) && SOFTGYM_VLANES == 8
-#define SOFTGYM_VPUTF(row, li, v) _mm256_storeu_ps((row) + (li), _mm512_cvtpd_ps((__m512d)(v)))
-#elif defined(SOFTGYM_VLANES)
-#define SOFTGYM_VPUTF(row, li, v) _mm_storeu_ps((row) + (li), _mm256_cvtpd_ps((__m256d)(v)))
-#endif
+/* (SOFTGYM_VPUTF, the same for vectors: softgym_simd.h) */
 /* one link's geometry into column li of those rows, from voxel 2's position relative
    to voxel 1's (dx, dy, dz), their orientations (w, x, y, z), (wj, xj, yj, zj) and
    sizes si, sj (the axis constants and output rows in scope); the engine's pass
@@ -140,26 +136,26 @@
    SOFTGYM_SEED_GEOM_LINK_T's, lane by lane: the same bits. */
 /* voxels idx[0..3]: position (x, y, z), quaternion (w, qx, qy, qz) and size as rows of 4 */
 static inline void softgym_seed_gather4(const Py_ssize_t *idx, const double *pos,
-                                        const double *quat, const double *scale, __m256d *r)
+                                        const double *quat, const double *scale, softgym_m4 *r)
 {
     const double *pa = pos + 3 * idx[0], *pb = pos + 3 * idx[1];
     const double *pc = pos + 3 * idx[2], *pd = pos + 3 * idx[3];
     const double *qa = quat + 4 * idx[0], *qb = quat + 4 * idx[1];
     const double *qc = quat + 4 * idx[2], *qd = quat + 4 * idx[3];
     SOFTGYM_GATHER_PAIRS(pa, pb, pc, pd, 0, r[0], r[1]);
-    r[2] = _mm256_set_pd(pd[2], pc[2], pb[2], pa[2]);
+    r[2] = SOFTGYM_M4SET(pa[2], pb[2], pc[2], pd[2]);
     SOFTGYM_GATHER_PAIRS(qa, qb, qc, qd, 0, r[3], r[4]);
     SOFTGYM_GATHER_PAIRS(qa, qb, qc, qd, 2, r[5], r[6]);
-    r[7] = _mm256_set_pd(scale[idx[3]], scale[idx[2]], scale[idx[1]], scale[idx[0]]);
+    r[7] = SOFTGYM_M4SET(scale[idx[0]], scale[idx[1]], scale[idx[2]], scale[idx[3]]);
 }
 /* the same for SOFTGYM_VLANES voxels, as vectors */
 static inline void softgym_seed_gather(const Py_ssize_t *idx, const double *pos,
                                        const double *quat, const double *scale, softgym_vd *r)
 {
-    __m256d a[8];
+    softgym_m4 a[8];
     softgym_seed_gather4(idx, pos, quat, scale, a);
 #if SOFTGYM_VLANES == 8
-    __m256d b[8];
+    softgym_m4 b[8];
     softgym_seed_gather4(idx + 4, pos, quat, scale, b);
     SOFTGYM_VJOIN(r, a, b, 8);
 #else
@@ -660,6 +656,15 @@ static inline float softgym_rotvec_k32_acos(float w, float w_acos)
     float r = w <= w_acos ? SOFTGYM_FMAF(z, p, 1.0f) : 1.0f;
     return softgym_rotvec_k32(w) * r;
 }
+/* whether row[li] (a double row's flag, 1.0 or 0.0) is set, as a condition of the float
+   passes' lanes: without AVX compared in float, so that the condition is as wide as the
+   lanes (a double compare's 64-bit mask among 32-bit lanes kept the SSE2 loop scalar:
+   -fopt-info-vec-missed, control flow in loop); a NaN is set either way */
+#if defined(__AVX__)
+#define SOFTGYM_FLAG32(row, li) ((row)[li] != 0.0)
+#else
+#define SOFTGYM_FLAG32(row, li) ((float)(row)[li] != 0.0f)
+#endif
 SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_impl(
     const int all_small, Py_ssize_t lo, Py_ssize_t hi, float sa_rad, float w_acos,
     const double *p0_, const double *p1_, const double *p2_, const double *qw_,
@@ -675,7 +680,7 @@ SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_impl(
         float p0 = (float)p0_[li], p1 = (float)p1_[li], p2 = (float)p2_[li];
         float qw = (float)qw_[li], n1 = (float)n1_[li], n2 = (float)n2_[li];
         float n3 = (float)n3_[li];
-        int is_sa = all_small ? 1 : sa_[li] != 0.0;
+        int is_sa = all_small ? 1 : SOFTGYM_FLAG32(sa_, li);
         int fix = 0;
         SOFTGYM_CHORD_FRAME(float, int, sqrtf, p0, p1, p2, sa_rad, (float)len_[li]);
         fix |= (1 - is_sa) & (1 - zero) & back;
@@ -1122,14 +1127,12 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
 #define SOFTGYM_FOUT_STRIDE SOFTGYM_CHUNK_FSTRIDE
 #if defined(__AVX__)
 #define SOFTGYM_FPICK(c, a, b) ((c) ? (a) : (b))
-#define SOFTGYM_FCOND(row, li) ((row)[li] != 0.0)
 #else
-/* without AVX (SSE2 on x86-64, NEON): a bitwise select, and the double rows' conditions
-   compared in float (the rows hold 1.0 or 0.0), so that every condition is as wide as the
-   lanes: else the loop stays scalar (-fopt-info-vec-missed: control flow in loop) */
+/* without AVX (SSE2 on x86-64, NEON): a bitwise select (a select before a store became a
+   conditional store, which SSE2 has no instruction for, and the loop stayed scalar) */
 #define SOFTGYM_FPICK softgym_pickf
-#define SOFTGYM_FCOND(row, li) ((float)(row)[li] != 0.0f)
 #endif
+#define SOFTGYM_FCOND SOFTGYM_FLAG32
 #define SOFTGYM_FMASK int
 #include "softgym_seed_forces.h"
 #undef SOFTGYM_FOUT_T

@@ -59,9 +59,7 @@ static inline double softgym_pick(long long c, double a, double b)
     memcpy(&r, &ua, sizeof r);
     return r;
 }
-/* the same for floats (c 0 or 1: the lanes' conditions of the float passes), for the
-   builds without AVX: there a select before a store becomes a conditional store, which
-   SSE2 has no instruction for, and the loop stays scalar */
+/* the same for floats (the float passes' selects in the builds without AVX) */
 static inline float softgym_pickf(int c, float a, float b)
 {
     unsigned int ua, ub, m = 0u - (unsigned int)(c != 0);
@@ -300,12 +298,115 @@ static inline int softgym_window8_index(const Py_ssize_t *a, const Py_ssize_t *b
 typedef double softgym_vd __attribute__((vector_size(32)));
 #define SOFTGYM_VSQRT(v) ((softgym_vd)_mm256_sqrt_pd((__m256d)(v)))
 #endif
+/* 4 doubles in a register (the 4-lane gathers' rows): AVX's own type here, GCC's vector
+   of 4 doubles in the portable builds (below) */
+typedef __m256d softgym_m4;
+#define SOFTGYM_V4SQRT(v) ((softgym_v4)_mm256_sqrt_pd((__m256d)(v)))
+/* (a, b, c, d) as 4 lanes; 4 doubles from p (unaligned) */
+#define SOFTGYM_M4SET(a, b, c, d) _mm256_set_pd((d), (c), (b), (a))
+#define SOFTGYM_M4LOADU(p) _mm256_loadu_pd(p)
+/* elements k and k + 1 of 4 voxels' rows at pa..pd as two rows of 4 lanes (lo_: k, hi_: k + 1) */
+#define SOFTGYM_GATHER_PAIRS(pa, pb, pc, pd, k, lo_, hi_) do { \
+        __m256d ac_ = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd((pa) + (k))), \
+                                           _mm_loadu_pd((pc) + (k)), 1); \
+        __m256d bd_ = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd((pb) + (k))), \
+                                           _mm_loadu_pd((pd) + (k)), 1); \
+        lo_ = _mm256_unpacklo_pd(ac_, bd_); \
+        hi_ = _mm256_unpackhi_pd(ac_, bd_); \
+    } while (0)
+/* rows a..d (4 doubles each) transposed: r0 = the a..d's element 0, ..., r3 element 3 */
+#define SOFTGYM_TRANSPOSE4(a, b, c, d, r0, r1, r2, r3) do { \
+        __m256d t0_ = _mm256_unpacklo_pd(a, b), t1_ = _mm256_unpackhi_pd(a, b); \
+        __m256d t2_ = _mm256_unpacklo_pd(c, d), t3_ = _mm256_unpackhi_pd(c, d); \
+        r0 = _mm256_permute2f128_pd(t0_, t2_, 0x20); \
+        r1 = _mm256_permute2f128_pd(t1_, t3_, 0x20); \
+        r2 = _mm256_permute2f128_pd(t0_, t2_, 0x31); \
+        r3 = _mm256_permute2f128_pd(t1_, t3_, 0x31); \
+    } while (0)
+/* v (4 or 8 lanes of softgym_vd) rounded to floats at row + li */
+#if SOFTGYM_VLANES == 8
+#define SOFTGYM_VPUTF(row, li, v) _mm256_storeu_ps((row) + (li), _mm512_cvtpd_ps((__m512d)(v)))
+#else
+#define SOFTGYM_VPUTF(row, li, v) _mm_storeu_ps((row) + (li), _mm256_cvtpd_ps((__m256d)(v)))
+#endif
+#elif defined(__GNUC__) || defined(__clang__)
+/* The portable builds (x86-64 without AVX: SSE2; aarch64: NEON; any target GCC or clang
+   knows): the same 4-lane link passes on GCC's vectors of 4 doubles, which the compiler
+   lowers to the target's registers (two SSE2 or NEON registers a vector), with the
+   loads and permutes written as element reads instead of AVX intrinsics. The arithmetic
+   is the formulas' own, lane by lane: the same bits as the scalar loops they replace. */
+#define SOFTGYM_VLANES 4
+#define SOFTGYM_PORTABLE_LANES 1
+#if defined(__GNUC__) && !defined(__clang__)
+/* GCC notes that a 32-byte vector passed or returned without AVX would change the
+   calling convention: these are static inline helpers, no call crosses a boundary */
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+typedef double softgym_vd __attribute__((vector_size(32)));
+typedef softgym_vd softgym_m4;
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#elif defined(__aarch64__) && defined(__ARM_NEON)
+#include <arm_neon.h>
+#endif
+/* the square root of each lane (IEEE, as sqrt) */
+static inline softgym_vd softgym_m4sqrt(softgym_vd v)
+{
+#if defined(__SSE2__)
+    __m128d lo, hi;
+    memcpy(&lo, &v, sizeof lo);
+    memcpy(&hi, (const char *)&v + sizeof lo, sizeof hi);
+    lo = _mm_sqrt_pd(lo);
+    hi = _mm_sqrt_pd(hi);
+    memcpy(&v, &lo, sizeof lo);
+    memcpy((char *)&v + sizeof lo, &hi, sizeof hi);
+#elif defined(__aarch64__) && defined(__ARM_NEON)
+    float64x2_t lo, hi;
+    memcpy(&lo, &v, sizeof lo);
+    memcpy(&hi, (const char *)&v + sizeof lo, sizeof hi);
+    lo = vsqrtq_f64(lo);
+    hi = vsqrtq_f64(hi);
+    memcpy(&v, &lo, sizeof lo);
+    memcpy((char *)&v + sizeof lo, &hi, sizeof hi);
+#else
+    for (int k = 0; k < 4; k++)
+        v[k] = sqrt(v[k]);
+#endif
+    return v;
+}
+#define SOFTGYM_VSQRT(v) softgym_m4sqrt(v)
+#define SOFTGYM_V4SQRT(v) softgym_m4sqrt(v)
+#define SOFTGYM_M4SET(a, b, c, d) ((softgym_vd){(a), (b), (c), (d)})
+static inline softgym_vd softgym_m4loadu(const double *p)
+{
+    softgym_vd v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+#define SOFTGYM_M4LOADU(p) softgym_m4loadu(p)
+#define SOFTGYM_GATHER_PAIRS(pa, pb, pc, pd, k, lo_, hi_) do { \
+        lo_ = SOFTGYM_M4SET((pa)[k], (pb)[k], (pc)[k], (pd)[k]); \
+        hi_ = SOFTGYM_M4SET((pa)[(k) + 1], (pb)[(k) + 1], (pc)[(k) + 1], (pd)[(k) + 1]); \
+    } while (0)
+#define SOFTGYM_TRANSPOSE4(a, b, c, d, r0, r1, r2, r3) do { \
+        softgym_vd a_ = (a), b_ = (b), c_ = (c), d_ = (d); \
+        r0 = SOFTGYM_M4SET(a_[0], b_[0], c_[0], d_[0]); \
+        r1 = SOFTGYM_M4SET(a_[1], b_[1], c_[1], d_[1]); \
+        r2 = SOFTGYM_M4SET(a_[2], b_[2], c_[2], d_[2]); \
+        r3 = SOFTGYM_M4SET(a_[3], b_[3], c_[3], d_[3]); \
+    } while (0)
+typedef float softgym_v4f __attribute__((vector_size(16)));
+#define SOFTGYM_VPUTF(row, li, v) do { \
+        softgym_v4f f_ = __builtin_convertvector((v), softgym_v4f); \
+        memcpy((row) + (li), &f_, sizeof f_); \
+    } while (0)
+#endif
+#if defined(SOFTGYM_VLANES)
 typedef long long softgym_vi __attribute__((vector_size(sizeof(softgym_vd))));
 /* 4 lanes whatever the build (a pass with many rows live at once: with AVX-512 these
    take the 32 vector registers at half width, where 8 lanes spilled) */
 typedef double softgym_v4 __attribute__((vector_size(32)));
 typedef long long softgym_v4i __attribute__((vector_size(32)));
-#define SOFTGYM_V4SQRT(v) ((softgym_v4)_mm256_sqrt_pd((__m256d)(v)))
 /* name(v): |v| lane by lane for the vector type VT (its integer twin VI): the sign bit
    cleared, as fabs */
 #define SOFTGYM_DEFINE_VABS(name, VT, VI) \
@@ -326,24 +427,6 @@ SOFTGYM_DEFINE_VABS(softgym_v4abs, softgym_v4, softgym_v4i)
     } while (0)
 #define SOFTGYM_VPUT(row, li, v) SOFTGYM_VTPUT(softgym_vd, row, li, v)
 #define SOFTGYM_V4PUT(row, li, v) SOFTGYM_VTPUT(softgym_v4, row, li, v)
-/* elements k and k + 1 of 4 voxels' rows at pa..pd as two rows of 4 lanes (lo_: k, hi_: k + 1) */
-#define SOFTGYM_GATHER_PAIRS(pa, pb, pc, pd, k, lo_, hi_) do { \
-        __m256d ac_ = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd((pa) + (k))), \
-                                           _mm_loadu_pd((pc) + (k)), 1); \
-        __m256d bd_ = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd((pb) + (k))), \
-                                           _mm_loadu_pd((pd) + (k)), 1); \
-        lo_ = _mm256_unpacklo_pd(ac_, bd_); \
-        hi_ = _mm256_unpackhi_pd(ac_, bd_); \
-    } while (0)
-/* rows a..d (4 doubles each) transposed: r0 = the a..d's element 0, ..., r3 element 3 */
-#define SOFTGYM_TRANSPOSE4(a, b, c, d, r0, r1, r2, r3) do { \
-        __m256d t0_ = _mm256_unpacklo_pd(a, b), t1_ = _mm256_unpackhi_pd(a, b); \
-        __m256d t2_ = _mm256_unpacklo_pd(c, d), t3_ = _mm256_unpackhi_pd(c, d); \
-        r0 = _mm256_permute2f128_pd(t0_, t2_, 0x20); \
-        r1 = _mm256_permute2f128_pd(t1_, t3_, 0x20); \
-        r2 = _mm256_permute2f128_pd(t0_, t2_, 0x31); \
-        r3 = _mm256_permute2f128_pd(t1_, t3_, 0x31); \
-    } while (0)
 /* 4 consecutive values of a row from li, as 4 lanes */
 static inline softgym_v4 softgym_v4load(const double *row, Py_ssize_t li)
 {
