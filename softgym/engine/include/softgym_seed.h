@@ -665,6 +665,14 @@ static inline float softgym_rotvec_k32_acos(float w, float w_acos)
 #else
 #define SOFTGYM_FLAG32(row, li) ((float)(row)[li] != 0.0f)
 #endif
+/* c ? a : b in the float passes: without AVX (SSE2 on x86-64, NEON) a bitwise select (a
+   select before a store became a conditional store, which SSE2 has no instruction for,
+   and the loop stayed scalar) */
+#if defined(__AVX__)
+#define SOFTGYM_PICK32(c, a, b) ((c) ? (a) : (b))
+#else
+#define SOFTGYM_PICK32 softgym_pickf
+#endif
 SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_impl(
     const int all_small, Py_ssize_t lo, Py_ssize_t hi, float sa_rad, float w_acos,
     const double *p0_, const double *p1_, const double *p2_, const double *qw_,
@@ -1125,13 +1133,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
 #define SOFTGYM_FIN_STRIDE SOFTGYM_CHUNK_FSTRIDE
 #define SOFTGYM_FOUT_T float
 #define SOFTGYM_FOUT_STRIDE SOFTGYM_CHUNK_FSTRIDE
-#if defined(__AVX__)
-#define SOFTGYM_FPICK(c, a, b) ((c) ? (a) : (b))
-#else
-/* without AVX (SSE2 on x86-64, NEON): a bitwise select (a select before a store became a
-   conditional store, which SSE2 has no instruction for, and the loop stayed scalar) */
-#define SOFTGYM_FPICK softgym_pickf
-#endif
+#define SOFTGYM_FPICK SOFTGYM_PICK32
 #define SOFTGYM_FCOND SOFTGYM_FLAG32
 #define SOFTGYM_FMASK int
 #include "softgym_seed_forces.h"
@@ -1565,10 +1567,13 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_links(const int ax, const int sid
         const float *q = of + li;
         float a[3], m[3];
         for (int c = 0; c < 3; c++) {
-            if (side == 1)
+            if (side == 1) {
                 a[c] = q[c * fs];
-            else
-                a[c] = neg2_row[li] != 0.0 ? -q[c * fs] : q[(3 + c) * fs];
+            } else {
+                /* both loaded, then a select (a conditional load kept SSE2's loop scalar) */
+                float minus_f1 = -q[c * fs], f2 = q[(3 + c) * fs];
+                a[c] = SOFTGYM_PICK32(SOFTGYM_FLAG32(neg2_row, li), minus_f1, f2);
+            }
             m[c] = q[((side == 1 ? 6 : 9) + c) * fs];
         }
         float x = a[ax], y = ax == 1 ? a[0] : a[1], z = ax == 2 ? a[0] : a[2];
