@@ -10,6 +10,14 @@
 #include <math.h>
 #include "softgym_restrict.h"
 #include "softgym_simd.h"
+/* the 4-lane gathers and scatter of AVX builds; the portable builds' 4 lanes (GCC's vectors
+   on SSE2 registers) were slower here than the compiler's loop (2.8x against 4.4x the seed's
+   engine, baseline build) and keep it */
+#if defined(SOFTGYM_VLANES) && !defined(SOFTGYM_PORTABLE_LANES)
+#define SOFTGYM_COROT_V4 1
+#else
+#define SOFTGYM_COROT_V4 0
+#endif
 
 /* One link's kernel in type T (double, or softgym_vd for SOFTGYM_VLANES links at once:
    SQRT, FABS T's square root and absolute value, PUT(row, li, v) storing v at row + li,
@@ -101,7 +109,7 @@
         PUT(o_m2z, li, n2z - (tor * rz)); \
     } while (0)
 
-#if defined(SOFTGYM_VLANES)
+#if SOFTGYM_COROT_V4
 /* voxels idx[0..3] as rows of 4: position 0-2, velocity 3-5, angular velocity 6-8,
    rotation matrix 9-17 (row-major), size 18. GCC's vectoriser loaded these 19 numbers a
    voxel one by one; here pairs of 16-byte loads and unpacks, and the matrix as two
@@ -279,7 +287,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_corot_links_ax(
     (void)vn;
     (void)vend;
 #endif
-#if defined(SOFTGYM_VLANES)
+#if SOFTGYM_COROT_V4
     /* with AVX2 (and where no rows are given), 4 links a vector from gathered records
        (8 lanes from gathered records spilled: 38 rows live, measured 5 % slower) */
     for (; li + 4 <= hi; li += 4) {
@@ -376,7 +384,7 @@ static Py_ssize_t softgym_corot_scatter(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t
 #undef SOFTGYM_COROT_ADD1
     }
 #endif
-#if defined(SOFTGYM_VLANES)
+#if SOFTGYM_COROT_V4
     softgym_v4 cf = {0.0, 0.0, 0.0, 0.0}, cm = cf;
     Py_ssize_t pj = -1;
 #endif
@@ -385,7 +393,7 @@ static Py_ssize_t softgym_corot_scatter(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t
             return li;
         Py_ssize_t i = v1[li], j = v2[li];
         double fx = o[n + li], fy = o[2 * n + li], fz = o[3 * n + li];
-#if defined(SOFTGYM_VLANES)
+#if SOFTGYM_COROT_V4
         softgym_v4 f = {fx, fy, fz, 0.0};
         softgym_v4 m1 = {o[4 * n + li], o[5 * n + li], o[6 * n + li], 0.0};
         softgym_v4 m2 = {o[7 * n + li], o[8 * n + li], o[9 * n + li], 0.0};
