@@ -99,20 +99,52 @@ def test_each_seed_pass_vectorises(name, tmp_path):
     assert vectorised or hand, f"{name}: GCC vectorised no loop"
 
 
-# the hand-vectorised passes' loops on doubles: the rest of a run, and every link of the
-# portable build (no AVX), where GCC must still vectorise them
-FALLBACKS = {
-    "softgym_seed_geom": PASSES["softgym_seed_geom"],
-    "softgym_corot_links": "softgym_corot_links(ax, 0, n, n, 100.0, ip, ip, d, d, d, d, d, d, d, "
-                           "d, d, d, d, (const double *)0, 0, 0, o);",
+# the hand-vectorised passes in the portable build (x86-64 without AVX: SSE2): the seed
+# geometry's 4 lanes on GCC's vectors (SOFTGYM_PORTABLE_LANES; its harness below holds them
+# to the formula), the corotational links the compiler's loop, which GCC must vectorise
+@pytest.mark.parametrize("name", ["softgym_seed_geom", "softgym_corot_links"])
+def test_the_portable_build_vectorises_the_hand_vectorised_passes(name, tmp_path):
+    if name == "softgym_seed_geom":
+        call = PASSES["softgym_seed_geom"]
+        guard = "#ifndef SOFTGYM_PORTABLE_LANES\n#error the portable lanes are not compiled in\n#endif\n"
+    else:
+        call = ("softgym_corot_links(ax, 0, n, n, 100.0, ip, ip, d, d, d, d, d, d, d, d, d, d, d, "
+                "(const double *)0, 0, 0, o);")  # fmt: skip
+        guard = "#if SOFTGYM_COROT_V4\n#error the portable build keeps the compiler's loop\n#endif\n"
+    vectorised = _compile_pass(call, "x86-64", guard, tmp_path)
+    assert vectorised or name == "softgym_seed_geom", f"{name}: GCC vectorised no loop"
+
+
+# the single-precision links' passes in the portable build: every copy of each one's main
+# loop (forces: 4, by mode and voxel 2's force; frames: 2, all small-angle or mixed; push:
+# the turn of each side along each axis, 6) vectorised. Each took a condition from a double
+# row, or a select before a store or load, that SSE2 cannot make a vector of, and ran scalar
+PORTABLE_FLOAT = {  # the call, and the function whose first loop is the main one
+    "softgym_seed_forces32": (PASSES["softgym_seed_forces32"], "softgym_seed_forces.h",
+                              "SOFTGYM_ALWAYS_INLINE void SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)", 4),
+    "softgym_seed_frames32": (PASSES["softgym_seed_frames32"], "softgym_seed.h",
+                              "SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_impl(", 2),
+    "softgym_seed_push32": ("softgym_seed_push32(ax, 0, n, ip, ip, fc, fc, d, fo[0], n);",
+                            "softgym_seed.h",
+                            "SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_links(", 6),
 }
 
 
-@pytest.mark.parametrize("name", sorted(FALLBACKS))
-def test_the_portable_build_vectorises_the_hand_vectorised_passes_loops(name, tmp_path):
-    guard = "#ifdef SOFTGYM_VLANES\n#error the portable build has no hand-vectorised loop\n#endif\n"
-    vectorised = _compile_pass(FALLBACKS[name], "x86-64", guard, tmp_path)
-    assert vectorised, f"{name}: GCC vectorised no loop in the portable build"
+def _first_loop_line(header: str, function: str) -> int:
+    """The line number of the first ``for (`` after ``function``'s definition in ``header``."""
+    lines = (INCLUDE / header).read_text().splitlines()
+    start = next(i for i, line in enumerate(lines) if line.startswith(function))
+    return next(i for i in range(start, len(lines)) if "for (" in lines[i]) + 1
+
+
+@pytest.mark.parametrize("name", sorted(PORTABLE_FLOAT))
+def test_the_portable_build_vectorises_every_copy_of_the_float_passes(name, tmp_path):
+    call, header, function, copies = PORTABLE_FLOAT[name]
+    at = f"{header}:{_first_loop_line(header, function)}:"
+    lines = _compile_pass(call, "x86-64", "", tmp_path)
+    # each copy's main loop in 16-byte vectors (an epilogue may add an 8-byte one)
+    main = [line for line in lines if at in line and "16 byte vectors" in line]
+    assert len(main) >= copies, f"{at} vectorised {len(main)} times of {copies}:\n" + "\n".join(lines)
 
 
 def _c_harness(header: str, body: str) -> str:
@@ -361,7 +393,7 @@ def test_hand_vectorised_corotational_kernel_is_the_formula_bit_for_bit(level, t
     assert out == "0", f"{out} of {3 * 3 * 10 * 203} link outputs differ"
 
 
-@pytest.mark.parametrize("level", ["x86-64-v3", "x86-64-v4"])
+@pytest.mark.parametrize("level", ["x86-64", "x86-64-v3", "x86-64-v4"])
 def test_hand_vectorised_geometry_is_the_formula_bit_for_bit(level, tmp_path):
     out = _run_harness(level, HARNESS, tmp_path)
     assert out == "0", f"{out} of {3 * 3 * 10 * 203} geometry values differ"
@@ -582,7 +614,7 @@ def test_the_scatters_in_blocks_are_the_scatters_link_by_link_bit_for_bit(model,
     assert out == "0", f"{out} voxel components (or ends) differ"
 
 
-@pytest.mark.parametrize("level", ["x86-64-v3", "x86-64-v4"])
+@pytest.mark.parametrize("level", ["x86-64", "x86-64-v3", "x86-64-v4"])
 def test_the_float_push_in_blocks_is_the_push_link_by_link_bit_for_bit(level, tmp_path):
     # the AVX-512 blocks (windows, runs, the guard's fall-back) against the links one by
     # one, bit for bit, and both within float rounding of the turns and sums in double
@@ -747,7 +779,7 @@ int main(void)
 """)
 
 
-@pytest.mark.parametrize("level", ["x86-64-v3", "x86-64-v4"])
+@pytest.mark.parametrize("level", ["x86-64", "x86-64-v3", "x86-64-v4"])
 @pytest.mark.parametrize("harness", ["modes", "geometry_then_modes"])
 def test_the_modes_pass_decides_as_the_seeds_scalar_loop(harness, level, tmp_path):
     # the modes pass against the seed's loop; the geometry with its modes (AVX-512: decided
