@@ -922,213 +922,86 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
 #undef SOFTGYM_FPICK
 #undef SOFTGYM_FMASK
 #undef SOFTGYM_FCOND
+/* The single-precision forces pass in vector lanes of intrinsics
+   (softgym_seed_forces_block.h, which documents it): blocks of 16 links with AVX-512, of 8
+   with AVX2 and FMA, the rest of a chunk by the compiler's loop */
 #if SOFTGYM_F16_LANES
-/* The single-precision forces pass (softgym_seed_forces.h) for the 16 links li..li + 15 in
-   the lanes of AVX-512, written in intrinsics: the compiler's loop of the same pass took
-   343 instructions a block, 82 of them loads and stores of spilled registers (with its
-   conditions as vectors of ints); here the conditions live in mask registers, the
-   damping's selects are masked multiply-adds and the memory's are masked stores (about
-   1.2x fewer cycles in the pass: benchmarks/RESULTS.md). Every multiply-add is written out
-   as the compiler fused the loop it replaces (its widening_mul dump of the x86-64-v4
-   build): the same IEEE operations lane by lane, bit for bit (benchmarks/check_bitident.py;
-   tests/engine/test_kernel_variants.py holds this build to the AVX2 one, which keeps the
-   loop). The large-angle turn RQ^T v takes its products in two orders, as that loop did:
-   f1 rounds its x product, the moments and f2 their y product; where every link is in
-   small-angle mode the loop had folded the moments' x output's negation into their
-   damping (a zero's sign differs from negating after), and so does this. Two blocks side
-   by side, as the frames pass's, were no faster (their registers spill). all_small,
-   all_neg2 as softgym_seed_forces32_impl's. */
-#define SOFTGYM_F16_ROW(row, li) ((softgym_v16f)_mm512_loadu_ps((row) + (li)))
-#define SOFTGYM_F16_FMS(a, b, c) \
-    ((softgym_v16f)_mm512_fmsub_ps((__m512)(a), (__m512)(b), (__m512)(c)))
-#define SOFTGYM_F16_FNMS(a, b, c) \
-    ((softgym_v16f)_mm512_fnmsub_ps((__m512)(a), (__m512)(b), (__m512)(c)))
-/* x + s d where m (else x): the damping added where the mode did not change */
-#define SOFTGYM_F16_DAMP(m, x, s, d) \
-    ((softgym_v16f)_mm512_mask3_fmadd_ps((__m512)(s), (__m512)(d), (__m512)(x), (m)))
+#define SOFTGYM_FB_LANES 16
+#define SOFTGYM_FB_NAME softgym_seed_forces32_block16
+#define SOFTGYM_FB_V softgym_v16f
+#define SOFTGYM_FB_M __mmask16
+#define SOFTGYM_FB_ROW(row, li) ((softgym_v16f)_mm512_loadu_ps((row) + (li)))
 /* 16 floats v at out + li (the scatter widens them to doubles as it loads them) */
-#define SOFTGYM_F16_PUT(out, li, v) _mm512_storeu_ps((out) + (li), (__m512)(v))
-/* the rate of the quantity x in memory row r, (x - last) inv_dt, and the row set to x where
-   the mode did not change */
-#define SOFTGYM_F16_MEMORY(r, x, rate) do { \
-        rate = vdt * ((x) - SOFTGYM_F16_ROW(SOFTGYM_MEM(r), li)); \
-        _mm512_mask_storeu_ps(SOFTGYM_MEM(r) + li, keep, (__m512)(x)); \
-    } while (0)
-SOFTGYM_ALWAYS_INLINE void softgym_seed_forces32_block16(
-    const int all_small, const int all_neg2, Py_ssize_t li, Py_ssize_t n, float L, float bz,
-    float bzh, float inv_dt, const float *in, const double *sa_, const double *chg_,
-    const float *ka_, const float *kt_, const float *kb_, const float *cs_,
-    float *link_last, float *out)
-{
-    const Py_ssize_t is = SOFTGYM_CHUNK_FSTRIDE, os = SOFTGYM_CHUNK_FSTRIDE;
-    softgym_v16f P0, P1, P2, a1y, a1z, a2x, a2y, a2z;
-    softgym_v16f ka, b2, f1x, f1y, f1z, m1x, m1y, m1z;
-    softgym_v16f m2x, m2y, m2z, f2x, f2y, f2z;
-    softgym_v16f vx, vy, vz, ra1x, ra1y, ra1z, ra2y, ra2z;
-    softgym_v16f s1z, s1y, dax, c0, c1, c2, c3, d1, d2, nm1x, nm2x;
-    __mmask16 keep, large;
-    const softgym_v16f two = SOFTGYM_F16_SET(2.0f), nil = SOFTGYM_F16_SET(0.0f);
-    const softgym_v16f vdt = SOFTGYM_F16_SET(inv_dt), vbz = SOFTGYM_F16_SET(bz);
-    const softgym_v16f vbzh = SOFTGYM_F16_SET(bzh);
-#define SOFTGYM_IN(r) SOFTGYM_F16_ROW(in + (r) * is, li)
-#define SOFTGYM_MEM(r) (link_last + (r) * n)
-    P0 = SOFTGYM_IN(0);
-    P1 = SOFTGYM_IN(1);
-    P2 = SOFTGYM_IN(2);
-    a1y = SOFTGYM_IN(3);
-    a1z = SOFTGYM_IN(4);
-    a2x = SOFTGYM_IN(5);
-    a2y = SOFTGYM_IN(6);
-    a2z = SOFTGYM_IN(7);
-    keep = (__mmask16)~SOFTGYM_F16_NONZERO(chg_, li);
-    ka = SOFTGYM_F16_ROW(ka_, li);
-    /* stiffness */
-    b2 = (ka * 0.5f) * L;
-    f1x = P0 * ka;
-    f1y = SOFTGYM_F16_FMS(P1, ka, b2 * (a1z + a2z));
-    f1z = SOFTGYM_F16_FMA(P2, ka, b2 * (a1y + a2y));
-    m1x = SOFTGYM_F16_ROW(kt_, li) * (nil - a2x);
-    c0 = SOFTGYM_F16_ROW(kb_, li);
-    m1y = SOFTGYM_F16_FMA(P2, b2, c0 * SOFTGYM_F16_FMA(a1y, two, a2y));
-    m1z = SOFTGYM_F16_FNMA(P1, b2, c0 * SOFTGYM_F16_FMA(a1z, two, a2z));
-    m2y = SOFTGYM_F16_FMA(P2, b2, c0 * SOFTGYM_F16_FMA(a2y, two, a1y));
-    m2z = SOFTGYM_F16_FNMA(P1, b2, c0 * SOFTGYM_F16_FMA(a2z, two, a1z));
-    m2x = -m1x;
-    /* damping: rates from the memory of the last step, which is updated where the mode did
-       not change */
-    SOFTGYM_F16_MEMORY(0, P0, vx);
-    SOFTGYM_F16_MEMORY(1, P1, vy);
-    SOFTGYM_F16_MEMORY(2, P2, vz);
-    SOFTGYM_F16_MEMORY(3, nil, ra1x);
-    SOFTGYM_F16_MEMORY(4, a1y, ra1y);
-    SOFTGYM_F16_MEMORY(5, a1z, ra1z);
-    /* ra2x - ra1x, ra2x = inv_dt (a2x - l6) fused into the difference */
-    c0 = SOFTGYM_F16_ROW(SOFTGYM_MEM(6), li);
-    dax = SOFTGYM_F16_FMS(vdt, a2x - c0, ra1x);
-    _mm512_mask_storeu_ps(SOFTGYM_MEM(6) + li, keep, (__m512)a2x);
-    SOFTGYM_F16_MEMORY(7, a2y, ra2y);
-    SOFTGYM_F16_MEMORY(8, a2z, ra2z);
-    s1z = ra1z + ra2z;
-    s1y = ra1y + ra2y;
-    /* voxel 2's damped force (c_seed rows 4-7), where it is its own */
-    if (!all_neg2) {
-        c0 = SOFTGYM_F16_ROW(cs_ + 4 * n, li);
-        c1 = SOFTGYM_F16_ROW(cs_ + 5 * n, li);
-        f2x = SOFTGYM_F16_FMS(vx * -c0, vbz, f1x);
-        f2y = SOFTGYM_F16_FMS(vbz, SOFTGYM_F16_FNMA(vy, c0, s1z * c1), f1y);
-        f2z = SOFTGYM_F16_FMS(vbz, SOFTGYM_F16_FNMS(vz, c0, s1y * c1), f1z);
-    }
-    /* voxel 1's damping (c_seed rows 0-3) */
-    c0 = SOFTGYM_F16_ROW(cs_, li);
-    c1 = SOFTGYM_F16_ROW(cs_ + n, li);
-    c2 = SOFTGYM_F16_ROW(cs_ + 2 * n, li);
-    c3 = SOFTGYM_F16_ROW(cs_ + 3 * n, li);
-    f1x = SOFTGYM_F16_DAMP(keep, f1x, vbz, vx * c0);
-    f1y = SOFTGYM_F16_DAMP(keep, f1y, vbz, SOFTGYM_F16_FNMA(c1, s1z, vy * c0));
-    f1z = SOFTGYM_F16_DAMP(keep, f1z, vbz, SOFTGYM_F16_FMA(c1, s1y, vz * c0));
-    /* m1x's damping: with all links in small-angle mode the compiler's loop fused its
-       output's negation into the damping's multiply-add (-(d bzh) - m1x, which differs
-       from -(d bzh + m1x) in the sign of a zero), elsewhere it negated the turned sum */
-    d1 = dax * -c2;
-    if (all_small)
-        nm1x = SOFTGYM_F16_PICK(keep, SOFTGYM_F16_FNMS(d1, vbzh, m1x), m2x);
-    d2 = SOFTGYM_F16_ROW(cs_ + 6 * n, li) * dax;
-    /* voxel 2's: m2x + bzh ca2 (ra2x - ra1x) = bzh ca2 (...) - m1x, fused, from m1x
-       before its damping (negated: m1x - bzh ca2 (...), where all links are small) */
-    if (all_small)
-        nm2x = SOFTGYM_F16_PICK(keep, SOFTGYM_F16_FNMA(vbzh, d2, m1x), m1x);
-    else
-        m2x = SOFTGYM_F16_PICK(keep, SOFTGYM_F16_FMS(vbzh, d2, m1x), m2x);
-    m1x = SOFTGYM_F16_DAMP(keep, m1x, vbzh, d1);
-    m1y = SOFTGYM_F16_DAMP(keep, m1y, vbzh,
-                           SOFTGYM_F16_FMA(c3, SOFTGYM_F16_FMA(ra1y, two, ra2y), vz * c1));
-    m1z = SOFTGYM_F16_DAMP(keep, m1z, vbzh,
-                           SOFTGYM_F16_FMA(c3, SOFTGYM_F16_FMA(ra1z, two, ra2z), vy * -c1));
-    /* voxel 2's moment's damping (c_seed rows 5 and 7) */
-    c1 = SOFTGYM_F16_ROW(cs_ + 5 * n, li);
-    c3 = SOFTGYM_F16_ROW(cs_ + 7 * n, li);
-    m2y = SOFTGYM_F16_DAMP(keep, m2y, vbzh,
-                           SOFTGYM_F16_FMA(c3, SOFTGYM_F16_FMA(ra2y, two, ra1y), vz * c1));
-    m2z = SOFTGYM_F16_DAMP(keep, m2z, vbzh,
-                           SOFTGYM_F16_FMA(c3, SOFTGYM_F16_FMA(ra2z, two, ra1z), vy * -c1));
-    if (!all_small) {
-        /* large angle: G = RQ^T v (RQ the matrix of rq over |rq|^2) */
-        softgym_v16f r0, r1, r2, r4, r5, r8, yy, zz, g;
-        large = (__mmask16)~SOFTGYM_F16_NONZERO(sa_, li);
-        c0 = SOFTGYM_IN(8);   /* rw */
-        c1 = SOFTGYM_IN(9);   /* ry */
-        c2 = SOFTGYM_IN(10);  /* rz */
-        yy = c1 * c1;
-        zz = c2 * c2;
-        c3 = zz + SOFTGYM_F16_FMA(c0, c0, yy);  /* |rq|^2 */
-        r0 = SOFTGYM_F16_FNMA(yy + zz, two, c3);
-        r1 = (c0 * c2) * 2.0f;
-        r2 = (c0 * c1) * 2.0f;
-        r4 = SOFTGYM_F16_FNMA(zz, two, c3);
-        r5 = (c1 * c2) * 2.0f;
-        r8 = SOFTGYM_F16_FNMA(yy, two, c3);
-/* (x, y, z) turned where the link is in large-angle mode; X: the x product rounded */
-#define SOFTGYM_F16_UNTURN_X(x, y, z) do { \
-            g = SOFTGYM_F16_FMA(r1, y, r0 * x); \
-            yy = SOFTGYM_F16_FMA(r4, y, -r1 * x); \
-            zz = SOFTGYM_F16_FMA(r5, y, r2 * x); \
-            SOFTGYM_F16_UNTURN_Z(x, y, z); \
-        } while (0)
-/* Y: the y product rounded */
-#define SOFTGYM_F16_UNTURN_Y(x, y, z) do { \
-            g = SOFTGYM_F16_FMA(r0, x, r1 * y); \
-            yy = SOFTGYM_F16_FNMA(r1, x, r4 * y); \
-            zz = SOFTGYM_F16_FMA(r2, x, r5 * y); \
-            SOFTGYM_F16_UNTURN_Z(x, y, z); \
-        } while (0)
-#define SOFTGYM_F16_UNTURN_Z(x, y, z) do { \
-            x = SOFTGYM_F16_PICK(large, SOFTGYM_F16_FNMA(r2, z, g), x); \
-            y = SOFTGYM_F16_PICK(large, SOFTGYM_F16_FMA(r5, z, yy), y); \
-            z = SOFTGYM_F16_PICK(large, SOFTGYM_F16_FMA(r8, z, zz), z); \
-        } while (0)
-        SOFTGYM_F16_UNTURN_X(f1x, f1y, f1z);
-        SOFTGYM_F16_UNTURN_Y(m1x, m1y, m1z);
-        SOFTGYM_F16_UNTURN_Y(m2x, m2y, m2z);
-        if (!all_neg2)
-            SOFTGYM_F16_UNTURN_Y(f2x, f2y, f2z);
-#undef SOFTGYM_F16_UNTURN_X
-#undef SOFTGYM_F16_UNTURN_Y
-#undef SOFTGYM_F16_UNTURN_Z
-    }
-    SOFTGYM_F16_PUT(out, li, f1x);
-    SOFTGYM_F16_PUT(out + os, li, f1y);
-    SOFTGYM_F16_PUT(out + 2 * os, li, f1z);
-    if (!all_neg2) {
-        SOFTGYM_F16_PUT(out + 3 * os, li, f2x);
-        SOFTGYM_F16_PUT(out + 4 * os, li, f2y);
-        SOFTGYM_F16_PUT(out + 5 * os, li, f2z);
-    }
-    if (all_small)
-        SOFTGYM_F16_PUT(out + 6 * os, li, nm1x);
-    else
-        SOFTGYM_F16_PUT(out + 6 * os, li, -m1x);
-    SOFTGYM_F16_PUT(out + 7 * os, li, -m1y);
-    SOFTGYM_F16_PUT(out + 8 * os, li, -m1z);
-    if (all_small)
-        SOFTGYM_F16_PUT(out + 9 * os, li, nm2x);
-    else
-        SOFTGYM_F16_PUT(out + 9 * os, li, -m2x);
-    SOFTGYM_F16_PUT(out + 10 * os, li, -m2y);
-    SOFTGYM_F16_PUT(out + 11 * os, li, -m2z);
-#undef SOFTGYM_F16_MEMORY
-#undef SOFTGYM_MEM
-#undef SOFTGYM_IN
-}
-#undef SOFTGYM_F16_PUT
-#undef SOFTGYM_F16_DAMP
-#undef SOFTGYM_F16_FNMS
-#undef SOFTGYM_F16_FMS
-#undef SOFTGYM_F16_ROW
+#define SOFTGYM_FB_PUT(out, li, v) _mm512_storeu_ps((out) + (li), (__m512)(v))
+#define SOFTGYM_FB_SET SOFTGYM_F16_SET
+#define SOFTGYM_FB_FMA SOFTGYM_F16_FMA
+#define SOFTGYM_FB_FNMA SOFTGYM_F16_FNMA
+#define SOFTGYM_FB_FMS(a, b, c) \
+    ((softgym_v16f)_mm512_fmsub_ps((__m512)(a), (__m512)(b), (__m512)(c)))
+#define SOFTGYM_FB_FNMS(a, b, c) \
+    ((softgym_v16f)_mm512_fnmsub_ps((__m512)(a), (__m512)(b), (__m512)(c)))
+#define SOFTGYM_FB_PICK SOFTGYM_F16_PICK
+/* x + s d where m (else x): a masked multiply-add */
+#define SOFTGYM_FB_DAMP(m, x, s, d) \
+    ((softgym_v16f)_mm512_mask3_fmadd_ps((__m512)(s), (__m512)(d), (__m512)(x), (m)))
+#define SOFTGYM_FB_NOT_NONZERO(row, li) ((__mmask16)~SOFTGYM_F16_NONZERO(row, li))
+/* a masked store (last, the row's loaded lanes, is not needed) */
+#define SOFTGYM_FB_KEEP(p, m, x, last) _mm512_mask_storeu_ps((p), (m), (__m512)(x))
+#elif defined(__AVX2__) && defined(__FMA__) && (defined(__GNUC__) || defined(__clang__))
+#define SOFTGYM_FB_LANES 8
+typedef float softgym_v8f __attribute__((vector_size(32)));
+typedef int softgym_v8m __attribute__((vector_size(32)));  /* all ones where set */
+#define SOFTGYM_FB_NAME softgym_seed_forces32_block8
+#define SOFTGYM_FB_V softgym_v8f
+#define SOFTGYM_FB_M softgym_v8m
+#define SOFTGYM_FB_ROW(row, li) ((softgym_v8f)_mm256_loadu_ps((row) + (li)))
+#define SOFTGYM_FB_PUT(out, li, v) _mm256_storeu_ps((out) + (li), (__m256)(v))
+#define SOFTGYM_FB_SET(c) ((softgym_v8f)_mm256_set1_ps(c))
+#define SOFTGYM_FB_FMA(a, b, c) \
+    ((softgym_v8f)_mm256_fmadd_ps((__m256)(a), (__m256)(b), (__m256)(c)))
+#define SOFTGYM_FB_FNMA(a, b, c) \
+    ((softgym_v8f)_mm256_fnmadd_ps((__m256)(a), (__m256)(b), (__m256)(c)))
+#define SOFTGYM_FB_FMS(a, b, c) \
+    ((softgym_v8f)_mm256_fmsub_ps((__m256)(a), (__m256)(b), (__m256)(c)))
+#define SOFTGYM_FB_FNMS(a, b, c) \
+    ((softgym_v8f)_mm256_fnmsub_ps((__m256)(a), (__m256)(b), (__m256)(c)))
+#define SOFTGYM_FB_PICK(m, a, b) \
+    ((softgym_v8f)_mm256_blendv_ps((__m256)(b), (__m256)(a), (__m256)(m)))
+/* x + s d where m (else x): the multiply-add in every lane, then a blend */
+#define SOFTGYM_FB_DAMP(m, x, s, d) SOFTGYM_FB_PICK(m, SOFTGYM_FB_FMA(s, d, x), x)
+/* the lanes whose double row holds 0.0: its 8 doubles rounded to floats (the rows hold 1.0
+   or 0.0, exact in float; a NaN stays one, not equal) and compared */
+#define SOFTGYM_FB_NOT_NONZERO(row, li) ((softgym_v8m)_mm256_cmp_ps( \
+        _mm256_insertf128_ps(_mm256_castps128_ps256(_mm256_cvtpd_ps(_mm256_loadu_pd((row) + (li)))), \
+                             _mm256_cvtpd_ps(_mm256_loadu_pd((row) + (li) + 4)), 1), \
+        _mm256_setzero_ps(), _CMP_EQ_OQ))
+/* the row's lanes at p set to x where m, else left as last (what was loaded from them) */
+#define SOFTGYM_FB_KEEP(p, m, x, last) \
+    _mm256_storeu_ps((p), (__m256)SOFTGYM_FB_PICK(m, x, last))
+#endif
+#if defined(SOFTGYM_FB_LANES)
+#include "softgym_seed_forces_block.h"
+#undef SOFTGYM_FB_NAME
+#undef SOFTGYM_FB_V
+#undef SOFTGYM_FB_M
+#undef SOFTGYM_FB_ROW
+#undef SOFTGYM_FB_PUT
+#undef SOFTGYM_FB_SET
+#undef SOFTGYM_FB_FMA
+#undef SOFTGYM_FB_FNMA
+#undef SOFTGYM_FB_FMS
+#undef SOFTGYM_FB_FNMS
+#undef SOFTGYM_FB_PICK
+#undef SOFTGYM_FB_DAMP
+#undef SOFTGYM_FB_NOT_NONZERO
+#undef SOFTGYM_FB_KEEP
 #endif
 #define SOFTGYM_FT float
 #define SOFTGYM_FNAME softgym_seed_forces32
-#if SOFTGYM_F16_LANES
+#if SOFTGYM_FB_LANES == 16
 #define SOFTGYM_FBLOCK softgym_seed_forces32_block16
+#elif SOFTGYM_FB_LANES == 8
+#define SOFTGYM_FBLOCK softgym_seed_forces32_block8
 #endif
 #define SOFTGYM_FIN_STRIDE SOFTGYM_CHUNK_FSTRIDE
 #define SOFTGYM_FOUT_T float

@@ -166,10 +166,10 @@ SOFTGYM_ALWAYS_INLINE void SOFTGYM_FCAT(SOFTGYM_FNAME, _impl)(const int all_smal
 #define SOFTGYM_FARGS lo, hi, n, L, bz, bzh, inv_dt, in, in_stride, sa_, chg_, neg2_, ka_, kt_, \
     kb_, cs_, link_last, out
 #if defined(SOFTGYM_FBLOCK)
-/* where the instantiation has one (softgym_seed.h: the float pass with AVX-512), the
-   16-lane blocks from lo by SOFTGYM_FBLOCK, the rest by the loop */
+/* where the instantiation has one (softgym_seed.h: the float pass with AVX-512 or AVX2), the
+   blocks of SOFTGYM_FB_LANES links from lo by SOFTGYM_FBLOCK, the rest by the loop */
 #define SOFTGYM_FBLOCKS(s, g) \
-    for (; lo + 16 <= hi; lo += 16) \
+    for (; lo + SOFTGYM_FB_LANES <= hi; lo += SOFTGYM_FB_LANES) \
         SOFTGYM_FBLOCK(s, g, lo, n, L, bz, bzh, inv_dt, in, sa_, chg_, ka_, kt_, kb_, cs_, \
                     link_last, out)
 #else
