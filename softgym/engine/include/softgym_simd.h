@@ -349,31 +349,30 @@ typedef softgym_vd softgym_m4;
 #elif defined(__aarch64__) && defined(__ARM_NEON)
 #include <arm_neon.h>
 #endif
+/* v's two halves as registers of type T, each replaced by SQRT of it */
+#define SOFTGYM_M4SQRT_HALVES(T, SQRT) do { \
+        T lo_, hi_; \
+        memcpy(&lo_, &v, sizeof lo_); \
+        memcpy(&hi_, (const char *)&v + sizeof lo_, sizeof hi_); \
+        lo_ = SQRT(lo_); \
+        hi_ = SQRT(hi_); \
+        memcpy(&v, &lo_, sizeof lo_); \
+        memcpy((char *)&v + sizeof lo_, &hi_, sizeof hi_); \
+    } while (0)
 /* the square root of each lane (IEEE, as sqrt) */
 static inline softgym_vd softgym_m4sqrt(softgym_vd v)
 {
 #if defined(__SSE2__)
-    __m128d lo, hi;
-    memcpy(&lo, &v, sizeof lo);
-    memcpy(&hi, (const char *)&v + sizeof lo, sizeof hi);
-    lo = _mm_sqrt_pd(lo);
-    hi = _mm_sqrt_pd(hi);
-    memcpy(&v, &lo, sizeof lo);
-    memcpy((char *)&v + sizeof lo, &hi, sizeof hi);
+    SOFTGYM_M4SQRT_HALVES(__m128d, _mm_sqrt_pd);
 #elif defined(__aarch64__) && defined(__ARM_NEON)
-    float64x2_t lo, hi;
-    memcpy(&lo, &v, sizeof lo);
-    memcpy(&hi, (const char *)&v + sizeof lo, sizeof hi);
-    lo = vsqrtq_f64(lo);
-    hi = vsqrtq_f64(hi);
-    memcpy(&v, &lo, sizeof lo);
-    memcpy((char *)&v + sizeof lo, &hi, sizeof hi);
+    SOFTGYM_M4SQRT_HALVES(float64x2_t, vsqrtq_f64);
 #else
     for (int k = 0; k < 4; k++)
         v[k] = sqrt(v[k]);
 #endif
     return v;
 }
+#undef SOFTGYM_M4SQRT_HALVES
 #define SOFTGYM_VSQRT(v) softgym_m4sqrt(v)
 #define SOFTGYM_V4SQRT(v) softgym_m4sqrt(v)
 #define SOFTGYM_M4SET(a, b, c, d) ((softgym_vd){(a), (b), (c), (d)})
