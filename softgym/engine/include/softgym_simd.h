@@ -112,10 +112,11 @@ static inline void softgym_quat_matrix(const double *q, double *R)
 }
 /* Vector code of our own for the link passes' loads (softgym_seed.h, softgym_corot.h):
    GCC's vectoriser loads a gathered number at a time, and with two voxels' indices per
-   lane it parks them in vector registers and spills. With AVX, softgym_vd is a vector of
-   SOFTGYM_VLANES doubles (8 with AVX-512, else 4) that GCC's arithmetic operators act on
-   lane by lane, so a pass's formula, written once as a macro over its type, runs on
-   doubles and on these vectors with the same operations. */
+   lane it parks them in vector registers and spills. softgym_vd is a vector of
+   SOFTGYM_VLANES doubles (8 with AVX-512, 4 with AVX, and 4 in the portable builds, below)
+   that GCC's arithmetic operators act on lane by lane, so a pass's formula, written once
+   as a macro over its type, runs on doubles and on these vectors with the same
+   operations. */
 #if defined(__AVX__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>
 #if defined(__AVX512F__)
