@@ -47,29 +47,25 @@ static inline int softgym_none8(const signed char *f)
     memcpy(&w, f, sizeof w);
     return w == 0;
 }
+/* name(c, a, b): c ? a : b on the bits of the floating type T (U: its unsigned integer
+   twin, C: the condition's type) */
+#define SOFTGYM_DEFINE_PICK(name, T, U, C) \
+    static inline T name(C c, T a, T b) \
+    { \
+        U ua, ub, m = (U)0 - (U)(c != 0); \
+        T r; \
+        memcpy(&ua, &a, sizeof ua); \
+        memcpy(&ub, &b, sizeof ub); \
+        ua = (ua & m) | (ub & ~m); \
+        memcpy(&r, &ua, sizeof r); \
+        return r; \
+    }
 /* c ? a : b on the bits: compilers keep it a blend (a select before a
    store may otherwise become a masked store, slow on some cores) */
-static inline double softgym_pick(long long c, double a, double b)
-{
-    unsigned long long ua, ub, m = (unsigned long long)0 - (unsigned long long)(c != 0);
-    double r;
-    memcpy(&ua, &a, sizeof ua);
-    memcpy(&ub, &b, sizeof ub);
-    ua = (ua & m) | (ub & ~m);
-    memcpy(&r, &ua, sizeof r);
-    return r;
-}
-/* the same for floats (the float passes' selects in the builds without AVX) */
-static inline float softgym_pickf(int c, float a, float b)
-{
-    unsigned int ua, ub, m = 0u - (unsigned int)(c != 0);
-    float r;
-    memcpy(&ua, &a, sizeof ua);
-    memcpy(&ub, &b, sizeof ub);
-    ua = (ua & m) | (ub & ~m);
-    memcpy(&r, &ua, sizeof r);
-    return r;
-}
+SOFTGYM_DEFINE_PICK(softgym_pick, double, unsigned long long, long long)
+/* the same for floats (the float passes' selects in the builds without AVX, which have no
+   conditional store) */
+SOFTGYM_DEFINE_PICK(softgym_pickf, float, unsigned int, int)
 /* |v|^2 of a voxel's velocity, for the seed's collision schedule (the fastest voxel's
    speed). Where the build fuses multiply-adds, the fusion is written out: the value
    is the same wherever the expression is inlined, (vy vy, then + vx vx and + vz vz
