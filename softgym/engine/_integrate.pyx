@@ -141,10 +141,12 @@ cdef inline void _spin(Batch* b, intp_t i, float64_t dt, float64_t mx, float64_t
 
 
 cdef extern from "softgym_voxels.h":
-    # both models' voxel updates for 8 voxels in vector lanes (AVX-512 builds:
-    # SOFTGYM_VOXELS8 is 1); 1: stepped, 0: nothing written (a fixed or runaway voxel
+    # the voxel updates of a block of voxels in vector lanes (AVX-512 builds: 8, both
+    # models; AVX2: 4, the seed model; SOFTGYM_VOXELS8 is 1 where either); 1: stepped, 0: nothing written (a fixed or runaway voxel
     # among them: the scalar loop steps them). Documented in include/softgym_voxels.h
     int SOFTGYM_VOXELS8
+    int SOFTGYM_VOXEL_BLOCK  # the lanes of a block (8: AVX-512, 4: AVX2)
+    int SOFTGYM_VOXEL_BLOCK_COROT  # whether the corotational model has blocks
     int voxels8 "softgym_voxels8" (
         int seed, intp_t i, intp_t vs, float64_t dt, float64_t g, int has_floor,
         float64_t* force, float64_t* moment, const float64_t* c_global, const float64_t* mass,
@@ -153,14 +155,16 @@ cdef extern from "softgym_voxels.h":
         const float64_t* mu_s, const float64_t* mu_k, const flag_t* fixed,
         const float64_t* ref, float64_t* c, int track_speed, float64_t runaway,
         float64_t* dmax, float64_t* vmax2, float64_t* rows, intp_t rn, float* lf,
-        intp_t lfs) noexcept nogil
+        intp_t lfs, float64_t* pos, float64_t* vel, float64_t* av,
+        const float64_t* ext) noexcept nogil
 
 
 cdef inline intp_t _scalar_run(Batch* b, intp_t r, intp_t* lo, int seed, const float64_t* ref,
                                float64_t* c, float64_t* dmax,
                                float64_t* vmax2) noexcept nogil:
-    # The voxel updates' schedule from voxel lo[0] on: blocks of 8 go to the vector lanes
-    # while they take them (where the build has them and the robot has no fluid and no
+    # The voxel updates' schedule from voxel lo[0] on: blocks of SOFTGYM_VOXEL_BLOCK go to
+    # the vector lanes while they take them (where the build has them: AVX-512, both
+    # models; AVX2, the seed model; and the robot has no fluid and no
     # terrain box; lo[0] moves past each block stepped; the block from the robot's first
     # voxel sets c, the drift reference's offset, as the scalar loop would); returns the
     # end of the run the scalar loop must do from lo[0]: a block the lanes left (a fixed
@@ -169,14 +173,16 @@ cdef inline intp_t _scalar_run(Batch* b, intp_t r, intp_t* lo, int seed, const f
         intp_t vs = b.vox_start[r], ve = b.vox_start[r + 1]
     if not SOFTGYM_VOXELS8 or b.fluid_drag > 0.0 or b.box_start[r] != b.box_start[r + 1]:
         return ve
-    while lo[0] + 8 <= ve:
+    if not seed and not SOFTGYM_VOXEL_BLOCK_COROT:
+        return ve
+    while lo[0] + SOFTGYM_VOXEL_BLOCK <= ve:
         if not voxels8(seed, lo[0], vs, b.dt[r], b.gravity, b.floor[r], b.force, b.moment,
                      b.c_global, b.mass, b.inv_mass, b.inv_inertia,
                      b.rot_damp, b.scale, b.k_floor, b.c_floor, b.mu_s, b.mu_k, b.fixed, ref,
                      c, b.self_collision and seed, RUNAWAY, dmax, vmax2, b.vox_out,
-                     b.vox_stride, b.link_f, b.link_fs):
-            return lo[0] + 8
-        lo[0] += 8
+                     b.vox_stride, b.link_f, b.link_fs, b.pos, b.vel, b.angvel, b.ext_force):
+            return lo[0] + SOFTGYM_VOXEL_BLOCK
+        lo[0] += SOFTGYM_VOXEL_BLOCK
     return ve
 
 
@@ -282,18 +288,15 @@ cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
 cdef extern from "softgym_orient.h":
     # the voxels' orientation step of both models (C, for the vectorising pragma;
     # documented in include/softgym_orient.h), and the seed step's state in the voxel rows
-    void softgym_seed_quats(intp_t lo, intp_t hi, intp_t n, float64_t dt, const float64_t* av,
-                            const float64_t* quat, float64_t* q_out, int newton) noexcept nogil
     void softgym_seed_quats_rows(intp_t lo, intp_t hi, intp_t n, float64_t dt,
                                  const flag_t* fixed, const float64_t* quat,
                                  float64_t* rows, int newton) noexcept nogil
-    void softgym_corot_quats(intp_t lo, intp_t hi, intp_t n, float64_t dt, const float64_t* av,
-                             const float64_t* quat, float64_t* q_out) noexcept nogil
     void softgym_corot_quats_rows(intp_t lo, intp_t hi, intp_t n, float64_t dt,
                                   const flag_t* fixed, const float64_t* quat,
                                   float64_t* rows) noexcept nogil
-    void softgym_orient_store(intp_t lo, intp_t hi, intp_t n, float64_t* q_out,
-                              const flag_t* fixed, float64_t* quat, float64_t* rot) noexcept nogil
+    void softgym_orient_records(intp_t lo, intp_t hi, intp_t n, float64_t dt,
+                                const flag_t* fixed, const float64_t* av, float64_t* quat,
+                                float64_t* q_out, float64_t* rot, int model) noexcept nogil
     void softgym_state_rows(intp_t lo, intp_t hi, intp_t n, const float64_t* pos,
                                  const float64_t* quat, const float64_t* vel,
                                  const float64_t* av, const float64_t* ext,
@@ -319,12 +322,11 @@ cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int
         else:
             softgym_corot_quats_rows(lo, hi, n, dt, b.fixed, b.quat, qo)
         return
-    if seed:
-        softgym_seed_quats(lo, hi, n, dt, b.angvel, b.quat, qo, b.link_f32)
-    else:
-        softgym_corot_quats(lo, hi, n, dt, b.angvel, b.quat, qo)
-    # (the rotation matrices: refresh_robot_rotations, where the step does not read them)
-    softgym_orient_store(lo, hi, n, qo, b.fixed, b.quat, NULL if SOFTGYM_ROT_DEFERRED else b.rot)
+    # from the records to the records (the rotation matrices: refresh_robot_rotations,
+    # where the step does not read them)
+    softgym_orient_records(lo, hi, n, dt, b.fixed, b.angvel, b.quat, qo,
+                           NULL if SOFTGYM_ROT_DEFERRED else b.rot,
+                           (2 if b.link_f32 else 1) if seed else 0)
 
 
 cdef inline void _run_from_rows(Batch* b, intp_t lo, intp_t hi) noexcept nogil:

@@ -302,6 +302,7 @@ typedef __m256d softgym_m4;
 /* (a, b, c, d) as 4 lanes; 4 doubles from p (unaligned) */
 #define SOFTGYM_M4SET(a, b, c, d) _mm256_set_pd((d), (c), (b), (a))
 #define SOFTGYM_M4LOADU(p) _mm256_loadu_pd(p)
+#define SOFTGYM_M4STOREU(p, v) _mm256_storeu_pd((p), (v))
 /* elements k and k + 1 of 4 voxels' rows at pa..pd as two rows of 4 lanes (lo_: k, hi_: k + 1) */
 #define SOFTGYM_GATHER_PAIRS(pa, pb, pc, pd, k, lo_, hi_) do { \
         __m256d ac_ = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd((pa) + (k))), \
@@ -380,6 +381,10 @@ static inline softgym_vd softgym_m4loadu(const double *p)
     return v;
 }
 #define SOFTGYM_M4LOADU(p) softgym_m4loadu(p)
+#define SOFTGYM_M4STOREU(p, v) do { \
+        softgym_vd v_ = (v); \
+        memcpy((p), &v_, sizeof v_); \
+    } while (0)
 #define SOFTGYM_GATHER_PAIRS(pa, pb, pc, pd, k, lo_, hi_) do { \
         lo_ = SOFTGYM_M4SET((pa)[k], (pb)[k], (pc)[k], (pd)[k]); \
         hi_ = SOFTGYM_M4SET((pa)[(k) + 1], (pb)[(k) + 1], (pc)[(k) + 1], (pd)[(k) + 1]); \
