@@ -297,127 +297,105 @@ static void softgym_orient_store(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, dou
 }
 #undef SOFTGYM_ORIENT_STORE1
 
-#if defined(SOFTGYM_VLANES) && SOFTGYM_VLANES == 4 && !defined(SOFTGYM_PORTABLE_LANES)
-/* The AVX builds without AVX-512, whose step loops keep the voxels' state in their records: the orientation step of 4 voxels in one pass,
-   from the records to the records, instead of the loop above and softgym_orient_store
-   (the loop's strided loads of 4 voxels' records, and the store's 13 scalar stores a
-   voxel with its branch, took 30 cycles a voxel-step on an AMD Zen 4 with AVX2). The
-   same formulas as softgym_quats_impl and softgym_quat_matrix_wxyz on vectors of 4, so the
-   same operations lane by lane, the same bits. (The portable build's GCC vectors do the
-   transposes element by element: three times slower than its loop; not used there.) */
-#define SOFTGYM_ORIENT4 1
-/* lanes of a where m is set (all bits of a lane), else of b */
-static inline softgym_v4 softgym_v4pick(softgym_v4i m, softgym_v4 a, softgym_v4 b)
-{
-    softgym_v4i ia, ib;
-    memcpy(&ia, &a, sizeof ia);
-    memcpy(&ib, &b, sizeof ib);
-    ia = (ia & m) | (ib & ~m);
-    memcpy(&a, &ia, sizeof a);
-    return a;
-}
-/* voxels i..i+3, none fixed: their quaternions (records of 4 in quat) turned by their
-   angular velocities (records of 3 in av) and renormalised as softgym_quats_impl's seed
-   (a compile-time constant), stored in place, and their rotation matrices into rot (9
-   doubles a voxel; rot NULL: none). Returns 0, with nothing stored, where the seed's
-   Newton steps leave a lane to the exact renormalisation (softgym_quats_impl's "far") */
-SOFTGYM_ALWAYS_INLINE int softgym_orient4(const int seed, Py_ssize_t i, double dt,
-                                          const double *av, double *quat, double *rot)
-{
-    softgym_m4 r0, r1, r2, r3, q0, q1, q2, q3, a0, a1, a2, ay;
-    double *qr = quat + 4 * i;
-    const double *ar = av + 3 * i;
-    r0 = SOFTGYM_M4LOADU(qr);
-    r1 = SOFTGYM_M4LOADU(qr + 4);
-    r2 = SOFTGYM_M4LOADU(qr + 8);
-    r3 = SOFTGYM_M4LOADU(qr + 12);
-    SOFTGYM_TRANSPOSE4(r0, r1, r2, r3, q0, q1, q2, q3);
-    SOFTGYM_GATHER_PAIRS(ar, ar + 3, ar + 6, ar + 9, 0, a0, a1);
-    SOFTGYM_GATHER_PAIRS(ar, ar + 3, ar + 6, ar + 9, 1, ay, a2);
-    (void)ay;
-    softgym_v4 Q0 = (softgym_v4)q0, Q1 = (softgym_v4)q1, Q2 = (softgym_v4)q2;
-    softgym_v4 Q3 = (softgym_v4)q3;
-    softgym_v4 wx = (softgym_v4)a0 * 0.5 * dt;
-    softgym_v4 wy = (softgym_v4)a1 * 0.5 * dt;
-    softgym_v4 wz = (softgym_v4)a2 * 0.5 * dt;
-    softgym_v4 qw = Q0 - wx * Q1 - wy * Q2 - wz * Q3;
-    softgym_v4 qx = Q1 + wx * Q0 + wy * Q3 - wz * Q2;
-    softgym_v4 qy = Q2 + wy * Q0 + wz * Q1 - wx * Q3;
-    softgym_v4 qz = Q3 + wz * Q0 + wx * Q2 - wy * Q1;
-    softgym_v4 nw, nx, ny, nz;
-    const softgym_v4 one = {1.0, 1.0, 1.0, 1.0}, zero = {0.0, 0.0, 0.0, 0.0};
-    if (seed == 2) {
-        softgym_v4 s = qw * qw + qx * qx + qy * qy + qz * qz;
-        softgym_v4 y = 1.5 - 0.5 * s;
-        y = y * (1.5 - (0.5 * s) * (y * y));
-        softgym_v4i out = (softgym_v4abs(s - 1.0) > SOFTGYM_QUAT_NEWTON_TOL) | (s != s);
-        if (_mm256_movemask_pd((__m256d)out) != 0)
-            return 0;
-        nw = qw * y;
-        nx = qx * y;
-        ny = qy * y;
-        nz = qz * y;
-    } else if (seed == 1) {
-        softgym_v4 nq = SOFTGYM_V4SQRT(qw * qw + qx * qx + qy * qy + qz * qz);
-        softgym_v4 inv = 1.0 / nq;
-        softgym_v4i nz0 = nq != 0.0;
-        nw = softgym_v4pick(nz0, qw * inv, qw);
-        nx = softgym_v4pick(nz0, qx * inv, qx);
-        ny = softgym_v4pick(nz0, qy * inv, qy);
-        nz = softgym_v4pick(nz0, qz * inv, qz);
-    } else {
-        softgym_v4 nq = 1.5 - 0.5 * (qw * qw + qx * qx + qy * qy + qz * qz);
-        nw = qw * nq;
-        nx = qx * nq;
-        ny = qy * nq;
-        nz = qz * nq;
-    }
-    if (seed != 0) {
-        /* snapped to the identity at w >= 1 */
-        softgym_v4i snap = nw >= 1.0;
-        nw = softgym_v4pick(snap, one, nw);
-        nx = softgym_v4pick(snap, zero, nx);
-        ny = softgym_v4pick(snap, zero, ny);
-        nz = softgym_v4pick(snap, zero, nz);
-    }
-    SOFTGYM_TRANSPOSE4((softgym_m4)nw, (softgym_m4)nx, (softgym_m4)ny, (softgym_m4)nz, r0, r1,
-                       r2, r3);
-    SOFTGYM_M4STOREU(qr, r0);
-    SOFTGYM_M4STOREU(qr + 4, r1);
-    SOFTGYM_M4STOREU(qr + 8, r2);
-    SOFTGYM_M4STOREU(qr + 12, r3);
-    if (rot != NULL) {
-        /* elements 0-3 and 4-7 of the 4 matrices by two transposes, element 8 lane by lane */
-        softgym_v4 R[9];
-        SOFTGYM_QUAT_MATRIX(nw, nx, ny, nz, R);
-        softgym_m4 a0_, a1_, a2_, a3_, b0_, b1_, b2_, b3_;
-        SOFTGYM_TRANSPOSE4((softgym_m4)R[0], (softgym_m4)R[1], (softgym_m4)R[2],
-                           (softgym_m4)R[3], a0_, a1_, a2_, a3_);
-        SOFTGYM_TRANSPOSE4((softgym_m4)R[4], (softgym_m4)R[5], (softgym_m4)R[6],
-                           (softgym_m4)R[7], b0_, b1_, b2_, b3_);
-        double *ro = rot + 9 * i;
-        SOFTGYM_M4STOREU(ro, a0_);
-        SOFTGYM_M4STOREU(ro + 4, b0_);
-        SOFTGYM_M4STOREU(ro + 9, a1_);
-        SOFTGYM_M4STOREU(ro + 13, b1_);
-        SOFTGYM_M4STOREU(ro + 18, a2_);
-        SOFTGYM_M4STOREU(ro + 22, b2_);
-        SOFTGYM_M4STOREU(ro + 27, a3_);
-        SOFTGYM_M4STOREU(ro + 31, b3_);
-        ro[8] = R[8][0];
-        ro[17] = R[8][1];
-        ro[26] = R[8][2];
-        ro[35] = R[8][3];
-    }
-    return 1;
-}
+/* The builds whose step loops keep the voxels' state in their records, with AVX (4 lanes)
+   or SSE2 (2 lanes, the portable x86-64 build): the orientation step of a block of voxels
+   in one pass, from the records to the records (softgym_orient_block.h), instead of the
+   loop above and softgym_orient_store (the loop's strided loads of the records, and the
+   store's 13 scalar stores a voxel with its branch, took 17 cycles a voxel-step on an AMD
+   Zen 4 with AVX2, 29 with SSE2). SOFTGYM_ORIENT_BLOCK: its lanes (0: none) */
+#if defined(__AVX__) && !defined(__AVX512F__) && (defined(__GNUC__) || defined(__clang__))
+#define SOFTGYM_ORIENT_BLOCK 4
+#define SOFTGYM_OB_NAME softgym_orient4
+#define SOFTGYM_ORIENT_BLOCK_FN softgym_orient4
+#define SOFTGYM_OB_T softgym_v4
+#define SOFTGYM_OB_TI softgym_v4i
+#define SOFTGYM_OB_ANY(m) (_mm256_movemask_pd((__m256d)(m)) != 0)
+#define SOFTGYM_OB_SQRT SOFTGYM_V4SQRT
+#define SOFTGYM_OB_ABS softgym_v4abs
+/* 4 voxels' quaternions (records of 4 at q) as rows w, x, y, z, and back */
+#define SOFTGYM_OB_LOADQ(q, w, x, y, z) do { \
+        __m256d w_, x_, y_, z_; \
+        SOFTGYM_TRANSPOSE4(_mm256_loadu_pd(q), _mm256_loadu_pd((q) + 4), \
+                           _mm256_loadu_pd((q) + 8), _mm256_loadu_pd((q) + 12), w_, x_, y_, z_); \
+        w = (softgym_v4)w_; \
+        x = (softgym_v4)x_; \
+        y = (softgym_v4)y_; \
+        z = (softgym_v4)z_; \
+    } while (0)
+#define SOFTGYM_OB_STOREQ(q, w, x, y, z) do { \
+        __m256d r0_, r1_, r2_, r3_; \
+        SOFTGYM_TRANSPOSE4((__m256d)(w), (__m256d)(x), (__m256d)(y), (__m256d)(z), r0_, r1_, \
+                           r2_, r3_); \
+        _mm256_storeu_pd((q), r0_); \
+        _mm256_storeu_pd((q) + 4, r1_); \
+        _mm256_storeu_pd((q) + 8, r2_); \
+        _mm256_storeu_pd((q) + 12, r3_); \
+    } while (0)
+/* the 4 voxels' matrices R[0..8] (rows of lanes) as their records of 9 at ro: elements
+   0-3 and 4-7 by two transposes, element 8 lane by lane */
+#define SOFTGYM_OB_STOREROT(ro, R) do { \
+        __m256d a0_, a1_, a2_, a3_, b0_, b1_, b2_, b3_; \
+        SOFTGYM_TRANSPOSE4((__m256d)(R)[0], (__m256d)(R)[1], (__m256d)(R)[2], (__m256d)(R)[3], \
+                           a0_, a1_, a2_, a3_); \
+        SOFTGYM_TRANSPOSE4((__m256d)(R)[4], (__m256d)(R)[5], (__m256d)(R)[6], (__m256d)(R)[7], \
+                           b0_, b1_, b2_, b3_); \
+        _mm256_storeu_pd((ro), a0_); \
+        _mm256_storeu_pd((ro) + 4, b0_); \
+        _mm256_storeu_pd((ro) + 9, a1_); \
+        _mm256_storeu_pd((ro) + 13, b1_); \
+        _mm256_storeu_pd((ro) + 18, a2_); \
+        _mm256_storeu_pd((ro) + 22, b2_); \
+        _mm256_storeu_pd((ro) + 27, a3_); \
+        _mm256_storeu_pd((ro) + 31, b3_); \
+        for (int k_ = 0; k_ < 4; k_++) \
+            (ro)[9 * k_ + 8] = (R)[8][k_]; \
+    } while (0)
+#define SOFTGYM_OB_LOAD3 softgym_v4_load3
+#include "softgym_orient_block.h"
+#elif defined(__SSE2__) && !defined(__AVX__) && (defined(__GNUC__) || defined(__clang__))
+#define SOFTGYM_ORIENT_BLOCK 2
+#define SOFTGYM_OB_NAME softgym_orient2
+#define SOFTGYM_ORIENT_BLOCK_FN softgym_orient2
+#define SOFTGYM_OB_T softgym_v2
+#define SOFTGYM_OB_TI softgym_v2i
+#define SOFTGYM_OB_ANY(m) (_mm_movemask_pd((__m128d)(m)) != 0)
+#define SOFTGYM_OB_SQRT(v) ((softgym_v2)_mm_sqrt_pd((__m128d)(v)))
+#define SOFTGYM_OB_ABS softgym_v2abs
+/* 2 voxels' quaternions (records of 4 at q) as rows w, x, y, z, and back */
+#define SOFTGYM_OB_LOADQ(q, w, x, y, z) do { \
+        __m128d a_ = _mm_loadu_pd(q), b_ = _mm_loadu_pd((q) + 2); \
+        __m128d c_ = _mm_loadu_pd((q) + 4), d_ = _mm_loadu_pd((q) + 6); \
+        w = (softgym_v2)_mm_unpacklo_pd(a_, c_); \
+        x = (softgym_v2)_mm_unpackhi_pd(a_, c_); \
+        y = (softgym_v2)_mm_unpacklo_pd(b_, d_); \
+        z = (softgym_v2)_mm_unpackhi_pd(b_, d_); \
+    } while (0)
+#define SOFTGYM_OB_STOREQ(q, w, x, y, z) do { \
+        __m128d w_ = (__m128d)(w), x_ = (__m128d)(x), y_ = (__m128d)(y), z_ = (__m128d)(z); \
+        _mm_storeu_pd((q), _mm_unpacklo_pd(w_, x_)); \
+        _mm_storeu_pd((q) + 2, _mm_unpacklo_pd(y_, z_)); \
+        _mm_storeu_pd((q) + 4, _mm_unpackhi_pd(w_, x_)); \
+        _mm_storeu_pd((q) + 6, _mm_unpackhi_pd(y_, z_)); \
+    } while (0)
+/* the 2 voxels' matrices R[0..8] (rows of lanes) as their records of 9 at ro */
+#define SOFTGYM_OB_STOREROT(ro, R) do { \
+        for (int k_ = 0; k_ < 8; k_ += 2) { \
+            __m128d e_ = (__m128d)(R)[k_], f_ = (__m128d)(R)[k_ + 1]; \
+            _mm_storeu_pd((ro) + k_, _mm_unpacklo_pd(e_, f_)); \
+            _mm_storeu_pd((ro) + 9 + k_, _mm_unpackhi_pd(e_, f_)); \
+        } \
+        (ro)[8] = (R)[8][0]; \
+        (ro)[17] = (R)[8][1]; \
+    } while (0)
+#define SOFTGYM_OB_LOAD3 softgym_v2_load3
+#include "softgym_orient_block.h"
 #else
-#define SOFTGYM_ORIENT4 0
+#define SOFTGYM_ORIENT_BLOCK 0
 #endif
 /* the orientation step of voxels lo..hi but the fixed, from the records (av, quat) to
    the records (quat, and rot unless NULL) for model 2 (the seed's with single-precision
    links: Newton steps), 1 (the seed's exact renormalisation) or 0 (corotational): blocks
-   of 4 by softgym_orient4 where the build has them and none of the block is fixed, the
+   of SOFTGYM_ORIENT_BLOCK where the build has them and none of the block is fixed, the
    rest by softgym_quats_impl into the scratch rows q_out (n apart) and
    softgym_orient_store */
 SOFTGYM_ALWAYS_INLINE void softgym_orient_records_impl(const int seed, Py_ssize_t lo,
@@ -427,14 +405,16 @@ SOFTGYM_ALWAYS_INLINE void softgym_orient_records_impl(const int seed, Py_ssize_
                                                        double *q_out, double *rot)
 {
     Py_ssize_t i = lo;
-#if SOFTGYM_ORIENT4
-    for (; i + 4 <= hi; i += 4) {
-        unsigned int fx;
-        memcpy(&fx, fixed + i, sizeof fx);
-        if (fx == 0 && softgym_orient4(seed, i, dt, av, quat, rot))
+#if SOFTGYM_ORIENT_BLOCK
+    const int B = SOFTGYM_ORIENT_BLOCK;
+    for (; i + B <= hi; i += B) {
+        int any_fixed = 0;
+        for (int k = 0; k < B; k++)
+            any_fixed |= fixed[i + k];
+        if (!any_fixed && SOFTGYM_ORIENT_BLOCK_FN(seed, i, dt, av, quat, rot))
             continue;
-        softgym_quats_impl(seed, i, i + 4, n, dt, av, av + 1, av + 2, 3, quat, 4, 1, q_out);
-        softgym_orient_store(i, i + 4, n, q_out, fixed, quat, rot);
+        softgym_quats_impl(seed, i, i + B, n, dt, av, av + 1, av + 2, 3, quat, 4, 1, q_out);
+        softgym_orient_store(i, i + B, n, q_out, fixed, quat, rot);
     }
 #endif
     if (i < hi) {

@@ -428,6 +428,58 @@ SOFTGYM_DEFINE_VABS(softgym_v4abs, softgym_v4, softgym_v4i)
     } while (0)
 #define SOFTGYM_VPUT(row, li, v) SOFTGYM_VTPUT(softgym_vd, row, li, v)
 #define SOFTGYM_V4PUT(row, li, v) SOFTGYM_VTPUT(softgym_v4, row, li, v)
+/* records of 3 doubles a voxel and rows of lanes, both ways: softgym_v4_load3 turns 4
+   voxels' records (a[0..11]) into rows x, y, z and softgym_v4_store3 back (AVX shuffles);
+   softgym_v2_load3, softgym_v2_store3 the same for 2 voxels in the SSE2 registers of the
+   portable x86-64 build (the voxel updates and orientation steps of the builds whose step
+   loops keep the voxels' state in their records: softgym_voxels.h, softgym_orient.h) */
+#if defined(__AVX__) && (defined(__GNUC__) || defined(__clang__))
+/* 4 voxels' records of 3 (a[0..11]) as rows x, y, z */
+static inline void softgym_v4_load3(const double *a, softgym_v4 *x, softgym_v4 *y,
+                                    softgym_v4 *z)
+{
+    __m256d A = _mm256_loadu_pd(a), B = _mm256_loadu_pd(a + 4), C = _mm256_loadu_pd(a + 8);
+    __m256d xy = _mm256_blend_pd(A, B, 0xC);          /* x0 y0 x2 y2 */
+    __m256d zx = _mm256_permute2f128_pd(A, C, 0x21);  /* z0 x1 z2 x3 */
+    __m256d yz = _mm256_blend_pd(B, C, 0xC);          /* y1 z1 y3 z3 */
+    *x = (softgym_v4)_mm256_blend_pd(xy, zx, 0xA);
+    *y = (softgym_v4)_mm256_shuffle_pd(xy, yz, 0x5);
+    *z = (softgym_v4)_mm256_blend_pd(zx, yz, 0xA);
+}
+/* rows x, y, z of 4 voxels as their records of 3 at a[0..11] */
+static inline void softgym_v4_store3(double *a, softgym_v4 x, softgym_v4 y, softgym_v4 z)
+{
+    __m256d X = (__m256d)x, Y = (__m256d)y, Z = (__m256d)z;
+    __m256d xy = _mm256_unpacklo_pd(X, Y);   /* x0 y0 x2 y2 */
+    __m256d xyh = _mm256_unpackhi_pd(X, Y);  /* x1 y1 x3 y3 */
+    __m256d zx = _mm256_unpacklo_pd(Z, xyh); /* z0 x1 z2 x3 */
+    __m256d yz = _mm256_unpackhi_pd(xyh, Z); /* y1 z1 y3 z3 */
+    _mm256_storeu_pd(a, _mm256_permute2f128_pd(xy, zx, 0x20));
+    _mm256_storeu_pd(a + 4, _mm256_blend_pd(yz, xy, 0xC));
+    _mm256_storeu_pd(a + 8, _mm256_permute2f128_pd(zx, yz, 0x31));
+}
+#elif defined(__SSE2__) && (defined(__GNUC__) || defined(__clang__))
+#include <emmintrin.h>
+typedef double softgym_v2 __attribute__((vector_size(16)));
+typedef long long softgym_v2i __attribute__((vector_size(16)));
+SOFTGYM_DEFINE_VABS(softgym_v2abs, softgym_v2, softgym_v2i)
+/* 2 voxels' records of 3 (a[0..5]: x0 y0 z0 x1 y1 z1) as rows x, y, z, and back */
+static inline void softgym_v2_load3(const double *a, softgym_v2 *x, softgym_v2 *y,
+                                    softgym_v2 *z)
+{
+    __m128d A = _mm_loadu_pd(a), B = _mm_loadu_pd(a + 2), C = _mm_loadu_pd(a + 4);
+    *x = (softgym_v2)_mm_shuffle_pd(A, B, 0x2);
+    *y = (softgym_v2)_mm_shuffle_pd(A, C, 0x1);
+    *z = (softgym_v2)_mm_shuffle_pd(B, C, 0x2);
+}
+static inline void softgym_v2_store3(double *a, softgym_v2 x, softgym_v2 y, softgym_v2 z)
+{
+    __m128d X = (__m128d)x, Y = (__m128d)y, Z = (__m128d)z;
+    _mm_storeu_pd(a, _mm_unpacklo_pd(X, Y));
+    _mm_storeu_pd(a + 2, _mm_shuffle_pd(Z, X, 0x2));
+    _mm_storeu_pd(a + 4, _mm_unpackhi_pd(Y, Z));
+}
+#endif
 /* 4 consecutive values of a row from li, as 4 lanes */
 static inline softgym_v4 softgym_v4load(const double *row, Py_ssize_t li)
 {

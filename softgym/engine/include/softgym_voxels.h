@@ -285,44 +285,14 @@ static int softgym_corot_voxels8(SOFTGYM_VOXELS8_PARAMS)
 }
 #elif defined(__AVX2__) && defined(__FMA__) && (defined(__GNUC__) || defined(__clang__))
 /* The AVX2 build (x86-64-v3), whose step loops keep the voxels' state in their records:
-   the seed model's voxel update for 4 voxels in the lanes of AVX2, the records turned
-   into rows of 4 lanes and back by shuffles (softgym_v4_load3, softgym_v4_store3), the
-   force and moment as the float rows of the single-precision links (Batch.link_f)
-   widened, or the double rows transposed. The same IEEE operations as the scalar loop,
-   each expression in softgym_seed_voxels8's shape (so the same fused multiply-adds); the
-   corotational model keeps its scalar loop. */
+   the seed model's voxel update for 4 voxels in the lanes of AVX2
+   (softgym_voxels_block.h), the records turned into rows of 4 lanes and back by shuffles,
+   the force and moment as the float rows of the single-precision links (Batch.link_f)
+   widened, or the double rows transposed; the corotational model keeps its scalar loop */
 #define SOFTGYM_VOXELS8 1
 #define SOFTGYM_VOXEL_BLOCK 4
 #define SOFTGYM_VOXEL_BLOCK_COROT 0
 
-/* 4 voxels' records of 3 (a[0..11]) as rows x, y, z */
-static inline void softgym_v4_load3(const double *a, softgym_v4 *x, softgym_v4 *y,
-                                    softgym_v4 *z)
-{
-    __m256d A = _mm256_loadu_pd(a), B = _mm256_loadu_pd(a + 4), C = _mm256_loadu_pd(a + 8);
-    __m256d xy = _mm256_blend_pd(A, B, 0xC);          /* x0 y0 x2 y2 */
-    __m256d zx = _mm256_permute2f128_pd(A, C, 0x21);  /* z0 x1 z2 x3 */
-    __m256d yz = _mm256_blend_pd(B, C, 0xC);          /* y1 z1 y3 z3 */
-    *x = (softgym_v4)_mm256_blend_pd(xy, zx, 0xA);
-    *y = (softgym_v4)_mm256_shuffle_pd(xy, yz, 0x5);
-    *z = (softgym_v4)_mm256_blend_pd(zx, yz, 0xA);
-}
-/* rows x, y, z of 4 voxels as their records of 3 at a[0..11] */
-static inline void softgym_v4_store3(double *a, softgym_v4 x, softgym_v4 y, softgym_v4 z)
-{
-    __m256d X = (__m256d)x, Y = (__m256d)y, Z = (__m256d)z;
-    __m256d xy = _mm256_unpacklo_pd(X, Y);   /* x0 y0 x2 y2 */
-    __m256d xyh = _mm256_unpackhi_pd(X, Y);  /* x1 y1 x3 y3 */
-    __m256d zx = _mm256_unpacklo_pd(Z, xyh); /* z0 x1 z2 x3 */
-    __m256d yz = _mm256_unpackhi_pd(xyh, Z); /* y1 z1 y3 z3 */
-    _mm256_storeu_pd(a, _mm256_permute2f128_pd(xy, zx, 0x20));
-    _mm256_storeu_pd(a + 4, _mm256_blend_pd(yz, xy, 0xC));
-    _mm256_storeu_pd(a + 8, _mm256_permute2f128_pd(zx, yz, 0x31));
-}
-static inline softgym_v4 softgym_v4_at(const double *a)
-{
-    return (softgym_v4)_mm256_loadu_pd(a);
-}
 /* the force (a = force + SOFTGYM_FM_STRIDE i) or moment columns of voxels i..i+3 as rows,
    or with lf their float rows (lfs apart) widened (exactly) */
 SOFTGYM_ALWAYS_INLINE void softgym_v4_forces(const double *a, const float *lf, Py_ssize_t lfs,
@@ -344,17 +314,18 @@ SOFTGYM_ALWAYS_INLINE void softgym_v4_forces(const double *a, const float *lf, P
         *z = (softgym_v4)r2;
     }
 }
-/* masks: all bits of a lane set where the comparison holds */
-#define SOFTGYM_V4_CMP(a, b, op) ((softgym_v4)_mm256_cmp_pd((__m256d)(a), (__m256d)(b), (op)))
-#define SOFTGYM_V4_AND(a, b) ((softgym_v4)_mm256_and_pd((__m256d)(a), (__m256d)(b)))
-#define SOFTGYM_V4_OR(a, b) ((softgym_v4)_mm256_or_pd((__m256d)(a), (__m256d)(b)))
-/* ~a & b */
-#define SOFTGYM_V4_ANDNOT(a, b) ((softgym_v4)_mm256_andnot_pd((__m256d)(a), (__m256d)(b)))
-#define SOFTGYM_V4_BITS(m) _mm256_movemask_pd((__m256d)(m))
-/* lanes of a where m is set, else of b */
-#define SOFTGYM_V4_PICK(m, a, b) \
-    ((softgym_v4)_mm256_blendv_pd((__m256d)(b), (__m256d)(a), (__m256d)(m)))
-/* the largest lane of v above *best (softgym_v8_raise_max) */
+/* the 4 voxels' force and moment: their float rows, or their rows of SOFTGYM_FM_STRIDE */
+static inline void softgym_v4_clear(double *a, float *lf, Py_ssize_t lfs, Py_ssize_t i)
+{
+    if (lf) {
+        for (int k = 0; k < 6; k++)
+            _mm_storeu_ps(lf + k * lfs + i, _mm_setzero_ps());
+    } else {
+        for (int k = 0; k < 8; k++)
+            _mm256_store_pd(a + 4 * k, _mm256_setzero_pd());
+    }
+}
+/* the largest lane of v above *best (as softgym_v8_raise_max) */
 static inline void softgym_v4_raise_max(softgym_v4 v, double *best)
 {
     __m256d a = (__m256d)v;
@@ -364,114 +335,114 @@ static inline void softgym_v4_raise_max(softgym_v4 v, double *best)
     if (x > *best)
         *best = x;
 }
-
-/* model 0 (integrate_seed): 1 when voxels i..i+3 were stepped, 0 when nothing was
-   written (a fixed voxel in the block, or a runaway one), as softgym_seed_voxels8 */
-static int softgym_seed_voxels4(SOFTGYM_VOXELS8_PARAMS)
+static inline int softgym_none4(const signed char *f)
 {
-    unsigned int fx;
-    (void)rows;
-    (void)rn;
-    memcpy(&fx, fixed + i, sizeof fx);
-    if (fx != 0)
-        return 0;
-    const softgym_v4 zero = {0.0, 0.0, 0.0, 0.0};
-    softgym_v4 v0, v1, v2, p0, p1, p2, F0, F1, F2, E0, E1, E2;
-    softgym_v4_load3(vel + 3 * i, &v0, &v1, &v2);
-    softgym_v4_load3(ext + 3 * i, &E0, &E1, &E2);
-    softgym_v4_load3(pos + 3 * i, &p0, &p1, &p2);
-    softgym_v4_forces(force + SOFTGYM_FM_STRIDE * i, lf, lfs, i, &F0, &F1, &F2);
-    softgym_v4 cg = softgym_v4_at(c_global + i), m = softgym_v4_at(mass + i);
-    softgym_v4 f0 = (((-cg) * v0) + F0) + E0;
-    softgym_v4 f1 = (((-cg) * v1) + F1) + E1;
-    softgym_v4 f2 = ((((-cg) * v2) + F2) + (m * g)) + E2;
-    if (has_floor) {
-        softgym_v4 sc = softgym_v4_at(scale + i);
-        softgym_v4 pen = (0.5 * sc) - p2;
-        /* not pen <= 0 (a NaN is in contact, as the AVX-512 block's ~(pen <= 0)) */
-        softgym_v4 contact = SOFTGYM_V4_CMP(pen, zero, _CMP_NLE_UQ);
-        if (SOFTGYM_V4_BITS(contact)) {
-            softgym_v4 n = softgym_v4_at(k_floor + i) * pen;
-            softgym_v4 fd = softgym_v4_at(mu_k + i) * n;
-            softgym_v4 still = SOFTGYM_V4_AND(SOFTGYM_V4_CMP(v0, zero, _CMP_EQ_OQ),
-                                              SOFTGYM_V4_CMP(v1, zero, _CMP_EQ_OQ));
-            softgym_v4 stat = zero;
-            if (SOFTGYM_V4_BITS(SOFTGYM_V4_AND(contact, still))) {
-                softgym_v4 sf = SOFTGYM_V4SQRT((f0 * f0) + (f1 * f1));
-                stat = SOFTGYM_V4_CMP(sf, (softgym_v4_at(mu_s + i) * n), _CMP_LT_OQ);
-            }
-            softgym_v4 moving = SOFTGYM_V4_ANDNOT(still, contact), stop = zero;
-            if (SOFTGYM_V4_BITS(moving)) {
-                softgym_v4 vsp = SOFTGYM_V4SQRT((v0 * v0) + (v1 * v1));
-                softgym_v4 kin = SOFTGYM_V4_CMP((fd * dt), (m * vsp), _CMP_LT_OQ);
-                softgym_v4 slide = SOFTGYM_V4_AND(moving, kin);  /* kinetic friction */
-                stop = SOFTGYM_V4_ANDNOT(kin, moving);           /* friction stops it */
-                if (SOFTGYM_V4_BITS(slide)) {
-                    softgym_v4 f0k = f0 - ((fd * v0) / vsp);
-                    softgym_v4 f1k = f1 - ((fd * v1) / vsp);
-                    f0 = SOFTGYM_V4_PICK(slide, f0k, f0);
-                    f1 = SOFTGYM_V4_PICK(slide, f1k, f1);
-                }
-            }
-            softgym_v4 stick = SOFTGYM_V4_OR(SOFTGYM_V4_AND(SOFTGYM_V4_AND(contact, still), stat),
-                                             stop);
-            v0 = SOFTGYM_V4_PICK(stop, zero, v0);
-            v1 = SOFTGYM_V4_PICK(stop, zero, v1);
-            softgym_v4 f2c = f2 + (n - (softgym_v4_at(c_floor + i) * v2));
-            f2 = SOFTGYM_V4_PICK(contact, f2c, f2);
-            f0 = SOFTGYM_V4_PICK(stick, zero, f0);
-            f1 = SOFTGYM_V4_PICK(stick, zero, f1);
-        }
+    unsigned int w;
+    memcpy(&w, f, sizeof w);
+    return w == 0;
+}
+#define SOFTGYM_VB_NAME softgym_seed_voxels4
+#define SOFTGYM_VB_T softgym_v4
+#define SOFTGYM_VB_LANES 4
+#define SOFTGYM_VB_LOAD3 softgym_v4_load3
+#define SOFTGYM_VB_STORE3 softgym_v4_store3
+#define SOFTGYM_VB_AT(p) ((softgym_v4)_mm256_loadu_pd(p))
+#define SOFTGYM_VB_FORCES softgym_v4_forces
+#define SOFTGYM_VB_CLEAR softgym_v4_clear
+#define SOFTGYM_VB_CMP_(a, b, op) ((softgym_v4)_mm256_cmp_pd((__m256d)(a), (__m256d)(b), (op)))
+#define SOFTGYM_VB_NLE(a, b) SOFTGYM_VB_CMP_(a, b, _CMP_NLE_UQ)
+#define SOFTGYM_VB_EQ(a, b) SOFTGYM_VB_CMP_(a, b, _CMP_EQ_OQ)
+#define SOFTGYM_VB_LT(a, b) SOFTGYM_VB_CMP_(a, b, _CMP_LT_OQ)
+#define SOFTGYM_VB_AND(a, b) ((softgym_v4)_mm256_and_pd((__m256d)(a), (__m256d)(b)))
+#define SOFTGYM_VB_OR(a, b) ((softgym_v4)_mm256_or_pd((__m256d)(a), (__m256d)(b)))
+#define SOFTGYM_VB_ANDNOT(a, b) ((softgym_v4)_mm256_andnot_pd((__m256d)(a), (__m256d)(b)))
+#define SOFTGYM_VB_BITS(m) _mm256_movemask_pd((__m256d)(m))
+#define SOFTGYM_VB_PICK(m, a, b) \
+    ((softgym_v4)_mm256_blendv_pd((__m256d)(b), (__m256d)(a), (__m256d)(m)))
+#define SOFTGYM_VB_SQRT SOFTGYM_V4SQRT
+#define SOFTGYM_VB_ABS softgym_v4abs
+#define SOFTGYM_VB_RAISE softgym_v4_raise_max
+/* softgym_speed2's fused form */
+#define SOFTGYM_VB_SPEED2(vx, vy, vz) ((softgym_v4)_mm256_fmadd_pd( \
+        (__m256d)(vz), (__m256d)(vz), \
+        _mm256_fmadd_pd((__m256d)(vx), (__m256d)(vx), _mm256_mul_pd((__m256d)(vy), (__m256d)(vy)))))
+#define SOFTGYM_VB_NONE_FIXED softgym_none4
+#include "softgym_voxels_block.h"
+#elif defined(__SSE2__) && !defined(__AVX__) && !defined(__FMA__) && \
+    (defined(__GNUC__) || defined(__clang__))
+/* The portable x86-64 build (SSE2, no fused multiply-adds: neither here nor in the scalar
+   loop): the seed model's voxel update for 2 voxels in the lanes of SSE2
+   (softgym_voxels_block.h); the corotational model keeps its scalar loop */
+#define SOFTGYM_VOXELS8 1
+#define SOFTGYM_VOXEL_BLOCK 2
+#define SOFTGYM_VOXEL_BLOCK_COROT 0
+/* the force (a = force + SOFTGYM_FM_STRIDE i) or moment columns of voxels i, i+1 as rows,
+   or with lf their float rows (lfs apart) widened (exactly) */
+static inline __m128d softgym_v2_floats(const float *p)
+{
+    return _mm_cvtps_pd(_mm_castsi128_ps(_mm_loadl_epi64((const __m128i *)p)));
+}
+SOFTGYM_ALWAYS_INLINE void softgym_v2_forces(const double *a, const float *lf, Py_ssize_t lfs,
+                                             Py_ssize_t i, softgym_v2 *x, softgym_v2 *y,
+                                             softgym_v2 *z)
+{
+    if (lf) {
+        *x = (softgym_v2)softgym_v2_floats(lf + i);
+        *y = (softgym_v2)softgym_v2_floats(lf + lfs + i);
+        *z = (softgym_v2)softgym_v2_floats(lf + 2 * lfs + i);
+    } else {
+        __m128d a01 = _mm_load_pd(a), b01 = _mm_load_pd(a + SOFTGYM_FM_STRIDE);
+        *x = (softgym_v2)_mm_unpacklo_pd(a01, b01);
+        *y = (softgym_v2)_mm_unpackhi_pd(a01, b01);
+        *z = (softgym_v2)_mm_unpacklo_pd(_mm_load_pd(a + 2), _mm_load_pd(a + SOFTGYM_FM_STRIDE + 2));
     }
-    /* the translation, the runaway check (nothing stored before it), the stores */
-    softgym_v4 M0, M1, M2;
-    softgym_v4_forces(moment + SOFTGYM_FM_STRIDE * i, lf ? lf + 3 * lfs : lf, lfs, i, &M0, &M1,
-                      &M2);
-    softgym_v4 h = dt * softgym_v4_at(inv_mass + i);
-    softgym_v4 vx = v0 + (f0 * h), vy = v1 + (f1 * h), vz = v2 + (f2 * h);
-    softgym_v4 px = p0 + (vx * dt), py = p1 + (vy * dt), pz = p2 + (vz * dt);
-    softgym_v4 run = (softgym_v4abs(px) + softgym_v4abs(py)) + softgym_v4abs(pz);
-    const softgym_v4 bound = {runaway, runaway, runaway, runaway};
-    if (SOFTGYM_V4_BITS(SOFTGYM_V4_CMP(run, bound, _CMP_LT_OQ)) != 0xF)
-        return 0;
-    softgym_v4_store3(vel + 3 * i, vx, vy, vz);
-    softgym_v4_store3(pos + 3 * i, px, py, pz);
+}
+static inline void softgym_v2_clear(double *a, float *lf, Py_ssize_t lfs, Py_ssize_t i)
+{
     if (lf) {
         for (int k = 0; k < 6; k++)
-            _mm_storeu_ps(lf + k * lfs + i, _mm_setzero_ps());
+            _mm_storel_epi64((__m128i *)(lf + k * lfs + i), _mm_setzero_si128());
     } else {
         for (int k = 0; k < 8; k++)
-            _mm256_store_pd(force + SOFTGYM_FM_STRIDE * i + 4 * k, _mm256_setzero_pd());
+            _mm_store_pd(a + 2 * k, _mm_setzero_pd());
     }
-    if (ref != NULL) {
-        softgym_v4 r0, r1, r2;
-        softgym_v4_load3(ref + 3 * (i - vs), &r0, &r1, &r2);
-        softgym_v4 e0 = px - r0, e1 = py - r1, e2 = pz - r2;
-        if (i == vs) {
-            /* the robot's first voxel's displacement, lane 0 (the scalar loop's c) */
-            c[0] = e0[0];
-            c[1] = e1[0];
-            c[2] = e2[0];
-        }
-        softgym_v4 d0 = e0 - c[0], d1 = e1 - c[1], d2 = e2 - c[2];
-        softgym_v4_raise_max(((d0 * d0) + (d1 * d1)) + (d2 * d2), dmax);
-    }
-    if (track_speed) {
-        /* softgym_speed2's fused form */
-        softgym_v4 s2 = (softgym_v4)_mm256_fmadd_pd(
-            (__m256d)vz, (__m256d)vz,
-            _mm256_fmadd_pd((__m256d)vx, (__m256d)vx, _mm256_mul_pd((__m256d)vy, (__m256d)vy)));
-        softgym_v4_raise_max(s2, vmax2);
-    }
-    softgym_v4 w0, w1, w2;
-    softgym_v4_load3(av + 3 * i, &w0, &w1, &w2);
-    softgym_v4 hi = dt * softgym_v4_at(inv_inertia + i), rd = softgym_v4_at(rot_damp + i);
-    w0 = (w0 + (M0 * hi)) * rd;
-    w1 = (w1 + (M1 * hi)) * rd;
-    w2 = (w2 + (M2 * hi)) * rd;
-    softgym_v4_store3(av + 3 * i, w0, w1, w2);
-    return 1;
 }
+static inline void softgym_v2_raise_max(softgym_v2 v, double *best)
+{
+    __m128d a = (__m128d)v;
+    double x = _mm_cvtsd_f64(_mm_max_sd(a, _mm_unpackhi_pd(a, a)));
+    if (x > *best)
+        *best = x;
+}
+static inline int softgym_none2(const signed char *f)
+{
+    unsigned short w;
+    memcpy(&w, f, sizeof w);
+    return w == 0;
+}
+#define SOFTGYM_VB_NAME softgym_seed_voxels2
+#define SOFTGYM_VB_T softgym_v2
+#define SOFTGYM_VB_LANES 2
+#define SOFTGYM_VB_LOAD3 softgym_v2_load3
+#define SOFTGYM_VB_STORE3 softgym_v2_store3
+#define SOFTGYM_VB_AT(p) ((softgym_v2)_mm_loadu_pd(p))
+#define SOFTGYM_VB_FORCES softgym_v2_forces
+#define SOFTGYM_VB_CLEAR softgym_v2_clear
+#define SOFTGYM_VB_NLE(a, b) ((softgym_v2)_mm_cmpnle_pd((__m128d)(a), (__m128d)(b)))
+#define SOFTGYM_VB_EQ(a, b) ((softgym_v2)_mm_cmpeq_pd((__m128d)(a), (__m128d)(b)))
+#define SOFTGYM_VB_LT(a, b) ((softgym_v2)_mm_cmplt_pd((__m128d)(a), (__m128d)(b)))
+#define SOFTGYM_VB_AND(a, b) ((softgym_v2)_mm_and_pd((__m128d)(a), (__m128d)(b)))
+#define SOFTGYM_VB_OR(a, b) ((softgym_v2)_mm_or_pd((__m128d)(a), (__m128d)(b)))
+#define SOFTGYM_VB_ANDNOT(a, b) ((softgym_v2)_mm_andnot_pd((__m128d)(a), (__m128d)(b)))
+#define SOFTGYM_VB_BITS(m) _mm_movemask_pd((__m128d)(m))
+#define SOFTGYM_VB_PICK(m, a, b) SOFTGYM_VB_OR(SOFTGYM_VB_AND(m, a), SOFTGYM_VB_ANDNOT(m, b))
+#define SOFTGYM_VB_SQRT(v) ((softgym_v2)_mm_sqrt_pd((__m128d)(v)))
+#define SOFTGYM_VB_ABS softgym_v2abs
+#define SOFTGYM_VB_RAISE softgym_v2_raise_max
+/* softgym_speed2's unfused form */
+#define SOFTGYM_VB_SPEED2(vx, vy, vz) ((vx) * (vx) + (vy) * (vy) + (vz) * (vz))
+#define SOFTGYM_VB_NONE_FIXED softgym_none2
+#include "softgym_voxels_block.h"
 #else
 #define SOFTGYM_VOXELS8 0
 #define SOFTGYM_VOXEL_BLOCK 8
@@ -487,7 +458,7 @@ static inline int softgym_voxels8(int seed, SOFTGYM_VOXELS8_PARAMS)
     return seed ? softgym_seed_voxels8(SOFTGYM_VOXELS8_ARGS)
                 : softgym_corot_voxels8(SOFTGYM_VOXELS8_ARGS);
 #elif SOFTGYM_VOXELS8
-    return seed ? softgym_seed_voxels4(SOFTGYM_VOXELS8_ARGS) : 0;
+    return seed ? SOFTGYM_VB_NAME(SOFTGYM_VOXELS8_ARGS) : 0;
 #else
     (void)seed;
     return 0;
