@@ -16,6 +16,9 @@ from softgym.engine._prof cimport softgym_prof_tsc, softgym_prof_add, prof_count
 from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t
 
 cdef float64_t RUNAWAY = 1.0e6  # |coordinate| (m) beyond which a robot diverged
+# whether the voxel updates and the orientation steps run their blocks of vector lanes
+# where the build has them (set_vector_blocks: off, the scalar loops, with the same bits)
+cdef int _vector_blocks = 1
 
 
 cdef extern from "softgym_simd.h":
@@ -173,7 +176,7 @@ cdef inline intp_t _scalar_run(Batch* b, intp_t r, intp_t* lo, int seed, const f
         intp_t vs = b.vox_start[r], ve = b.vox_start[r + 1]
     if not SOFTGYM_VOXELS8 or b.fluid_drag > 0.0 or b.box_start[r] != b.box_start[r + 1]:
         return ve
-    if not seed and not SOFTGYM_VOXEL_BLOCK_COROT:
+    if not _vector_blocks or (not seed and not SOFTGYM_VOXEL_BLOCK_COROT):
         return ve
     while lo[0] + SOFTGYM_VOXEL_BLOCK <= ve:
         if not voxels8(seed, lo[0], vs, b.dt[r], b.gravity, b.floor[r], b.force, b.moment,
@@ -294,9 +297,11 @@ cdef extern from "softgym_orient.h":
     void softgym_corot_quats_rows(intp_t lo, intp_t hi, intp_t n, float64_t dt,
                                   const flag_t* fixed, const float64_t* quat,
                                   float64_t* rows) noexcept nogil
+    int SOFTGYM_ORIENT_BLOCK  # the lanes of the orientation step's blocks (0: none)
     void softgym_orient_records(intp_t lo, intp_t hi, intp_t n, float64_t dt,
                                 const flag_t* fixed, const float64_t* av, float64_t* quat,
-                                float64_t* q_out, float64_t* rot, int model) noexcept nogil
+                                float64_t* q_out, float64_t* rot, int model,
+                                int blocks) noexcept nogil
     void softgym_state_rows(intp_t lo, intp_t hi, intp_t n, const float64_t* pos,
                                  const float64_t* quat, const float64_t* vel,
                                  const float64_t* av, const float64_t* ext,
@@ -326,7 +331,7 @@ cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int
     # where the step does not read them)
     softgym_orient_records(lo, hi, n, dt, b.fixed, b.angvel, b.quat, qo,
                            NULL if SOFTGYM_ROT_DEFERRED else b.rot,
-                           (2 if b.link_f32 else 1) if seed else 0)
+                           (2 if b.link_f32 else 1) if seed else 0, _vector_blocks)
 
 
 cdef inline void _run_from_rows(Batch* b, intp_t lo, intp_t hi) noexcept nogil:
@@ -462,6 +467,25 @@ cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
 #: the parts of integrate_seed that the cycle probes time, in slot order: the
 #: translation and spin (the vector lanes and the scalar loop), the orientation
 CYCLE_PASSES = ("voxels", "orient")
+
+
+def set_vector_blocks(bint enabled):
+    """Whether the voxel updates and orientation steps run in blocks of vector lanes
+    where the build has them (the default), or in the scalar loops only: the same
+    bits either way (tests/engine/test_vector_blocks.py holds them to it). Not to be
+    called while a simulation steps."""
+    global _vector_blocks
+    _vector_blocks = 1 if enabled else 0
+
+
+def vector_blocks():
+    """The lanes of this build's blocks (0: none): the seed and corotational models'
+    voxel updates, and the orientation step on the records (AVX-512 builds step the
+    orientations in the voxel rows instead)."""
+    return {"seed_voxels": SOFTGYM_VOXEL_BLOCK if SOFTGYM_VOXELS8 else 0,
+            "corotational_voxels": (SOFTGYM_VOXEL_BLOCK if SOFTGYM_VOXELS8
+                                    and SOFTGYM_VOXEL_BLOCK_COROT else 0),
+            "orientation": SOFTGYM_ORIENT_BLOCK}
 
 
 def cycle_counts(bint reset=False):

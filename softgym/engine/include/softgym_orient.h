@@ -395,19 +395,21 @@ static void softgym_orient_store(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, dou
 /* the orientation step of voxels lo..hi but the fixed, from the records (av, quat) to
    the records (quat, and rot unless NULL) for model 2 (the seed's with single-precision
    links: Newton steps), 1 (the seed's exact renormalisation) or 0 (corotational): blocks
-   of SOFTGYM_ORIENT_BLOCK where the build has them and none of the block is fixed, the
+   of SOFTGYM_ORIENT_BLOCK where the build has them, blocks is not 0 and none of the
+   block is fixed, the
    rest by softgym_quats_impl into the scratch rows q_out (n apart) and
    softgym_orient_store */
 SOFTGYM_ALWAYS_INLINE void softgym_orient_records_impl(const int seed, Py_ssize_t lo,
                                                        Py_ssize_t hi, Py_ssize_t n, double dt,
                                                        const signed char *fixed,
                                                        const double *av, double *quat,
-                                                       double *q_out, double *rot)
+                                                       double *q_out, double *rot,
+                                                       int blocks)
 {
     Py_ssize_t i = lo;
 #if SOFTGYM_ORIENT_BLOCK
     const int B = SOFTGYM_ORIENT_BLOCK;
-    for (; i + B <= hi; i += B) {
+    for (; blocks && i + B <= hi; i += B) {
         int any_fixed = 0;
         for (int k = 0; k < B; k++)
             any_fixed |= fixed[i + k];
@@ -424,14 +426,14 @@ SOFTGYM_ALWAYS_INLINE void softgym_orient_records_impl(const int seed, Py_ssize_
 }
 static void softgym_orient_records(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, double dt,
                                    const signed char *fixed, const double *av, double *quat,
-                                   double *q_out, double *rot, int model)
+                                   double *q_out, double *rot, int model, int blocks)
 {
     if (model == 2)
-        softgym_orient_records_impl(2, lo, hi, n, dt, fixed, av, quat, q_out, rot);
+        softgym_orient_records_impl(2, lo, hi, n, dt, fixed, av, quat, q_out, rot, blocks);
     else if (model == 1)
-        softgym_orient_records_impl(1, lo, hi, n, dt, fixed, av, quat, q_out, rot);
+        softgym_orient_records_impl(1, lo, hi, n, dt, fixed, av, quat, q_out, rot, blocks);
     else
-        softgym_orient_records_impl(0, lo, hi, n, dt, fixed, av, quat, q_out, rot);
+        softgym_orient_records_impl(0, lo, hi, n, dt, fixed, av, quat, q_out, rot, blocks);
 }
 
 #endif  /* SOFTGYM_ORIENT_H */
