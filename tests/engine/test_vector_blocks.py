@@ -15,7 +15,6 @@ import platform
 import subprocess
 import sys
 
-import numpy as np
 import pytest
 
 from softgym.engine import available_kernels
