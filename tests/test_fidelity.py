@@ -260,13 +260,14 @@ def test_the_fidelity_benchmark_records_labels_and_compares_them_in_pairs(tmp_pa
 
 def test_the_stored_paired_comparison_is_what_its_stored_values_give(tmp_path):
     # benchmarks/data/fidelity_paired: the per-draw values of both link precisions and the
-    # comparison they gave (fidelity_seed.py --paired single double --stored-only
-    # --oracle-draws 0,1); recomputed from the committed data (the point figures are
-    # exact, the intervals depend on the resamples)
+    # comparison they gave (fidelity_seed.py --paired single double --stored-only, against
+    # the seed's engine's draws it names); recomputed from the committed data (the point
+    # figures are exact, the intervals depend on the resamples)
     stored = DATA.parent / "fidelity_paired"
     committed = json.loads((stored / "comparison.json").read_text())
+    draws = ",".join(str(d) for d in committed["oracle_draws"])
     out = tmp_path / "comparison.json"
-    res = _fidelity_cli("--paired", "single", "double", "--stored-only", "--oracle-draws", "0,1",
+    res = _fidelity_cli("--paired", "single", "double", "--stored-only", "--oracle-draws", draws,
                         "--resamples", "200", "--store", str(stored / "values.json"),
                         "--report-out", str(out))  # fmt: skip
     assert res.returncode == 0, res.stderr
