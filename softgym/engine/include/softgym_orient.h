@@ -48,6 +48,25 @@ static inline void softgym_quat_exact(Py_ssize_t i, Py_ssize_t n, double *q_out)
     for (int k = 0; k < 4; k++)
         q_out[k * n + i] = nv[k];
 }
+/* The orientation step's formulas for any arithmetic type T (doubles, or GCC's vectors of
+   doubles, lane by lane: softgym_orient_block.h), so that the loop below and the blocks
+   run the same operations. SOFTGYM_QUAT_TURN declares qw, qx, qy, qz: the quaternion
+   (q0, q1, q2, q3) plus (w dt / 2) x q for the angular velocity (a0, a1, a2);
+   SOFTGYM_QUAT_NEWTON declares s = |q|^2 and y, two Newton steps of 1 / sqrt(s) from 1;
+   SOFTGYM_QUAT_COROT declares nq, the corotational model's one step */
+#define SOFTGYM_QUAT_TURN(T, a0, a1, a2, q0, q1, q2, q3, dt) \
+    T wx = (a0) * 0.5 * (dt); \
+    T wy = (a1) * 0.5 * (dt); \
+    T wz = (a2) * 0.5 * (dt); \
+    T qw = (q0) - wx * (q1) - wy * (q2) - wz * (q3); \
+    T qx = (q1) + wx * (q0) + wy * (q3) - wz * (q2); \
+    T qy = (q2) + wy * (q0) + wz * (q1) - wx * (q3); \
+    T qz = (q3) + wz * (q0) + wx * (q2) - wy * (q1)
+#define SOFTGYM_QUAT_NEWTON(T) \
+    T s = qw * qw + qx * qx + qy * qy + qz * qz; \
+    T y = 1.5 - 0.5 * s; \
+    y = y * (1.5 - (0.5 * s) * (y * y))
+#define SOFTGYM_QUAT_COROT(T) T nq = 1.5 - 0.5 * (qw * qw + qx * qx + qy * qy + qz * qz)
 /* voxels lo..hi: q + (w dt / 2) x q, then (seed, a compile-time constant in each copy)
    the seed's renormalisation snapped to the identity at w >= 1: 1, its square root and
    division (the seed's own operations: the seed model with double-precision links); 2,
@@ -68,20 +87,12 @@ SOFTGYM_ALWAYS_INLINE void softgym_quats_impl(const int seed, Py_ssize_t lo, Py_
     long far = 0;
     SOFTGYM_IVDEP
     for (i = lo; i < hi; i++) {
-        double wx = ax[as * i] * 0.5 * dt;
-        double wy = ay[as * i] * 0.5 * dt;
-        double wz = az[as * i] * 0.5 * dt;
         double q0 = quat[qs * i], q1 = quat[qs * i + qc], q2 = quat[qs * i + 2 * qc];
         double q3 = quat[qs * i + 3 * qc];
-        double qw = q0 - wx * q1 - wy * q2 - wz * q3;
-        double qx = q1 + wx * q0 + wy * q3 - wz * q2;
-        double qy = q2 + wy * q0 + wz * q1 - wx * q3;
-        double qz = q3 + wz * q0 + wx * q2 - wy * q1;
+        SOFTGYM_QUAT_TURN(double, ax[as * i], ay[as * i], az[as * i], q0, q1, q2, q3, dt);
         double nw, nx, ny, nz;
         if (seed == 2) {
-            double s = qw * qw + qx * qx + qy * qy + qz * qz;
-            double y = 1.5 - 0.5 * s;
-            y = y * (1.5 - (0.5 * s) * (y * y));
+            SOFTGYM_QUAT_NEWTON(double);
             long long out = fabs(s - 1.0) > SOFTGYM_QUAT_NEWTON_TOL || s != s;
             long long one;
             far += out;
@@ -103,7 +114,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_quats_impl(const int seed, Py_ssize_t lo, Py_
             ny = nv[2];
             nz = nv[3];
         } else {
-            double nq = 1.5 - 0.5 * (qw * qw + qx * qx + qy * qy + qz * qz);
+            SOFTGYM_QUAT_COROT(double);
             nw = qw * nq;
             nx = qx * nq;
             ny = qy * nq;

@@ -6,8 +6,9 @@
    SOFTGYM_OB_STOREQ (records of 4 as rows w, x, y, z and back), SOFTGYM_OB_LOAD3 (records
    of 3 as rows), SOFTGYM_OB_STOREROT (rows of the 9 matrix elements as records of 9),
    SOFTGYM_OB_ANY (whether a comparison holds in a lane), SOFTGYM_OB_SQRT and
-   SOFTGYM_OB_ABS. The same formulas as softgym_quats_impl and softgym_quat_matrix_wxyz,
-   so the same operations lane by lane, the same bits.
+   SOFTGYM_OB_ABS. The same formulas as softgym_quats_impl (SOFTGYM_QUAT_TURN,
+   SOFTGYM_QUAT_NEWTON, SOFTGYM_QUAT_COROT) and softgym_quat_matrix_wxyz
+   (SOFTGYM_QUAT_MATRIX), so the same operations lane by lane, the same bits.
 
    The voxels, none fixed: their quaternions (quat) turned by their angular velocities
    (av) and renormalised as softgym_quats_impl's seed (a compile-time constant where
@@ -22,13 +23,7 @@ SOFTGYM_ALWAYS_INLINE int SOFTGYM_OB_NAME(const int seed, Py_ssize_t i, double d
     T Q0, Q1, Q2, Q3, a0, a1, a2;
     SOFTGYM_OB_LOADQ(quat + 4 * i, Q0, Q1, Q2, Q3);
     SOFTGYM_OB_LOAD3(av + 3 * i, &a0, &a1, &a2);
-    T wx = a0 * 0.5 * dt;
-    T wy = a1 * 0.5 * dt;
-    T wz = a2 * 0.5 * dt;
-    T qw = Q0 - wx * Q1 - wy * Q2 - wz * Q3;
-    T qx = Q1 + wx * Q0 + wy * Q3 - wz * Q2;
-    T qy = Q2 + wy * Q0 + wz * Q1 - wx * Q3;
-    T qz = Q3 + wz * Q0 + wx * Q2 - wy * Q1;
+    SOFTGYM_QUAT_TURN(T, a0, a1, a2, Q0, Q1, Q2, Q3, dt);
     T nw, nx, ny, nz;
     const T zero = {0.0}, one = zero + 1.0;
 /* lanes of a where m is set (all bits of a lane), else of b */
@@ -42,9 +37,7 @@ SOFTGYM_ALWAYS_INLINE int SOFTGYM_OB_NAME(const int seed, Py_ssize_t i, double d
     } while (0)
     T pick_;
     if (seed == 2) {
-        T s = qw * qw + qx * qx + qy * qy + qz * qz;
-        T y = 1.5 - 0.5 * s;
-        y = y * (1.5 - (0.5 * s) * (y * y));
+        SOFTGYM_QUAT_NEWTON(T);
         TI out = (SOFTGYM_OB_ABS(s - 1.0) > SOFTGYM_QUAT_NEWTON_TOL) | (s != s);
         if (SOFTGYM_OB_ANY(out))
             return 0;
@@ -65,7 +58,7 @@ SOFTGYM_ALWAYS_INLINE int SOFTGYM_OB_NAME(const int seed, Py_ssize_t i, double d
         SOFTGYM_OB_PICK(nz0, qz * inv, qz);
         nz = pick_;
     } else {
-        T nq = 1.5 - 0.5 * (qw * qw + qx * qx + qy * qy + qz * qz);
+        SOFTGYM_QUAT_COROT(T);
         nw = qw * nq;
         nx = qx * nq;
         ny = qy * nq;
