@@ -2,7 +2,7 @@
 
 Where a build has them (``softgym.engine._integrate.vector_blocks``: AVX-512 steps 8
 voxels at a time in its voxel rows; AVX2 4 and the portable x86-64 build's SSE2 2, on
-the records), the seed model's voxel update and both models' orientation steps run
+the records), both models' voxel updates and orientation steps run
 blocks of voxels in vector lanes, and leave to the scalar loops the rest: a block with
 a fixed voxel, one where a voxel runs away, one whose quaternion needs the exact
 renormalisation, the robot's last voxels. ``set_vector_blocks(False)`` runs the scalar
@@ -66,12 +66,14 @@ for model, precision in (("seed", "single"), ("seed", "double"), ("corotational"
         differ += not np.array_equal(a[key], b[key], equal_nan=True)
 _integrate.set_vector_blocks(True)
 blocks = _integrate.vector_blocks()
-print(kernel_build(), blocks["seed_voxels"], blocks["orientation"], differ, arrays)
+print(kernel_build(), blocks["seed_voxels"], blocks["corotational_voxels"], blocks["orientation"],
+      differ, arrays)
 """
 
-# the lanes each build's blocks have on x86-64 (seed voxel update, orientation step on
-# the records: the AVX-512 build steps the orientations in its voxel rows)
-LANES = {"baseline": (2, 2), "x86-64-v3": (4, 4), "x86-64-v4": (8, 0)}
+# the lanes each build's blocks have on x86-64 (the seed and corotational voxel updates,
+# the orientation step on the records: the AVX-512 build steps the orientations in its
+# voxel rows)
+LANES = {"baseline": (2, 2, 2), "x86-64-v3": (4, 4, 4), "x86-64-v4": (8, 8, 0)}
 
 
 @pytest.mark.parametrize("kernel", available_kernels())
@@ -80,9 +82,9 @@ def test_the_vector_blocks_give_the_scalar_loops_bits(kernel):
     res = subprocess.run([sys.executable, "-c", CHILD], capture_output=True, text=True,
                          env=env, timeout=300)  # fmt: skip
     assert res.returncode == 0, res.stderr[-2000:]
-    name, voxel_lanes, orient_lanes, differ, arrays = res.stdout.split()
+    name, *lanes, differ, arrays = res.stdout.split()
     assert name == kernel
     if platform.machine().lower() in ("x86_64", "amd64"):
-        assert (int(voxel_lanes), int(orient_lanes)) == LANES[kernel]
+        assert tuple(int(n) for n in lanes) == LANES[kernel]
     assert int(arrays) > 0
     assert int(differ) == 0, f"{differ} of {arrays} state arrays differ with the blocks off"

@@ -1,7 +1,7 @@
 /* Both models' voxel updates (softgym/engine/_integrate.pyx, integrate_seed and
-   integrate_corotational) for 8 voxels at once, in the lanes of AVX-512 (and the seed
-   model's for 4 in the lanes of AVX2: below, softgym_seed_voxels4): the same IEEE
-   operations as the scalar loop, lane by lane, each expression written in the scalar
+   integrate_corotational) for 8 voxels at once, in the lanes of AVX-512 (and for 4 in
+   the lanes of AVX2 and 2 in SSE2's, on the records: below, softgym_voxels_block.h): the
+   same IEEE operations as the scalar loop, lane by lane, each expression written in the scalar
    code's shape (so the build fuses the same multiply-adds), the seed's floor with every
    branch computed and one selected. The positions, velocities, angular velocities and
    external forces come from the voxel rows (the step loops' state in these builds), the
@@ -285,13 +285,13 @@ static int softgym_corot_voxels8(SOFTGYM_VOXELS8_PARAMS)
 }
 #elif defined(__AVX2__) && defined(__FMA__) && (defined(__GNUC__) || defined(__clang__))
 /* The AVX2 build (x86-64-v3), whose step loops keep the voxels' state in their records:
-   the seed model's voxel update for 4 voxels in the lanes of AVX2
+   both models' voxel updates for 4 voxels in the lanes of AVX2
    (softgym_voxels_block.h), the records turned into rows of 4 lanes and back by shuffles,
    the force and moment as the float rows of the single-precision links (Batch.link_f)
-   widened, or the double rows transposed; the corotational model keeps its scalar loop */
+   widened, or the double rows transposed; both models */
 #define SOFTGYM_VOXELS8 1
 #define SOFTGYM_VOXEL_BLOCK 4
-#define SOFTGYM_VOXEL_BLOCK_COROT 0
+#define SOFTGYM_VOXEL_BLOCK_COROT 1
 
 /* the force (a = force + SOFTGYM_FM_STRIDE i) or moment columns of voxels i..i+3 as rows,
    or with lf their float rows (lfs apart) widened (exactly) */
@@ -341,7 +341,7 @@ static inline int softgym_none4(const signed char *f)
     memcpy(&w, f, sizeof w);
     return w == 0;
 }
-#define SOFTGYM_VB_NAME softgym_seed_voxels4
+#define SOFTGYM_VB_NAME softgym_voxels4
 #define SOFTGYM_VB_T softgym_v4
 #define SOFTGYM_VB_LANES 4
 #define SOFTGYM_VB_LOAD3 softgym_v4_load3
@@ -353,6 +353,9 @@ static inline int softgym_none4(const signed char *f)
 #define SOFTGYM_VB_NLE(a, b) SOFTGYM_VB_CMP_(a, b, _CMP_NLE_UQ)
 #define SOFTGYM_VB_EQ(a, b) SOFTGYM_VB_CMP_(a, b, _CMP_EQ_OQ)
 #define SOFTGYM_VB_LT(a, b) SOFTGYM_VB_CMP_(a, b, _CMP_LT_OQ)
+#define SOFTGYM_VB_GT(a, b) SOFTGYM_VB_CMP_(a, b, _CMP_GT_OQ)
+#define SOFTGYM_VB_LE(a, b) SOFTGYM_VB_CMP_(a, b, _CMP_LE_OQ)
+#define SOFTGYM_VB_GE(a, b) SOFTGYM_VB_CMP_(a, b, _CMP_GE_OQ)
 #define SOFTGYM_VB_AND(a, b) ((softgym_v4)_mm256_and_pd((__m256d)(a), (__m256d)(b)))
 #define SOFTGYM_VB_OR(a, b) ((softgym_v4)_mm256_or_pd((__m256d)(a), (__m256d)(b)))
 #define SOFTGYM_VB_ANDNOT(a, b) ((softgym_v4)_mm256_andnot_pd((__m256d)(a), (__m256d)(b)))
@@ -371,11 +374,11 @@ static inline int softgym_none4(const signed char *f)
 #elif defined(__SSE2__) && !defined(__AVX__) && !defined(__FMA__) && \
     (defined(__GNUC__) || defined(__clang__))
 /* The portable x86-64 build (SSE2, no fused multiply-adds: neither here nor in the scalar
-   loop): the seed model's voxel update for 2 voxels in the lanes of SSE2
-   (softgym_voxels_block.h); the corotational model keeps its scalar loop */
+   loop): both models' voxel updates for 2 voxels in the lanes of SSE2
+   (softgym_voxels_block.h), both models */
 #define SOFTGYM_VOXELS8 1
 #define SOFTGYM_VOXEL_BLOCK 2
-#define SOFTGYM_VOXEL_BLOCK_COROT 0
+#define SOFTGYM_VOXEL_BLOCK_COROT 1
 /* the force (a = force + SOFTGYM_FM_STRIDE i) or moment columns of voxels i, i+1 as rows,
    or with lf their float rows (lfs apart) widened (exactly) */
 static inline __m128d softgym_v2_floats(const float *p)
@@ -420,7 +423,7 @@ static inline int softgym_none2(const signed char *f)
     memcpy(&w, f, sizeof w);
     return w == 0;
 }
-#define SOFTGYM_VB_NAME softgym_seed_voxels2
+#define SOFTGYM_VB_NAME softgym_voxels2
 #define SOFTGYM_VB_T softgym_v2
 #define SOFTGYM_VB_LANES 2
 #define SOFTGYM_VB_LOAD3 softgym_v2_load3
@@ -431,6 +434,9 @@ static inline int softgym_none2(const signed char *f)
 #define SOFTGYM_VB_NLE(a, b) ((softgym_v2)_mm_cmpnle_pd((__m128d)(a), (__m128d)(b)))
 #define SOFTGYM_VB_EQ(a, b) ((softgym_v2)_mm_cmpeq_pd((__m128d)(a), (__m128d)(b)))
 #define SOFTGYM_VB_LT(a, b) ((softgym_v2)_mm_cmplt_pd((__m128d)(a), (__m128d)(b)))
+#define SOFTGYM_VB_GT(a, b) ((softgym_v2)_mm_cmpgt_pd((__m128d)(a), (__m128d)(b)))
+#define SOFTGYM_VB_LE(a, b) ((softgym_v2)_mm_cmple_pd((__m128d)(a), (__m128d)(b)))
+#define SOFTGYM_VB_GE(a, b) ((softgym_v2)_mm_cmpge_pd((__m128d)(a), (__m128d)(b)))
 #define SOFTGYM_VB_AND(a, b) ((softgym_v2)_mm_and_pd((__m128d)(a), (__m128d)(b)))
 #define SOFTGYM_VB_OR(a, b) ((softgym_v2)_mm_or_pd((__m128d)(a), (__m128d)(b)))
 #define SOFTGYM_VB_ANDNOT(a, b) ((softgym_v2)_mm_andnot_pd((__m128d)(a), (__m128d)(b)))
@@ -450,15 +456,16 @@ static inline int softgym_none2(const signed char *f)
 #endif
 
 /* the entry _integrate.pyx calls: model 0 (seed = 1) or 1's block of SOFTGYM_VOXEL_BLOCK
-   voxels from i (the corotational model's only where SOFTGYM_VOXEL_BLOCK_COROT); without
-   AVX2 the scalar loops step every voxel (0) */
+   voxels from i (the corotational model's where SOFTGYM_VOXEL_BLOCK_COROT); without
+   vector blocks the scalar loops step every voxel (0) */
 static inline int softgym_voxels8(int seed, SOFTGYM_VOXELS8_PARAMS)
 {
 #if SOFTGYM_VOXELS8 && SOFTGYM_VOXEL_BLOCK == 8
     return seed ? softgym_seed_voxels8(SOFTGYM_VOXELS8_ARGS)
                 : softgym_corot_voxels8(SOFTGYM_VOXELS8_ARGS);
 #elif SOFTGYM_VOXELS8
-    return seed ? SOFTGYM_VB_NAME(SOFTGYM_VOXELS8_ARGS) : 0;
+    return seed ? SOFTGYM_VB_NAME(1, SOFTGYM_VOXELS8_ARGS)
+                : SOFTGYM_VB_NAME(0, SOFTGYM_VOXELS8_ARGS);
 #else
     (void)seed;
     return 0;
