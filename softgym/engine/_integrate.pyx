@@ -145,10 +145,11 @@ cdef inline void _spin(Batch* b, intp_t i, float64_t dt, float64_t mx, float64_t
 
 cdef extern from "softgym_voxels.h":
     # the voxel updates of a block of voxels in vector lanes (both models; AVX-512: 8,
-    # AVX2: 4, SSE2: 2; SOFTGYM_VOXELS8 is 1 where any); 1: stepped, 0: nothing written (a fixed or runaway voxel
-    # among them: the scalar loop steps them). Documented in include/softgym_voxels.h
+    # AVX2: 4, SSE2: 2; SOFTGYM_VOXELS8 is 1 where any); 1: stepped, 0: nothing written
+    # (a fixed or runaway voxel among them: the scalar loop steps them). Documented in
+    # include/softgym_voxels.h
     int SOFTGYM_VOXELS8
-    int SOFTGYM_VOXEL_BLOCK  # the lanes of a block (8: AVX-512, 4: AVX2)
+    int SOFTGYM_VOXEL_BLOCK  # the lanes of a block (8: AVX-512, 4: AVX2, 2: SSE2)
     int SOFTGYM_VOXEL_BLOCK_COROT  # whether the corotational model has blocks
     int voxels8 "softgym_voxels8" (
         int seed, intp_t i, intp_t vs, float64_t dt, float64_t g, int has_floor,
@@ -166,9 +167,8 @@ cdef inline intp_t _scalar_run(Batch* b, intp_t r, intp_t* lo, int seed, const f
                                float64_t* c, float64_t* dmax,
                                float64_t* vmax2) noexcept nogil:
     # The voxel updates' schedule from voxel lo[0] on: blocks of SOFTGYM_VOXEL_BLOCK go to
-    # the vector lanes while they take them (where the build has them and the robot has
-    # no fluid and no
-    # terrain box; lo[0] moves past each block stepped; the block from the robot's first
+    # the vector lanes while they take them (where the build has them, set_vector_blocks
+    # left them on, and the robot has no fluid and no terrain box; lo[0] moves past each block stepped; the block from the robot's first
     # voxel sets c, the drift reference's offset, as the scalar loop would); returns the
     # end of the run the scalar loop must do from lo[0]: a block the lanes left (a fixed
     # or runaway voxel), or the rest

@@ -317,7 +317,6 @@ static void softgym_orient_store(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, dou
 #if defined(__AVX__) && !defined(__AVX512F__) && (defined(__GNUC__) || defined(__clang__))
 #define SOFTGYM_ORIENT_BLOCK 4
 #define SOFTGYM_OB_NAME softgym_orient4
-#define SOFTGYM_ORIENT_BLOCK_FN softgym_orient4
 #define SOFTGYM_OB_T softgym_v4
 #define SOFTGYM_OB_TI softgym_v4i
 #define SOFTGYM_OB_ANY(m) (_mm256_movemask_pd((__m256d)(m)) != 0)
@@ -366,7 +365,6 @@ static void softgym_orient_store(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, dou
 #elif defined(__SSE2__) && !defined(__AVX__) && (defined(__GNUC__) || defined(__clang__))
 #define SOFTGYM_ORIENT_BLOCK 2
 #define SOFTGYM_OB_NAME softgym_orient2
-#define SOFTGYM_ORIENT_BLOCK_FN softgym_orient2
 #define SOFTGYM_OB_T softgym_v2
 #define SOFTGYM_OB_TI softgym_v2i
 #define SOFTGYM_OB_ANY(m) (_mm_movemask_pd((__m128d)(m)) != 0)
@@ -424,7 +422,7 @@ SOFTGYM_ALWAYS_INLINE void softgym_orient_records_impl(const int seed, Py_ssize_
         int any_fixed = 0;
         for (int k = 0; k < B; k++)
             any_fixed |= fixed[i + k];
-        if (!any_fixed && SOFTGYM_ORIENT_BLOCK_FN(seed, i, dt, av, quat, rot))
+        if (!any_fixed && SOFTGYM_OB_NAME(seed, i, dt, av, quat, rot))
             continue;
         softgym_quats_impl(seed, i, i + B, n, dt, av, av + 1, av + 2, 3, quat, 4, 1, q_out);
         softgym_orient_store(i, i + B, n, q_out, fixed, quat, rot);

@@ -14,7 +14,9 @@
    (av) and renormalised as softgym_quats_impl's seed (a compile-time constant where
    inlined), stored in place, and their rotation matrices into rot (rot NULL: none).
    Returns 0, with nothing stored, where the seed's Newton steps leave a lane to the
-   exact renormalisation (softgym_quats_impl's "far"). No include guard, on purpose. */
+   exact renormalisation (softgym_quats_impl's "far"). SOFTGYM_OB_NAME stays defined
+   (softgym_orient_records calls it); the operations are undefined at the end. No include
+   guard, on purpose. */
 SOFTGYM_ALWAYS_INLINE int SOFTGYM_OB_NAME(const int seed, Py_ssize_t i, double dt,
                                           const double *av, double *quat, double *rot)
 {
@@ -86,7 +88,6 @@ SOFTGYM_ALWAYS_INLINE int SOFTGYM_OB_NAME(const int seed, Py_ssize_t i, double d
     }
     return 1;
 }
-#undef SOFTGYM_OB_NAME
 #undef SOFTGYM_OB_T
 #undef SOFTGYM_OB_TI
 #undef SOFTGYM_OB_ANY
