@@ -243,9 +243,10 @@ cdef int advance_robot(Batch* b, intp_t r, step_t target, Contacts* c) noexcept 
         status = _advance_seed(b, r, target, c)
     else:
         status = _advance_corotational(b, r, target, c)
-    # the rotation matrices, where the AVX-512 steps leave them (neither model's reads
-    # them: the seed's scatter takes voxel 1's from its geometry, the corotational links
-    # rows computed from the quaternions): up to date whenever the kernel returns
+    # the rotation matrices, where the steps leave them (_integrate.rotations_deferred: the
+    # AVX-512 builds, whose seed scatter takes voxel 1's from its geometry and corotational
+    # links rows computed from the quaternions; the seed model's single-precision links in
+    # every build): up to date whenever the kernel returns
     refresh_robot_rotations(b, r)
     return status
 

@@ -7,8 +7,8 @@ from softgym.engine._typedefs cimport float64_t, intp_t
 cdef int integrate_corotational(Batch* b, intp_t r, const float64_t* ref,
                                 float64_t* dmax2) noexcept nogil
     # model 1. IN: force, moment (cleared on the way). OUT: pos, vel, quat,
-    # angvel, and rot unless the build's steps do not read it (SOFTGYM_ROT_DEFERRED:
-    # then refresh_robot_rotations when the step loop returns); dmax2: the largest squared displacement from ref (the
+    # angvel, and rot unless the steps do not read it (rotations_deferred: then
+    # refresh_robot_rotations when the step loop returns); dmax2: the largest squared displacement from ref (the
     # positions of the last candidate rebuild, NULL: none). Returns a STATUS_*.
 cdef int integrate_seed(Batch* b, intp_t r, const float64_t* ref,
                         float64_t* dmax2) noexcept nogil
@@ -31,8 +31,13 @@ cdef void voxel_link_rows(Batch* b, intp_t r, int seed) noexcept nogil
 cdef void voxel_state_leave(Batch* b, intp_t r) noexcept nogil
     # when the step loop returns: robot r's pos, quat, vel and angvel from the voxel rows
     # where voxel_state_enter put its state there; b.state_rows cleared
+cdef bint rotations_deferred(const Batch* b) noexcept nogil
+    # whether the step loops leave b.rot to refresh_robot_rotations: no step reads it in
+    # the AVX-512 builds (SOFTGYM_ROT_DEFERRED), nor in the seed model's with
+    # single-precision links in any build (their push turns the forces with the
+    # geometry's float rows of voxel 1's rotation: include/softgym_seed.h)
 cdef void refresh_robot_rotations(Batch* b, intp_t r) noexcept nogil
-    # robot r's rot from its quat where the voxel updates leave it
-    # (SOFTGYM_ROT_DEFERRED; else nothing)
+    # robot r's rot from its quat where the voxel updates leave it (rotations_deferred;
+    # else nothing)
 cdef void clear_robot(Batch* b, intp_t r) noexcept nogil
     # zero robot r's force and moment scratch (before its steps, after an early exit)

@@ -10,7 +10,8 @@
 from libc.math cimport fabs, sqrt
 from libc.string cimport memset
 
-from softgym.engine._batch cimport Batch, STATUS_OK, STATUS_NONFINITE, SOFTGYM_FM_STRIDE
+from softgym.engine._batch cimport (Batch, MODEL_SEED, STATUS_OK, STATUS_NONFINITE,
+                                   SOFTGYM_FM_STRIDE)
 from softgym.engine._contact cimport surface_contact, box_penetration, seed_floor
 from softgym.engine._prof cimport softgym_prof_tsc, softgym_prof_add, prof_counts
 from softgym.engine._typedefs cimport float64_t, intp_t, int32, flag_t
@@ -330,7 +331,7 @@ cdef inline void _orient(Batch* b, intp_t lo, intp_t hi, float64_t dt, const int
     # from the records to the records (the rotation matrices: refresh_robot_rotations,
     # where the step does not read them)
     softgym_orient_records(lo, hi, n, dt, b.fixed, b.angvel, b.quat, qo,
-                           NULL if SOFTGYM_ROT_DEFERRED else b.rot,
+                           NULL if rotations_deferred(b) else b.rot,
                            (2 if b.link_f32 else 1) if seed else 0, _vector_blocks)
 
 
@@ -376,10 +377,16 @@ cdef void voxel_state_leave(Batch* b, intp_t r) noexcept nogil:
     b.state_rows = NULL
 
 
+cdef bint rotations_deferred(const Batch* b) noexcept nogil:
+    # whether the step loop leaves the rotation matrices (b.rot) to refresh_robot_rotations
+    # (_integrate.pxd)
+    return SOFTGYM_ROT_DEFERRED or (b.model == MODEL_SEED and b.link_f32)
+
+
 cdef void refresh_robot_rotations(Batch* b, intp_t r) noexcept nogil:
     # robot r's rotation matrices from its quaternions (where the step leaves them)
     cdef intp_t i
-    if not SOFTGYM_ROT_DEFERRED:
+    if not rotations_deferred(b):
         return
     for i in range(b.vox_start[r], b.vox_start[r + 1]):
         _rotation_matrix(b.quat + 4 * i, b.rot + 9 * i)
