@@ -1591,6 +1591,221 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_16(const int ax, const int full, 
         softgym_seed_push32_links(ax, 2, li, hi, v1, v2, rf, of, neg2_row, lf, lfs);
 }
 #undef SOFTGYM_TURN16
+#elif defined(__AVX2__) && defined(__FMA__) && (defined(__GNUC__) || defined(__clang__))
+#define SOFTGYM_PUSH8 1
+/* The AVX2 builds' push: a block of 16 links as two halves of 8 float lanes (AVX2 has no
+   expand or masked permute; its permute takes one register of 8). */
+/* entry m, byte k: the number of set bits of m below bit k (a window's voxel k takes the
+   link in lane `before` + that, where bit k of m is set) */
+#define SOFTGYM_RANK1(m, k) ((unsigned char)__builtin_popcount((unsigned)(m) & ((1u << (k)) - 1u)))
+#define SOFTGYM_RANK8(m) {SOFTGYM_RANK1(m, 0), SOFTGYM_RANK1(m, 1), SOFTGYM_RANK1(m, 2), \
+                          SOFTGYM_RANK1(m, 3), SOFTGYM_RANK1(m, 4), SOFTGYM_RANK1(m, 5), \
+                          SOFTGYM_RANK1(m, 6), SOFTGYM_RANK1(m, 7)}
+#define SOFTGYM_RANK32(m) SOFTGYM_RANK8(m), SOFTGYM_RANK8((m) + 1), SOFTGYM_RANK8((m) + 2), \
+    SOFTGYM_RANK8((m) + 3), SOFTGYM_RANK8((m) + 4), SOFTGYM_RANK8((m) + 5), \
+    SOFTGYM_RANK8((m) + 6), SOFTGYM_RANK8((m) + 7)
+static const unsigned char softgym_rank8[256][8] __attribute__((aligned(64))) = {
+    SOFTGYM_RANK32(0), SOFTGYM_RANK32(8), SOFTGYM_RANK32(16), SOFTGYM_RANK32(24),
+    SOFTGYM_RANK32(32), SOFTGYM_RANK32(40), SOFTGYM_RANK32(48), SOFTGYM_RANK32(56),
+    SOFTGYM_RANK32(64), SOFTGYM_RANK32(72), SOFTGYM_RANK32(80), SOFTGYM_RANK32(88),
+    SOFTGYM_RANK32(96), SOFTGYM_RANK32(104), SOFTGYM_RANK32(112), SOFTGYM_RANK32(120),
+    SOFTGYM_RANK32(128), SOFTGYM_RANK32(136), SOFTGYM_RANK32(144), SOFTGYM_RANK32(152),
+    SOFTGYM_RANK32(160), SOFTGYM_RANK32(168), SOFTGYM_RANK32(176), SOFTGYM_RANK32(184),
+    SOFTGYM_RANK32(192), SOFTGYM_RANK32(200), SOFTGYM_RANK32(208), SOFTGYM_RANK32(216),
+    SOFTGYM_RANK32(224), SOFTGYM_RANK32(232), SOFTGYM_RANK32(240), SOFTGYM_RANK32(248)};
+#undef SOFTGYM_RANK32
+#undef SOFTGYM_RANK8
+#undef SOFTGYM_RANK1
+/* (x, y, z) of the bond frame turned to the world in 8 lanes: w[c] for c = 0..2, the
+   multiply-adds of softgym_seed_push32_links's SOFTGYM_TURN32 (fmaf: the same roundings) */
+#define SOFTGYM_TURN8(R, x, y, z, w) do { \
+        for (int c_ = 0; c_ < 3; c_++) \
+            (w)[c_] = _mm256_fmadd_ps((R)[3 * c_ + 2], (z), \
+                                      _mm256_fmadd_ps((R)[3 * c_ + 1], (y), \
+                                                      _mm256_mul_ps((R)[3 * c_], (x)))); \
+    } while (0)
+/* one side of the 8 links li..li + 7 turned: w[0..5] (force x, y, z, moment x, y, z), the
+   lanes from nl on (nl < 8: a run's last block) taken from the rows' padding (never added:
+   softgym_push8x2) */
+SOFTGYM_ALWAYS_INLINE void softgym_seed_turn8(const int ax, const int side, Py_ssize_t li,
+                                              int nl, const float *rf, const float *of,
+                                              const double *neg2_row, __m256 *w)
+{
+    const Py_ssize_t fs = SOFTGYM_CHUNK_FSTRIDE;
+    const float *q = of + li;
+    __m256 R[9], a[3], m[3];
+    for (int k = 0; k < 9; k++)
+        R[k] = _mm256_loadu_ps(rf + k * fs + li);
+    if (ax != 0) {
+        const __m256 sign = _mm256_set1_ps(-0.0f);
+        R[0] = _mm256_xor_ps(R[0], sign);
+        R[3] = _mm256_xor_ps(R[3], sign);
+        R[6] = _mm256_xor_ps(R[6], sign);
+    }
+    if (side == 1) {
+        for (int c = 0; c < 3; c++) {
+            a[c] = _mm256_loadu_ps(q + c * fs);
+            m[c] = _mm256_loadu_ps(q + (6 + c) * fs);
+        }
+    } else {
+        /* -f1 in the lanes whose row 23 is not 0.0 (1.0: voxel 2 takes -F1), else f2 */
+        __m256d n_lo, n_hi;
+        if (nl == 8) {
+            n_lo = _mm256_loadu_pd(neg2_row + li);
+            n_hi = _mm256_loadu_pd(neg2_row + li + 4);
+        } else {
+            const __m256i lane = _mm256_set_epi64x(3, 2, 1, 0);
+            n_lo = _mm256_maskload_pd(neg2_row + li,
+                                      _mm256_cmpgt_epi64(_mm256_set1_epi64x(nl), lane));
+            n_hi = _mm256_maskload_pd(neg2_row + li + 4,
+                                      _mm256_cmpgt_epi64(_mm256_set1_epi64x(nl - 4), lane));
+        }
+        /* the two halves' 64-bit conditions as 32-bit lanes: lanes 0-3's from the even
+           halves of the first, 4-7's from the odd halves of the second, put in order */
+        const __m256d zero = _mm256_setzero_pd();
+        __m256 neg2 = _mm256_permutevar8x32_ps(
+            _mm256_blend_ps(_mm256_castpd_ps(_mm256_cmp_pd(n_lo, zero, _CMP_NEQ_UQ)),
+                            _mm256_castpd_ps(_mm256_cmp_pd(n_hi, zero, _CMP_NEQ_UQ)), 0xAA),
+            _mm256_set_epi32(7, 5, 3, 1, 6, 4, 2, 0));
+        for (int c = 0; c < 3; c++) {
+            __m256 f1 = _mm256_loadu_ps(q + c * fs);
+            a[c] = _mm256_blendv_ps(_mm256_loadu_ps(q + (3 + c) * fs),
+                                    _mm256_xor_ps(f1, _mm256_set1_ps(-0.0f)), neg2);
+            m[c] = _mm256_loadu_ps(q + (9 + c) * fs);
+        }
+    }
+    SOFTGYM_TURN8(R, a[ax], ax == 1 ? a[0] : a[1], ax == 2 ? a[0] : a[2], w);
+    SOFTGYM_TURN8(R, m[ax], ax == 1 ? m[0] : m[1], ax == 2 ? m[0] : m[2], w + 3);
+}
+#undef SOFTGYM_TURN8
+/* the voxels idx[0..nl) of a block's side (1 <= nl <= 16) placed: 2 where they are
+   consecutive (a run from idx[0]); else 1 where they rise strictly and lie within the 4
+   windows of 8 from base, with bit idx[k] - base of *mask set for each; else 0 (the layout's
+   links along an axis rise, by voxel: a guard, never 0 for a lattice's links). In four
+   groups of 4 lanes of 64 bits (the lanes from nl on masked off) */
+SOFTGYM_ALWAYS_INLINE int softgym_place16(const Py_ssize_t *idx, int nl, Py_ssize_t base,
+                                          unsigned int *mask)
+{
+    const __m256i four = _mm256_set1_epi64x(4), one = _mm256_set1_epi64x(1);
+    const __m256i vnl = _mm256_set1_epi64x(nl), first = _mm256_set1_epi64x(idx[0]);
+    __m256i lane = _mm256_set_epi64x(3, 2, 1, 0), x[5], valid[4];
+    __m256i off = _mm256_setzero_si256();
+    for (int g = 0; g < 4; g++) {
+        valid[g] = _mm256_cmpgt_epi64(vnl, lane);
+        x[g] = _mm256_maskload_epi64((const long long *)(idx + 4 * g), valid[g]);
+        off = _mm256_or_si256(off, _mm256_andnot_si256(
+                                       _mm256_cmpeq_epi64(x[g], _mm256_add_epi64(first, lane)),
+                                       valid[g]));
+        lane = _mm256_add_epi64(lane, four);
+    }
+    if (_mm256_testz_si256(off, off))
+        return 2;
+    if (idx[nl - 1] - base >= 32)
+        return 0;
+    /* lane k below lane k + 1 where k + 1 < nl, and each lane's bit */
+    const __m256i vbase = _mm256_set1_epi64x(base);
+    __m256i down = _mm256_setzero_si256(), bits = _mm256_setzero_si256();
+    x[4] = x[3];
+    lane = _mm256_set_epi64x(4, 3, 2, 1);
+    for (int g = 0; g < 4; g++) {
+        __m256i next = _mm256_blend_epi32(_mm256_permute4x64_epi64(x[g], _MM_SHUFFLE(3, 3, 2, 1)),
+                                          _mm256_permute4x64_epi64(x[g + 1], 0), 0xC0);
+        down = _mm256_or_si256(down, _mm256_andnot_si256(_mm256_cmpgt_epi64(next, x[g]),
+                                                         _mm256_cmpgt_epi64(vnl, lane)));
+        bits = _mm256_or_si256(bits, _mm256_and_si256(
+                                         _mm256_sllv_epi64(one, _mm256_sub_epi64(x[g], vbase)),
+                                         valid[g]));
+        lane = _mm256_add_epi64(lane, four);
+    }
+    if (!_mm256_testz_si256(down, down))
+        return 0;
+    __m128i b2 = _mm_or_si128(_mm256_castsi256_si128(bits), _mm256_extracti128_si256(bits, 1));
+    *mask = (unsigned int)(_mm_cvtsi128_si64(b2) | _mm_extract_epi64(b2, 1));
+    return 1;
+}
+/* w (the turned rows of the links in lanes 0..nl - 1: lanes 0-7 in wl, 8-15 in wh) added
+   to the float rows of their voxels idx[0..nl - 1]: a run of consecutive voxels in one
+   unaligned read-add-write a half and a row (lanes past nl add +0.0: a sum of floats that
+   starts at +0.0 is never -0.0, so adding +0.0 leaves it as it is); else voxels that rise
+   in aligned windows of 8 (lf's rows start on lines, lfs a multiple of 16): a window's
+   lanes are the links' lanes permuted to their voxels (the ranks of its voxels among the
+   block's, softgym_rank8), +0.0 where no link of the block has its voxel, and one
+   read-add-write a row. Every voxel of a side takes one link at most, so each voxel's sum
+   is the one of softgym_seed_push32_links, bit for bit. Returns 0 (nothing added) where
+   softgym_place16 does */
+SOFTGYM_ALWAYS_INLINE int softgym_push8x2(const __m256 *wl, const __m256 *wh,
+                                          const Py_ssize_t *idx, int nl, float *lf,
+                                          Py_ssize_t lfs)
+{
+    Py_ssize_t base = idx[0] - (Py_ssize_t)(((uintptr_t)(lf + idx[0]) & 31) / sizeof(float));
+    unsigned int mask = 0;
+    int place = softgym_place16(idx, nl, base, &mask);
+    if (place == 0)
+        return 0;
+    if (place == 2) {
+        float *p = lf + idx[0];
+        const __m256i lane = _mm256_set_epi32(7, 6, 5, 4, 3, 2, 1, 0);
+        if (nl >= 8) {
+            for (int k = 0; k < 6; k++)
+                _mm256_storeu_ps(p + k * lfs, _mm256_add_ps(_mm256_loadu_ps(p + k * lfs), wl[k]));
+            if (nl > 8) {
+                __m256 keep = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(nl - 8), lane));
+                for (int k = 0; k < 6; k++)
+                    _mm256_storeu_ps(p + 8 + k * lfs,
+                                     _mm256_add_ps(_mm256_loadu_ps(p + 8 + k * lfs),
+                                                   _mm256_and_ps(wh[k], keep)));
+            }
+        } else {
+            __m256 keep = _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(nl), lane));
+            for (int k = 0; k < 6; k++)
+                _mm256_storeu_ps(p + k * lfs, _mm256_add_ps(_mm256_loadu_ps(p + k * lfs),
+                                                            _mm256_and_ps(wl[k], keep)));
+        }
+        return 1;
+    }
+    const __m256i bit = _mm256_set_epi32(128, 64, 32, 16, 8, 4, 2, 1);
+    __m256i before = _mm256_setzero_si256();
+    for (int win = 0; win < 4 && (mask >> (8 * win)) != 0; win++) {
+        unsigned int m = (mask >> (8 * win)) & 0xFFu;
+        __m128i r8 = _mm_loadl_epi64((const __m128i *)softgym_rank8[m]);
+        __m256i rank = _mm256_add_epi32(_mm256_cvtepu8_epi32(r8), before);
+        before = _mm256_add_epi32(before, _mm256_set1_epi32(__builtin_popcount(m)));
+        /* lanes 8-15 (bit 3 of the rank) from wh: the sign bit for blendv */
+        __m256 hi = _mm256_castsi256_ps(_mm256_slli_epi32(rank, 28));
+        __m256 has = _mm256_castsi256_ps(
+            _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32((int)m), bit), bit));
+        float *p = lf + base + 8 * win;
+        for (int k = 0; k < 6; k++) {
+            __m256 v = _mm256_blendv_ps(_mm256_permutevar8x32_ps(wl[k], rank),
+                                        _mm256_permutevar8x32_ps(wh[k], rank), hi);
+            _mm256_store_ps(p + k * lfs, _mm256_add_ps(_mm256_load_ps(p + k * lfs),
+                                                       _mm256_and_ps(v, has)));
+        }
+    }
+    return 1;
+}
+/* the block of links li..hi (at most 16: all a block's, or a run's last few), both sides,
+   in two halves of 8 lanes (rf: the geometry's float rows); a side whose voxels
+   softgym_push8x2 leaves goes link by link */
+SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_8x2(const int ax, Py_ssize_t li, Py_ssize_t hi,
+                                                   const Py_ssize_t *v1, const Py_ssize_t *v2,
+                                                   const float *rf, const float *of,
+                                                   const double *neg2_row, float *lf,
+                                                   Py_ssize_t lfs)
+{
+    const int nl = (int)(hi - li);
+    __m256 wl[6], wh[6];
+    for (int side = 1; side <= 2; side++) {
+        softgym_seed_turn8(ax, side, li, nl < 8 ? nl : 8, rf, of, neg2_row, wl);
+        if (nl > 8)
+            softgym_seed_turn8(ax, side, li + 8, nl - 8, rf, of, neg2_row, wh);
+        else
+            for (int k = 0; k < 6; k++)
+                wh[k] = _mm256_setzero_ps();
+        if (!softgym_push8x2(wl, wh, (side == 1 ? v1 : v2) + li, nl, lf, lfs))
+            softgym_seed_push32_links(ax, side, li, hi, v1, v2, rf, of, neg2_row, lf, lfs);
+    }
+}
 #endif
 SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
                                                   const Py_ssize_t *v1, const Py_ssize_t *v2,
@@ -1607,6 +1822,8 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_ax(const int ax, Py_ssize_t lo, P
         else
             softgym_seed_push32_16(ax, 0, li, (__mmask16)((1u << (e - li)) - 1u), v1, v2, rf,
                                    of, neg2_row, lf, lfs);
+#elif defined(SOFTGYM_PUSH8)
+        softgym_seed_push32_8x2(ax, li, e, v1, v2, rf, of, neg2_row, lf, lfs);
 #else
         softgym_seed_push32_links(ax, 1, li, e, v1, v2, rf, of, neg2_row, lf, lfs);
         softgym_seed_push32_links(ax, 2, li, e, v1, v2, rf, of, neg2_row, lf, lfs);
