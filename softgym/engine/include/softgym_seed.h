@@ -517,6 +517,21 @@ static inline int softgym_all_nonzero(const double *row, Py_ssize_t lo, Py_ssize
     for (; li + 8 <= hi; li += 8)
         if (_mm512_cmp_pd_mask(_mm512_loadu_pd(row + li), _mm512_setzero_pd(), _CMP_EQ_OQ))
             return 0;
+#elif defined(__AVX__)
+    /* the same, 8 at a time in two compares (the scalar loop, a load and two branches a
+       link, took about 3 % of the AVX2 build's step) */
+    const __m256d zero = _mm256_setzero_pd();
+    for (; li + 8 <= hi; li += 8)
+        if (_mm256_movemask_pd(_mm256_or_pd(
+                _mm256_cmp_pd(_mm256_loadu_pd(row + li), zero, _CMP_EQ_OQ),
+                _mm256_cmp_pd(_mm256_loadu_pd(row + li + 4), zero, _CMP_EQ_OQ))))
+            return 0;
+#elif defined(__SSE2__)
+    const __m128d zero = _mm_setzero_pd();
+    for (; li + 4 <= hi; li += 4)
+        if (_mm_movemask_pd(_mm_or_pd(_mm_cmpeq_pd(_mm_loadu_pd(row + li), zero),
+                                      _mm_cmpeq_pd(_mm_loadu_pd(row + li + 2), zero))))
+            return 0;
 #endif
     for (; li < hi; li++)
         if (!(row[li] != 0.0))
