@@ -122,11 +122,12 @@ def _mixed_geometry(n, seed, small_share=0.4):
 
 
 def test_single_precision_pass_pairs_of_blocks_equal_its_loop():
-    # The float pass takes a chunk's mixed links 32 at a time in paired 16-lane blocks
-    # where the build has AVX-512 (softgym_seed_frames32_x2, its multiply-adds written out)
-    # and the rest in the compiler's loop: a chunk of 64 links goes through the pairs, one
-    # of 28 through the loop. Their results are the same bits, link by link (elsewhere,
-    # and for chunks all in small-angle mode, both are the loop).
+    # The float pass takes a chunk's mixed links in pairs of blocks (softgym_seed_frames32_x2,
+    # its multiply-adds written out: 2 x 16 lanes with AVX-512, 2 x 8 with AVX2) and the
+    # rest in the compiler's loop: a chunk of 64 links goes through the pairs, one of 28
+    # through the loop (AVX-512) or a pair and the loop (AVX2). Their results are the same
+    # bits, link by link (elsewhere, and for chunks all in small-angle mode, both are the
+    # loop).
     for seed in range(4):
         for small_share in (0.4, 1.0):
             geom = _mixed_geometry(64, seed, small_share)

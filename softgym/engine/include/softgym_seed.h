@@ -770,115 +770,61 @@ typedef float softgym_v16f __attribute__((vector_size(64)));
     ((softgym_v16f)_mm512_fmadd_ps((__m512)(a), (__m512)(b), (__m512)(c)))
 #define SOFTGYM_F16_FNMA(a, b, c) \
     ((softgym_v16f)_mm512_fnmadd_ps((__m512)(a), (__m512)(b), (__m512)(c)))
-/* softgym_rotvec_k32_acos(w, w_acos) of 16 lanes (softgym_rotvec_k32's operations lane by lane) */
-#define SOFTGYM_F16_ROTVEC_K(w, w_acos, k) do { \
-        softgym_v16f w2_ = (w) * (w); \
-        softgym_v16f x16_ = SOFTGYM_F16_FMA((w), SOFTGYM_F16_SET(0.0625f), SOFTGYM_F16_SET(0.0625f)); \
-        softgym_v16f e_ = SOFTGYM_F16_FMA( \
-            SOFTGYM_F16_FMA(SOFTGYM_F16_SET(SOFTGYM_RSQ_D3), (w), SOFTGYM_F16_SET(SOFTGYM_RSQ_D2)), \
-            w2_, SOFTGYM_F16_FMA(SOFTGYM_F16_SET(SOFTGYM_RSQ_D1), (w), SOFTGYM_F16_SET(SOFTGYM_RSQ_D0))); \
-        softgym_v16f u_ = SOFTGYM_F16_FNMA(x16_, e_ * e_, SOFTGYM_F16_SET(0.5f)); \
-        softgym_v16f z_ = SOFTGYM_F16_FNMA(SOFTGYM_F16_SET(0.5f), (w), SOFTGYM_F16_SET(0.5f)); \
-        softgym_v16f z2_ = z_ * z_; \
-        softgym_v16f p_ = SOFTGYM_F16_FMA( \
-            SOFTGYM_F16_FMA(SOFTGYM_F16_SET(SOFTGYM_ASIN_P4), z2_, SOFTGYM_F16_FMA( \
-                SOFTGYM_F16_SET(SOFTGYM_ASIN_P3), z_, SOFTGYM_F16_SET(SOFTGYM_ASIN_P2))), \
-            z2_, SOFTGYM_F16_FMA(SOFTGYM_F16_SET(SOFTGYM_ASIN_P1), z_, SOFTGYM_F16_SET(SOFTGYM_ASIN_P0))); \
-        softgym_v16f r_ = SOFTGYM_F16_PICK( \
-            SOFTGYM_F16_CMP((w), SOFTGYM_F16_SET(w_acos), _CMP_LE_OQ), \
-            SOFTGYM_F16_FMA(z_, p_, SOFTGYM_F16_SET(1.0f)), SOFTGYM_F16_SET(1.0f)); \
-        k = SOFTGYM_F16_FMA(e_, u_, e_) * r_; \
+#define SOFTGYM_FP_LANES 16
+#define SOFTGYM_FP_NAME softgym_seed_frames32_x2
+#define SOFTGYM_FP_V softgym_v16f
+#define SOFTGYM_FP_M __mmask16
+#define SOFTGYM_FP_LOAD SOFTGYM_F16_LOAD
+#define SOFTGYM_FP_NONZERO SOFTGYM_F16_NONZERO
+#define SOFTGYM_FP_PICK SOFTGYM_F16_PICK
+#define SOFTGYM_FP_CMP SOFTGYM_F16_CMP
+#define SOFTGYM_FP_SET SOFTGYM_F16_SET
+#define SOFTGYM_FP_FMA SOFTGYM_F16_FMA
+#define SOFTGYM_FP_FNMA SOFTGYM_F16_FNMA
+#define SOFTGYM_FP_SQRT(v) ((softgym_v16f)_mm512_sqrt_ps((__m512)(v)))
+#define SOFTGYM_FP_STORE(p, v) _mm512_storeu_ps((p), (__m512)(v))
+#define SOFTGYM_FP_ANY(m) ((m) != 0)
+#include "softgym_frames_pair.h"
+#elif defined(__AVX2__) && defined(__FMA__) && (defined(__GNUC__) || defined(__clang__))
+#define SOFTGYM_F16_LANES 0
+/* the same two blocks in the 8 lanes of AVX2 (conditions: vectors of ints) */
+typedef float softgym_v8f __attribute__((vector_size(32)));
+typedef int softgym_v8m __attribute__((vector_size(32)));  /* all ones where set */
+#define SOFTGYM_X2(stmt) do { \
+        for (int k_ = 0; k_ < 2; k_++) { \
+            stmt; \
+        } \
     } while (0)
-SOFTGYM_ALWAYS_INLINE int softgym_seed_frames32_x2(
-    Py_ssize_t li, float sa_rad, float w_acos, const double *p0_, const double *p1_,
-    const double *p2_, const double *qw_, const double *n1_, const double *n2_,
-    const double *n3_, const double *P0_, const double *len_, const double *sa_, float *o_P0,
-    float *o_P1, float *o_P2, float *o_a1y, float *o_a1z, float *o_a2x, float *o_a2y, float *o_a2z,
-    float *o_rw, float *o_ry, float *o_rz, float *o_fix)
-{
-    softgym_v16f p0[2], p1[2], p2[2], qw[2], n1[2], n2[2], n3[2];
-    softgym_v16f inv_p0[2], yx[2], zx[2], ry_s[2], rz_s[2], rw_s[2], ln[2], lp[2];
-    softgym_v16f inv_s[2], ch[2], ry_l[2], rz_l[2], rw[2], ry[2], rz[2], k1[2], k2[2];
-    softgym_v16f tw[2], tx[2], ty[2], tz[2], w2[2];
-    __mmask16 is_sa[2], zero[2], small[2], fix[2];
-    const softgym_v16f one = SOFTGYM_F16_SET(1.0f), nil = SOFTGYM_F16_SET(0.0f);
-#define SOFTGYM_L (li + 16 * k_)
-    SOFTGYM_X2(p0[k_] = SOFTGYM_F16_LOAD(p0_ + SOFTGYM_L));
-    SOFTGYM_X2(p1[k_] = SOFTGYM_F16_LOAD(p1_ + SOFTGYM_L));
-    SOFTGYM_X2(p2[k_] = SOFTGYM_F16_LOAD(p2_ + SOFTGYM_L));
-    SOFTGYM_X2(is_sa[k_] = SOFTGYM_F16_NONZERO(sa_, SOFTGYM_L));
-    /* SOFTGYM_CHORD_FRAME */
-    SOFTGYM_X2(zero[k_] = SOFTGYM_F16_CMP(p0[k_], nil, _CMP_EQ_OQ)
-                          & SOFTGYM_F16_CMP(p1[k_], nil, _CMP_EQ_OQ)
-                          & SOFTGYM_F16_CMP(p2[k_], nil, _CMP_EQ_OQ));
-    SOFTGYM_X2(inv_p0[k_] = 1.0f / p0[k_]);
-    SOFTGYM_X2(ln[k_] = SOFTGYM_F16_LOAD(len_ + SOFTGYM_L));
-    SOFTGYM_X2(yx[k_] = p1[k_] * inv_p0[k_]);
-    SOFTGYM_X2(zx[k_] = p2[k_] * inv_p0[k_]);
-    SOFTGYM_X2(lp[k_] = ln[k_] + p0[k_]);
-    SOFTGYM_X2(small[k_] = SOFTGYM_F16_CMP(yx[k_], SOFTGYM_F16_SET(sa_rad), _CMP_LT_OQ)
-                           & SOFTGYM_F16_CMP(yx[k_], SOFTGYM_F16_SET(-sa_rad), _CMP_GT_OQ)
-                           & SOFTGYM_F16_CMP(zx[k_], SOFTGYM_F16_SET(sa_rad), _CMP_LT_OQ)
-                           & SOFTGYM_F16_CMP(zx[k_], SOFTGYM_F16_SET(-sa_rad), _CMP_GT_OQ));
-    SOFTGYM_X2(inv_s[k_] = 1.0f / (softgym_v16f)_mm512_sqrt_ps(
-                   (__m512)(2.0f * ln[k_] * lp[k_])));
-    SOFTGYM_X2(ry_s[k_] = 0.5f * zx[k_]);
-    SOFTGYM_X2(rz_s[k_] = -0.5f * yx[k_]);
-    SOFTGYM_X2(rw_s[k_] = SOFTGYM_F16_FMA(
-                   SOFTGYM_F16_SET(0.5f),
-                   SOFTGYM_F16_FNMA(rz_s[k_], rz_s[k_], -ry_s[k_] * ry_s[k_]), one));
-    SOFTGYM_X2(qw[k_] = SOFTGYM_F16_LOAD(qw_ + SOFTGYM_L));
-    SOFTGYM_X2(n1[k_] = SOFTGYM_F16_LOAD(n1_ + SOFTGYM_L));
-    SOFTGYM_X2(ch[k_] = lp[k_] * inv_s[k_]);
-    SOFTGYM_X2(ry_l[k_] = p2[k_] * inv_s[k_]);
-    SOFTGYM_X2(rz_l[k_] = -p1[k_] * inv_s[k_]);
-    /* fix: a large-angle link (not zero) whose chord points backwards */
-    SOFTGYM_X2(fix[k_] = ~is_sa[k_] & ~zero[k_] & ~small[k_]
-                         & SOFTGYM_F16_CMP(p0[k_], -0.5f * ln[k_], _CMP_LT_OQ));
-    SOFTGYM_X2(rw[k_] = SOFTGYM_F16_PICK(zero[k_], one,
-                                         SOFTGYM_F16_PICK(small[k_], rw_s[k_], ch[k_])));
-    SOFTGYM_X2(ry[k_] = SOFTGYM_F16_PICK(zero[k_], nil,
-                                         SOFTGYM_F16_PICK(small[k_], ry_s[k_], ry_l[k_])));
-    SOFTGYM_X2(rz[k_] = SOFTGYM_F16_PICK(zero[k_], nil,
-                                         SOFTGYM_F16_PICK(small[k_], rz_s[k_], rz_l[k_])));
-    SOFTGYM_X2(n2[k_] = SOFTGYM_F16_LOAD(n2_ + SOFTGYM_L));
-    SOFTGYM_X2(n3[k_] = SOFTGYM_F16_LOAD(n3_ + SOFTGYM_L));
-    SOFTGYM_X2(SOFTGYM_F16_ROTVEC_K(rw[k_], w_acos, k1[k_]));
-    SOFTGYM_X2(fix[k_] |= ~is_sa[k_] & ~zero[k_]
-                          & SOFTGYM_F16_CMP(rw[k_], SOFTGYM_F16_SET(0.5f), _CMP_LT_OQ));
-    /* SOFTGYM_TQ */
-    SOFTGYM_X2(tw[k_] = SOFTGYM_F16_FNMA(rz[k_], n3[k_],
-                                         SOFTGYM_F16_FNMA(ry[k_], n2[k_], rw[k_] * qw[k_])));
-    SOFTGYM_X2(tx[k_] = SOFTGYM_F16_FNMA(rz[k_], n2[k_],
-                                         SOFTGYM_F16_FMA(ry[k_], n3[k_], rw[k_] * n1[k_])));
-    SOFTGYM_X2(ty[k_] = SOFTGYM_F16_FMA(rz[k_], n1[k_],
-                                        SOFTGYM_F16_FMA(ry[k_], qw[k_], rw[k_] * n2[k_])));
-    SOFTGYM_X2(tz[k_] = SOFTGYM_F16_FMA(rz[k_], qw[k_],
-                                        SOFTGYM_F16_FNMA(ry[k_], n1[k_], rw[k_] * n3[k_])));
-    SOFTGYM_X2(w2[k_] = SOFTGYM_F16_PICK(is_sa[k_], qw[k_], tw[k_]));
-    SOFTGYM_X2(SOFTGYM_F16_ROTVEC_K(w2[k_], w_acos, k2[k_]));
-    SOFTGYM_X2(fix[k_] |= SOFTGYM_F16_CMP(w2[k_], SOFTGYM_F16_SET(0.5f), _CMP_LT_OQ));
-    /* the outputs, as softgym_seed_frames32_impl's */
-#define SOFTGYM_F16_OUT(row, v) SOFTGYM_X2(_mm512_storeu_ps((row) + SOFTGYM_L, (__m512)(v)))
-    SOFTGYM_F16_OUT(o_P0, SOFTGYM_F16_LOAD(P0_ + SOFTGYM_L));
-    SOFTGYM_F16_OUT(o_P1, SOFTGYM_F16_PICK(is_sa[k_], p1[k_], nil));
-    SOFTGYM_F16_OUT(o_P2, SOFTGYM_F16_PICK(is_sa[k_], p2[k_], nil));
-    SOFTGYM_F16_OUT(o_a1y, SOFTGYM_F16_PICK(is_sa[k_] | zero[k_], nil, ry[k_] * k1[k_]));
-    SOFTGYM_F16_OUT(o_a1z, SOFTGYM_F16_PICK(is_sa[k_] | zero[k_], nil, rz[k_] * k1[k_]));
-    SOFTGYM_F16_OUT(o_a2x, SOFTGYM_F16_PICK(is_sa[k_], n1[k_], tx[k_]) * k2[k_]);
-    SOFTGYM_F16_OUT(o_a2y, SOFTGYM_F16_PICK(is_sa[k_], n2[k_], ty[k_]) * k2[k_]);
-    SOFTGYM_F16_OUT(o_a2z, SOFTGYM_F16_PICK(is_sa[k_], n3[k_], tz[k_]) * k2[k_]);
-    SOFTGYM_F16_OUT(o_rw, SOFTGYM_F16_PICK(is_sa[k_], one, rw[k_]));
-    SOFTGYM_F16_OUT(o_ry, SOFTGYM_F16_PICK(is_sa[k_], nil, ry[k_]));
-    SOFTGYM_F16_OUT(o_rz, SOFTGYM_F16_PICK(is_sa[k_], nil, rz[k_]));
-    SOFTGYM_F16_OUT(o_fix, SOFTGYM_F16_PICK(fix[k_], one, nil));
-#undef SOFTGYM_F16_OUT
-#undef SOFTGYM_L
-    return (fix[0] | fix[1]) != 0;
-}
-#undef SOFTGYM_F16_ROTVEC_K
+#define SOFTGYM_FP_LANES 8
+#define SOFTGYM_FP_NAME softgym_seed_frames32_x2
+#define SOFTGYM_FP_V softgym_v8f
+#define SOFTGYM_FP_M softgym_v8m
+#define SOFTGYM_FP_LOAD(a) ((softgym_v8f)_mm256_set_m128(_mm256_cvtpd_ps(_mm256_loadu_pd((a) + 4)), \
+                                                          _mm256_cvtpd_ps(_mm256_loadu_pd(a))))
+/* a double row's 8 conditions as 32-bit lanes: lanes 0-3's from the even halves of the
+   first compare, 4-7's from the odd halves of the second, put in order */
+#define SOFTGYM_FP_NONZERO(row, li) ((softgym_v8m)_mm256_permutevar8x32_ps( \
+        _mm256_blend_ps(_mm256_castpd_ps(_mm256_cmp_pd(_mm256_loadu_pd((row) + (li)), \
+                                                       _mm256_setzero_pd(), _CMP_NEQ_UQ)), \
+                        _mm256_castpd_ps(_mm256_cmp_pd(_mm256_loadu_pd((row) + (li) + 4), \
+                                                       _mm256_setzero_pd(), _CMP_NEQ_UQ)), \
+                        0xAA), \
+        _mm256_set_epi32(7, 5, 3, 1, 6, 4, 2, 0)))
+#define SOFTGYM_FP_PICK(m, a, b) \
+    ((softgym_v8f)_mm256_blendv_ps((__m256)(b), (__m256)(a), (__m256)(m)))
+#define SOFTGYM_FP_CMP(a, b, op) ((softgym_v8m)_mm256_cmp_ps((__m256)(a), (__m256)(b), (op)))
+#define SOFTGYM_FP_SET(c) ((softgym_v8f)_mm256_set1_ps(c))
+#define SOFTGYM_FP_FMA(a, b, c) \
+    ((softgym_v8f)_mm256_fmadd_ps((__m256)(a), (__m256)(b), (__m256)(c)))
+#define SOFTGYM_FP_FNMA(a, b, c) \
+    ((softgym_v8f)_mm256_fnmadd_ps((__m256)(a), (__m256)(b), (__m256)(c)))
+#define SOFTGYM_FP_SQRT(v) ((softgym_v8f)_mm256_sqrt_ps((__m256)(v)))
+#define SOFTGYM_FP_STORE(p, v) _mm256_storeu_ps((p), (__m256)(v))
+#define SOFTGYM_FP_ANY(m) (!_mm256_testz_si256((__m256i)(m), (__m256i)(m)))
+#include "softgym_frames_pair.h"
 #else
 #define SOFTGYM_F16_LANES 0
+#define SOFTGYM_FP_LANES 0
 #endif
 /* the frames pass in float: rows in as softgym_seed_frames, but the axial displacement P0
    from row 10 (softgym_seed_modes leaves it) instead of row 7, float rows out (row k at f +
@@ -898,10 +844,10 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
     if (all_small) {
         any_fix = SOFTGYM_FRAMES32(1);
     } else {
-#if SOFTGYM_F16_LANES
-        /* 32 links at a time where they make whole pairs of blocks from lo (a chunk's rows
-           start on cache lines) */
-        for (; lo + 32 <= hi; lo += 32)
+#if SOFTGYM_FP_LANES
+        /* two blocks at a time where they make whole pairs from lo (a chunk's rows start on
+           cache lines) */
+        for (; lo + 2 * SOFTGYM_FP_LANES <= hi; lo += 2 * SOFTGYM_FP_LANES)
             any_fix |= softgym_seed_frames32_x2(
                 lo, sa_rad, w_acos, o, o + n, o + 2 * n, o + 3 * n, o + 4 * n, o + 5 * n,
                 o + 6 * n, o + 10 * n, o + 8 * n, sa_, f, f + fs, f + 2 * fs, f + 3 * fs, f + 4 * fs,
@@ -964,8 +910,7 @@ static int softgym_seed_frames32(Py_ssize_t lo, Py_ssize_t hi, Py_ssize_t n, flo
 #define SOFTGYM_FB_KEEP(p, m, x, last) _mm512_mask_storeu_ps((p), (m), (__m512)(x))
 #elif defined(__AVX2__) && defined(__FMA__) && (defined(__GNUC__) || defined(__clang__))
 #define SOFTGYM_FB_LANES 8
-typedef float softgym_v8f __attribute__((vector_size(32)));
-typedef int softgym_v8m __attribute__((vector_size(32)));  /* all ones where set */
+/* (softgym_v8f, softgym_v8m: the frames pairs' types, above) */
 #define SOFTGYM_FB_NAME softgym_seed_forces32_block8
 #define SOFTGYM_FB_V softgym_v8f
 #define SOFTGYM_FB_M softgym_v8m
