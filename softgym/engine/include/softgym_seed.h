@@ -1584,58 +1584,59 @@ static const unsigned char softgym_rank8[256][8] __attribute__((aligned(64))) = 
                                       _mm256_fmadd_ps((R)[3 * c_ + 1], (y), \
                                                       _mm256_mul_ps((R)[3 * c_], (x)))); \
     } while (0)
-/* one side of the 8 links li..li + 7 turned: w[0..5] (force x, y, z, moment x, y, z), the
-   lanes from nl on (nl < 8: a run's last block) taken from the rows' padding (never added:
-   softgym_push8x2) */
-SOFTGYM_ALWAYS_INLINE void softgym_seed_turn8(const int ax, const int side, Py_ssize_t li,
-                                              int nl, const float *rf, const float *of,
-                                              const double *neg2_row, __m256 *w)
+/* both sides of the 8 links li..li + 7 turned: w1[0..5] voxel 1's (force x, y, z, moment
+   x, y, z), w2[0..5] voxel 2's; the lanes from nl on (nl < 8: a run's last block) taken
+   from the rows' padding (never added: softgym_push8x2). For the y and z links the bond
+   frame's x input is negated instead of the rotation's first column ((-R) x = R (-x),
+   exactly) */
+SOFTGYM_ALWAYS_INLINE void softgym_seed_turn8(const int ax, Py_ssize_t li, int nl,
+                                              const float *rf, const float *of,
+                                              const double *neg2_row, __m256 *w1, __m256 *w2)
 {
     const Py_ssize_t fs = SOFTGYM_CHUNK_FSTRIDE;
     const float *q = of + li;
+    const __m256 sign = _mm256_set1_ps(-0.0f);
     __m256 R[9], a[3], m[3];
     for (int k = 0; k < 9; k++)
         R[k] = _mm256_loadu_ps(rf + k * fs + li);
-    if (ax != 0) {
-        const __m256 sign = _mm256_set1_ps(-0.0f);
-        R[0] = _mm256_xor_ps(R[0], sign);
-        R[3] = _mm256_xor_ps(R[3], sign);
-        R[6] = _mm256_xor_ps(R[6], sign);
-    }
-    if (side == 1) {
-        for (int c = 0; c < 3; c++) {
-            a[c] = _mm256_loadu_ps(q + c * fs);
-            m[c] = _mm256_loadu_ps(q + (6 + c) * fs);
-        }
+    /* -f1 in the lanes whose row 23 is not 0.0 (1.0: voxel 2 takes -F1), else f2 */
+    __m256d n_lo, n_hi;
+    if (nl == 8) {
+        n_lo = _mm256_loadu_pd(neg2_row + li);
+        n_hi = _mm256_loadu_pd(neg2_row + li + 4);
     } else {
-        /* -f1 in the lanes whose row 23 is not 0.0 (1.0: voxel 2 takes -F1), else f2 */
-        __m256d n_lo, n_hi;
-        if (nl == 8) {
-            n_lo = _mm256_loadu_pd(neg2_row + li);
-            n_hi = _mm256_loadu_pd(neg2_row + li + 4);
-        } else {
-            const __m256i lane = _mm256_set_epi64x(3, 2, 1, 0);
-            n_lo = _mm256_maskload_pd(neg2_row + li,
-                                      _mm256_cmpgt_epi64(_mm256_set1_epi64x(nl), lane));
-            n_hi = _mm256_maskload_pd(neg2_row + li + 4,
-                                      _mm256_cmpgt_epi64(_mm256_set1_epi64x(nl - 4), lane));
-        }
-        /* the two halves' 64-bit conditions as 32-bit lanes: lanes 0-3's from the even
-           halves of the first, 4-7's from the odd halves of the second, put in order */
-        const __m256d zero = _mm256_setzero_pd();
-        __m256 neg2 = _mm256_permutevar8x32_ps(
-            _mm256_blend_ps(_mm256_castpd_ps(_mm256_cmp_pd(n_lo, zero, _CMP_NEQ_UQ)),
-                            _mm256_castpd_ps(_mm256_cmp_pd(n_hi, zero, _CMP_NEQ_UQ)), 0xAA),
-            _mm256_set_epi32(7, 5, 3, 1, 6, 4, 2, 0));
-        for (int c = 0; c < 3; c++) {
-            __m256 f1 = _mm256_loadu_ps(q + c * fs);
-            a[c] = _mm256_blendv_ps(_mm256_loadu_ps(q + (3 + c) * fs),
-                                    _mm256_xor_ps(f1, _mm256_set1_ps(-0.0f)), neg2);
-            m[c] = _mm256_loadu_ps(q + (9 + c) * fs);
-        }
+        const __m256i lane = _mm256_set_epi64x(3, 2, 1, 0);
+        n_lo = _mm256_maskload_pd(neg2_row + li, _mm256_cmpgt_epi64(_mm256_set1_epi64x(nl), lane));
+        n_hi = _mm256_maskload_pd(neg2_row + li + 4,
+                                  _mm256_cmpgt_epi64(_mm256_set1_epi64x(nl - 4), lane));
     }
-    SOFTGYM_TURN8(R, a[ax], ax == 1 ? a[0] : a[1], ax == 2 ? a[0] : a[2], w);
-    SOFTGYM_TURN8(R, m[ax], ax == 1 ? m[0] : m[1], ax == 2 ? m[0] : m[2], w + 3);
+    /* the two halves' 64-bit conditions as 32-bit lanes: lanes 0-3's from the even halves
+       of the first, 4-7's from the odd halves of the second, put in order */
+    const __m256d zero = _mm256_setzero_pd();
+    __m256 neg2 = _mm256_permutevar8x32_ps(
+        _mm256_blend_ps(_mm256_castpd_ps(_mm256_cmp_pd(n_lo, zero, _CMP_NEQ_UQ)),
+                        _mm256_castpd_ps(_mm256_cmp_pd(n_hi, zero, _CMP_NEQ_UQ)), 0xAA),
+        _mm256_set_epi32(7, 5, 3, 1, 6, 4, 2, 0));
+    for (int side = 1; side <= 2; side++) {
+        for (int c = 0; c < 3; c++) {
+            if (side == 1) {
+                a[c] = _mm256_loadu_ps(q + c * fs);
+                m[c] = _mm256_loadu_ps(q + (6 + c) * fs);
+            } else {
+                a[c] = _mm256_blendv_ps(_mm256_loadu_ps(q + (3 + c) * fs),
+                                        _mm256_xor_ps(_mm256_loadu_ps(q + c * fs), sign), neg2);
+                m[c] = _mm256_loadu_ps(q + (9 + c) * fs);
+            }
+        }
+        __m256 x = a[ax], mx = m[ax];
+        if (ax != 0) {
+            x = _mm256_xor_ps(x, sign);
+            mx = _mm256_xor_ps(mx, sign);
+        }
+        __m256 *w = side == 1 ? w1 : w2;
+        SOFTGYM_TURN8(R, x, ax == 1 ? a[0] : a[1], ax == 2 ? a[0] : a[2], w);
+        SOFTGYM_TURN8(R, mx, ax == 1 ? m[0] : m[1], ax == 2 ? m[0] : m[2], w + 3);
+    }
 }
 #undef SOFTGYM_TURN8
 /* the voxels idx[0..nl) of a block's side (1 <= nl <= 16) placed: 2 where they are
@@ -1725,7 +1726,11 @@ SOFTGYM_ALWAYS_INLINE int softgym_push8x2(const __m256 *wl, const __m256 *wh,
     }
     const __m256i bit = _mm256_set_epi32(128, 64, 32, 16, 8, 4, 2, 1);
     __m256i before = _mm256_setzero_si256();
-    for (int win = 0; win < 4 && (mask >> (8 * win)) != 0; win++) {
+    /* the windows up to the last voxel's (counted from the indices, not from the mask: the
+       loop's branch then does not wait on the mask's chain; a window without a voxel of
+       the block adds +0.0) */
+    const int nwin = (int)((idx[nl - 1] - base) >> 3) + 1;
+    for (int win = 0; win < nwin; win++) {
         unsigned int m = (mask >> (8 * win)) & 0xFFu;
         __m128i r8 = _mm_loadl_epi64((const __m128i *)softgym_rank8[m]);
         __m256i rank = _mm256_add_epi32(_mm256_cvtepu8_epi32(r8), before);
@@ -1754,17 +1759,19 @@ SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_8x2(const int ax, Py_ssize_t li, 
                                                    Py_ssize_t lfs)
 {
     const int nl = (int)(hi - li);
-    __m256 wl[6], wh[6];
-    for (int side = 1; side <= 2; side++) {
-        softgym_seed_turn8(ax, side, li, nl < 8 ? nl : 8, rf, of, neg2_row, wl);
-        if (nl > 8)
-            softgym_seed_turn8(ax, side, li + 8, nl - 8, rf, of, neg2_row, wh);
-        else
-            for (int k = 0; k < 6; k++)
-                wh[k] = _mm256_setzero_ps();
-        if (!softgym_push8x2(wl, wh, (side == 1 ? v1 : v2) + li, nl, lf, lfs))
-            softgym_seed_push32_links(ax, side, li, hi, v1, v2, rf, of, neg2_row, lf, lfs);
+    /* side s's turned rows: w[s - 1][0..5] lanes 0-7, w[s - 1][6..11] lanes 8-15 */
+    __m256 w[2][12];
+    softgym_seed_turn8(ax, li, nl < 8 ? nl : 8, rf, of, neg2_row, w[0], w[1]);
+    if (nl > 8) {
+        softgym_seed_turn8(ax, li + 8, nl - 8, rf, of, neg2_row, w[0] + 6, w[1] + 6);
+    } else {
+        for (int k = 6; k < 12; k++)
+            w[0][k] = w[1][k] = _mm256_setzero_ps();
     }
+    for (int side = 1; side <= 2; side++)
+        if (!softgym_push8x2(w[side - 1], w[side - 1] + 6, (side == 1 ? v1 : v2) + li, nl, lf,
+                             lfs))
+            softgym_seed_push32_links(ax, side, li, hi, v1, v2, rf, of, neg2_row, lf, lfs);
 }
 #endif
 SOFTGYM_ALWAYS_INLINE void softgym_seed_push32_ax(const int ax, Py_ssize_t lo, Py_ssize_t hi,
