@@ -40,8 +40,8 @@ cdef struct Contacts:
                              #   ranks in the seed's order
     lane_flag_t* hit         # (n_voxels_r + 8,) scratch: 1 where a pair is a candidate
                              #   (64-bit: softgym_pair_hits' vector lanes), or with AVX-512
-                             #   the candidates' indices (softgym_pair_idx)
-    uint64_t* xbits          # with AVX-512: the all-pairs test's exclusions, a row of bits
+                             #   or AVX2 the candidates' indices (softgym_pair_idx)
+    uint64_t* xbits          # with AVX-512 or AVX2: the all-pairs test's exclusions, a row of bits
                              #   per surface voxel (bit b of row a: surface voxels a and b are
                              #   within collision_exclusion hops; _exclusion_bits), or NULL
     intp_t xbits_n           # the surface voxels xbits was built for (0: not built)

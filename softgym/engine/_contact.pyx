@@ -226,7 +226,8 @@ cdef extern from "softgym_pairs.h":
                            const float64_t* y, const float64_t* z, const float64_t* s,
                            const intp_t* rank, float64_t lim2,
                            lane_flag_t* hit) noexcept nogil
-    # with AVX-512 (SOFTGYM_PAIR_IDX 1): the same test, the candidates' indices compressed
+    # with AVX-512 or AVX2 (SOFTGYM_PAIR_IDX 1): the same test, the candidates' indices
+    # compressed
     intp_t softgym_pair_idx(int seed_rule, intp_t a, intp_t n, const float64_t* x,
                             const float64_t* y, const float64_t* z, const float64_t* s,
                             const intp_t* rank, float64_t lim2, const uint64_t* xb,

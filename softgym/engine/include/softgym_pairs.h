@@ -121,6 +121,70 @@ static Py_ssize_t softgym_pair_idx(int seed_rule, Py_ssize_t a, Py_ssize_t n, co
         return softgym_pair_idx_impl(1, a, n, x, y, z, s, rank, lim2, xb, idx);
     return softgym_pair_idx_impl(0, a, n, x, y, z, s, rank, lim2, xb, idx);
 }
+#elif defined(__AVX2__) && defined(SOFTGYM_VLANES) && (defined(__GNUC__) || defined(__clang__))
+#define SOFTGYM_PAIR_IDX 1
+/* the same with AVX2, 4 voxels b a vector (softgym_v4: GCC's vector of 4 doubles, the
+   decision written in SOFTGYM_PAIR_OUT's shape, as the AVX-512 loop's), each kept voxel's
+   index stored at idx[m] and m advanced by its bit (no branch a lane) */
+SOFTGYM_ALWAYS_INLINE Py_ssize_t softgym_pair_idx_impl(const int seed_rule, Py_ssize_t a,
+                                                       Py_ssize_t n, const double *x,
+                                                       const double *y, const double *z,
+                                                       const double *s,
+                                                       const Py_ssize_t *rank, double lim2,
+                                                       const unsigned long long *xb,
+                                                       long long *idx)
+{
+    const double xa = x[a], ya = y[a], za = z[a], sa = s[a];
+    const Py_ssize_t ra = rank[a];
+    Py_ssize_t k = a + 1, m = 0;
+    for (; k + 4 <= n; k += 4) {
+        softgym_v4 dx, dy, dz;
+        memcpy(&dx, x + k, sizeof dx);
+        memcpy(&dy, y + k, sizeof dy);
+        memcpy(&dz, z + k, sizeof dz);
+        dx = dx - xa;
+        dy = dy - ya;
+        dz = dz - za;
+        softgym_v4 d2 = dx * dx + dy * dy + dz * dz;
+        int out = _mm256_movemask_pd(_mm256_cmp_pd((__m256d)d2, _mm256_set1_pd(lim2), _CMP_GE_OQ));
+        if (seed_rule) {
+            __m256d first = _mm256_castsi256_pd(_mm256_cmpgt_epi64(
+                _mm256_loadu_si256((const __m256i *)(rank + k)), _mm256_set1_epi64x(ra)));
+            softgym_v4 act = 2.0 * (softgym_v4)_mm256_blendv_pd(_mm256_loadu_pd(s + k),
+                                                                 _mm256_set1_pd(sa), first);
+            out |= _mm256_movemask_pd(_mm256_cmp_pd((__m256d)d2, (__m256d)(act * act),
+                                                    _CMP_GE_OQ));
+        }
+        /* bits k .. k + 3 of the exclusion row (the next word's low bits past its end) */
+        const int sh = (int)(k & 63);
+        const unsigned long long w0 = xb[k >> 6], w1 = xb[(k >> 6) + 1];
+        out |= (int)((w0 >> sh) | (sh ? w1 << (64 - sh) : 0)) & 15;
+        const int keep = ~out & 15;
+        if (keep) {
+            for (int l = 0; l < 4; l++) {
+                idx[m] = k + l;
+                m += (keep >> l) & 1;
+            }
+        }
+    }
+    for (; k < n; k++) {
+        long long out;
+        SOFTGYM_PAIR_OUT(seed_rule, xa, ya, za, sa, ra, x, y, z, s, rank, k, lim2, out);
+        out |= (long long)((xb[k >> 6] >> (k & 63)) & 1);
+        idx[m] = k;
+        m += out == 0;
+    }
+    return m;
+}
+static Py_ssize_t softgym_pair_idx(int seed_rule, Py_ssize_t a, Py_ssize_t n, const double *x,
+                                   const double *y, const double *z, const double *s,
+                                   const Py_ssize_t *rank, double lim2,
+                                   const unsigned long long *xb, long long *idx)
+{
+    if (seed_rule)
+        return softgym_pair_idx_impl(1, a, n, x, y, z, s, rank, lim2, xb, idx);
+    return softgym_pair_idx_impl(0, a, n, x, y, z, s, rank, lim2, xb, idx);
+}
 #else
 #define SOFTGYM_PAIR_IDX 0
 static Py_ssize_t softgym_pair_idx(int seed_rule, Py_ssize_t a, Py_ssize_t n, const double *x,
