@@ -54,8 +54,33 @@ SOFTGYM_ALWAYS_INLINE Py_ssize_t softgym_pair_hits_impl(const int seed_rule, Py_
     }
     return last;
 }
-#if defined(SOFTGYM_VLANES) && SOFTGYM_VLANES == 8
+#if defined(SOFTGYM_VLANES) && (SOFTGYM_VLANES == 8 || defined(__AVX2__)) && \
+    (defined(__GNUC__) || defined(__clang__))
 #define SOFTGYM_PAIR_IDX 1
+/* the vector loops' last voxels b = k .. n - 1, one at a time (SOFTGYM_PAIR_OUT and the
+   exclusion bit), their kept indices stored from idx[m]; returns the count */
+SOFTGYM_ALWAYS_INLINE Py_ssize_t softgym_pair_idx_tail(const int seed_rule, Py_ssize_t a,
+                                                       Py_ssize_t k, Py_ssize_t m,
+                                                       Py_ssize_t n, const double *x,
+                                                       const double *y, const double *z,
+                                                       const double *s,
+                                                       const Py_ssize_t *rank, double lim2,
+                                                       const unsigned long long *xb,
+                                                       long long *idx)
+{
+    const double xa = x[a], ya = y[a], za = z[a], sa = s[a];
+    const Py_ssize_t ra = rank[a];
+    for (; k < n; k++) {
+        long long out;
+        SOFTGYM_PAIR_OUT(seed_rule, xa, ya, za, sa, ra, x, y, z, s, rank, k, lim2, out);
+        out |= (long long)((xb[k >> 6] >> (k & 63)) & 1);
+        idx[m] = k;
+        m += out == 0;
+    }
+    return m;
+}
+#endif
+#if defined(SOFTGYM_VLANES) && SOFTGYM_VLANES == 8
 /* the same test with AVX-512, 8 voxels b a vector, its candidates' indices b compressed
    into idx[0..] in increasing order (a two-uop compress a vector where the caller walked
    every flag up to the last hit, a branch each: on an Intel Xeon a third of the list's
@@ -103,26 +128,9 @@ SOFTGYM_ALWAYS_INLINE Py_ssize_t softgym_pair_idx_impl(const int seed_rule, Py_s
         }
         kv = _mm512_add_epi64(kv, eight);
     }
-    for (; k < n; k++) {
-        long long out;
-        SOFTGYM_PAIR_OUT(seed_rule, xa, ya, za, sa, ra, x, y, z, s, rank, k, lim2, out);
-        out |= (long long)((xb[k >> 6] >> (k & 63)) & 1);
-        idx[m] = k;
-        m += out == 0;
-    }
-    return m;
-}
-static Py_ssize_t softgym_pair_idx(int seed_rule, Py_ssize_t a, Py_ssize_t n, const double *x,
-                                   const double *y, const double *z, const double *s,
-                                   const Py_ssize_t *rank, double lim2,
-                                   const unsigned long long *xb, long long *idx)
-{
-    if (seed_rule)
-        return softgym_pair_idx_impl(1, a, n, x, y, z, s, rank, lim2, xb, idx);
-    return softgym_pair_idx_impl(0, a, n, x, y, z, s, rank, lim2, xb, idx);
+    return softgym_pair_idx_tail(seed_rule, a, k, m, n, x, y, z, s, rank, lim2, xb, idx);
 }
 #elif defined(__AVX2__) && defined(SOFTGYM_VLANES) && (defined(__GNUC__) || defined(__clang__))
-#define SOFTGYM_PAIR_IDX 1
 /* the same with AVX2, 4 voxels b a vector (softgym_v4: GCC's vector of 4 doubles, the
    decision written in SOFTGYM_PAIR_OUT's shape, as the AVX-512 loop's), each kept voxel's
    index stored at idx[m] and m advanced by its bit (no branch a lane) */
@@ -167,15 +175,10 @@ SOFTGYM_ALWAYS_INLINE Py_ssize_t softgym_pair_idx_impl(const int seed_rule, Py_s
             }
         }
     }
-    for (; k < n; k++) {
-        long long out;
-        SOFTGYM_PAIR_OUT(seed_rule, xa, ya, za, sa, ra, x, y, z, s, rank, k, lim2, out);
-        out |= (long long)((xb[k >> 6] >> (k & 63)) & 1);
-        idx[m] = k;
-        m += out == 0;
-    }
-    return m;
+    return softgym_pair_idx_tail(seed_rule, a, k, m, n, x, y, z, s, rank, lim2, xb, idx);
 }
+#endif
+#if SOFTGYM_PAIR_IDX
 static Py_ssize_t softgym_pair_idx(int seed_rule, Py_ssize_t a, Py_ssize_t n, const double *x,
                                    const double *y, const double *z, const double *s,
                                    const Py_ssize_t *rank, double lim2,
