@@ -57,6 +57,14 @@ SOFTGYM_ALWAYS_INLINE Py_ssize_t softgym_pair_hits_impl(const int seed_rule, Py_
 #if defined(SOFTGYM_VLANES) && (SOFTGYM_VLANES == 8 || defined(__AVX2__)) && \
     (defined(__GNUC__) || defined(__clang__))
 #define SOFTGYM_PAIR_IDX 1
+/* bits k .. k + 63 of the exclusion row xb (the next word's low bits past its end) */
+SOFTGYM_ALWAYS_INLINE unsigned long long softgym_xbits_at(const unsigned long long *xb,
+                                                          Py_ssize_t k)
+{
+    const int sh = (int)(k & 63);
+    const unsigned long long w0 = xb[k >> 6], w1 = xb[(k >> 6) + 1];
+    return (w0 >> sh) | (sh ? w1 << (64 - sh) : 0);
+}
 /* the vector loops' last voxels b = k .. n - 1, one at a time (SOFTGYM_PAIR_OUT and the
    exclusion bit), their kept indices stored from idx[m]; returns the count */
 SOFTGYM_ALWAYS_INLINE Py_ssize_t softgym_pair_idx_tail(const int seed_rule, Py_ssize_t a,
@@ -115,10 +123,8 @@ SOFTGYM_ALWAYS_INLINE Py_ssize_t softgym_pair_idx_impl(const int seed_rule, Py_s
                 first, _mm512_loadu_pd(s + k), _mm512_set1_pd(sa));
             out |= _mm512_cmp_pd_mask((__m512d)d2, (__m512d)(act * act), _CMP_GE_OQ);
         }
-        /* bits k .. k + 7 of the exclusion row (the next word's low bits past its end) */
-        const int sh = (int)(k & 63);
-        const unsigned long long w0 = xb[k >> 6], w1 = xb[(k >> 6) + 1];
-        out |= (__mmask8)((w0 >> sh) | (sh ? w1 << (64 - sh) : 0));
+        /* bits k .. k + 7 of the exclusion row */
+        out |= (__mmask8)softgym_xbits_at(xb, k);
         __mmask8 keep = ~out;
         /* most vectors keep no pair (the exclusions dropped): no store, and no step of the
            chain through m (mask, count, add: its latency was the loop's bound) */
@@ -163,10 +169,8 @@ SOFTGYM_ALWAYS_INLINE Py_ssize_t softgym_pair_idx_impl(const int seed_rule, Py_s
             out |= _mm256_movemask_pd(_mm256_cmp_pd((__m256d)d2, (__m256d)(act * act),
                                                     _CMP_GE_OQ));
         }
-        /* bits k .. k + 3 of the exclusion row (the next word's low bits past its end) */
-        const int sh = (int)(k & 63);
-        const unsigned long long w0 = xb[k >> 6], w1 = xb[(k >> 6) + 1];
-        out |= (int)((w0 >> sh) | (sh ? w1 << (64 - sh) : 0)) & 15;
+        /* bits k .. k + 3 of the exclusion row */
+        out |= (int)(softgym_xbits_at(xb, k) & 15);
         const int keep = ~out & 15;
         if (keep) {
             for (int l = 0; l < 4; l++) {
